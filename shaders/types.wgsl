@@ -1,0 +1,93 @@
+// Records shared by the tracing and display passes. Each struct is the twin of the
+// `#[repr(C)]` struct of the same name (with a `Gpu` prefix) in src/gpu/layout.rs;
+// tests/layout.rs checks sizes and offsets with naga's layouter.
+
+struct FrameUniforms {
+    eye: vec3<f32>,
+    tan_half_fov_y: f32,
+    forward: vec3<f32>,
+    aspect: f32,
+    right: vec3<f32>,
+    width: u32,
+    up: vec3<f32>,
+    height: u32,
+    background: vec3<f32>,
+    samples_per_pixel: u32,
+    ambient: vec3<f32>,
+    max_depth: u32,
+    sphere_count: u32,
+    plane_count: u32,
+    polygon_count: u32,
+    triangle_count: u32,
+    light_count: u32,
+    row_offset: u32,
+    row_count: u32,
+    _pad: u32,
+}
+
+struct Sphere {
+    center: vec3<f32>,
+    radius: f32,
+    material: u32,
+    _pad: vec3<u32>,
+}
+
+// The plane normal · p = offset.
+struct Plane {
+    normal: vec3<f32>,
+    offset: f32,
+    material: u32,
+    _pad: vec3<u32>,
+}
+
+struct Polygon {
+    normal: vec3<f32>,
+    offset: f32,
+    first_vertex: u32,
+    vertex_count: u32,
+    dropped_axis: u32,
+    material: u32,
+}
+
+struct Triangle {
+    v0: vec3<f32>,
+    material: u32,
+    v1: vec3<f32>,
+    _pad1: u32,
+    v2: vec3<f32>,
+    _pad2: u32,
+}
+
+const MATERIAL_LAMBERT: u32 = 0u;
+const MATERIAL_BLINN_PHONG: u32 = 1u;
+const MATERIAL_MIRROR: u32 = 2u;
+const MATERIAL_DIELECTRIC: u32 = 3u;
+const MATERIAL_EMISSIVE: u32 = 4u;
+
+struct Material {
+    diffuse: vec3<f32>,
+    shininess: f32,
+    specular: vec3<f32>,
+    ior: f32,
+    reflectance: vec3<f32>,
+    kind: u32,
+    transmittance: vec3<f32>,
+    coat_ior: f32,
+    emission: vec3<f32>,
+    _pad: f32,
+}
+
+const LIGHT_POINT: u32 = 0u;
+const LIGHT_DIRECTIONAL: u32 = 1u;
+
+struct Light {
+    position_or_direction: vec3<f32>,
+    kind: u32,
+    power: vec3<f32>,
+    _pad: u32,
+}
+
+struct DisplayUniforms {
+    encode_srgb: u32,
+    _pad: vec3<u32>,
+}

@@ -1,0 +1,65 @@
+//! Colour transfer functions: the exact piecewise sRGB curve (IEC 61966-2-1), not a
+//! 2.2 power. The GPU twin lives in `shaders/color.wgsl`.
+
+/// Encodes one linear channel in [0, 1] with the sRGB transfer curve (IEC 61966-2-1:
+/// `12.92·c` below 0.0031308, `1.055·c^(1/2.4) − 0.055` above). Values outside [0, 1]
+/// are clamped first, NaN maps to 0.
+pub fn srgb_encode(linear: f64) -> f64 {
+    let c = if linear.is_nan() {
+        0.0
+    } else {
+        linear.clamp(0.0, 1.0)
+    };
+    if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Decodes one sRGB-encoded channel in [0, 1] to linear (the inverse of
+/// [`srgb_encode`]: `c/12.92` up to 0.04045, `((c+0.055)/1.055)^2.4` above).
+pub fn srgb_decode(encoded: f64) -> f64 {
+    let c = if encoded.is_nan() {
+        0.0
+    } else {
+        encoded.clamp(0.0, 1.0)
+    };
+    if c <= 0.040_45 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Quantises an encoded value in [0, 1] to 8 bits with round-to-nearest, as the GPU's
+/// `Rgba8Unorm` store does.
+pub fn quantize_unorm8(encoded: f64) -> u8 {
+    (encoded.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn encode_and_decode_are_inverse() {
+        for i in 0..=1000 {
+            let x = i as f64 / 1000.0;
+            assert!((srgb_decode(srgb_encode(x)) - x).abs() < 1e-12, "at {x}");
+        }
+    }
+
+    #[test]
+    fn curve_matches_published_points() {
+        // Linear 0.5 encodes to 0.7353569830524495 (IEC 61966-2-1 formula);
+        // linear 0.18 (mid grey) to 0.4613561295004...; the two pieces meet at 0.0031308.
+        assert!((srgb_encode(0.5) - 0.735_356_983_052_449_5).abs() < 1e-12);
+        assert!((srgb_encode(0.18) - 0.461_356_129_500_4).abs() < 1e-9);
+        let below = 12.92 * 0.003_130_8;
+        let above = 1.055 * 0.003_130_8_f64.powf(1.0 / 2.4) - 0.055;
+        assert!((below - above).abs() < 1e-6);
+        assert_eq!(srgb_encode(f64::NAN), 0.0);
+        assert_eq!(srgb_encode(7.0), 1.0);
+    }
+}

@@ -1,0 +1,181 @@
+//! The `#[repr(C)]` records uploaded to the GPU, twins of the structs in
+//! `shaders/types.wgsl`. `tests/layout.rs` checks with naga's layouter that every size
+//! and field offset agrees. WGSL `vec3<f32>` is 16-byte aligned with size 12, so every
+//! `[f32; 3]` here is followed by a 4-byte scalar that fills its last lane.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Per-frame constants (`FrameUniforms` in WGSL), bound as a uniform buffer.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct FrameUniforms {
+    /// Camera position.
+    pub eye: [f32; 3],
+    /// Tangent of half the vertical field of view.
+    pub tan_half_fov_y: f32,
+    /// Unit view direction.
+    pub forward: [f32; 3],
+    /// Image width divided by height.
+    pub aspect: f32,
+    /// Unit camera right vector.
+    pub right: [f32; 3],
+    /// Image width in pixels.
+    pub width: u32,
+    /// Unit camera up vector (orthogonal to `forward` and `right`).
+    pub up: [f32; 3],
+    /// Image height in pixels.
+    pub height: u32,
+    /// Radiance of rays that escape.
+    pub background: [f32; 3],
+    /// Samples per pixel.
+    pub samples_per_pixel: u32,
+    /// Whitted ambient radiance.
+    pub ambient: [f32; 3],
+    /// Largest bounce depth after the primary ray.
+    pub max_depth: u32,
+    /// Number of spheres in the sphere buffer (the buffer may hold a padding record).
+    pub sphere_count: u32,
+    /// Number of planes.
+    pub plane_count: u32,
+    /// Number of polygons.
+    pub polygon_count: u32,
+    /// Number of triangles.
+    pub triangle_count: u32,
+    /// Number of lights.
+    pub light_count: u32,
+    /// First image row this dispatch traces (dispatches are split into row chunks).
+    pub row_offset: u32,
+    /// Number of rows this dispatch traces.
+    pub row_count: u32,
+    /// Padding to a 16-byte multiple.
+    pub _pad: u32,
+}
+
+/// A sphere (`Sphere` in WGSL).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuSphere {
+    /// Centre.
+    pub center: [f32; 3],
+    /// Radius.
+    pub radius: f32,
+    /// Material index.
+    pub material: u32,
+    /// Padding.
+    pub _pad: [u32; 3],
+}
+
+/// An infinite plane `normal · p = offset` (`Plane` in WGSL).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuPlane {
+    /// Unit normal.
+    pub normal: [f32; 3],
+    /// Plane offset along the normal.
+    pub offset: f32,
+    /// Material index.
+    pub material: u32,
+    /// Padding.
+    pub _pad: [u32; 3],
+}
+
+/// A planar polygon whose vertices live in the polygon-vertex buffer (`Polygon` in WGSL).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuPolygon {
+    /// Unit normal of the polygon's plane.
+    pub normal: [f32; 3],
+    /// Plane offset along the normal.
+    pub offset: f32,
+    /// Index of the first vertex in the polygon-vertex buffer.
+    pub first_vertex: u32,
+    /// Number of vertices.
+    pub vertex_count: u32,
+    /// The axis (0 = x, 1 = y, 2 = z) dropped when projecting for the inside test.
+    pub dropped_axis: u32,
+    /// Material index.
+    pub material: u32,
+}
+
+/// A triangle (`Triangle` in WGSL).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuTriangle {
+    /// First corner.
+    pub v0: [f32; 3],
+    /// Material index.
+    pub material: u32,
+    /// Second corner.
+    pub v1: [f32; 3],
+    /// Padding.
+    pub _pad1: u32,
+    /// Third corner.
+    pub v2: [f32; 3],
+    /// Padding.
+    pub _pad2: u32,
+}
+
+/// A material (`Material` in WGSL); see [`crate::scene::Material`] for the meaning.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuMaterial {
+    /// Diffuse albedo.
+    pub diffuse: [f32; 3],
+    /// Blinn-Phong exponent.
+    pub shininess: f32,
+    /// Blinn-Phong specular colour.
+    pub specular: [f32; 3],
+    /// Dielectric index of refraction.
+    pub ior: f32,
+    /// Mirror reflectance.
+    pub reflectance: [f32; 3],
+    /// One of the `MATERIAL_*` constants.
+    pub kind: u32,
+    /// Dielectric transmittance filter.
+    pub transmittance: [f32; 3],
+    /// Clear-coat index of refraction (0 = none).
+    pub coat_ior: f32,
+    /// Emitted radiance.
+    pub emission: [f32; 3],
+    /// Padding.
+    pub _pad: f32,
+}
+
+/// A light (`Light` in WGSL).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuLight {
+    /// Point light: position. Directional light: unit direction of travel.
+    pub position_or_direction: [f32; 3],
+    /// One of the `LIGHT_*` constants.
+    pub kind: u32,
+    /// Point light: intensity in W/sr. Directional light: irradiance in W/m².
+    pub power: [f32; 3],
+    /// Padding.
+    pub _pad: u32,
+}
+
+/// Uniforms of the display pass (`DisplayUniforms` in WGSL).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct DisplayUniforms {
+    /// 1: apply the sRGB transfer curve; 0: write the values unchanged (naive gamma mode).
+    pub encode_srgb: u32,
+    /// Padding.
+    pub _pad: [u32; 3],
+}
+
+/// `Material.kind` value for Lambert.
+pub const MATERIAL_LAMBERT: u32 = 0;
+/// `Material.kind` value for Blinn-Phong.
+pub const MATERIAL_BLINN_PHONG: u32 = 1;
+/// `Material.kind` value for a mirror.
+pub const MATERIAL_MIRROR: u32 = 2;
+/// `Material.kind` value for a dielectric.
+pub const MATERIAL_DIELECTRIC: u32 = 3;
+/// `Material.kind` value for a pure emitter.
+pub const MATERIAL_EMISSIVE: u32 = 4;
+/// `Light.kind` value for a point light.
+pub const LIGHT_POINT: u32 = 0;
+/// `Light.kind` value for a directional light.
+pub const LIGHT_DIRECTIONAL: u32 = 1;

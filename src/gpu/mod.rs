@@ -1,0 +1,3 @@
+//! The wgpu backend (being written).
+
+pub mod layout;

@@ -1,0 +1,20 @@
+//! # gpu-render
+//!
+//! A Whitted-style, physically based ray tracer whose tracing runs in WGSL compute
+//! shaders through wgpu, with a plain CPU reference tracer that implements the same
+//! model and serves as the test oracle.
+//!
+//! - [`scene`]: the scene model and the TOML scene-file format.
+//! - [`camera`], [`color`], [`film`]: the pinhole camera and sample pattern, the sRGB
+//!   curve, and the image a render produces.
+//! - [`cpu`]: the reference tracer (f64).
+//! - [`gpu`]: the wgpu backend, built from the caller's `Device` and `Queue`.
+//! - [`output`]: writing PNG, EXR and HDR files atomically.
+
+pub mod camera;
+pub mod color;
+pub mod cpu;
+pub mod film;
+pub mod gpu;
+pub mod output;
+pub mod scene;

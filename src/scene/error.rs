@@ -1,0 +1,31 @@
+//! Errors about scene files: each names the file, the place and the problem.
+
+use std::fmt;
+use std::path::PathBuf;
+
+/// A problem with a scene file: unreadable, malformed, or describing an impossible scene.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub struct SceneError {
+    /// The scene file (or a placeholder such as `<string>` for text parsed from memory).
+    pub path: PathBuf,
+    /// 1-based line and column of the offending item, where known.
+    pub location: Option<(usize, usize)>,
+    /// What is wrong, naming the field or item.
+    pub message: String,
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.location {
+            Some((line, column)) => write!(
+                f,
+                "{}:{}:{}: {}",
+                self.path.display(),
+                line,
+                column,
+                self.message
+            ),
+            None => write!(f, "{}: {}", self.path.display(), self.message),
+        }
+    }
+}
