@@ -74,3 +74,12 @@ impl RenderStats {
 
 /// A callback told how many image rows are done out of how many, as a render proceeds.
 pub type ProgressFn<'a> = &'a (dyn Fn(u32, u32) + Sync);
+
+/// A finished render: the linear image and its statistics.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rendered {
+    /// The linear float image.
+    pub image: LinearImage,
+    /// Ray count and time.
+    pub stats: RenderStats,
+}
