@@ -17,6 +17,16 @@ pub fn srgb_encode(linear: f64) -> f64 {
     }
 }
 
+/// The sRGB curve extended monotonically above 1 (no clamp at the top), for radiance
+/// values such as emission that may exceed 1. Negative and NaN inputs map to 0.
+pub fn srgb_encode_extended(linear: f64) -> f64 {
+    if linear > 1.0 {
+        1.055 * linear.powf(1.0 / 2.4) - 0.055
+    } else {
+        srgb_encode(linear)
+    }
+}
+
 /// Decodes one sRGB-encoded channel in [0, 1] to linear (the inverse of
 /// [`srgb_encode`]: `c/12.92` up to 0.04045, `((c+0.055)/1.055)^2.4` above).
 pub fn srgb_decode(encoded: f64) -> f64 {

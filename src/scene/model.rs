@@ -224,3 +224,136 @@ impl Shape {
         }
     }
 }
+
+/// Largest accepted image width or height in pixels (a device may allow less; the GPU
+/// backend checks its own limit).
+pub const MAX_IMAGE_DIMENSION: u32 = 32_768;
+/// Largest accepted number of pixels in one image (2^27: 2 GiB of linear RGBA f32).
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 27;
+/// Largest accepted samples per pixel.
+pub const MAX_SAMPLES_PER_PIXEL: u32 = 65_536;
+/// Largest accepted bounce depth.
+pub const MAX_DEPTH_LIMIT: u32 = 64;
+/// Largest accepted bounce-stack capacity.
+pub const MAX_STACK_SIZE: u32 = 128;
+
+/// Settings a user may override on the command line, on top of the scene file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct RenderOverrides {
+    /// Image width in pixels.
+    pub width: Option<u32>,
+    /// Image height in pixels.
+    pub height: Option<u32>,
+    /// Samples per pixel.
+    pub samples_per_pixel: Option<u32>,
+    /// Maximum bounce depth. Without an explicit stack size, the stack grows with it.
+    pub max_depth: Option<u32>,
+    /// Bounce-stack capacity.
+    pub stack_size: Option<u32>,
+    /// Lighting space.
+    pub lighting_space: Option<LightingSpace>,
+}
+
+impl RenderSettings {
+    /// Applies `overrides` and checks the result, returning a description of the first
+    /// setting out of range.
+    pub fn with_overrides(mut self, overrides: &RenderOverrides) -> Result<Self, String> {
+        if let Some(width) = overrides.width {
+            self.width = width;
+        }
+        if let Some(height) = overrides.height {
+            self.height = height;
+        }
+        if let Some(spp) = overrides.samples_per_pixel {
+            self.samples_per_pixel = spp;
+        }
+        if let Some(depth) = overrides.max_depth {
+            self.max_depth = depth;
+            if overrides.stack_size.is_none() {
+                self.stack_size = self.stack_size.max(Self::sufficient_stack_size(depth));
+            }
+        }
+        if let Some(stack) = overrides.stack_size {
+            self.stack_size = stack;
+        }
+        if let Some(space) = overrides.lighting_space {
+            self.lighting_space = space;
+        }
+        self.check()?;
+        Ok(self)
+    }
+
+    /// Checks every setting against the accepted ranges.
+    pub fn check(&self) -> Result<(), String> {
+        for (name, value) in [("width", self.width), ("height", self.height)] {
+            if value == 0 || value > MAX_IMAGE_DIMENSION {
+                return Err(format!(
+                    "{name} must be between 1 and {MAX_IMAGE_DIMENSION} pixels, got {value}"
+                ));
+            }
+        }
+        let pixels = u64::from(self.width) * u64::from(self.height);
+        if pixels > MAX_IMAGE_PIXELS {
+            return Err(format!(
+                "{}x{} is {pixels} pixels, more than the {MAX_IMAGE_PIXELS} accepted",
+                self.width, self.height
+            ));
+        }
+        if self.samples_per_pixel == 0 || self.samples_per_pixel > MAX_SAMPLES_PER_PIXEL {
+            return Err(format!(
+                "samples_per_pixel must be between 1 and {MAX_SAMPLES_PER_PIXEL}, got {}",
+                self.samples_per_pixel
+            ));
+        }
+        if self.max_depth > MAX_DEPTH_LIMIT {
+            return Err(format!(
+                "max_depth must be at most {MAX_DEPTH_LIMIT}, got {}",
+                self.max_depth
+            ));
+        }
+        if self.stack_size == 0 || self.stack_size > MAX_STACK_SIZE {
+            return Err(format!(
+                "stack_size must be between 1 and {MAX_STACK_SIZE}, got {}",
+                self.stack_size
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl Scene {
+    /// The scene as the tracers shade it. In [`LightingSpace::Linear`] that is the scene
+    /// itself. In [`LightingSpace::NaiveGamma`] every colour (albedos, reflectances,
+    /// transmittances, emission, background and ambient radiance) is replaced by its
+    /// sRGB-encoded value, the number an artist picking colours on screen would type,
+    /// so that shading happens on gamma-encoded values as in the lecture's wrong
+    /// example. Light intensities are physical quantities and stay as they are.
+    pub fn in_lighting_space(&self) -> Scene {
+        let mut scene = self.clone();
+        if self.render.lighting_space == LightingSpace::NaiveGamma {
+            let encode = |c: DVec3| {
+                DVec3::new(
+                    crate::color::srgb_encode_extended(c.x),
+                    crate::color::srgb_encode_extended(c.y),
+                    crate::color::srgb_encode_extended(c.z),
+                )
+            };
+            for m in &mut scene.materials {
+                m.diffuse = encode(m.diffuse);
+                m.specular = encode(m.specular);
+                m.reflectance = encode(m.reflectance);
+                m.transmittance = encode(m.transmittance);
+                m.emission = encode(m.emission);
+            }
+            scene.environment.background = encode(scene.environment.background);
+            scene.environment.ambient = encode(scene.environment.ambient);
+        }
+        scene
+    }
+
+    /// Whether the display pass applies the sRGB curve (false in naive gamma mode,
+    /// whose values are already "display" values).
+    pub fn display_encodes_srgb(&self) -> bool {
+        self.render.lighting_space == LightingSpace::Linear
+    }
+}
