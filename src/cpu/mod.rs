@@ -1,14 +1,86 @@
 //! The CPU reference tracer: the same model as the WGSL shaders, with the same function
-//! names, written plainly in `f64` so that it can serve as the oracle (being written).
+//! names, written plainly in `f64`.
+//!
+//! It is the oracle of the GPU tests and the fallback when no GPU adapter exists. It
+//! computes in `f64` so that its own rounding error is negligible next to the GPU's
+//! `f32`: the difference between the two images is then the GPU's error budget.
+
+pub mod bxdf;
+pub mod intersect;
+pub mod trace;
+
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use std::time::Instant;
 
 use crate::film::{LinearImage, ProgressFn, RenderStats, Rendered};
 use crate::scene::Scene;
+pub use trace::{PreparedScene, trace_pixel};
 
-/// Renders `scene` on all CPU cores. `progress` is told the number of finished rows.
+/// Renders `scene` on all CPU cores, rows handed out one at a time. `progress` is told
+/// the number of finished rows after each row.
+///
+/// ```
+/// # use gpu_render::scene::parse_scene;
+/// # fn main() -> Result<(), gpu_render::scene::SceneError> {
+/// let scene = parse_scene(
+///     "[render]\nwidth = 8\nheight = 6\n[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\n",
+///     std::path::Path::new("<inline>"),
+/// )?;
+/// let rendered = gpu_render::cpu::render(&scene, None);
+/// assert_eq!(rendered.image.pixels.len(), 48);
+/// # Ok(())
+/// # }
+/// ```
 pub fn render(scene: &Scene, progress: Option<ProgressFn<'_>>) -> Rendered {
-    let _ = progress;
+    let started = Instant::now();
+    let prepared = PreparedScene::new(scene);
+    let (width, height) = (scene.render.width, scene.render.height);
+    let mut image = LinearImage::new(width, height);
+    let rows: Vec<(u32, &mut [[f32; 4]])> = image
+        .pixels
+        .chunks_mut(width as usize)
+        .enumerate()
+        .map(|(y, row)| (y as u32, row))
+        .collect();
+    let queue = Mutex::new(rows);
+    let rays = AtomicU64::new(0);
+    let rows_done = AtomicU32::new(0);
+    let threads = std::thread::available_parallelism().map_or(1, usize::from);
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| {
+                loop {
+                    let next = queue
+                        .lock()
+                        .unwrap_or_else(std::sync::PoisonError::into_inner)
+                        .pop();
+                    let Some((y, row)) = next else { break };
+                    let mut row_rays = 0;
+                    for (x, pixel) in row.iter_mut().enumerate() {
+                        let result = trace_pixel(&prepared, x as u32, y);
+                        *pixel = [
+                            result.radiance.x as f32,
+                            result.radiance.y as f32,
+                            result.radiance.z as f32,
+                            1.0,
+                        ];
+                        row_rays += result.rays;
+                    }
+                    rays.fetch_add(row_rays, Ordering::Relaxed);
+                    let done = rows_done.fetch_add(1, Ordering::Relaxed) + 1;
+                    if let Some(report) = progress {
+                        report(done, height);
+                    }
+                }
+            });
+        }
+    });
     Rendered {
-        image: LinearImage::new(scene.render.width, scene.render.height),
-        stats: RenderStats::default(),
+        image,
+        stats: RenderStats {
+            rays_traced: rays.into_inner(),
+            elapsed: started.elapsed(),
+        },
     }
 }

@@ -357,3 +357,50 @@ impl Scene {
         self.render.lighting_space == LightingSpace::Linear
     }
 }
+
+/// The plane of a polygon and the axis dropped to project it for the inside test.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PolygonPlane {
+    /// Unit normal (Newell's method; follows the vertex winding by the right-hand rule).
+    pub normal: DVec3,
+    /// `normal · p` for every point `p` of the plane.
+    pub offset: f64,
+    /// Index (0 = x, 1 = y, 2 = z) of the largest normal component: dropping that
+    /// coordinate projects the polygon onto a coordinate plane with the least distortion.
+    pub dropped_axis: u32,
+}
+
+/// The plane of a polygon by Newell's method (Sutherland, Sproull and Schumacker 1974;
+/// see also Christer Ericson, "Real-Time Collision Detection", §12.3.1), robust for
+/// concave polygons and nearly collinear vertices. Returns `None` when the polygon is
+/// degenerate (zero area).
+pub fn polygon_plane(vertices: &[DVec3]) -> Option<PolygonPlane> {
+    let mut normal = DVec3::ZERO;
+    let mut centroid = DVec3::ZERO;
+    for (i, current) in vertices.iter().enumerate() {
+        let next = vertices[(i + 1) % vertices.len()];
+        normal.x += (current.y - next.y) * (current.z + next.z);
+        normal.y += (current.z - next.z) * (current.x + next.x);
+        normal.z += (current.x - next.x) * (current.y + next.y);
+        centroid += *current;
+    }
+    let length = normal.length();
+    if vertices.len() < 3 || !(length > 0.0) || !length.is_finite() {
+        return None;
+    }
+    let normal = normal / length;
+    centroid /= vertices.len() as f64;
+    let magnitude = normal.abs();
+    let dropped_axis = if magnitude.x >= magnitude.y && magnitude.x >= magnitude.z {
+        0
+    } else if magnitude.y >= magnitude.z {
+        1
+    } else {
+        2
+    };
+    Some(PolygonPlane {
+        normal,
+        offset: normal.dot(centroid),
+        dropped_axis,
+    })
+}

@@ -1,0 +1,236 @@
+//! The Whitted tracer with an explicit bounce stack: the CPU twin of
+//! `shaders/trace.wgsl` (same function names and the same stack discipline, so the two
+//! agree even when a small stack drops branches).
+
+use glam::DVec3;
+
+use super::bxdf::{eval_brdf, reflect, surface_response};
+use super::intersect::{
+    Hit, PreparedShape, Ray, intersect_scene, occluded, offset_ray_origin, prepare_shapes,
+};
+use crate::camera::{CameraFrame, sample_offset};
+use crate::scene::{Light, Material, MaterialKind, RenderSettings, Scene};
+
+/// The scene in the form the tracer reads: colours in the lighting space, polygons with
+/// their planes, the camera basis.
+#[derive(Debug, Clone)]
+pub struct PreparedScene {
+    /// Sampling and depth settings.
+    pub settings: RenderSettings,
+    /// The camera basis.
+    pub camera: CameraFrame,
+    /// Radiance of escaping rays.
+    pub background: DVec3,
+    /// Whitted ambient radiance.
+    pub ambient: DVec3,
+    /// Materials in the lighting space.
+    pub materials: Vec<Material>,
+    /// Lights.
+    pub lights: Vec<Light>,
+    /// Shapes with precomputed constants.
+    pub shapes: Vec<PreparedShape>,
+}
+
+impl PreparedScene {
+    /// Prepares a validated scene.
+    pub fn new(scene: &Scene) -> Self {
+        let scene = scene.in_lighting_space();
+        Self {
+            settings: scene.render,
+            camera: CameraFrame::new(&scene.camera, scene.render.width, scene.render.height),
+            background: scene.environment.background,
+            ambient: scene.environment.ambient,
+            materials: scene.materials.clone(),
+            lights: scene.lights.clone(),
+            shapes: prepare_shapes(&scene),
+        }
+    }
+}
+
+/// One pending ray on the bounce stack.
+#[derive(Debug, Clone, Copy)]
+struct StackEntry {
+    ray: Ray,
+    /// Product of the weights of the bounces that led here.
+    weight: DVec3,
+    /// Bounces since the primary ray.
+    depth: u32,
+}
+
+/// Radiance and ray count of one pixel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PixelResult {
+    /// Mean radiance over the pixel's samples.
+    pub radiance: DVec3,
+    /// Rays traced for this pixel.
+    pub rays: u64,
+}
+
+/// Traces every sample of pixel (`x`, `y`) and averages them (box filter).
+pub fn trace_pixel(scene: &PreparedScene, x: u32, y: u32) -> PixelResult {
+    let settings = &scene.settings;
+    let mut sum = DVec3::ZERO;
+    let mut rays = 0;
+    for index in 0..settings.samples_per_pixel {
+        let (dx, dy) = sample_offset(x, y, index, settings);
+        let direction = scene.camera.ray_direction(
+            f64::from(x) + dx,
+            f64::from(y) + dy,
+            settings.width,
+            settings.height,
+        );
+        let primary = Ray {
+            origin: scene.camera.eye,
+            direction,
+        };
+        let (radiance, sample_rays) = trace_radiance(scene, primary);
+        sum += radiance;
+        rays += sample_rays;
+    }
+    PixelResult {
+        radiance: sum / f64::from(settings.samples_per_pixel),
+        rays,
+    }
+}
+
+/// Radiance arriving along `primary`, traced iteratively: every reflected or refracted
+/// ray is pushed on a stack of `stack_size` entries and popped until none is left.
+/// Returns the radiance and the number of rays traced (camera, shadow and secondary).
+pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
+    let capacity = scene.settings.stack_size as usize;
+    let mut stack: Vec<StackEntry> = Vec::with_capacity(capacity);
+    stack.push(StackEntry {
+        ray: primary,
+        weight: DVec3::ONE,
+        depth: 0,
+    });
+    let mut radiance = DVec3::ZERO;
+    let mut rays = 0u64;
+    while let Some(entry) = stack.pop() {
+        rays += 1;
+        let Some(hit) = intersect_scene(&scene.shapes, &entry.ray, f64::INFINITY) else {
+            radiance += entry.weight * scene.background;
+            continue;
+        };
+        let shaded = shade_hit(scene, &entry.ray, &hit);
+        radiance += entry.weight * shaded.radiance;
+        rays += shaded.shadow_rays;
+        if entry.depth >= scene.settings.max_depth {
+            continue;
+        }
+        // Refraction is pushed first so that reflection is traced first; a branch that
+        // finds the stack full is dropped (both backends do the same).
+        for (weight, ray) in [shaded.transmitted, shaded.reflected] {
+            let weight = entry.weight * weight;
+            if weight.max_element() > 0.0 && stack.len() < capacity {
+                stack.push(StackEntry {
+                    ray,
+                    weight,
+                    depth: entry.depth + 1,
+                });
+            }
+        }
+    }
+    (radiance, rays)
+}
+
+/// What shading one hit produced.
+#[derive(Debug, Clone, Copy)]
+pub struct ShadedHit {
+    /// Emitted plus directly lit (and ambient) radiance leaving the hit towards the eye.
+    pub radiance: DVec3,
+    /// Shadow rays traced.
+    pub shadow_rays: u64,
+    /// Weight and ray of the reflected branch (weight zero when there is none).
+    pub reflected: (DVec3, Ray),
+    /// Weight and ray of the refracted branch (weight zero when there is none).
+    pub transmitted: (DVec3, Ray),
+}
+
+/// Shades `hit` for a ray travelling along `ray.direction`: emission, ambient and
+/// direct light with one shadow ray per light, and the secondary rays.
+pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit) -> ShadedHit {
+    let material = &scene.materials[hit.material as usize];
+    let position = ray.at(hit.t);
+    let entering = ray.direction.dot(hit.normal) < 0.0;
+    // Shading happens on the side the ray came from.
+    let n = if entering { hit.normal } else { -hit.normal };
+    let wo = -ray.direction;
+    let response = surface_response(material, ray.direction, n, entering);
+
+    let mut radiance = material.emission;
+    let mut shadow_rays = 0;
+    let has_base = matches!(
+        material.kind,
+        MaterialKind::Lambert | MaterialKind::BlinnPhong
+    );
+    if has_base && response.base > 0.0 {
+        let mut direct = material.diffuse * scene.ambient;
+        let shadow_origin = offset_ray_origin(position, n);
+        for light in &scene.lights {
+            let (lit, traced) = direct_light(scene, light, material, shadow_origin, n, wo);
+            direct += lit;
+            shadow_rays += traced;
+        }
+        radiance += direct * response.base;
+    }
+
+    let reflected = Ray {
+        origin: offset_ray_origin(position, n),
+        direction: reflect(ray.direction, n).normalize(),
+    };
+    let transmitted = Ray {
+        origin: offset_ray_origin(position, -n),
+        direction: response.transmit_direction,
+    };
+    ShadedHit {
+        radiance,
+        shadow_rays,
+        reflected: (response.reflect, reflected),
+        transmitted: (response.transmit, transmitted),
+    }
+}
+
+/// Reflected radiance due to one light: `f(wi, wo) · E · cos θ_i` when the shadow ray
+/// from `origin` towards the light is unblocked. Returns it and the number of shadow
+/// rays traced (0 when the light is behind the surface).
+pub fn direct_light(
+    scene: &PreparedScene,
+    light: &Light,
+    material: &Material,
+    origin: DVec3,
+    n: DVec3,
+    wo: DVec3,
+) -> (DVec3, u64) {
+    let (wi, distance, irradiance) = match *light {
+        Light::Point {
+            position,
+            intensity,
+        } => {
+            let to_light = position - origin;
+            let distance_squared = to_light.length_squared();
+            if distance_squared == 0.0 {
+                return (DVec3::ZERO, 0);
+            }
+            let distance = distance_squared.sqrt();
+            // Inverse-square law: E = I / r² on a surface facing the light.
+            (to_light / distance, distance, intensity / distance_squared)
+        }
+        Light::Directional {
+            direction,
+            irradiance,
+        } => (-direction, f64::INFINITY, irradiance),
+    };
+    let cos_i = n.dot(wi).clamp(-1.0, 1.0);
+    if cos_i <= 0.0 {
+        return (DVec3::ZERO, 0);
+    }
+    let shadow = Ray {
+        origin,
+        direction: wi,
+    };
+    if occluded(&scene.shapes, &shadow, distance) {
+        return (DVec3::ZERO, 1);
+    }
+    (eval_brdf(material, n, wi, wo) * irradiance * cos_i, 1)
+}
