@@ -385,7 +385,7 @@ pub fn polygon_plane(vertices: &[DVec3]) -> Option<PolygonPlane> {
         centroid += *current;
     }
     let length = normal.length();
-    if vertices.len() < 3 || !(length > 0.0) || !length.is_finite() {
+    if vertices.len() < 3 || length.is_nan() || length <= 0.0 || length.is_infinite() {
         return None;
     }
     let normal = normal / length;
