@@ -1,0 +1,50 @@
+// The pinhole camera and the pixel sample pattern.
+// CPU twin: src/camera.rs (pcg_hash, unit_from_hash, strata_grid, sample_offset,
+// CameraFrame::ray_direction -> camera_ray_direction).
+
+// PCG hash of one 32-bit word (Jarzynski and Olano, "Hash Functions for GPU Rendering",
+// JCGT 2020). u32 arithmetic wraps, as Rust's wrapping_mul/wrapping_add do.
+fn pcg_hash(input: u32) -> u32 {
+    let state = input * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// A uniform number in [0, 1) from the top 24 bits of a hash: exact in f32.
+fn unit_from_hash(hash: u32) -> f32 {
+    return f32(hash >> 8u) * (1.0 / 16777216.0);
+}
+
+// ceil(sqrt(n)) columns and as many rows as needed for n samples.
+fn strata_grid(samples_per_pixel: u32) -> vec2<u32> {
+    var columns = u32(sqrt(f32(samples_per_pixel)));
+    if columns * columns < samples_per_pixel {
+        columns += 1u;
+    }
+    let rows = (samples_per_pixel + columns - 1u) / columns;
+    return vec2<u32>(columns, rows);
+}
+
+// Offset in [0, 1)^2 of sample `index` inside pixel (px, py): the pixel centre for one
+// sample, otherwise jittered stratified with a hash of pixel and sample index.
+fn sample_offset(px: u32, py: u32, index: u32) -> vec2<f32> {
+    let spp = frame.samples_per_pixel;
+    if spp <= 1u {
+        return vec2<f32>(0.5, 0.5);
+    }
+    let grid = strata_grid(spp);
+    let pixel_index = py * frame.width + px;
+    let seed = pcg_hash(pixel_index * spp + index);
+    let jitter = vec2<f32>(unit_from_hash(seed), unit_from_hash(pcg_hash(seed)));
+    let cell = vec2<f32>(f32(index % grid.x), f32(index / grid.x));
+    return (cell + jitter) / vec2<f32>(grid);
+}
+
+// Unit direction through image position (x, y) in pixels from the top-left corner.
+fn camera_ray_direction(x: f32, y: f32) -> vec3<f32> {
+    let ndc_x = 2.0 * x / f32(frame.width) - 1.0;
+    let ndc_y = 1.0 - 2.0 * y / f32(frame.height);
+    return normalize(frame.forward
+        + frame.right * (ndc_x * frame.aspect * frame.tan_half_fov_y)
+        + frame.up * (ndc_y * frame.tan_half_fov_y));
+}
