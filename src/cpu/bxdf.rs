@@ -9,7 +9,7 @@ use crate::scene::{Material, MaterialKind};
 
 /// Mirror reflection of the incident direction `u` about the unit normal `n`
 /// (lecture: `R = u - 2(u·N)N`).
-pub fn reflect(u: DVec3, n: DVec3) -> DVec3 {
+pub fn reflect_direction(u: DVec3, n: DVec3) -> DVec3 {
     u - n * (2.0 * u.dot(n))
 }
 
@@ -17,7 +17,7 @@ pub fn reflect(u: DVec3, n: DVec3) -> DVec3 {
 /// `n` facing the incident side, with `k = η_i / η_t` (lecture, Snell's law):
 /// `T = k·u + (k·cos θ_i - sqrt(1 - k²(1 - cos² θ_i)))·N`, `cos θ_i = N·(-u)`.
 /// Returns `None` under total internal reflection (negative radicand).
-pub fn refract(u: DVec3, n: DVec3, k: f64) -> Option<DVec3> {
+pub fn refract_direction(u: DVec3, n: DVec3, k: f64) -> Option<DVec3> {
     let cos_i = (-u.dot(n)).clamp(-1.0, 1.0);
     let radicand = 1.0 - k * k * (1.0 - cos_i * cos_i);
     if radicand < 0.0 {
@@ -128,7 +128,7 @@ pub fn surface_response(
             } else {
                 (material.ior, 1.0)
             };
-            match refract(direction, n, eta_i / eta_t) {
+            match refract_direction(direction, n, eta_i / eta_t) {
                 Some(t) => {
                     let f = fresnel_dielectric(cos_o, eta_i, eta_t);
                     response.reflect = DVec3::splat(f);
@@ -172,9 +172,9 @@ mod tests {
         assert!(fresnel_dielectric(just_below, 1.5, 1.0) < 1.0);
         assert_eq!(fresnel_dielectric(just_above, 1.5, 1.0), 1.0);
         let incoming = DVec3::new((critical + 1e-6).sin(), -(critical + 1e-6).cos(), 0.0);
-        assert!(refract(incoming, DVec3::Y, 1.5).is_none());
+        assert!(refract_direction(incoming, DVec3::Y, 1.5).is_none());
         let below = DVec3::new((critical - 1e-6).sin(), -(critical - 1e-6).cos(), 0.0);
-        let t = refract(below, DVec3::Y, 1.5).expect("refracts");
+        let t = refract_direction(below, DVec3::Y, 1.5).expect("refracts");
         // Just below the critical angle the refracted ray grazes the surface.
         assert!(t.y.abs() < 1e-2 && t.x > 0.99);
     }
@@ -183,7 +183,7 @@ mod tests {
     fn refraction_obeys_snell() {
         let theta_i: f64 = 0.6;
         let u = DVec3::new(theta_i.sin(), -theta_i.cos(), 0.0);
-        let t = refract(u, DVec3::Y, 1.0 / 1.33).expect("refracts");
+        let t = refract_direction(u, DVec3::Y, 1.0 / 1.33).expect("refracts");
         assert!((t.length() - 1.0).abs() < 1e-12);
         let sin_t = t.x;
         assert!((theta_i.sin() - 1.33 * sin_t).abs() < 1e-12);
@@ -192,7 +192,7 @@ mod tests {
     #[test]
     fn reflection_mirrors_about_the_normal() {
         let u = DVec3::new(1.0, -1.0, 0.0).normalize();
-        let r = reflect(u, DVec3::Y);
+        let r = reflect_direction(u, DVec3::Y);
         assert!((r - DVec3::new(1.0, 1.0, 0.0).normalize()).length() < 1e-15);
     }
 

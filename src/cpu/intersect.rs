@@ -162,7 +162,9 @@ pub fn intersect_sphere(ray: &Ray, center: DVec3, radius: f64, t_max: f64) -> Op
         return None;
     }
     let c = f.dot(f) - radius * radius;
-    let q = b + b.signum() * discriminant.sqrt();
+    // sign(b) with sign(0) = +1, as the WGSL twin computes it.
+    let sign_b = if b >= 0.0 { 1.0 } else { -1.0 };
+    let q = b + sign_b * discriminant.sqrt();
     let (t0, t1) = if q == 0.0 {
         (0.0, 0.0)
     } else {

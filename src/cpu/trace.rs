@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 
-use super::bxdf::{eval_brdf, reflect, surface_response};
+use super::bxdf::{eval_brdf, reflect_direction, surface_response};
 use super::intersect::{
     Hit, PreparedShape, Ray, intersect_scene, occluded, offset_ray_origin, prepare_shapes,
 };
@@ -177,7 +177,7 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit) -> ShadedHit {
 
     let reflected = Ray {
         origin: offset_ray_origin(position, n),
-        direction: reflect(ray.direction, n).normalize(),
+        direction: reflect_direction(ray.direction, n).normalize(),
     };
     let transmitted = Ray {
         origin: offset_ray_origin(position, -n),
