@@ -1,0 +1,186 @@
+//! A headless wgpu context for apps and tests that do not bring their own device.
+
+use std::sync::{Arc, Mutex, PoisonError};
+
+use super::GpuError;
+
+/// Which adapter [`HeadlessGpu::new`] should open.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub enum AdapterChoice {
+    /// wgpu's choice with [`wgpu::PowerPreference::HighPerformance`].
+    #[default]
+    Default,
+    /// The adapter at this position in [`list_adapters`].
+    Index(usize),
+    /// The first adapter whose name contains this text (case-insensitive).
+    NameContains(String),
+}
+
+/// The backends to try first: `WGPU_BACKEND` if set (for example `vulkan` or `gl`),
+/// otherwise the native modern APIs. GL is left out here so that machines offering
+/// both Vulkan and EGL (lavapipe and llvmpipe, say) pick deterministically.
+fn primary_backends() -> wgpu::Backends {
+    wgpu::Backends::from_env()
+        .unwrap_or(wgpu::Backends::VULKAN | wgpu::Backends::METAL | wgpu::Backends::DX12)
+}
+
+fn instance_for(backends: wgpu::Backends) -> wgpu::Instance {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    desc.backends = backends;
+    wgpu::Instance::new(desc)
+}
+
+/// An instance with its adapters: the primary backends, or GL when those offer none
+/// (and `WGPU_BACKEND` did not pin the choice).
+fn instance_with_adapters() -> (wgpu::Instance, Vec<wgpu::Adapter>) {
+    let backends = primary_backends();
+    let instance = instance_for(backends);
+    let adapters = pollster::block_on(instance.enumerate_adapters(backends));
+    if !adapters.is_empty() || wgpu::Backends::from_env().is_some() {
+        return (instance, adapters);
+    }
+    let gl = instance_for(wgpu::Backends::GL);
+    let adapters = pollster::block_on(gl.enumerate_adapters(wgpu::Backends::GL));
+    (gl, adapters)
+}
+
+/// Every adapter [`HeadlessGpu::new`] could open, in the order [`AdapterChoice::Index`]
+/// counts them.
+///
+/// ```no_run
+/// for (i, info) in gpu_render::gpu::list_adapters().iter().enumerate() {
+///     println!("{i}: {} ({:?})", info.name, info.backend);
+/// }
+/// ```
+pub fn list_adapters() -> Vec<wgpu::AdapterInfo> {
+    let (_instance, adapters) = instance_with_adapters();
+    adapters.iter().map(wgpu::Adapter::get_info).collect()
+}
+
+/// A wgpu instance, adapter, device and queue without any window.
+///
+/// The device is created with the adapter's own limits (not [`wgpu::Limits::default`]),
+/// so large storage buffers and image sizes the hardware supports are usable.
+pub struct HeadlessGpu {
+    /// The instance the adapter came from.
+    pub instance: wgpu::Instance,
+    /// The chosen adapter.
+    pub adapter: wgpu::Adapter,
+    /// The device; pass it to [`super::GpuRenderer::new`] and its methods.
+    pub device: wgpu::Device,
+    /// The device's queue.
+    pub queue: wgpu::Queue,
+    lost: Arc<Mutex<Option<String>>>,
+}
+
+impl std::fmt::Debug for HeadlessGpu {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("HeadlessGpu")
+            .field("adapter", &self.adapter.get_info())
+            .field("lost", &self.lost_reason())
+            .finish_non_exhaustive()
+    }
+}
+
+impl HeadlessGpu {
+    /// Opens the adapter `choice` names and creates a device with its full limits.
+    ///
+    /// Errors: [`GpuError::NoAdapter`] when nothing matches (the message lists what
+    /// exists), [`GpuError::RequestDevice`] when the adapter refuses the device.
+    ///
+    /// ```no_run
+    /// use gpu_render::gpu::{AdapterChoice, HeadlessGpu};
+    /// let gpu = HeadlessGpu::new(&AdapterChoice::NameContains("llvmpipe".into()))?;
+    /// println!("rendering on {}", gpu.adapter_info().name);
+    /// # Ok::<(), gpu_render::gpu::GpuError>(())
+    /// ```
+    pub fn new(choice: &AdapterChoice) -> Result<Self, GpuError> {
+        let (instance, adapters) = instance_with_adapters();
+        let names = || {
+            let list: Vec<String> = adapters
+                .iter()
+                .enumerate()
+                .map(|(i, a)| {
+                    let info = a.get_info();
+                    format!("{i}: {} ({:?})", info.name, info.backend)
+                })
+                .collect();
+            if list.is_empty() {
+                "no adapters found".to_string()
+            } else {
+                format!("available: {}", list.join(", "))
+            }
+        };
+        let adapter = match choice {
+            AdapterChoice::Default => {
+                let options = wgpu::RequestAdapterOptions {
+                    power_preference: wgpu::PowerPreference::HighPerformance,
+                    ..Default::default()
+                };
+                match pollster::block_on(instance.request_adapter(&options)) {
+                    Ok(adapter) => adapter,
+                    // request_adapter may decline where enumeration found something
+                    // (for example only a CPU adapter): take the first one then.
+                    Err(e) => adapters
+                        .first()
+                        .cloned()
+                        .ok_or_else(|| GpuError::NoAdapter(format!("{e}; {}", names())))?,
+                }
+            }
+            AdapterChoice::Index(i) => adapters.get(*i).cloned().ok_or_else(|| {
+                GpuError::NoAdapter(format!("no adapter with index {i}; {}", names()))
+            })?,
+            AdapterChoice::NameContains(text) => {
+                let wanted = text.to_lowercase();
+                adapters
+                    .iter()
+                    .find(|a| a.get_info().name.to_lowercase().contains(&wanted))
+                    .cloned()
+                    .ok_or_else(|| {
+                        GpuError::NoAdapter(format!(
+                            "no adapter name contains {text:?}; {}",
+                            names()
+                        ))
+                    })?
+            }
+        };
+        let desc = wgpu::DeviceDescriptor {
+            label: Some("gpu-render headless device"),
+            required_features: wgpu::Features::empty(),
+            required_limits: adapter.limits(),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&desc))
+            .map_err(|e| GpuError::RequestDevice(e.to_string()))?;
+        // Record the reason if the device is lost, so callers can tell a reset from
+        // other failures (see `lost_reason`).
+        let lost = Arc::new(Mutex::new(None));
+        let sink = Arc::clone(&lost);
+        device.set_device_lost_callback(move |reason, message| {
+            *sink.lock().unwrap_or_else(PoisonError::into_inner) =
+                Some(format!("{reason:?}: {message}"));
+        });
+        Ok(Self {
+            instance,
+            adapter,
+            device,
+            queue,
+            lost,
+        })
+    }
+
+    /// Name, backend, device type and driver of the adapter, for summaries.
+    pub fn adapter_info(&self) -> wgpu::AdapterInfo {
+        self.adapter.get_info()
+    }
+
+    /// Why the device was lost, if it was (`None` while it is healthy).
+    pub fn lost_reason(&self) -> Option<String> {
+        self.lost
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone()
+    }
+}

@@ -1,0 +1,862 @@
+//! [`GpuRenderer`]: pipelines, scene upload, chunked dispatch and readback.
+//!
+//! The renderer owns no device: it is built from the caller's [`wgpu::Device`] and
+//! every method takes the device (and queue where it submits), so an app can embed
+//! the tracer in its own frame. Two levels:
+//!
+//! - high level: [`GpuRenderer::render`] (textures, chunked tracing, display pass,
+//!   readback, statistics) and [`GpuRenderer::render_to_texture`];
+//! - low level: [`GpuRenderer::prepare`] uploads a scene, [`GpuRenderer::encode_trace`]
+//!   and [`GpuRenderer::encode_display`] record passes into the caller's encoder.
+
+use std::collections::HashMap;
+use std::ops::Range;
+use std::sync::{Mutex, PoisonError};
+use std::time::{Duration, Instant};
+
+use wgpu::util::DeviceExt;
+
+use super::GpuError;
+use super::layout::{DisplayUniforms, FrameUniforms};
+use super::readback::{Caught, capture, read_buffer, read_texture, submit_and_wait};
+use super::shaders::{
+    DISPLAY_ENTRY_POINT, TRACE_ENTRY_POINT, WORKGROUP_SIZE, display_shader_source,
+    trace_shader_source,
+};
+use super::upload::{SceneRecords, frame_uniforms};
+use crate::film::{LinearImage, ProgressFn, RenderStats};
+use crate::scene::Scene;
+
+/// Most pixel samples (`rows × width × samples_per_pixel`) traced by one submission
+/// of [`GpuRenderer::render`]. Each chunk is submitted and waited for on its own, so
+/// no single dispatch runs long enough to trip an OS GPU watchdog (about 2 s on
+/// Windows), and progress can be reported between chunks. 2^21 samples take well under
+/// a second on lavapipe for moderate scenes. A single row wider than this is still
+/// traced as one chunk.
+pub const MAX_CHUNK_SAMPLES: u64 = 1 << 21;
+
+/// Default bound on one wait for the GPU; see [`GpuRenderer::with_poll_timeout`].
+pub const DEFAULT_POLL_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// Format of the linear radiance texture the trace pass writes.
+pub const LINEAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// Format of the display texture (sRGB encoding is done in the shader because
+/// `Rgba8UnormSrgb` cannot be a storage texture).
+pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+/// The GPU tracer's pipelines, built for one device.
+///
+/// ```no_run
+/// use gpu_render::gpu::{AdapterChoice, GpuRenderer, HeadlessGpu};
+/// # fn demo(scene: &gpu_render::scene::Scene) -> Result<(), gpu_render::gpu::GpuError> {
+/// let gpu = HeadlessGpu::new(&AdapterChoice::Default)?;
+/// let renderer = GpuRenderer::new(&gpu.device)?;
+/// let progress = |done: u32, total: u32| eprintln!("{done}/{total} rows");
+/// let out = renderer.render(&gpu.device, &gpu.queue, scene, Some(&progress))?;
+/// assert_eq!(out.display_rgba8.len(), out.image.pixels.len() * 4);
+/// # Ok(())
+/// # }
+/// ```
+#[derive(Debug)]
+pub struct GpuRenderer {
+    trace_bind_group_layout: wgpu::BindGroupLayout,
+    trace_pipeline_layout: wgpu::PipelineLayout,
+    display_bind_group_layout: wgpu::BindGroupLayout,
+    display_pipeline: wgpu::ComputePipeline,
+    /// Trace pipelines by bounce-stack size, built on first use: the stack size is a
+    /// shader constant, and most runs need only one.
+    trace_pipelines: Mutex<HashMap<u32, wgpu::ComputePipeline>>,
+    poll_timeout: Duration,
+}
+
+/// A scene uploaded to one device: the storage buffers, the per-row ray counters and
+/// the frame constants, ready for [`GpuRenderer::encode_trace`].
+///
+/// The ray counters accumulate over every trace recorded with this scene; clear them
+/// with [`GpuRenderer::encode_clear_ray_counts`] before re-rendering.
+#[derive(Debug)]
+pub struct PreparedScene {
+    frame: FrameUniforms,
+    stack_size: u32,
+    encode_srgb: bool,
+    spheres: wgpu::Buffer,
+    planes: wgpu::Buffer,
+    polygons: wgpu::Buffer,
+    polygon_vertices: wgpu::Buffer,
+    triangles: wgpu::Buffer,
+    materials: wgpu::Buffer,
+    lights: wgpu::Buffer,
+    ray_counts: wgpu::Buffer,
+}
+
+impl PreparedScene {
+    /// Image width in pixels.
+    pub fn width(&self) -> u32 {
+        self.frame.width
+    }
+
+    /// Image height in pixels (also the number of ray counters).
+    pub fn height(&self) -> u32 {
+        self.frame.height
+    }
+
+    /// Samples per pixel.
+    pub fn samples_per_pixel(&self) -> u32 {
+        self.frame.samples_per_pixel
+    }
+
+    /// Bounce-stack capacity, which selects the trace pipeline.
+    pub fn stack_size(&self) -> u32 {
+        self.stack_size
+    }
+
+    /// Whether the display pass should apply the sRGB curve for this scene (false in
+    /// naive gamma mode).
+    pub fn display_encodes_srgb(&self) -> bool {
+        self.encode_srgb
+    }
+
+    /// The frame constants for the whole image (`row_offset` 0, `row_count` height).
+    pub fn frame_uniforms(&self) -> &FrameUniforms {
+        &self.frame
+    }
+
+    /// The ray counters: one `u32` per image row (`STORAGE | COPY_SRC | COPY_DST`).
+    pub fn ray_count_buffer(&self) -> &wgpu::Buffer {
+        &self.ray_counts
+    }
+}
+
+/// The result of [`GpuRenderer::render`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct GpuRendered {
+    /// The linear radiance image, as traced.
+    pub image: LinearImage,
+    /// The display pass's output: `width × height` RGBA8 pixels, row-major, top row
+    /// first, sRGB-encoded unless the scene is in naive gamma mode.
+    pub display_rgba8: Vec<u8>,
+    /// Rays traced (summed from the per-row counters) and the wall time of tracing.
+    pub stats: RenderStats,
+}
+
+fn compute_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty,
+        count: None,
+    }
+}
+
+fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    compute_entry(
+        binding,
+        wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+    )
+}
+
+fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    compute_entry(
+        binding,
+        wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+    )
+}
+
+fn storage_texture_entry(binding: u32, format: wgpu::TextureFormat) -> wgpu::BindGroupLayoutEntry {
+    compute_entry(
+        binding,
+        wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+    )
+}
+
+fn buffer_binding(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: buffer.as_entire_binding(),
+    }
+}
+
+/// Checks that `view`'s texture has `format`, `usage` and at least `width × height`.
+fn check_texture(
+    view: &wgpu::TextureView,
+    role: &str,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+    width: u32,
+    height: u32,
+) -> Result<(), GpuError> {
+    let texture = view.texture();
+    if texture.format() != format {
+        return Err(GpuError::Validation(format!(
+            "{role} texture must be {format:?}, got {:?}",
+            texture.format()
+        )));
+    }
+    if !texture.usage().contains(usage) {
+        return Err(GpuError::Validation(format!(
+            "{role} texture needs usage {usage:?}, has {:?}",
+            texture.usage()
+        )));
+    }
+    if texture.width() < width || texture.height() < height {
+        return Err(GpuError::Validation(format!(
+            "{role} texture is {}x{}, the image is {width}x{height}",
+            texture.width(),
+            texture.height()
+        )));
+    }
+    Ok(())
+}
+
+/// The row ranges [`GpuRenderer::render`] dispatches for an image of `width × height`
+/// with `samples_per_pixel`: consecutive, covering every row once, each at most
+/// [`MAX_CHUNK_SAMPLES`] samples (or one row, if a row alone is more).
+pub fn row_chunks(width: u32, height: u32, samples_per_pixel: u32) -> Vec<Range<u32>> {
+    let samples_per_row = (u64::from(width) * u64::from(samples_per_pixel)).max(1);
+    let rows_per_chunk = (MAX_CHUNK_SAMPLES / samples_per_row).clamp(1, u64::from(u32::MAX));
+    let rows_per_chunk = rows_per_chunk as u32;
+    let mut chunks = Vec::new();
+    let mut start = 0;
+    while start < height {
+        let end = start.saturating_add(rows_per_chunk).min(height);
+        chunks.push(start..end);
+        start = end;
+    }
+    chunks
+}
+
+impl GpuRenderer {
+    /// Builds the bind group layouts and the display pipeline on `device`. Trace
+    /// pipelines are built on first use for each stack size.
+    ///
+    /// Errors: [`GpuError::Shader`] if the display shader fails to compile.
+    pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
+        // Explicit layouts: an automatic layout would drop bindings a shader leaves
+        // unused, and the bind groups below would no longer match it.
+        let trace_bind_group_layout =
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("gpu-render trace bindings"),
+                entries: &[
+                    uniform_entry(0),
+                    storage_entry(1, true),
+                    storage_entry(2, true),
+                    storage_entry(3, true),
+                    storage_entry(4, true),
+                    storage_entry(5, true),
+                    storage_entry(6, true),
+                    storage_entry(7, true),
+                    storage_texture_entry(8, LINEAR_FORMAT),
+                    storage_entry(9, false),
+                ],
+            });
+        let trace_pipeline_layout =
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("gpu-render trace layout"),
+                bind_group_layouts: &[Some(&trace_bind_group_layout)],
+                immediate_size: 0,
+            });
+        let display_bind_group_layout =
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("gpu-render display bindings"),
+                entries: &[
+                    uniform_entry(0),
+                    compute_entry(
+                        1,
+                        wgpu::BindingType::Texture {
+                            // Rgba32Float is not filterable without an extra feature;
+                            // the pass only uses textureLoad.
+                            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                            view_dimension: wgpu::TextureViewDimension::D2,
+                            multisampled: false,
+                        },
+                    ),
+                    storage_texture_entry(2, DISPLAY_FORMAT),
+                ],
+            });
+        let display_pipeline_layout =
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("gpu-render display layout"),
+                bind_group_layouts: &[Some(&display_bind_group_layout)],
+                immediate_size: 0,
+            });
+        let display_pipeline = build_pipeline(
+            device,
+            "display",
+            display_shader_source(),
+            &display_pipeline_layout,
+            DISPLAY_ENTRY_POINT,
+        )?;
+        Ok(Self {
+            trace_bind_group_layout,
+            trace_pipeline_layout,
+            display_bind_group_layout,
+            display_pipeline,
+            trace_pipelines: Mutex::new(HashMap::new()),
+            poll_timeout: DEFAULT_POLL_TIMEOUT,
+        })
+    }
+
+    /// Sets the longest this renderer waits for one submission (one chunk, the display
+    /// pass, one readback) before reporting [`GpuError::DeviceLost`] instead of hanging.
+    /// Default: [`DEFAULT_POLL_TIMEOUT`].
+    pub fn with_poll_timeout(mut self, timeout: Duration) -> Self {
+        self.poll_timeout = timeout;
+        self
+    }
+
+    /// The trace pipeline for `stack_size`, built and cached on first use.
+    ///
+    /// Errors: [`GpuError::Shader`] if the composed trace shader does not compile.
+    pub fn trace_pipeline(
+        &self,
+        device: &wgpu::Device,
+        stack_size: u32,
+    ) -> Result<wgpu::ComputePipeline, GpuError> {
+        let mut cache = self
+            .trace_pipelines
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner);
+        if let Some(pipeline) = cache.get(&stack_size) {
+            return Ok(pipeline.clone());
+        }
+        let pipeline = build_pipeline(
+            device,
+            &format!("trace (stack size {stack_size})"),
+            trace_shader_source(stack_size),
+            &self.trace_pipeline_layout,
+            TRACE_ENTRY_POINT,
+        )?;
+        cache.insert(stack_size, pipeline.clone());
+        Ok(pipeline)
+    }
+
+    /// Uploads `scene` (converted with [`Scene::in_lighting_space`] here, so pass the
+    /// scene as loaded) and allocates its per-row ray counters.
+    ///
+    /// Errors: [`GpuError::DeviceLimit`] if the image or a buffer exceeds the device's
+    /// limits, [`GpuError::OutOfMemory`] if an allocation fails,
+    /// [`GpuError::Validation`] if the render settings are out of range.
+    pub fn prepare(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+    ) -> Result<PreparedScene, GpuError> {
+        scene.render.check().map_err(GpuError::Validation)?;
+        let scene = scene.in_lighting_space();
+        let records = SceneRecords::from_scene(&scene);
+        let frame = frame_uniforms(&scene, &records);
+        let limits = device.limits();
+        let over = |what: &str, value: u64, limit: u64| {
+            if value > limit {
+                Err(GpuError::DeviceLimit {
+                    what: what.to_string(),
+                    value,
+                    limit,
+                })
+            } else {
+                Ok(())
+            }
+        };
+        let max_dim = u64::from(limits.max_texture_dimension_2d);
+        over("image width", u64::from(frame.width), max_dim)?;
+        over("image height", u64::from(frame.height), max_dim)?;
+        let max_groups = u64::from(limits.max_compute_workgroups_per_dimension);
+        let groups = |n: u32| u64::from(n.div_ceil(WORKGROUP_SIZE));
+        over(
+            "workgroups across the width",
+            groups(frame.width),
+            max_groups,
+        )?;
+        over(
+            "workgroups down the height",
+            groups(frame.height),
+            max_groups,
+        )?;
+
+        let padded = records.padded();
+        let max_binding = limits.max_storage_buffer_binding_size;
+        let max_buffer = limits.max_buffer_size;
+        let upload = |what: &str, bytes: &[u8]| -> Result<wgpu::Buffer, GpuError> {
+            let size = bytes.len() as u64;
+            over(
+                &format!("{what} buffer bytes"),
+                size,
+                max_binding.min(max_buffer),
+            )?;
+            let buffer = capture(device, what, Caught::Resource, || {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(what),
+                    size,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                })
+            })?;
+            // write_buffer stages through the queue: no mapped_at_creation, whose
+            // mapping would panic if the allocation had failed.
+            queue.write_buffer(&buffer, 0, bytes);
+            Ok(buffer)
+        };
+        let spheres = upload("sphere", bytemuck::cast_slice(&padded.spheres))?;
+        let planes = upload("plane", bytemuck::cast_slice(&padded.planes))?;
+        let polygons = upload("polygon", bytemuck::cast_slice(&padded.polygons))?;
+        let polygon_vertices = upload(
+            "polygon vertex",
+            bytemuck::cast_slice(&padded.polygon_vertices),
+        )?;
+        let triangles = upload("triangle", bytemuck::cast_slice(&padded.triangles))?;
+        let materials = upload("material", bytemuck::cast_slice(&padded.materials))?;
+        let lights = upload("light", bytemuck::cast_slice(&padded.lights))?;
+        let ray_count_bytes = u64::from(frame.height) * 4;
+        over(
+            "ray counter buffer bytes",
+            ray_count_bytes,
+            max_binding.min(max_buffer),
+        )?;
+        let ray_counts = capture(device, "ray counters", Caught::Resource, || {
+            // wgpu zero-initialises new buffers, so the counters start at 0.
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("gpu-render ray counters"),
+                size: ray_count_bytes,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        })?;
+        Ok(PreparedScene {
+            frame,
+            stack_size: scene.render.stack_size,
+            encode_srgb: scene.display_encodes_srgb(),
+            spheres,
+            planes,
+            polygons,
+            polygon_vertices,
+            triangles,
+            materials,
+            lights,
+            ray_counts,
+        })
+    }
+
+    /// Records one trace dispatch of image rows `rows` into `encoder`, writing
+    /// linear radiance into `target` and adding to the prepared scene's ray counters.
+    ///
+    /// `target` must view an [`LINEAR_FORMAT`] (`Rgba32Float`) texture with
+    /// `STORAGE_BINDING` usage, at least as large as the image. Each call creates a
+    /// small uniform buffer holding the frame constants with this chunk's
+    /// `row_offset`/`row_count`, initialised at creation: unlike `Queue::write_buffer`
+    /// (which lands before the whole submission), this lets several chunks be recorded
+    /// into one encoder. wgpu keeps the buffer alive until the work completes. An empty
+    /// range records nothing.
+    ///
+    /// Errors: [`GpuError::Validation`] for an out-of-range `rows` or an unsuitable
+    /// target, [`GpuError::Shader`] if the trace pipeline cannot be built. Validation of
+    /// the recorded pass itself happens when the caller finishes the encoder.
+    ///
+    /// ```no_run
+    /// # fn demo(gpu: &gpu_render::gpu::HeadlessGpu, scene: &gpu_render::scene::Scene)
+    /// # -> Result<(), gpu_render::gpu::GpuError> {
+    /// # let (device, queue) = (&gpu.device, &gpu.queue);
+    /// let renderer = gpu_render::gpu::GpuRenderer::new(device)?;
+    /// let prepared = renderer.prepare(device, queue, scene)?;
+    /// let texture = device.create_texture(&wgpu::TextureDescriptor {
+    ///     label: Some("linear"),
+    ///     size: wgpu::Extent3d { width: prepared.width(), height: prepared.height(), depth_or_array_layers: 1 },
+    ///     mip_level_count: 1,
+    ///     sample_count: 1,
+    ///     dimension: wgpu::TextureDimension::D2,
+    ///     format: wgpu::TextureFormat::Rgba32Float,
+    ///     usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+    ///     view_formats: &[],
+    /// });
+    /// let view = texture.create_view(&Default::default());
+    /// let mut encoder = device.create_command_encoder(&Default::default());
+    /// renderer.encode_trace(device, &mut encoder, &prepared, &view, 0..prepared.height())?;
+    /// queue.submit([encoder.finish()]);
+    /// # Ok(())
+    /// # }
+    /// ```
+    pub fn encode_trace(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        prepared: &PreparedScene,
+        target: &wgpu::TextureView,
+        rows: Range<u32>,
+    ) -> Result<(), GpuError> {
+        if rows.start > rows.end || rows.end > prepared.height() {
+            return Err(GpuError::Validation(format!(
+                "row range {rows:?} is outside the image's {} rows",
+                prepared.height()
+            )));
+        }
+        if rows.is_empty() {
+            return Ok(());
+        }
+        check_texture(
+            target,
+            "trace target",
+            LINEAR_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING,
+            prepared.width(),
+            prepared.height(),
+        )?;
+        let pipeline = self.trace_pipeline(device, prepared.stack_size)?;
+        let chunk = FrameUniforms {
+            row_offset: rows.start,
+            row_count: rows.end - rows.start,
+            ..prepared.frame
+        };
+        let bind_group = capture(device, "trace bind group", Caught::Resource, || {
+            let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("gpu-render chunk uniforms"),
+                contents: bytemuck::bytes_of(&chunk),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("gpu-render trace bind group"),
+                layout: &self.trace_bind_group_layout,
+                entries: &[
+                    buffer_binding(0, &uniforms),
+                    buffer_binding(1, &prepared.spheres),
+                    buffer_binding(2, &prepared.planes),
+                    buffer_binding(3, &prepared.polygons),
+                    buffer_binding(4, &prepared.polygon_vertices),
+                    buffer_binding(5, &prepared.triangles),
+                    buffer_binding(6, &prepared.materials),
+                    buffer_binding(7, &prepared.lights),
+                    wgpu::BindGroupEntry {
+                        binding: 8,
+                        resource: wgpu::BindingResource::TextureView(target),
+                    },
+                    buffer_binding(9, &prepared.ray_counts),
+                ],
+            })
+        })?;
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("gpu-render trace"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.dispatch_workgroups(
+            prepared.width().div_ceil(WORKGROUP_SIZE),
+            chunk.row_count.div_ceil(WORKGROUP_SIZE),
+            1,
+        );
+        Ok(())
+    }
+
+    /// Records a clear of the prepared scene's ray counters into `encoder`.
+    pub fn encode_clear_ray_counts(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        prepared: &PreparedScene,
+    ) {
+        encoder.clear_buffer(&prepared.ray_counts, 0, None);
+    }
+
+    /// Reads the prepared scene's ray counters (after the traces that fill them have
+    /// been submitted) and returns their sum. Each row's counter is a `u32` that wraps
+    /// past 2^32 rays in one row; the sum is taken in `u64`.
+    pub fn read_ray_count(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        prepared: &PreparedScene,
+    ) -> Result<u64, GpuError> {
+        let bytes = read_buffer(
+            device,
+            queue,
+            &prepared.ray_counts,
+            u64::from(prepared.height()) * 4,
+            self.poll_timeout,
+        )?;
+        Ok(bytes
+            .chunks_exact(4)
+            .map(|c| u64::from(u32::from_ne_bytes([c[0], c[1], c[2], c[3]])))
+            .sum())
+    }
+
+    /// Records the display pass into `encoder`: reads `linear` (an `Rgba32Float`
+    /// texture with `TEXTURE_BINDING`), applies the exact sRGB curve if `encode_srgb`
+    /// (else clamps only), quantises to 8 bits and writes `display` (an `Rgba8Unorm`
+    /// texture with `STORAGE_BINDING` of the same size).
+    ///
+    /// Errors: [`GpuError::Validation`] for unsuitable textures.
+    pub fn encode_display(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        linear: &wgpu::TextureView,
+        display: &wgpu::TextureView,
+        encode_srgb: bool,
+    ) -> Result<(), GpuError> {
+        let (width, height) = (linear.texture().width(), linear.texture().height());
+        check_texture(
+            linear,
+            "display input",
+            LINEAR_FORMAT,
+            wgpu::TextureUsages::TEXTURE_BINDING,
+            width,
+            height,
+        )?;
+        check_texture(
+            display,
+            "display output",
+            DISPLAY_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING,
+            width,
+            height,
+        )?;
+        let uniforms = DisplayUniforms {
+            encode_srgb: u32::from(encode_srgb),
+            _pad: [0; 3],
+        };
+        let bind_group = capture(device, "display bind group", Caught::Resource, || {
+            let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("gpu-render display uniforms"),
+                contents: bytemuck::bytes_of(&uniforms),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("gpu-render display bind group"),
+                layout: &self.display_bind_group_layout,
+                entries: &[
+                    buffer_binding(0, &buffer),
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(linear),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(display),
+                    },
+                ],
+            })
+        })?;
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("gpu-render display"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.display_pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.dispatch_workgroups(
+            width.div_ceil(WORKGROUP_SIZE),
+            height.div_ceil(WORKGROUP_SIZE),
+            1,
+        );
+        Ok(())
+    }
+
+    /// Renders `scene` completely: traces it in row chunks (see [`MAX_CHUNK_SAMPLES`]),
+    /// each submitted and waited for, calling `progress(rows_done, height)` after each;
+    /// runs the display pass; reads back both images and the ray counters.
+    /// `stats.elapsed` covers the tracing submissions only (not upload, display pass or
+    /// readback); the trace pipeline is built before the clock starts.
+    ///
+    /// Errors: see [`GpuRenderer::prepare`]; [`GpuError::DeviceLost`] if the device
+    /// fails or a chunk exceeds the poll timeout; [`GpuError::Readback`].
+    pub fn render(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        progress: Option<ProgressFn<'_>>,
+    ) -> Result<GpuRendered, GpuError> {
+        let prepared = self.prepare(device, queue, scene)?;
+        let (width, height) = (prepared.width(), prepared.height());
+        let linear = create_texture(
+            device,
+            "gpu-render linear image",
+            width,
+            height,
+            LINEAR_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+        )?;
+        let display = create_texture(
+            device,
+            "gpu-render display image",
+            width,
+            height,
+            DISPLAY_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        )?;
+        let linear_view = linear.create_view(&wgpu::TextureViewDescriptor::default());
+        let display_view = display.create_view(&wgpu::TextureViewDescriptor::default());
+
+        let mut stats = self.trace_chunks(device, queue, &prepared, &linear_view, progress)?;
+
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("gpu-render display pass"),
+        });
+        self.encode_display(
+            device,
+            &mut encoder,
+            &linear_view,
+            &display_view,
+            prepared.display_encodes_srgb(),
+        )?;
+        submit_and_wait(device, queue, encoder, "display pass", self.poll_timeout)?;
+
+        let linear_bytes = read_texture(device, queue, &linear, 16, self.poll_timeout)?;
+        let display_rgba8 = read_texture(device, queue, &display, 4, self.poll_timeout)?;
+        stats.rays_traced = self.read_ray_count(device, queue, &prepared)?;
+        // pod_collect_to_vec copies, so the byte vector's alignment does not matter.
+        let pixels: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&linear_bytes);
+        Ok(GpuRendered {
+            image: LinearImage {
+                width,
+                height,
+                pixels,
+            },
+            display_rgba8,
+            stats,
+        })
+    }
+
+    /// Traces `scene` into the caller's `target` (an `Rgba32Float` texture with
+    /// `STORAGE_BINDING`, at least image-sized), chunked and timed like
+    /// [`GpuRenderer::render`], without the display pass or image readback. Returns the
+    /// ray count and trace time.
+    pub fn render_to_texture(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        target: &wgpu::TextureView,
+        progress: Option<ProgressFn<'_>>,
+    ) -> Result<RenderStats, GpuError> {
+        let prepared = self.prepare(device, queue, scene)?;
+        let mut stats = self.trace_chunks(device, queue, &prepared, target, progress)?;
+        stats.rays_traced = self.read_ray_count(device, queue, &prepared)?;
+        Ok(stats)
+    }
+
+    /// Traces every row chunk, one submission and wait each; returns the elapsed time
+    /// (ray count left 0 for the caller to fill).
+    fn trace_chunks(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        prepared: &PreparedScene,
+        target: &wgpu::TextureView,
+        progress: Option<ProgressFn<'_>>,
+    ) -> Result<RenderStats, GpuError> {
+        // Compile before timing: shader and pipeline creation is not tracing.
+        self.trace_pipeline(device, prepared.stack_size)?;
+        let start = Instant::now();
+        for rows in row_chunks(
+            prepared.width(),
+            prepared.height(),
+            prepared.samples_per_pixel(),
+        ) {
+            let done = rows.end;
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("gpu-render trace chunk"),
+            });
+            self.encode_trace(device, &mut encoder, prepared, target, rows)?;
+            submit_and_wait(device, queue, encoder, "trace chunk", self.poll_timeout)?;
+            if let Some(progress) = progress {
+                progress(done, prepared.height());
+            }
+        }
+        Ok(RenderStats {
+            rays_traced: 0,
+            elapsed: start.elapsed(),
+        })
+    }
+}
+
+/// Creates a shader module and a compute pipeline inside error scopes, so that WGSL or
+/// pipeline errors come back as [`GpuError::Shader`] instead of panicking.
+fn build_pipeline(
+    device: &wgpu::Device,
+    name: &str,
+    source: String,
+    layout: &wgpu::PipelineLayout,
+    entry_point: &str,
+) -> Result<wgpu::ComputePipeline, GpuError> {
+    capture(device, &format!("{name} shader"), Caught::Shader, || {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(name),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(name),
+            layout: Some(layout),
+            module: &module,
+            entry_point: Some(entry_point),
+            compilation_options: wgpu::PipelineCompilationOptions::default(),
+            cache: None,
+        })
+    })
+}
+
+/// Creates a 2D texture inside error scopes (allocation failure becomes
+/// [`GpuError::OutOfMemory`]).
+fn create_texture(
+    device: &wgpu::Device,
+    label: &str,
+    width: u32,
+    height: u32,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> Result<wgpu::Texture, GpuError> {
+    capture(device, label, Caught::Resource, || {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        })
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chunks_cover_rows_once_within_budget() {
+        for &(w, h, spp) in &[(37, 19, 1), (1920, 1080, 16), (4000, 3, 1024), (1, 1, 1)] {
+            let chunks = row_chunks(w, h, spp);
+            assert_eq!(chunks.first().map(|c| c.start), Some(0));
+            assert_eq!(chunks.last().map(|c| c.end), Some(h));
+            for pair in chunks.windows(2) {
+                assert_eq!(pair[0].end, pair[1].start);
+            }
+            for c in &chunks {
+                let samples = u64::from(c.end - c.start) * u64::from(w) * u64::from(spp);
+                assert!(c.end > c.start);
+                assert!(samples <= MAX_CHUNK_SAMPLES || c.end - c.start == 1);
+            }
+        }
+        // 1920 x 16 spp = 30720 samples per row: 68 rows per chunk.
+        assert_eq!(row_chunks(1920, 1080, 16)[0], 0..68);
+        assert!(row_chunks(1, 0, 1).is_empty());
+    }
+}

@@ -1,0 +1,71 @@
+//! Composition of the WGSL sources. WGSL has no `#include`, so the modules are
+//! concatenated in dependency order; every source file is embedded at compile time.
+
+/// The shared records (`FrameUniforms`, `Sphere`, ...), twins of [`super::layout`].
+pub const TYPES_WGSL: &str = include_str!("../../shaders/types.wgsl");
+/// The exact sRGB curve, twin of [`crate::color::srgb_encode`].
+pub const COLOR_WGSL: &str = include_str!("../../shaders/color.wgsl");
+/// The display pass (`encode_display`).
+pub const DISPLAY_WGSL: &str = include_str!("../../shaders/display.wgsl");
+/// Camera rays and the sample pattern, twin of [`crate::camera`].
+pub const SAMPLING_WGSL: &str = include_str!("../../shaders/sampling.wgsl");
+/// Ray/shape intersection.
+pub const INTERSECT_WGSL: &str = include_str!("../../shaders/intersect.wgsl");
+/// Materials.
+pub const BXDF_WGSL: &str = include_str!("../../shaders/bxdf.wgsl");
+/// The tracing kernel (`trace_pixels`).
+pub const TRACE_WGSL: &str = include_str!("../../shaders/trace.wgsl");
+
+/// Entry point of the trace module.
+pub const TRACE_ENTRY_POINT: &str = "trace_pixels";
+/// Entry point of the display module.
+pub const DISPLAY_ENTRY_POINT: &str = "encode_display";
+/// Workgroup size (x and y) of both compute entry points, `@workgroup_size(8, 8, 1)`.
+pub const WORKGROUP_SIZE: u32 = 8;
+
+/// The complete trace module for a bounce stack of `stack_size` entries: the
+/// `STACK_SIZE` constant, then types, sampling, intersect, bxdf and trace.
+///
+/// The stack size is a `const` rather than a pipeline-overridable constant because
+/// WGSL array sizes in function address space must be creation-time constants; each
+/// stack size therefore gets its own pipeline (cached by the renderer).
+///
+/// ```
+/// let src = gpu_render::gpu::shaders::trace_shader_source(9);
+/// assert!(src.starts_with("const STACK_SIZE: u32 = 9u;\n"));
+/// ```
+pub fn trace_shader_source(stack_size: u32) -> String {
+    let parts = [
+        TYPES_WGSL,
+        SAMPLING_WGSL,
+        INTERSECT_WGSL,
+        BXDF_WGSL,
+        TRACE_WGSL,
+    ];
+    let mut source = format!("const STACK_SIZE: u32 = {stack_size}u;\n");
+    for part in parts {
+        source.push_str(part);
+        // A missing final newline in one file must not glue a comment to the next.
+        if !part.ends_with('\n') {
+            source.push('\n');
+        }
+    }
+    source
+}
+
+/// The complete display module: types, colour and display.
+///
+/// ```
+/// let src = gpu_render::gpu::shaders::display_shader_source();
+/// assert!(src.contains("fn encode_display"));
+/// ```
+pub fn display_shader_source() -> String {
+    let mut source = String::new();
+    for part in [TYPES_WGSL, COLOR_WGSL, DISPLAY_WGSL] {
+        source.push_str(part);
+        if !part.ends_with('\n') {
+            source.push('\n');
+        }
+    }
+    source
+}

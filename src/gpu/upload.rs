@@ -1,0 +1,449 @@
+//! Pure conversion of a validated [`Scene`] into the records the shaders read.
+//!
+//! Nothing here touches wgpu, so it is unit-tested on any machine. Call it with the
+//! scene as the tracers shade it ([`Scene::in_lighting_space`]); the renderer does.
+
+use glam::DVec3;
+
+use super::layout::{
+    FrameUniforms, GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle,
+    LIGHT_DIRECTIONAL, LIGHT_POINT, MATERIAL_BLINN_PHONG, MATERIAL_DIELECTRIC, MATERIAL_EMISSIVE,
+    MATERIAL_LAMBERT, MATERIAL_MIRROR,
+};
+use crate::camera::CameraFrame;
+use crate::scene::{Light, Material, MaterialKind, Scene, Shape};
+
+/// Every record list of a scene, ready for upload. The lists hold exactly the scene's
+/// items (possibly none); [`SceneRecords::padded`] adds the padding record WGSL needs.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SceneRecords {
+    /// Spheres, in scene order.
+    pub spheres: Vec<GpuSphere>,
+    /// Planes, in scene order.
+    pub planes: Vec<GpuPlane>,
+    /// Polygons, in scene order; their vertices are in `polygon_vertices`.
+    pub polygons: Vec<GpuPolygon>,
+    /// The vertices of all polygons, concatenated, as `vec4` with `w = 0`.
+    pub polygon_vertices: Vec<[f32; 4]>,
+    /// Triangles, in scene order.
+    pub triangles: Vec<GpuTriangle>,
+    /// Materials, indexed by the shapes' `material`.
+    pub materials: Vec<GpuMaterial>,
+    /// Lights, in scene order.
+    pub lights: Vec<GpuLight>,
+}
+
+impl SceneRecords {
+    /// Converts every shape, material and light of `scene` (already in lighting space).
+    pub fn from_scene(scene: &Scene) -> Self {
+        let mut records = Self::default();
+        for shape in &scene.shapes {
+            match shape {
+                Shape::Sphere {
+                    center,
+                    radius,
+                    material,
+                } => records.spheres.push(GpuSphere {
+                    center: vec3(*center),
+                    radius: *radius as f32,
+                    material: *material,
+                    _pad: [0; 3],
+                }),
+                Shape::Plane {
+                    normal,
+                    offset,
+                    material,
+                } => records.planes.push(GpuPlane {
+                    normal: vec3(*normal),
+                    offset: *offset as f32,
+                    material: *material,
+                    _pad: [0; 3],
+                }),
+                Shape::Polygon { vertices, material } => {
+                    let first_vertex = records.polygon_vertices.len();
+                    records.polygon_vertices.extend(
+                        vertices
+                            .iter()
+                            .map(|v| [v.x as f32, v.y as f32, v.z as f32, 0.0]),
+                    );
+                    records
+                        .polygons
+                        .push(polygon_record(vertices, first_vertex, *material));
+                }
+                Shape::Triangle { vertices, material } => records.triangles.push(GpuTriangle {
+                    v0: vec3(vertices[0]),
+                    material: *material,
+                    v1: vec3(vertices[1]),
+                    _pad1: 0,
+                    v2: vec3(vertices[2]),
+                    _pad2: 0,
+                }),
+            }
+        }
+        records.materials = scene.materials.iter().map(material_record).collect();
+        records.lights = scene.lights.iter().map(light_record).collect();
+        records
+    }
+
+    /// The same lists with one zeroed record in place of each empty list: WGSL has no
+    /// zero-sized storage buffers, and the real counts travel in [`FrameUniforms`].
+    pub fn padded(&self) -> Self {
+        Self {
+            spheres: pad(&self.spheres),
+            planes: pad(&self.planes),
+            polygons: pad(&self.polygons),
+            polygon_vertices: pad(&self.polygon_vertices),
+            triangles: pad(&self.triangles),
+            materials: pad(&self.materials),
+            lights: pad(&self.lights),
+        }
+    }
+}
+
+/// `items`, or a single zeroed record if it is empty.
+pub fn pad<T: bytemuck::Zeroable + Clone>(items: &[T]) -> Vec<T> {
+    if items.is_empty() {
+        vec![T::zeroed()]
+    } else {
+        items.to_vec()
+    }
+}
+
+fn vec3(v: DVec3) -> [f32; 3] {
+    [v.x as f32, v.y as f32, v.z as f32]
+}
+
+/// The unnormalised polygon normal by Newell's method (sum over edges of
+/// `(y_i - y_j)(z_i + z_j)`, ...): robust for concave and slightly non-planar polygons
+/// and independent of which three vertices one would otherwise pick.
+pub fn newell_normal(vertices: &[DVec3]) -> DVec3 {
+    let mut normal = DVec3::ZERO;
+    for (i, current) in vertices.iter().enumerate() {
+        let next = vertices[(i + 1) % vertices.len()];
+        normal.x += (current.y - next.y) * (current.z + next.z);
+        normal.y += (current.z - next.z) * (current.x + next.x);
+        normal.z += (current.x - next.x) * (current.y + next.y);
+    }
+    normal
+}
+
+/// The axis (0 = x, 1 = y, 2 = z) of the largest `|normal|` component: dropping it
+/// projects the polygon onto the coordinate plane where its area is largest, so the
+/// 2D inside test is best conditioned. Ties go to the lower axis.
+pub fn dropped_axis(normal: DVec3) -> u32 {
+    let a = normal.abs();
+    if a.x >= a.y && a.x >= a.z {
+        0
+    } else if a.y >= a.z {
+        1
+    } else {
+        2
+    }
+}
+
+/// The record of one polygon whose vertices start at `first_vertex` in the vertex list.
+/// The plane offset is taken at the vertex centroid, which averages out rounding in
+/// the vertices. A degenerate (zero-area) polygon gets a zero normal, which no ray
+/// can hit; scene validation rejects those anyway.
+pub fn polygon_record(vertices: &[DVec3], first_vertex: usize, material: u32) -> GpuPolygon {
+    let normal = newell_normal(vertices).normalize_or_zero();
+    let centroid = vertices.iter().copied().sum::<DVec3>() / vertices.len().max(1) as f64;
+    GpuPolygon {
+        normal: vec3(normal),
+        offset: normal.dot(centroid) as f32,
+        first_vertex: u32::try_from(first_vertex).unwrap_or(u32::MAX),
+        vertex_count: u32::try_from(vertices.len()).unwrap_or(u32::MAX),
+        dropped_axis: dropped_axis(normal),
+        material,
+    }
+}
+
+/// The `MATERIAL_*` constant of a material kind.
+pub fn material_kind_code(kind: MaterialKind) -> u32 {
+    match kind {
+        MaterialKind::Lambert => MATERIAL_LAMBERT,
+        MaterialKind::BlinnPhong => MATERIAL_BLINN_PHONG,
+        MaterialKind::Mirror => MATERIAL_MIRROR,
+        MaterialKind::Dielectric => MATERIAL_DIELECTRIC,
+        MaterialKind::Emissive => MATERIAL_EMISSIVE,
+    }
+}
+
+/// The record of one material.
+pub fn material_record(material: &Material) -> GpuMaterial {
+    GpuMaterial {
+        diffuse: vec3(material.diffuse),
+        shininess: material.shininess as f32,
+        specular: vec3(material.specular),
+        ior: material.ior as f32,
+        reflectance: vec3(material.reflectance),
+        kind: material_kind_code(material.kind),
+        transmittance: vec3(material.transmittance),
+        coat_ior: material.coat_ior as f32,
+        emission: vec3(material.emission),
+        _pad: 0.0,
+    }
+}
+
+/// The record of one light.
+pub fn light_record(light: &Light) -> GpuLight {
+    let (position_or_direction, kind, power) = match light {
+        Light::Point {
+            position,
+            intensity,
+        } => (*position, LIGHT_POINT, *intensity),
+        Light::Directional {
+            direction,
+            irradiance,
+        } => (*direction, LIGHT_DIRECTIONAL, *irradiance),
+    };
+    GpuLight {
+        position_or_direction: vec3(position_or_direction),
+        kind,
+        power: vec3(power),
+        _pad: 0,
+    }
+}
+
+/// The frame constants for `scene` (in lighting space) and its `records`, covering the
+/// whole image (`row_offset` 0, `row_count` = height); chunked dispatches override the
+/// two row fields.
+pub fn frame_uniforms(scene: &Scene, records: &SceneRecords) -> FrameUniforms {
+    let settings = &scene.render;
+    let camera = CameraFrame::new(&scene.camera, settings.width, settings.height);
+    let count = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+    FrameUniforms {
+        eye: vec3(camera.eye),
+        tan_half_fov_y: camera.tan_half_fov_y as f32,
+        forward: vec3(camera.forward),
+        aspect: camera.aspect as f32,
+        right: vec3(camera.right),
+        width: settings.width,
+        up: vec3(camera.up),
+        height: settings.height,
+        background: vec3(scene.environment.background),
+        samples_per_pixel: settings.samples_per_pixel,
+        ambient: vec3(scene.environment.ambient),
+        max_depth: settings.max_depth,
+        sphere_count: count(records.spheres.len()),
+        plane_count: count(records.planes.len()),
+        polygon_count: count(records.polygons.len()),
+        triangle_count: count(records.triangles.len()),
+        light_count: count(records.lights.len()),
+        row_offset: 0,
+        row_count: settings.height,
+        _pad: 0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use bytemuck::Zeroable;
+
+    use super::*;
+    use crate::scene::{Camera, Environment, LightingSpace, RenderSettings};
+
+    fn scene(shapes: Vec<Shape>, lights: Vec<Light>) -> Scene {
+        Scene {
+            render: RenderSettings {
+                width: 40,
+                height: 20,
+                samples_per_pixel: 4,
+                max_depth: 3,
+                stack_size: 4,
+                lighting_space: LightingSpace::Linear,
+            },
+            camera: Camera {
+                eye: DVec3::new(0.0, 0.0, 5.0),
+                look_at: DVec3::ZERO,
+                up: DVec3::Y,
+                fov_y_degrees: 60.0,
+            },
+            environment: Environment {
+                background: DVec3::new(0.1, 0.2, 0.3),
+                ambient: DVec3::ZERO,
+            },
+            materials: vec![Material::lambert(DVec3::splat(0.5))],
+            material_names: vec!["grey".into()],
+            lights,
+            shapes,
+        }
+    }
+
+    #[test]
+    fn polygon_in_xz_plane_drops_y() {
+        // Counter-clockwise seen from +y: normal +y.
+        let square = vec![
+            DVec3::new(0.0, 2.0, 0.0),
+            DVec3::new(0.0, 2.0, 1.0),
+            DVec3::new(1.0, 2.0, 1.0),
+            DVec3::new(1.0, 2.0, 0.0),
+        ];
+        let rec = polygon_record(&square, 7, 3);
+        assert_eq!(rec.normal, [0.0, 1.0, 0.0]);
+        assert_eq!(rec.offset, 2.0);
+        assert_eq!(rec.dropped_axis, 1);
+        assert_eq!(
+            (rec.first_vertex, rec.vertex_count, rec.material),
+            (7, 4, 3)
+        );
+    }
+
+    #[test]
+    fn concave_polygon_normal_and_axis() {
+        // An L shape in a tilted plane mostly facing +x (x = 0.1 z + 1).
+        let pts = [
+            (0.0, 0.0),
+            (2.0, 0.0),
+            (2.0, 1.0),
+            (1.0, 1.0),
+            (1.0, 2.0),
+            (0.0, 2.0),
+        ];
+        let l: Vec<DVec3> = pts
+            .iter()
+            .map(|&(y, z)| DVec3::new(0.1 * z + 1.0, y, z))
+            .collect();
+        let rec = polygon_record(&l, 0, 0);
+        let n = DVec3::new(
+            f64::from(rec.normal[0]),
+            f64::from(rec.normal[1]),
+            f64::from(rec.normal[2]),
+        );
+        let expected = DVec3::new(1.0, 0.0, -0.1).normalize();
+        assert!((n - expected).length() < 1e-6, "{n}");
+        assert_eq!(rec.dropped_axis, 0);
+        for v in &l {
+            assert!((n.dot(*v) - f64::from(rec.offset)).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn dropped_axis_picks_largest_component() {
+        assert_eq!(dropped_axis(DVec3::new(0.1, -0.9, 0.3)), 1);
+        assert_eq!(dropped_axis(DVec3::new(0.1, 0.2, -0.97)), 2);
+        assert_eq!(dropped_axis(DVec3::new(-1.0, 0.0, 0.0)), 0);
+        assert_eq!(dropped_axis(DVec3::ZERO), 0);
+    }
+
+    #[test]
+    fn empty_lists_get_one_padding_record_and_counts_stay_zero() {
+        let s = scene(vec![], vec![]);
+        let records = SceneRecords::from_scene(&s);
+        assert!(records.spheres.is_empty() && records.lights.is_empty());
+        let padded = records.padded();
+        assert_eq!(padded.spheres, vec![GpuSphere::zeroed()]);
+        assert_eq!(padded.planes.len(), 1);
+        assert_eq!(padded.polygons.len(), 1);
+        assert_eq!(padded.polygon_vertices, vec![[0.0; 4]]);
+        assert_eq!(padded.triangles.len(), 1);
+        assert_eq!(padded.lights.len(), 1);
+        assert_eq!(padded.materials.len(), 1, "the scene's one material");
+        let frame = frame_uniforms(&s, &records);
+        assert_eq!(
+            (
+                frame.sphere_count,
+                frame.plane_count,
+                frame.polygon_count,
+                frame.triangle_count,
+                frame.light_count
+            ),
+            (0, 0, 0, 0, 0)
+        );
+    }
+
+    #[test]
+    fn shapes_lights_and_frame_are_converted() {
+        let tri = [DVec3::X, DVec3::Y, DVec3::Z];
+        let square = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+        ];
+        let s = scene(
+            vec![
+                Shape::Sphere {
+                    center: DVec3::new(1.0, 2.0, 3.0),
+                    radius: 0.5,
+                    material: 0,
+                },
+                Shape::Polygon {
+                    vertices: square.clone(),
+                    material: 0,
+                },
+                Shape::Triangle {
+                    vertices: tri,
+                    material: 0,
+                },
+                Shape::Polygon {
+                    vertices: square[..3].to_vec(),
+                    material: 0,
+                },
+                Shape::Plane {
+                    normal: DVec3::Y,
+                    offset: -1.0,
+                    material: 0,
+                },
+            ],
+            vec![
+                Light::Point {
+                    position: DVec3::new(0.0, 5.0, 0.0),
+                    intensity: DVec3::splat(10.0),
+                },
+                Light::Directional {
+                    direction: DVec3::NEG_Y,
+                    irradiance: DVec3::ONE,
+                },
+            ],
+        );
+        let r = SceneRecords::from_scene(&s);
+        assert_eq!(r.spheres[0].center, [1.0, 2.0, 3.0]);
+        assert_eq!(r.spheres[0].radius, 0.5);
+        assert_eq!(r.planes[0].offset, -1.0);
+        assert_eq!(r.polygons.len(), 2);
+        assert_eq!(
+            (r.polygons[1].first_vertex, r.polygons[1].vertex_count),
+            (4, 3)
+        );
+        assert_eq!(r.polygon_vertices.len(), 7);
+        assert_eq!(r.polygon_vertices[5], [1.0, 0.0, 0.0, 0.0]);
+        assert_eq!(r.polygons[0].dropped_axis, 2);
+        assert_eq!(r.triangles[0].v2, [0.0, 0.0, 1.0]);
+        assert_eq!(r.lights[0].kind, LIGHT_POINT);
+        assert_eq!(r.lights[1].kind, LIGHT_DIRECTIONAL);
+        assert_eq!(r.lights[1].position_or_direction, [0.0, -1.0, 0.0]);
+        assert_eq!(r.materials[0].kind, MATERIAL_LAMBERT);
+        let f = frame_uniforms(&s, &r);
+        assert_eq!(
+            (f.width, f.height, f.samples_per_pixel, f.max_depth),
+            (40, 20, 4, 3)
+        );
+        assert_eq!((f.sphere_count, f.plane_count, f.polygon_count), (1, 1, 2));
+        assert_eq!((f.triangle_count, f.light_count), (1, 2));
+        assert_eq!((f.row_offset, f.row_count), (0, 20));
+        assert_eq!(f.aspect, 2.0);
+        assert_eq!(f.forward, [0.0, 0.0, -1.0]);
+        assert_eq!(f.background, [0.1, 0.2, 0.3]);
+    }
+
+    #[test]
+    fn material_kinds_map_to_constants() {
+        for (kind, code) in [
+            (MaterialKind::Lambert, MATERIAL_LAMBERT),
+            (MaterialKind::BlinnPhong, MATERIAL_BLINN_PHONG),
+            (MaterialKind::Mirror, MATERIAL_MIRROR),
+            (MaterialKind::Dielectric, MATERIAL_DIELECTRIC),
+            (MaterialKind::Emissive, MATERIAL_EMISSIVE),
+        ] {
+            let mut m = Material::blank(kind);
+            m.ior = 1.5;
+            m.emission = DVec3::new(1.0, 2.0, 3.0);
+            let rec = material_record(&m);
+            assert_eq!(rec.kind, code);
+            assert_eq!(rec.ior, 1.5);
+            assert_eq!(rec.emission, [1.0, 2.0, 3.0]);
+            assert_eq!(rec.transmittance, [1.0; 3]);
+        }
+    }
+}

@@ -1,0 +1,242 @@
+//! End-to-end plumbing of the GPU backend, independent of what the trace shader
+//! computes: chunked dispatch, readback of a width whose rows need padding, the ray
+//! counters, the low-level API and its error paths.
+
+mod common;
+
+use std::sync::Mutex;
+use std::time::Duration;
+
+use glam::DVec3;
+use gpu_render::gpu::renderer::{MAX_CHUNK_SAMPLES, row_chunks};
+use gpu_render::gpu::{GpuError, read_texture};
+use gpu_render::scene::{
+    Camera, Environment, Light, LightingSpace, Material, RenderSettings, Scene, Shape,
+};
+
+// 37 columns: 37 * 16 and 37 * 4 bytes are not multiples of 256, so both readbacks
+// strip row padding. 37 * 61 * 1024 samples are more than one chunk.
+const WIDTH: u32 = 37;
+const HEIGHT: u32 = 61;
+const SPP: u32 = 1024;
+
+fn scene(samples_per_pixel: u32) -> Scene {
+    Scene {
+        render: RenderSettings {
+            width: WIDTH,
+            height: HEIGHT,
+            samples_per_pixel,
+            max_depth: 2,
+            stack_size: 3,
+            lighting_space: LightingSpace::Linear,
+        },
+        camera: Camera {
+            eye: DVec3::new(0.0, 1.0, 4.0),
+            look_at: DVec3::new(0.0, 0.5, 0.0),
+            up: DVec3::Y,
+            fov_y_degrees: 50.0,
+        },
+        environment: Environment {
+            background: DVec3::new(0.2, 0.3, 0.5),
+            ambient: DVec3::ZERO,
+        },
+        materials: vec![Material::lambert(DVec3::splat(0.6))],
+        material_names: vec!["grey".into()],
+        lights: vec![Light::Point {
+            position: DVec3::new(2.0, 4.0, 3.0),
+            intensity: DVec3::splat(20.0),
+        }],
+        shapes: vec![
+            Shape::Sphere {
+                center: DVec3::new(0.0, 0.5, 0.0),
+                radius: 0.5,
+                material: 0,
+            },
+            Shape::Plane {
+                normal: DVec3::Y,
+                offset: 0.0,
+                material: 0,
+            },
+        ],
+    }
+}
+
+#[test]
+fn render_chunks_reads_back_and_counts_rays() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let renderer = common::gpu::renderer(&gpu);
+    let scene = scene(SPP);
+    let chunks = row_chunks(WIDTH, HEIGHT, SPP);
+    assert!(chunks.len() > 1, "the scene must need several chunks");
+    assert!(u64::from(WIDTH * HEIGHT * SPP) > MAX_CHUNK_SAMPLES);
+
+    let reported = Mutex::new(Vec::new());
+    let progress = |done: u32, total: u32| reported.lock().unwrap().push((done, total));
+    let out = renderer
+        .render(&gpu.device, &gpu.queue, &scene, Some(&progress))
+        .expect("render succeeds");
+
+    let reported = reported.into_inner().unwrap();
+    let expected: Vec<(u32, u32)> = chunks.iter().map(|c| (c.end, HEIGHT)).collect();
+    assert_eq!(reported, expected, "one progress call per chunk");
+
+    assert_eq!((out.image.width, out.image.height), (WIDTH, HEIGHT));
+    assert_eq!(out.image.pixels.len(), (WIDTH * HEIGHT) as usize);
+    for (i, p) in out.image.pixels.iter().enumerate() {
+        assert!(p.iter().all(|c| c.is_finite()), "pixel {i} = {p:?}");
+        assert_eq!(p[3], 1.0, "alpha of pixel {i}");
+    }
+    // The display image is the CPU encoding of the linear one, up to f32 rounding.
+    let cpu_display = out.image.to_display_rgba8(true);
+    assert_eq!(out.display_rgba8.len(), cpu_display.len());
+    for (g, c) in out.display_rgba8.iter().zip(&cpu_display) {
+        assert!(g.abs_diff(*c) <= 1);
+    }
+    let primary = u64::from(WIDTH) * u64::from(HEIGHT) * u64::from(SPP);
+    assert!(
+        out.stats.rays_traced >= primary,
+        "{} rays traced, at least {primary} primary rays expected",
+        out.stats.rays_traced
+    );
+    assert!(out.stats.elapsed > Duration::ZERO);
+    eprintln!(
+        "{}x{} at {SPP} spp in {} chunks: {} rays in {:?} ({:.1} Mrays/s)",
+        WIDTH,
+        HEIGHT,
+        chunks.len(),
+        out.stats.rays_traced,
+        out.stats.elapsed,
+        out.stats.rays_per_second() / 1e6
+    );
+}
+
+fn linear_target(device: &wgpu::Device) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("smoke linear"),
+        size: wgpu::Extent3d {
+            width: WIDTH,
+            height: HEIGHT,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba32Float,
+        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+#[test]
+fn chunks_recorded_into_one_encoder_match_render_to_texture() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let renderer = common::gpu::renderer(&gpu);
+    let scene = scene(4);
+
+    // Reference: the high-level call into a caller-owned texture.
+    let reference = linear_target(device);
+    let stats = renderer
+        .render_to_texture(
+            device,
+            queue,
+            &scene,
+            &reference.create_view(&Default::default()),
+            None,
+        )
+        .expect("render_to_texture succeeds");
+    let reference = read_texture(device, queue, &reference, 16, Duration::from_secs(60))
+        .expect("reference reads back");
+
+    // Low level: three uneven chunks in a single encoder and submission; each chunk
+    // must get its own row offset.
+    let prepared = renderer.prepare(device, queue, &scene).expect("prepare");
+    let target = linear_target(device);
+    let view = target.create_view(&Default::default());
+    let mut encoder = device.create_command_encoder(&Default::default());
+    for rows in [0..5, 5..40, 40..HEIGHT] {
+        renderer
+            .encode_trace(device, &mut encoder, &prepared, &view, rows)
+            .expect("encode_trace");
+    }
+    queue.submit([encoder.finish()]);
+    let chunked = read_texture(device, queue, &target, 16, Duration::from_secs(60))
+        .expect("chunked image reads back");
+    assert_eq!(chunked, reference, "chunking must not change the image");
+    let rays = renderer
+        .read_ray_count(device, queue, &prepared)
+        .expect("ray count");
+    assert_eq!(rays, stats.rays_traced, "same rays either way");
+
+    // Clearing the counters resets them.
+    let mut encoder = device.create_command_encoder(&Default::default());
+    renderer.encode_clear_ray_counts(&mut encoder, &prepared);
+    queue.submit([encoder.finish()]);
+    assert_eq!(
+        renderer.read_ray_count(device, queue, &prepared).unwrap(),
+        0
+    );
+}
+
+#[test]
+fn bad_input_is_an_error_not_a_panic() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let renderer = common::gpu::renderer(&gpu);
+
+    let mut bad = scene(1);
+    bad.render.stack_size = 0;
+    assert!(matches!(
+        renderer.prepare(device, queue, &bad),
+        Err(GpuError::Validation(_))
+    ));
+
+    let too_wide = device.limits().max_texture_dimension_2d.checked_add(1);
+    if let Some(width) = too_wide.filter(|&w| w <= gpu_render::scene::MAX_IMAGE_DIMENSION) {
+        let mut wide = scene(1);
+        wide.render.width = width;
+        match renderer.prepare(device, queue, &wide) {
+            Err(GpuError::DeviceLimit { value, limit, .. }) => {
+                assert_eq!((value, limit), (u64::from(width), u64::from(width - 1)));
+            }
+            other => panic!("expected DeviceLimit, got {other:?}"),
+        }
+    }
+
+    let prepared = renderer.prepare(device, queue, &scene(1)).expect("prepare");
+    let target = linear_target(device);
+    let view = target.create_view(&Default::default());
+    let mut encoder = device.create_command_encoder(&Default::default());
+    assert!(matches!(
+        renderer.encode_trace(device, &mut encoder, &prepared, &view, 0..HEIGHT + 1),
+        Err(GpuError::Validation(_))
+    ));
+    let wrong_format = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("wrong format"),
+        size: wgpu::Extent3d {
+            width: WIDTH,
+            height: HEIGHT,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba8Unorm,
+        usage: wgpu::TextureUsages::STORAGE_BINDING,
+        view_formats: &[],
+    });
+    let result = renderer.encode_trace(
+        device,
+        &mut encoder,
+        &prepared,
+        &wrong_format.create_view(&Default::default()),
+        0..HEIGHT,
+    );
+    assert!(matches!(result, Err(GpuError::Validation(_))), "{result:?}");
+}

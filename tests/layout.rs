@@ -1,0 +1,243 @@
+//! The WGSL records in `shaders/types.wgsl` and their `#[repr(C)]` twins in
+//! `src/gpu/layout.rs` must agree byte for byte; naga's layouter computes the WGSL
+//! side. Also checks that the composed shaders parse and validate.
+
+use std::collections::BTreeMap;
+use std::mem::{offset_of, size_of};
+
+use gpu_render::gpu::layout::*;
+use gpu_render::gpu::shaders::{TYPES_WGSL, display_shader_source, trace_shader_source};
+
+/// Rust twin of one WGSL struct: size and (member name, offset) pairs.
+type Twin = (usize, Vec<(&'static str, usize)>);
+
+macro_rules! twin {
+    ($ty:ty { $($field:ident),* $(,)? }) => {
+        (size_of::<$ty>(), vec![$((stringify!($field), offset_of!($ty, $field))),*])
+    };
+}
+
+fn rust_twins() -> BTreeMap<&'static str, Twin> {
+    BTreeMap::from([
+        (
+            "FrameUniforms",
+            twin!(FrameUniforms {
+                eye,
+                tan_half_fov_y,
+                forward,
+                aspect,
+                right,
+                width,
+                up,
+                height,
+                background,
+                samples_per_pixel,
+                ambient,
+                max_depth,
+                sphere_count,
+                plane_count,
+                polygon_count,
+                triangle_count,
+                light_count,
+                row_offset,
+                row_count,
+                _pad,
+            }),
+        ),
+        (
+            "Sphere",
+            twin!(GpuSphere {
+                center,
+                radius,
+                material,
+                _pad
+            }),
+        ),
+        (
+            "Plane",
+            twin!(GpuPlane {
+                normal,
+                offset,
+                material,
+                _pad
+            }),
+        ),
+        (
+            "Polygon",
+            twin!(GpuPolygon {
+                normal,
+                offset,
+                first_vertex,
+                vertex_count,
+                dropped_axis,
+                material
+            }),
+        ),
+        (
+            "Triangle",
+            twin!(GpuTriangle {
+                v0,
+                material,
+                v1,
+                _pad1,
+                v2,
+                _pad2
+            }),
+        ),
+        (
+            "Material",
+            twin!(GpuMaterial {
+                diffuse,
+                shininess,
+                specular,
+                ior,
+                reflectance,
+                kind,
+                transmittance,
+                coat_ior,
+                emission,
+                _pad,
+            }),
+        ),
+        (
+            "Light",
+            twin!(GpuLight {
+                position_or_direction,
+                kind,
+                power,
+                _pad
+            }),
+        ),
+        (
+            "DisplayUniforms",
+            twin!(DisplayUniforms { encode_srgb, _pad }),
+        ),
+    ])
+}
+
+#[test]
+fn wgsl_structs_match_rust_twins() {
+    let module = naga::front::wgsl::parse_str(TYPES_WGSL).expect("types.wgsl parses");
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).expect("layouts compute");
+    let twins = rust_twins();
+    let mut seen = Vec::new();
+    // Collect every mismatch before failing, so one run shows the whole picture.
+    let mut mismatches = Vec::new();
+    for (handle, ty) in module.types.iter() {
+        let naga::TypeInner::Struct { members, span } = &ty.inner else {
+            continue;
+        };
+        let name = ty.name.as_deref().unwrap_or("<unnamed>");
+        seen.push(name.to_string());
+        let Some((rust_size, rust_fields)) = twins.get(name) else {
+            mismatches.push(format!("WGSL struct {name} has no Rust twin in this test"));
+            continue;
+        };
+        let wgsl_size = layouter[handle].size as usize;
+        if wgsl_size != *rust_size || *span as usize != *rust_size {
+            mismatches.push(format!(
+                "{name}: WGSL size {wgsl_size} (span {span}), Rust size {rust_size}"
+            ));
+        }
+        // Padding members (named `_...`) may be spelled differently on the two sides
+        // (`_pad: [u32; 3]` in Rust, three scalars in WGSL): only the offsets of the
+        // meaningful members and the total size must agree.
+        let wgsl_fields: Vec<(String, usize)> = members
+            .iter()
+            .map(|m| (m.name.clone().unwrap_or_default(), m.offset as usize))
+            .filter(|(n, _)| !n.starts_with('_'))
+            .collect();
+        let rust_fields: Vec<(String, usize)> = rust_fields
+            .iter()
+            .filter(|(n, _)| !n.starts_with('_'))
+            .map(|(n, o)| (n.to_string(), *o))
+            .collect();
+        if wgsl_fields != rust_fields {
+            mismatches.push(format!(
+                "{name}: WGSL members {wgsl_fields:?}, Rust fields {rust_fields:?}"
+            ));
+        }
+    }
+    seen.sort();
+    let expected: Vec<String> = twins.keys().map(|k| k.to_string()).collect();
+    for missing in expected.iter().filter(|e| !seen.contains(e)) {
+        mismatches.push(format!("Rust twin {missing} has no WGSL struct"));
+    }
+    assert!(
+        mismatches.is_empty(),
+        "WGSL/Rust layout mismatches:\n  {}",
+        mismatches.join("\n  ")
+    );
+}
+
+#[test]
+fn constants_match() {
+    let module = naga::front::wgsl::parse_str(TYPES_WGSL).expect("types.wgsl parses");
+    let rust = BTreeMap::from([
+        ("MATERIAL_LAMBERT", MATERIAL_LAMBERT),
+        ("MATERIAL_BLINN_PHONG", MATERIAL_BLINN_PHONG),
+        ("MATERIAL_MIRROR", MATERIAL_MIRROR),
+        ("MATERIAL_DIELECTRIC", MATERIAL_DIELECTRIC),
+        ("MATERIAL_EMISSIVE", MATERIAL_EMISSIVE),
+        ("LIGHT_POINT", LIGHT_POINT),
+        ("LIGHT_DIRECTIONAL", LIGHT_DIRECTIONAL),
+    ]);
+    let mut found = 0;
+    for (_, constant) in module.constants.iter() {
+        let Some(name) = constant.name.as_deref() else {
+            continue;
+        };
+        let Some(&value) = rust.get(name) else {
+            continue;
+        };
+        let expr = &module.global_expressions[constant.init];
+        assert_eq!(
+            *expr,
+            naga::Expression::Literal(naga::Literal::U32(value)),
+            "{name}"
+        );
+        found += 1;
+    }
+    assert_eq!(found, rust.len());
+}
+
+fn validate(name: &str, source: &str) {
+    let module = naga::front::wgsl::parse_str(source)
+        .unwrap_or_else(|e| panic!("{name} does not parse:\n{}", e.emit_to_string(source)));
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::default(),
+    )
+    .validate(&module)
+    .unwrap_or_else(|e| panic!("{name} does not validate:\n{}", e.emit_to_string(source)));
+}
+
+#[test]
+fn composed_trace_shader_validates() {
+    for stack_size in [1, 9] {
+        let source = trace_shader_source(stack_size);
+        validate(&format!("trace shader (stack size {stack_size})"), &source);
+        let module = naga::front::wgsl::parse_str(&source).expect("parsed above");
+        let entry = module
+            .entry_points
+            .iter()
+            .find(|e| e.name == "trace_pixels")
+            .expect("entry point trace_pixels");
+        assert_eq!(entry.stage, naga::ShaderStage::Compute);
+        assert_eq!(entry.workgroup_size, [8, 8, 1]);
+    }
+}
+
+#[test]
+fn composed_display_shader_validates() {
+    let source = display_shader_source();
+    validate("display shader", &source);
+    let module = naga::front::wgsl::parse_str(&source).expect("parsed above");
+    let entry = module
+        .entry_points
+        .iter()
+        .find(|e| e.name == "encode_display")
+        .expect("entry point encode_display");
+    assert_eq!(entry.workgroup_size, [8, 8, 1]);
+}
