@@ -29,7 +29,8 @@ struct Sphere {
     center: vec3<f32>,
     radius: f32,
     material: u32,
-    _pad: vec3<u32>,
+    // Not vec3<u32>: that is 16-byte aligned and would grow the struct to 48 bytes.
+    _pad: array<u32, 3>,
 }
 
 // The plane normal · p = offset.
@@ -37,7 +38,8 @@ struct Plane {
     normal: vec3<f32>,
     offset: f32,
     material: u32,
-    _pad: vec3<u32>,
+    // Not vec3<u32>: that is 16-byte aligned and would grow the struct to 48 bytes.
+    _pad: array<u32, 3>,
 }
 
 struct Polygon {
@@ -89,5 +91,9 @@ struct Light {
 
 struct DisplayUniforms {
     encode_srgb: u32,
-    _pad: vec3<u32>,
+    // Three scalars, not vec3<u32> (16-byte aligned, 32-byte struct) nor array<u32, 3>
+    // (invalid in the uniform address space, which needs a 16-byte array stride).
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
