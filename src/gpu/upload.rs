@@ -11,7 +11,7 @@ use super::layout::{
     MATERIAL_LAMBERT, MATERIAL_MIRROR,
 };
 use crate::camera::CameraFrame;
-use crate::scene::{Light, Material, MaterialKind, Scene, Shape};
+use crate::scene::{Light, Material, MaterialKind, PolygonPlane, Scene, Shape, polygon_plane};
 
 /// Every record list of a scene, ready for upload. The lists hold exactly the scene's
 /// items (possibly none); [`SceneRecords::padded`] adds the padding record WGSL needs.
@@ -113,47 +113,22 @@ fn vec3(v: DVec3) -> [f32; 3] {
     [v.x as f32, v.y as f32, v.z as f32]
 }
 
-/// The unnormalised polygon normal by Newell's method (sum over edges of
-/// `(y_i - y_j)(z_i + z_j)`, ...): robust for concave and slightly non-planar polygons
-/// and independent of which three vertices one would otherwise pick.
-pub fn newell_normal(vertices: &[DVec3]) -> DVec3 {
-    let mut normal = DVec3::ZERO;
-    for (i, current) in vertices.iter().enumerate() {
-        let next = vertices[(i + 1) % vertices.len()];
-        normal.x += (current.y - next.y) * (current.z + next.z);
-        normal.y += (current.z - next.z) * (current.x + next.x);
-        normal.z += (current.x - next.x) * (current.y + next.y);
-    }
-    normal
-}
-
-/// The axis (0 = x, 1 = y, 2 = z) of the largest `|normal|` component: dropping it
-/// projects the polygon onto the coordinate plane where its area is largest, so the
-/// 2D inside test is best conditioned. Ties go to the lower axis.
-pub fn dropped_axis(normal: DVec3) -> u32 {
-    let a = normal.abs();
-    if a.x >= a.y && a.x >= a.z {
-        0
-    } else if a.y >= a.z {
-        1
-    } else {
-        2
-    }
-}
-
 /// The record of one polygon whose vertices start at `first_vertex` in the vertex list.
-/// The plane offset is taken at the vertex centroid, which averages out rounding in
-/// the vertices. A degenerate (zero-area) polygon gets a zero normal, which no ray
-/// can hit; scene validation rejects those anyway.
+/// The plane comes from [`polygon_plane`], as on the CPU. A degenerate (zero-area)
+/// polygon gets a zero normal, which no ray can hit; scene validation rejects those
+/// anyway.
 pub fn polygon_record(vertices: &[DVec3], first_vertex: usize, material: u32) -> GpuPolygon {
-    let normal = newell_normal(vertices).normalize_or_zero();
-    let centroid = vertices.iter().copied().sum::<DVec3>() / vertices.len().max(1) as f64;
+    let plane = polygon_plane(vertices).unwrap_or(PolygonPlane {
+        normal: DVec3::ZERO,
+        offset: 0.0,
+        dropped_axis: 2,
+    });
     GpuPolygon {
-        normal: vec3(normal),
-        offset: normal.dot(centroid) as f32,
+        normal: vec3(plane.normal),
+        offset: plane.offset as f32,
         first_vertex: u32::try_from(first_vertex).unwrap_or(u32::MAX),
         vertex_count: u32::try_from(vertices.len()).unwrap_or(u32::MAX),
-        dropped_axis: dropped_axis(normal),
+        dropped_axis: plane.dropped_axis,
         material,
     }
 }
@@ -319,11 +294,21 @@ mod tests {
     }
 
     #[test]
-    fn dropped_axis_picks_largest_component() {
-        assert_eq!(dropped_axis(DVec3::new(0.1, -0.9, 0.3)), 1);
-        assert_eq!(dropped_axis(DVec3::new(0.1, 0.2, -0.97)), 2);
-        assert_eq!(dropped_axis(DVec3::new(-1.0, 0.0, 0.0)), 0);
-        assert_eq!(dropped_axis(DVec3::ZERO), 0);
+    fn polygon_record_drops_the_largest_normal_axis() {
+        let tilted = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.1, 0.0),
+            DVec3::new(1.0, 0.3, 1.0),
+            DVec3::new(0.0, 0.2, 1.0),
+        ];
+        let record = polygon_record(&tilted, 4, 2);
+        assert_eq!(record.dropped_axis, 1);
+        assert_eq!(
+            (record.first_vertex, record.vertex_count, record.material),
+            (4, 4, 2)
+        );
+        let degenerate = [DVec3::ZERO, DVec3::X, DVec3::X * 2.0];
+        assert_eq!(polygon_record(&degenerate, 0, 0).normal, [0.0; 3]);
     }
 
     #[test]
