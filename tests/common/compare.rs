@@ -18,6 +18,14 @@ pub struct Tolerance {
     pub outlier_fraction: f64,
 }
 
+impl Tolerance {
+    /// Whether one channel passes; a NaN on either side never does.
+    pub fn channel_passes(&self, expected: f32, actual: f32) -> bool {
+        let difference = (actual - expected).abs();
+        !difference.is_nan() && difference <= self.absolute + self.relative * expected.abs()
+    }
+}
+
 /// What a comparison measured.
 #[derive(Debug, Clone, Copy)]
 pub struct Comparison {
@@ -53,10 +61,7 @@ pub fn measure(expected: &LinearImage, actual: &LinearImage, tolerance: Toleranc
         let mut outlier = false;
         for c in 0..3 {
             let difference = (a[c] - e[c]).abs();
-            // A NaN on either side is always an outlier.
-            if !(difference <= tolerance.absolute + tolerance.relative * e[c].abs()) {
-                outlier = true;
-            }
+            outlier |= !tolerance.channel_passes(e[c], a[c]);
             max_abs_error = max_abs_error.max(if difference.is_nan() {
                 f32::INFINITY
             } else {
@@ -131,7 +136,7 @@ fn write_failure_images(
         for c in 0..3 {
             let difference = (a[c] - e[c]).abs();
             worst = worst.max(if difference.is_nan() { 1.0 } else { difference });
-            outlier |= !(difference <= tolerance.absolute + tolerance.relative * e[c].abs());
+            outlier |= !tolerance.channel_passes(e[c], a[c]);
         }
         let grey = (worst.sqrt().min(1.0) * 255.0) as u8;
         let pixel = if outlier {
