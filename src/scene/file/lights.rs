@@ -1,0 +1,64 @@
+//! `[[lights]]` entries.
+
+use glam::DVec3;
+use toml::Spanned;
+
+use super::check::{ColourRange, Item, Source};
+use super::raw::RawLight;
+use crate::scene::{Light, SceneError};
+
+const POINT_FIELDS: &[&str] = &["position", "intensity", "color"];
+const DIRECTIONAL_FIELDS: &[&str] = &["direction", "irradiance", "color"];
+
+/// Light `index` (0-based, in file order), checked.
+pub fn light(
+    source: &Source<'_>,
+    index: usize,
+    raw: Spanned<RawLight>,
+) -> Result<Light, SceneError> {
+    let span = raw.span();
+    let raw = raw.into_inner();
+    let untyped = source.item(format!("lights[{index}]"), Some(span.clone()));
+    let kind = untyped.require("type", raw.kind.clone())?;
+    let item = source.item(format!("lights[{index}] ({kind})"), Some(span));
+    let given = raw.given_fields();
+    match kind.as_str() {
+        "point" => {
+            item.only_fields(&kind, POINT_FIELDS, &given)?;
+            point(&item, &raw)
+        }
+        "directional" => {
+            item.only_fields(&kind, DIRECTIONAL_FIELDS, &given)?;
+            directional(&item, &raw)
+        }
+        other => Err(untyped.fail(format_args!(
+            "unknown light type `{other}` (expected one of: point, directional)"
+        ))),
+    }
+}
+
+fn point(item: &Item<'_>, raw: &RawLight) -> Result<Light, SceneError> {
+    let position = item.vector("position", item.require("position", raw.position)?)?;
+    let intensity = item.non_negative("intensity", item.require("intensity", raw.intensity)?)?;
+    Ok(Light::Point {
+        position,
+        intensity: intensity * color(item, raw)?,
+    })
+}
+
+fn directional(item: &Item<'_>, raw: &RawLight) -> Result<Light, SceneError> {
+    let direction = item.vector("direction", item.require("direction", raw.direction)?)?;
+    let Some(direction) = direction.try_normalize() else {
+        return Err(item.fail("direction is the zero vector"));
+    };
+    let irradiance =
+        item.non_negative("irradiance", item.require("irradiance", raw.irradiance)?)?;
+    Ok(Light::Directional {
+        direction,
+        irradiance: irradiance * color(item, raw)?,
+    })
+}
+
+fn color(item: &Item<'_>, raw: &RawLight) -> Result<DVec3, SceneError> {
+    item.colour_or("color", raw.color, ColourRange::Radiance, DVec3::ONE)
+}

@@ -1,0 +1,195 @@
+//! `[[objects]]` entries and their geometric checks.
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+use toml::Spanned;
+
+use super::check::{Item, Source};
+use super::raw::{RawObject, RawVec3};
+use crate::scene::{SceneError, Shape};
+
+const SPHERE_FIELDS: &[&str] = &["center", "radius", "material"];
+const PLANE_FIELDS: &[&str] = &["point", "normal", "material"];
+const POLYGON_FIELDS: &[&str] = &["vertices", "material"];
+const TRIANGLE_FIELDS: &[&str] = &["vertices", "material"];
+/// A vertex farther than this fraction of the bounding-box diagonal from the polygon's
+/// plane makes it non-planar.
+const PLANARITY_TOLERANCE: f64 = 1e-6;
+/// Twice the area, relative to the squared size of the shape, below which a polygon or
+/// triangle counts as degenerate.
+const DEGENERACY_TOLERANCE: f64 = 1e-12;
+
+/// Material names (sorted) and their indices, for resolving references.
+pub struct MaterialTable<'a> {
+    indices: HashMap<&'a str, u32>,
+    names: &'a [String],
+}
+
+impl<'a> MaterialTable<'a> {
+    /// The table for `names`, whose positions are the material indices.
+    pub fn new(names: &'a [String]) -> Self {
+        let indices = names
+            .iter()
+            .enumerate()
+            .filter_map(|(i, n)| Some((n.as_str(), u32::try_from(i).ok()?)))
+            .collect();
+        Self { indices, names }
+    }
+
+    fn resolve(&self, item: &Item<'_>, name: &str) -> Result<u32, SceneError> {
+        if let Some(&index) = self.indices.get(name) {
+            return Ok(index);
+        }
+        let defined = if self.names.is_empty() {
+            "no materials are defined".to_owned()
+        } else {
+            let quoted: Vec<String> = self.names.iter().map(|n| format!("`{n}`")).collect();
+            format!("defined materials: {}", quoted.join(", "))
+        };
+        Err(item.fail(format_args!("material `{name}` is not defined ({defined})")))
+    }
+}
+
+/// Object `index` (0-based, in file order), checked.
+pub fn object(
+    source: &Source<'_>,
+    materials: &MaterialTable<'_>,
+    index: usize,
+    raw: Spanned<RawObject>,
+) -> Result<Shape, SceneError> {
+    let span = raw.span();
+    let raw = raw.into_inner();
+    let untyped = source.item(format!("objects[{index}]"), Some(span.clone()));
+    let kind = untyped.require("type", raw.kind.clone())?;
+    let item = source.item(format!("objects[{index}] ({kind})"), Some(span));
+    let allowed = match kind.as_str() {
+        "sphere" => SPHERE_FIELDS,
+        "plane" => PLANE_FIELDS,
+        "polygon" => POLYGON_FIELDS,
+        "triangle" => TRIANGLE_FIELDS,
+        other => {
+            return Err(untyped.fail(format_args!(
+                "unknown object type `{other}` (expected one of: sphere, plane, polygon, triangle)"
+            )));
+        }
+    };
+    item.only_fields(&kind, allowed, &raw.given_fields())?;
+    let material_name = item.require("material", raw.material.as_deref())?;
+    let material = materials.resolve(&item, material_name)?;
+    match kind.as_str() {
+        "sphere" => sphere(&item, &raw, material),
+        "plane" => plane(&item, &raw, material),
+        "polygon" => polygon(&item, &raw, material),
+        _ => triangle(&item, &raw, material),
+    }
+}
+
+fn sphere(item: &Item<'_>, raw: &RawObject, material: u32) -> Result<Shape, SceneError> {
+    let center = item.vector("center", item.require("center", raw.center)?)?;
+    let radius = item.number("radius", item.require("radius", raw.radius)?)?;
+    if radius <= 0.0 {
+        return Err(item.fail(format_args!("radius must be > 0, got {radius}")));
+    }
+    Ok(Shape::Sphere {
+        center,
+        radius,
+        material,
+    })
+}
+
+fn plane(item: &Item<'_>, raw: &RawObject, material: u32) -> Result<Shape, SceneError> {
+    let point = item.vector("point", item.require("point", raw.point)?)?;
+    let normal = item.vector("normal", item.require("normal", raw.normal)?)?;
+    let Some(normal) = normal.try_normalize() else {
+        return Err(item.fail("normal is the zero vector"));
+    };
+    let offset = item.number("normal · point", normal.dot(point))?;
+    Ok(Shape::Plane {
+        normal,
+        offset,
+        material,
+    })
+}
+
+fn vertices(item: &Item<'_>, raw: &RawObject) -> Result<Vec<DVec3>, SceneError> {
+    let raw_vertices: &[RawVec3] = item.require("vertices", raw.vertices.as_deref())?;
+    raw_vertices
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| item.vector(&format!("vertices[{i}]"), v))
+        .collect()
+}
+
+fn polygon(item: &Item<'_>, raw: &RawObject, material: u32) -> Result<Shape, SceneError> {
+    let vertices = vertices(item, raw)?;
+    if vertices.len() < 3 {
+        return Err(item.fail(format_args!(
+            "a polygon needs at least 3 vertices, got {}",
+            vertices.len()
+        )));
+    }
+    check_planar_polygon(item, &vertices)?;
+    Ok(Shape::Polygon { vertices, material })
+}
+
+fn triangle(item: &Item<'_>, raw: &RawObject, material: u32) -> Result<Shape, SceneError> {
+    let vertices = vertices(item, raw)?;
+    let Ok(vertices) = <[DVec3; 3]>::try_from(vertices.as_slice()) else {
+        return Err(item.fail(format_args!(
+            "a triangle needs exactly 3 vertices, got {}",
+            vertices.len()
+        )));
+    };
+    let [a, b, c] = vertices;
+    let longest = (b - a).length().max((c - b).length()).max((a - c).length());
+    let twice_area = (b - a).cross(c - a).length();
+    if !(twice_area > DEGENERACY_TOLERANCE * longest * longest) {
+        return Err(item
+            .fail("the triangle is degenerate: its vertices are (nearly) collinear or coincide"));
+    }
+    Ok(Shape::Triangle { vertices, material })
+}
+
+/// Rejects degenerate polygons and those whose vertices do not lie on one plane.
+fn check_planar_polygon(item: &Item<'_>, vertices: &[DVec3]) -> Result<(), SceneError> {
+    let centroid = vertices.iter().sum::<DVec3>() / vertices.len() as f64;
+    let (min, max) = vertices
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    let diagonal = (max - min).length();
+    let newell = newell_normal(vertices, centroid);
+    if !(newell.length() > DEGENERACY_TOLERANCE * diagonal * diagonal) {
+        return Err(item.fail("the polygon is degenerate: its vertices enclose (nearly) no area"));
+    }
+    let normal = newell.normalize();
+    let (worst, distance) = vertices
+        .iter()
+        .map(|&v| (v - centroid).dot(normal).abs())
+        .enumerate()
+        .fold(
+            (0, 0.0),
+            |best, (i, d)| if d > best.1 { (i, d) } else { best },
+        );
+    let tolerance = PLANARITY_TOLERANCE * diagonal;
+    if distance > tolerance {
+        return Err(item.fail(format_args!(
+            "the polygon is not planar: vertex {worst} lies {distance:e} from the plane \
+             through the centroid (tolerance {tolerance:e})"
+        )));
+    }
+    Ok(())
+}
+
+/// Newell's normal (twice the area vector) of the closed loop `vertices`, computed
+/// relative to `origin` for accuracy.
+fn newell_normal(vertices: &[DVec3], origin: DVec3) -> DVec3 {
+    let next = vertices.iter().cycle().skip(1);
+    vertices
+        .iter()
+        .zip(next)
+        .map(|(&a, &b)| (a - origin).cross(b - origin))
+        .sum()
+}

@@ -1,0 +1,104 @@
+//! The singleton tables: `[render]`, `[camera]` and `[environment]`.
+
+use glam::DVec3;
+use toml::Spanned;
+
+use super::check::{ColourRange, Source};
+use super::raw::{RawCamera, RawEnvironment, RawLighting, RawRender};
+use crate::scene::{Camera, Environment, LightingSpace, RenderSettings, SceneError};
+
+/// Default image width in pixels.
+const DEFAULT_WIDTH: u32 = 640;
+/// Default image height in pixels.
+const DEFAULT_HEIGHT: u32 = 480;
+/// Default bounce depth.
+const DEFAULT_MAX_DEPTH: u32 = 5;
+/// Default vertical field of view in degrees.
+const DEFAULT_FOV_Y_DEGREES: f64 = 45.0;
+/// Below this, the view direction and `up` count as parallel.
+const PARALLEL_TOLERANCE: f64 = 1e-6;
+
+/// `[render]` with defaults applied, checked by [`RenderSettings::check`].
+pub fn render(
+    source: &Source<'_>,
+    raw: Option<Spanned<RawRender>>,
+) -> Result<RenderSettings, SceneError> {
+    let span = raw.as_ref().map(Spanned::span);
+    let raw = raw.map(Spanned::into_inner).unwrap_or_default();
+    let max_depth = raw.max_depth.unwrap_or(DEFAULT_MAX_DEPTH);
+    let settings = RenderSettings {
+        width: raw.width.unwrap_or(DEFAULT_WIDTH),
+        height: raw.height.unwrap_or(DEFAULT_HEIGHT),
+        samples_per_pixel: raw.samples_per_pixel.unwrap_or(1),
+        max_depth,
+        stack_size: raw
+            .stack_size
+            .unwrap_or_else(|| RenderSettings::sufficient_stack_size(max_depth)),
+        lighting_space: match raw.lighting {
+            None | Some(RawLighting::Linear) => LightingSpace::Linear,
+            Some(RawLighting::NaiveGamma) => LightingSpace::NaiveGamma,
+        },
+    };
+    let item = source.item("render".into(), span);
+    settings.check().map_err(|message| item.fail(message))?;
+    Ok(settings)
+}
+
+/// `[camera]`: required, with a distinct eye and target and a usable `up`.
+pub fn camera(source: &Source<'_>, raw: Option<Spanned<RawCamera>>) -> Result<Camera, SceneError> {
+    let Some(raw) = raw else {
+        return Err(source.error(None, "missing the required [camera] table"));
+    };
+    let item = source.item("camera".into(), Some(raw.span()));
+    let raw = raw.into_inner();
+    let eye = item.vector("eye", item.require("eye", raw.eye)?)?;
+    let look_at = item.vector("look_at", item.require("look_at", raw.look_at)?)?;
+    let up = item.vector("up", raw.up.unwrap_or([0.0, 1.0, 0.0]))?;
+    let fov_y_degrees = item.number(
+        "fov_y_degrees",
+        raw.fov_y_degrees.unwrap_or(DEFAULT_FOV_Y_DEGREES),
+    )?;
+    if !(fov_y_degrees > 0.0 && fov_y_degrees < 180.0) {
+        return Err(item.fail(format_args!(
+            "fov_y_degrees must be in (0, 180), got {fov_y_degrees}"
+        )));
+    }
+    let Some(view) = (look_at - eye).try_normalize() else {
+        return Err(
+            item.fail("eye and look_at are the same point; the view direction is undefined")
+        );
+    };
+    let Some(up_unit) = up.try_normalize() else {
+        return Err(item.fail("up is the zero vector"));
+    };
+    if view.cross(up_unit).length() < PARALLEL_TOLERANCE {
+        return Err(item.fail(format_args!(
+            "up {up} is parallel to the view direction {view} (look_at - eye); choose another up"
+        )));
+    }
+    Ok(Camera {
+        eye,
+        look_at,
+        up,
+        fov_y_degrees,
+    })
+}
+
+/// `[environment]`: background and ambient radiance, black by default.
+pub fn environment(
+    source: &Source<'_>,
+    raw: Option<Spanned<RawEnvironment>>,
+) -> Result<Environment, SceneError> {
+    let span = raw.as_ref().map(Spanned::span);
+    let raw = raw.map(Spanned::into_inner).unwrap_or_default();
+    let item = source.item("environment".into(), span);
+    Ok(Environment {
+        background: item.colour_or(
+            "background",
+            raw.background,
+            ColourRange::Radiance,
+            DVec3::ZERO,
+        )?,
+        ambient: item.colour_or("ambient", raw.ambient, ColourRange::Radiance, DVec3::ZERO)?,
+    })
+}

@@ -1,0 +1,163 @@
+//! Happy paths of the scene-file parser.
+
+use std::path::Path;
+
+use glam::DVec3;
+
+use super::parse_scene;
+use crate::scene::{Light, LightingSpace, Material, MaterialKind, RenderSettings, Scene, Shape};
+
+const CAMERA: &str = "[camera]\neye = [0, 1, 5]\nlook_at = [0, 0.5, 0]\n";
+
+fn parse(text: &str) -> Scene {
+    match parse_scene(text, Path::new("test.toml")) {
+        Ok(scene) => scene,
+        Err(e) => panic!("unexpected error: {e}"),
+    }
+}
+
+#[test]
+fn defaults_are_applied() {
+    let scene = parse(CAMERA);
+    assert_eq!(
+        scene.render,
+        RenderSettings {
+            width: 640,
+            height: 480,
+            samples_per_pixel: 1,
+            max_depth: 5,
+            stack_size: 6,
+            lighting_space: LightingSpace::Linear,
+        }
+    );
+    assert_eq!(scene.camera.up, DVec3::Y);
+    assert_eq!(scene.camera.fov_y_degrees, 45.0);
+    assert_eq!(scene.environment.background, DVec3::ZERO);
+    assert_eq!(scene.environment.ambient, DVec3::ZERO);
+    assert!(scene.materials.is_empty() && scene.lights.is_empty() && scene.shapes.is_empty());
+}
+
+#[test]
+fn stack_size_follows_max_depth_unless_given() {
+    let scene = parse(&format!(
+        "[render]\nmax_depth = 9\nlighting = \"naive_gamma\"\n{CAMERA}"
+    ));
+    assert_eq!(scene.render.stack_size, 10);
+    assert_eq!(scene.render.lighting_space, LightingSpace::NaiveGamma);
+    let scene = parse(&format!(
+        "[render]\nmax_depth = 9\nstack_size = 3\n{CAMERA}"
+    ));
+    assert_eq!(scene.render.stack_size, 3);
+}
+
+#[test]
+fn grey_shorthand_and_rgb_colours() {
+    let scene = parse(&format!(
+        "{CAMERA}[environment]\nbackground = 0.25\nambient = [0.1, 0.2, 0.3]\n\
+         [materials.m]\ntype = \"lambert\"\nalbedo = 0.5\n"
+    ));
+    assert_eq!(scene.environment.background, DVec3::splat(0.25));
+    assert_eq!(scene.environment.ambient, DVec3::new(0.1, 0.2, 0.3));
+    assert_eq!(scene.materials[0], Material::lambert(DVec3::splat(0.5)));
+}
+
+#[test]
+fn light_strength_times_colour() {
+    let scene = parse(&format!(
+        "{CAMERA}[[lights]]\ntype = \"point\"\nposition = [0, 4, 0]\nintensity = 50\n\
+         color = [1, 0.5, 0]\n\
+         [[lights]]\ntype = \"directional\"\ndirection = [0, -2, 0]\nirradiance = 2\n"
+    ));
+    assert_eq!(
+        scene.lights,
+        vec![
+            Light::Point {
+                position: DVec3::new(0.0, 4.0, 0.0),
+                intensity: DVec3::new(50.0, 25.0, 0.0),
+            },
+            Light::Directional {
+                direction: DVec3::NEG_Y,
+                irradiance: DVec3::splat(2.0),
+            },
+        ]
+    );
+}
+
+#[test]
+fn plane_normal_is_normalized_and_offset_computed() {
+    let scene = parse(&format!(
+        "{CAMERA}[materials.m]\ntype = \"mirror\"\n\
+         [[objects]]\ntype = \"plane\"\npoint = [0, -1, 3]\nnormal = [0, 5, 0]\nmaterial = \"m\"\n"
+    ));
+    assert_eq!(
+        scene.shapes,
+        vec![Shape::Plane {
+            normal: DVec3::Y,
+            offset: -1.0,
+            material: 0
+        }]
+    );
+    assert_eq!(scene.materials[0].reflectance, DVec3::ONE);
+}
+
+#[test]
+fn materials_are_sorted_by_name_and_referenced_by_index() {
+    let scene = parse(&format!(
+        "{CAMERA}[materials.zinc]\ntype = \"mirror\"\nreflectance = 0.9\n\
+         [materials.air]\ntype = \"dielectric\"\nior = 1.5\n\
+         [materials.lamp]\ntype = \"emissive\"\nradiance = [4, 3, 2]\n\
+         [materials.paint]\ntype = \"blinn_phong\"\ndiffuse = 0.5\nspecular = 0.5\n\
+         shininess = 20\ncoat_ior = 1.5\nemission = 0.1\n\
+         [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"zinc\"\n\
+         [[objects]]\ntype = \"triangle\"\nvertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\n\
+         material = \"air\"\n\
+         [[objects]]\ntype = \"polygon\"\n\
+         vertices = [[0, 0, 0], [2, 0, 0], [2, 2, 0], [1, 0.5, 0], [0, 2, 0]]\n\
+         material = \"paint\"\n"
+    ));
+    assert_eq!(scene.material_names, ["air", "lamp", "paint", "zinc"]);
+    let kinds: Vec<MaterialKind> = scene.materials.iter().map(|m| m.kind).collect();
+    assert_eq!(
+        kinds,
+        [
+            MaterialKind::Dielectric,
+            MaterialKind::Emissive,
+            MaterialKind::BlinnPhong,
+            MaterialKind::Mirror
+        ]
+    );
+    assert_eq!(scene.materials[0].ior, 1.5);
+    assert_eq!(scene.materials[0].transmittance, DVec3::ONE);
+    assert_eq!(scene.materials[1].emission, DVec3::new(4.0, 3.0, 2.0));
+    assert_eq!(scene.materials[2].coat_ior, 1.5);
+    assert_eq!(scene.materials[2].shininess, 20.0);
+    assert_eq!(scene.materials[2].emission, DVec3::splat(0.1));
+    let indices: Vec<u32> = scene.shapes.iter().map(Shape::material).collect();
+    assert_eq!(indices, [3, 0, 2]);
+    match &scene.shapes[2] {
+        Shape::Polygon { vertices, .. } => assert_eq!(vertices.len(), 5),
+        other => panic!("expected a polygon, got {other:?}"),
+    }
+}
+
+#[test]
+fn minimal_scene_file_loads() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/minimal.toml");
+    let scene = match super::load_scene(&path) {
+        Ok(scene) => scene,
+        Err(e) => panic!("{e}"),
+    };
+    assert_eq!((scene.render.width, scene.render.height), (320, 240));
+    assert_eq!(scene.render.samples_per_pixel, 1);
+    assert_eq!(scene.materials, [Material::lambert(DVec3::splat(0.7))]);
+    assert_eq!(scene.environment.background, DVec3::ZERO);
+    assert_eq!(scene.lights.len(), 1);
+    assert!(matches!(
+        scene.shapes[..],
+        [Shape::Sphere {
+            radius: 1.0,
+            material: 0,
+            ..
+        }]
+    ));
+}

@@ -1,0 +1,351 @@
+//! Bad scene files: each must give a `SceneError` naming the file, the place and the
+//! problem, never a panic.
+
+use std::path::Path;
+
+use gpu_render::scene::{SceneError, load_scene, parse_scene};
+
+const FILE: &str = "bad.toml";
+const CAMERA: &str = "[camera]\neye = [0, 1, 5]\nlook_at = [0, 0.5, 0]\n";
+const LAMBERT: &str = "[materials.grey]\ntype = \"lambert\"\nalbedo = 0.5\n";
+
+/// Parses `text` expecting an error; checks that it names the file and contains every
+/// one of `needles`; returns it.
+fn error(text: &str, needles: &[&str]) -> SceneError {
+    let err = match parse_scene(text, Path::new(FILE)) {
+        Ok(_) => panic!("scene unexpectedly accepted:\n{text}"),
+        Err(err) => err,
+    };
+    let shown = err.to_string();
+    assert!(shown.starts_with(FILE), "no file name in {shown:?}");
+    for needle in needles {
+        assert!(shown.contains(needle), "{needle:?} missing from {shown:?}");
+    }
+    err
+}
+
+/// A scene with a camera, one material `grey` and `rest` appended.
+fn scene(rest: &str) -> String {
+    format!("{CAMERA}{LAMBERT}{rest}")
+}
+
+#[test]
+fn syntax_error_has_line_and_column() {
+    let err = error(
+        "[camera]\neye = [0, 1, 5]\nlook_at = oops\n",
+        &["bad.toml:3:11:"],
+    );
+    assert_eq!(err.location, Some((3, 11)));
+}
+
+#[test]
+fn unknown_top_level_table() {
+    let err = error(&format!("{CAMERA}[lighting]\nx = 1\n"), &["lighting"]);
+    assert_eq!(err.location.map(|l| l.0), Some(4));
+}
+
+#[test]
+fn unknown_field_is_named_and_located() {
+    let err = error(
+        &scene("[[objects]]\ntype = \"sphere\"\ncentre = [0, 0, 0]\n"),
+        &["unknown field `centre`", "objects"],
+    );
+    assert_eq!(err.location, Some((9, 1)));
+}
+
+#[test]
+fn field_of_another_type_is_rejected() {
+    let err = error(
+        &scene(
+            "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nnormal = [0, 1, 0]\nmaterial = \"grey\"\n",
+        ),
+        &[
+            "objects[0] (sphere)",
+            "no field `normal`",
+            "center, radius, material",
+        ],
+    );
+    assert_eq!(err.location, Some((7, 1)));
+}
+
+#[test]
+fn wrong_type_names_the_field() {
+    let err = error(
+        &scene(
+            "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = \"big\"\nmaterial = \"grey\"\n",
+        ),
+        &["`objects.radius`", "invalid type"],
+    );
+    assert_eq!(err.location, Some((10, 10)));
+}
+
+#[test]
+fn unknown_object_type() {
+    let err = error(
+        &scene("[[objects]]\ntype = \"cube\"\nmaterial = \"grey\"\n"),
+        &[
+            "objects[0]",
+            "unknown object type `cube`",
+            "sphere, plane, polygon, triangle",
+        ],
+    );
+    assert_eq!(err.location, Some((7, 1)));
+}
+
+#[test]
+fn missing_required_field() {
+    error(
+        &scene("[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nmaterial = \"grey\"\n"),
+        &["objects[0] (sphere)", "missing required field `radius`"],
+    );
+}
+
+#[test]
+fn missing_camera() {
+    let err = error(LAMBERT, &["[camera]"]);
+    assert_eq!(err.location, None);
+}
+
+#[test]
+fn undefined_material_lists_defined_ones() {
+    let err = error(
+        &scene(
+            "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"gray\"\n",
+        ),
+        &[
+            "objects[0] (sphere)",
+            "material `gray` is not defined",
+            "`grey`",
+        ],
+    );
+    assert_eq!(err.location, Some((7, 1)));
+}
+
+#[test]
+fn nan_component_is_named() {
+    let err = error(
+        &scene(
+            "[[objects]]\ntype = \"sphere\"\ncenter = [0, nan, 0]\nradius = 1\nmaterial = \"grey\"\n",
+        ),
+        &["objects[0] (sphere): center.y is NaN"],
+    );
+    assert_eq!(err.location, Some((7, 1)));
+}
+
+#[test]
+fn infinite_number_is_named() {
+    error(
+        &format!("{CAMERA}[[lights]]\ntype = \"point\"\nposition = [0, 4, 0]\nintensity = inf\n"),
+        &["lights[0] (point): intensity is infinite"],
+    );
+}
+
+#[test]
+fn colour_out_of_range_names_the_channel() {
+    error(
+        &format!("{CAMERA}[materials.hot]\ntype = \"lambert\"\nalbedo = [0.5, 1.5, 0.5]\n"),
+        &[
+            "materials.hot (lambert)",
+            "albedo.g must be in [0, 1], got 1.5",
+        ],
+    );
+}
+
+#[test]
+fn blinn_phong_energy_names_the_channel() {
+    error(
+        &format!(
+            "{CAMERA}[materials.shiny]\ntype = \"blinn_phong\"\ndiffuse = [0.5, 0.5, 0.8]\n\
+             specular = 0.3\nshininess = 10\n"
+        ),
+        &["materials.shiny (blinn_phong)", "diffuse.b + specular.b"],
+    );
+}
+
+#[test]
+fn coat_ior_below_one() {
+    error(
+        &format!("{CAMERA}[materials.m]\ntype = \"lambert\"\nalbedo = 0.5\ncoat_ior = 0.5\n"),
+        &["materials.m (lambert)", "coat_ior must be >= 1"],
+    );
+}
+
+#[test]
+fn eye_equals_look_at() {
+    let err = error(
+        "\n[camera]\neye = [1, 1, 1]\nlook_at = [1, 1, 1]\n",
+        &["camera", "eye", "look_at"],
+    );
+    assert_eq!(err.location, Some((2, 1)));
+}
+
+#[test]
+fn zero_up() {
+    error(
+        &format!("{CAMERA}up = [0, 0, 0]\n"),
+        &["camera: up is the zero vector"],
+    );
+}
+
+#[test]
+fn up_parallel_to_view() {
+    error(
+        "[camera]\neye = [0, 5, 0]\nlook_at = [0, 0, 0]\n",
+        &["camera: up", "parallel to the view direction"],
+    );
+}
+
+#[test]
+fn fov_out_of_range() {
+    error(
+        &format!("{CAMERA}fov_y_degrees = 180\n"),
+        &["camera", "fov_y_degrees must be in (0, 180)"],
+    );
+}
+
+#[test]
+fn width_zero() {
+    let err = error(
+        &format!("[render]\nwidth = 0\n{CAMERA}"),
+        &["render: width must be between 1 and"],
+    );
+    assert_eq!(err.location, Some((1, 1)));
+}
+
+#[test]
+fn width_too_large() {
+    error(
+        &format!("[render]\nwidth = 100000\n{CAMERA}"),
+        &["render: width", "got 100000"],
+    );
+}
+
+#[test]
+fn negative_width_is_a_type_error() {
+    let err = error(
+        &format!("[render]\nwidth = -1\n{CAMERA}"),
+        &["`render.width`"],
+    );
+    assert_eq!(err.location, Some((2, 9)));
+}
+
+#[test]
+fn polygon_needs_three_vertices() {
+    error(
+        &scene(
+            "[[objects]]\ntype = \"polygon\"\nvertices = [[0, 0, 0], [1, 0, 0]]\nmaterial = \"grey\"\n",
+        ),
+        &["objects[0] (polygon)", "at least 3 vertices, got 2"],
+    );
+}
+
+#[test]
+fn non_planar_polygon_names_worst_vertex() {
+    let err = error(
+        &scene(
+            "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"grey\"\n\
+             [[objects]]\ntype = \"polygon\"\n\
+             vertices = [[0, 0, 0], [1, 0, 0], [1, 1, 0.5], [0, 1, 0]]\nmaterial = \"grey\"\n",
+        ),
+        &["objects[1] (polygon)", "not planar", "vertex"],
+    );
+    assert_eq!(err.location, Some((12, 1)));
+}
+
+#[test]
+fn degenerate_polygon() {
+    error(
+        &scene(
+            "[[objects]]\ntype = \"polygon\"\nvertices = [[0, 0, 0], [1, 1, 1], [2, 2, 2]]\nmaterial = \"grey\"\n",
+        ),
+        &["objects[0] (polygon)", "degenerate"],
+    );
+}
+
+#[test]
+fn degenerate_triangle() {
+    error(
+        &scene(
+            "[[objects]]\ntype = \"triangle\"\nvertices = [[0, 0, 0], [1, 0, 0], [2, 0, 0]]\nmaterial = \"grey\"\n",
+        ),
+        &["objects[0] (triangle)", "degenerate"],
+    );
+}
+
+#[test]
+fn triangle_needs_exactly_three_vertices() {
+    error(
+        &scene(
+            "[[objects]]\ntype = \"triangle\"\nvertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]]\nmaterial = \"grey\"\n",
+        ),
+        &["objects[0] (triangle)", "exactly 3 vertices, got 4"],
+    );
+}
+
+#[test]
+fn sphere_radius_must_be_positive() {
+    error(
+        &scene(
+            "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 0\nmaterial = \"grey\"\n",
+        ),
+        &["objects[0] (sphere)", "radius must be > 0"],
+    );
+}
+
+#[test]
+fn plane_zero_normal() {
+    error(
+        &scene(
+            "[[objects]]\ntype = \"plane\"\npoint = [0, 0, 0]\nnormal = [0, 0, 0]\nmaterial = \"grey\"\n",
+        ),
+        &["objects[0] (plane)", "normal is the zero vector"],
+    );
+}
+
+#[test]
+fn directional_zero_direction() {
+    error(
+        &format!(
+            "{CAMERA}[[lights]]\ntype = \"directional\"\ndirection = [0, 0, 0]\nirradiance = 1\n"
+        ),
+        &["lights[0] (directional)", "direction is the zero vector"],
+    );
+}
+
+#[test]
+fn too_many_objects() {
+    let text = format!("objects = [{}]\n{}", "{},".repeat(1_000_001), scene(""));
+    error(&text, &["1000001", "more than the 1000000 accepted"]);
+}
+
+#[test]
+fn missing_file_names_the_os_error() {
+    let dir = match tempfile::tempdir() {
+        Ok(dir) => dir,
+        Err(e) => panic!("{e}"),
+    };
+    let path = dir.path().join("absent.toml");
+    let err = match load_scene(&path) {
+        Ok(_) => panic!("loaded a missing file"),
+        Err(err) => err,
+    };
+    let shown = err.to_string();
+    assert!(
+        shown.contains("absent.toml") && shown.contains("cannot read"),
+        "{shown}"
+    );
+    assert!(shown.to_lowercase().contains("no such file"), "{shown}");
+}
+
+#[test]
+fn directory_is_rejected() {
+    let dir = match tempfile::tempdir() {
+        Ok(dir) => dir,
+        Err(e) => panic!("{e}"),
+    };
+    let err = match load_scene(dir.path()) {
+        Ok(_) => panic!("loaded a directory"),
+        Err(err) => err,
+    };
+    assert!(err.to_string().contains("directory"), "{err}");
+}
