@@ -144,7 +144,7 @@ fn triangle(item: &Item<'_>, raw: &RawObject, material: u32) -> Result<Shape, Sc
     let [a, b, c] = vertices;
     let longest = (b - a).length().max((c - b).length()).max((a - c).length());
     let twice_area = (b - a).cross(c - a).length();
-    if !(twice_area > DEGENERACY_TOLERANCE * longest * longest) {
+    if negligible(twice_area, longest * longest) {
         return Err(item
             .fail("the triangle is degenerate: its vertices are (nearly) collinear or coincide"));
     }
@@ -161,7 +161,7 @@ fn check_planar_polygon(item: &Item<'_>, vertices: &[DVec3]) -> Result<(), Scene
         });
     let diagonal = (max - min).length();
     let newell = newell_normal(vertices, centroid);
-    if !(newell.length() > DEGENERACY_TOLERANCE * diagonal * diagonal) {
+    if negligible(newell.length(), diagonal * diagonal) {
         return Err(item.fail("the polygon is degenerate: its vertices enclose (nearly) no area"));
     }
     let normal = newell.normalize();
@@ -181,6 +181,12 @@ fn check_planar_polygon(item: &Item<'_>, vertices: &[DVec3]) -> Result<(), Scene
         )));
     }
     Ok(())
+}
+
+/// Whether an area is (nearly) zero relative to `scale`, a squared length; also true
+/// when the comparison is undefined (NaN from overflowing coordinates).
+fn negligible(twice_area: f64, scale: f64) -> bool {
+    twice_area.partial_cmp(&(DEGENERACY_TOLERANCE * scale)) != Some(std::cmp::Ordering::Greater)
 }
 
 /// Newell's normal (twice the area vector) of the closed loop `vertices`, computed

@@ -161,3 +161,18 @@ fn minimal_scene_file_loads() {
         }]
     ));
 }
+
+#[test]
+fn documented_example_parses() {
+    let doc = include_str!("../../../docs/scene-format.md");
+    let Some((_, after)) = doc.split_once("## Complete example\n\n```toml\n") else {
+        panic!("docs/scene-format.md lost its example");
+    };
+    let Some((example, _)) = after.split_once("```") else {
+        panic!("unterminated example");
+    };
+    let scene = parse(example);
+    assert_eq!(scene.materials.len(), 5);
+    assert_eq!(scene.lights.len(), 2);
+    assert_eq!(scene.shapes.len(), 5);
+}
