@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# The project's test command: formatting, lints and every test, headless.
+# Works on a fresh Debian 12 machine with a Rust toolchain: installs lavapipe (software
+# Vulkan) with apt when no Vulkan driver for it is present.
+set -euo pipefail
+
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+# shellcheck source=scripts/lib.sh
+source scripts/lib.sh
+
+section "Environment"
+ensure_lavapipe
+setup_gpu_env
+cargo --version
+rustc --version
+
+section "cargo fmt --check"
+cargo fmt --all -- --check
+
+section "cargo clippy (warnings are errors)"
+cargo clippy --all-targets -- -D warnings
+
+section "cargo test --all-targets"
+cargo test --all-targets
+
+section "cargo test --doc"
+cargo test --doc
+
+section "All checks passed"

@@ -1,0 +1,250 @@
+//! The command line: what `gpu-render` accepts, as clap derive types.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use gpu_render::scene::{LightingSpace, RenderOverrides};
+
+const AFTER_HELP: &str = "\
+Output formats (chosen by the extension of --output):
+  .png   8-bit sRGB display image
+  .exr   linear 32-bit float RGBA (OpenEXR)
+  .hdr   linear RGB (Radiance RGBE)
+
+Examples:
+  gpu-render scenes/showcase.toml -o showcase.png
+  gpu-render scene.toml -o scene.exr --spp 64 --max-depth 8
+  gpu-render scene.toml -o gamma.png --compare-gamma --backend cpu
+  gpu-render --adapter list";
+
+/// Renders a scene file with the GPU ray tracer (or its CPU reference).
+#[derive(Debug, Parser)]
+#[command(
+    name = "gpu-render",
+    version,
+    about,
+    long_about = "Renders a TOML scene file with a Whitted-style, physically based ray \
+                  tracer that runs in WGSL compute shaders through wgpu, or with the CPU \
+                  reference tracer.",
+    override_usage = "gpu-render [OPTIONS] SCENE --output <PATH>\n       gpu-render --adapter list",
+    after_help = AFTER_HELP,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
+pub struct Cli {
+    /// A tool other than rendering (none yet; rendering is the default).
+    #[command(subcommand)]
+    pub command: Option<Command>,
+
+    /// What to render and how.
+    #[command(flatten)]
+    pub render: RenderArgs,
+}
+
+/// Subcommands. Rendering needs none: `gpu-render SCENE -o OUT`.
+///
+/// Tools such as `brdf-check FILE` or `tradeoff SCENE` go here as variants.
+#[derive(Debug, Subcommand)]
+pub enum Command {}
+
+/// The arguments of a render.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// The scene file (TOML).
+    #[arg(value_name = "SCENE", required_unless_present = "adapter")]
+    pub scene: Option<PathBuf>,
+
+    /// The image to write; its extension picks the format (.png, .exr or .hdr).
+    #[arg(short, long, value_name = "PATH", required_unless_present = "adapter")]
+    pub output: Option<PathBuf>,
+
+    /// Image width in pixels [default: the scene's].
+    #[arg(long, value_name = "N", help_heading = "Render settings")]
+    pub width: Option<u32>,
+
+    /// Image height in pixels [default: the scene's].
+    #[arg(long, value_name = "N", help_heading = "Render settings")]
+    pub height: Option<u32>,
+
+    /// Samples per pixel [default: the scene's].
+    #[arg(long, value_name = "N", help_heading = "Render settings")]
+    pub spp: Option<u32>,
+
+    /// Maximum reflection/refraction bounces; the bounce stack grows to fit unless
+    /// --stack-size is given [default: the scene's].
+    #[arg(long, value_name = "N", help_heading = "Render settings")]
+    pub max_depth: Option<u32>,
+
+    /// Bounce-stack capacity; smaller than max depth + 1 drops deep branches
+    /// [default: the scene's].
+    #[arg(long, value_name = "N", help_heading = "Render settings")]
+    pub stack_size: Option<u32>,
+
+    /// Shade in linear space (correct) or naively on gamma-encoded colours
+    /// [default: the scene's].
+    #[arg(
+        long,
+        value_enum,
+        value_name = "SPACE",
+        help_heading = "Render settings"
+    )]
+    pub lighting: Option<LightingArg>,
+
+    /// Render twice, in linear and in naive gamma space, and write both side by side
+    /// (linear on the left) into a .png.
+    #[arg(long, conflicts_with = "lighting", help_heading = "Render settings")]
+    pub compare_gamma: bool,
+
+    /// Where to trace: the GPU if one is found (auto), the GPU only, or the CPU
+    /// reference tracer.
+    #[arg(
+        long,
+        value_enum,
+        default_value_t = BackendArg::Auto,
+        help_heading = "Device"
+    )]
+    pub backend: BackendArg,
+
+    /// `list` prints the GPU adapters and exits; an index from that list or part of
+    /// an adapter's name selects one.
+    #[arg(long, value_name = "list|INDEX|NAME", value_parser = parse_adapter, help_heading = "Device")]
+    pub adapter: Option<AdapterArg>,
+
+    /// Print nothing but errors: no progress, notes or summary.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+impl RenderArgs {
+    /// The command-line settings that override the scene file's.
+    pub fn overrides(&self) -> RenderOverrides {
+        RenderOverrides {
+            width: self.width,
+            height: self.height,
+            samples_per_pixel: self.spp,
+            max_depth: self.max_depth,
+            stack_size: self.stack_size,
+            lighting_space: self.lighting.map(LightingSpace::from),
+        }
+    }
+
+    /// The flag that sets the render setting a range-check message is about, with the
+    /// value given, if the user gave that flag (`"--width 0"`).
+    pub fn flag_for_setting_message(&self, message: &str) -> Option<String> {
+        let flags = [
+            ("width", "--width", self.width),
+            ("height", "--height", self.height),
+            ("samples_per_pixel", "--spp", self.spp),
+            ("max_depth", "--max-depth", self.max_depth),
+            ("stack_size", "--stack-size", self.stack_size),
+        ];
+        flags.into_iter().find_map(|(setting, flag, value)| {
+            let about_it = message
+                .strip_prefix(setting)
+                .is_some_and(|rest| rest.starts_with(' '));
+            match (about_it, value) {
+                (true, Some(value)) => Some(format!("{flag} {value}")),
+                _ => None,
+            }
+        })
+    }
+}
+
+/// `--lighting` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum LightingArg {
+    /// Correct: light in linear space, encode to sRGB once at the end.
+    Linear,
+    /// The classic mistake: light on sRGB-encoded colours, no final encode.
+    NaiveGamma,
+}
+
+impl From<LightingArg> for LightingSpace {
+    fn from(arg: LightingArg) -> Self {
+        match arg {
+            LightingArg::Linear => LightingSpace::Linear,
+            LightingArg::NaiveGamma => LightingSpace::NaiveGamma,
+        }
+    }
+}
+
+/// `--backend` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BackendArg {
+    /// The GPU if an adapter is found, otherwise the CPU reference tracer.
+    Auto,
+    /// The GPU; fail if there is none.
+    Gpu,
+    /// The CPU reference tracer.
+    Cpu,
+}
+
+/// `--adapter` values.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum AdapterArg {
+    /// Print the adapters and exit.
+    List,
+    /// The adapter at this index of the list.
+    Index(usize),
+    /// The first adapter whose name contains this text.
+    Name(String),
+}
+
+fn parse_adapter(text: &str) -> Result<AdapterArg, String> {
+    let text = text.trim();
+    if text.is_empty() {
+        return Err("expected `list`, an adapter index or part of an adapter name".into());
+    }
+    if text.eq_ignore_ascii_case("list") {
+        return Ok(AdapterArg::List);
+    }
+    if text.bytes().all(|b| b.is_ascii_digit()) {
+        return text
+            .parse()
+            .map(AdapterArg::Index)
+            .map_err(|e| format!("adapter index {text}: {e}"));
+    }
+    Ok(AdapterArg::Name(text.to_owned()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn clap_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn adapter_values() {
+        assert_eq!(parse_adapter("list"), Ok(AdapterArg::List));
+        assert_eq!(parse_adapter("2"), Ok(AdapterArg::Index(2)));
+        assert_eq!(
+            parse_adapter("NVIDIA"),
+            Ok(AdapterArg::Name("NVIDIA".into()))
+        );
+        assert!(parse_adapter(" ").is_err());
+    }
+
+    #[test]
+    fn names_the_flag_behind_a_settings_message() {
+        let cli = Cli::try_parse_from(["gpu-render", "s.toml", "-o", "o.png", "--spp", "0"])
+            .expect("parses");
+        let message = "samples_per_pixel must be between 1 and 65536, got 0";
+        assert_eq!(
+            cli.render.flag_for_setting_message(message).as_deref(),
+            Some("--spp 0")
+        );
+        assert_eq!(cli.render.flag_for_setting_message("width must be"), None);
+    }
+
+    #[test]
+    fn adapter_list_needs_no_scene() {
+        let cli = Cli::try_parse_from(["gpu-render", "--adapter", "list"]).expect("parses");
+        assert_eq!(cli.render.adapter, Some(AdapterArg::List));
+        assert!(Cli::try_parse_from(["gpu-render", "s.toml"]).is_err());
+        assert!(Cli::try_parse_from(["gpu-render", "-o", "x.png"]).is_err());
+    }
+}

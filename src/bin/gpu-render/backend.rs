@@ -1,0 +1,150 @@
+//! Choosing where to trace (GPU or CPU reference) and rendering a scene there.
+
+use std::io::Write;
+
+use anyhow::{Context, Result, bail};
+use gpu_render::cpu;
+use gpu_render::film::{LinearImage, ProgressFn, RenderStats};
+use gpu_render::gpu::{self, AdapterChoice, GpuRenderer, HeadlessGpu};
+use gpu_render::scene::Scene;
+
+use crate::args::{AdapterArg, BackendArg};
+
+/// A render as the command line needs it: both images and the statistics.
+pub struct Frame {
+    /// The linear image.
+    pub image: LinearImage,
+    /// The 8-bit display image, RGBA.
+    pub display_rgba8: Vec<u8>,
+    /// Ray count and tracing time.
+    pub stats: RenderStats,
+}
+
+/// An opened backend, ready to render any number of scenes.
+pub enum Backend {
+    /// The wgpu tracer on an opened device.
+    Gpu {
+        /// Instance, adapter, device and queue.
+        gpu: Box<HeadlessGpu>,
+        /// The compiled pipelines.
+        renderer: GpuRenderer,
+        /// The adapter's name, for the summary.
+        adapter_name: String,
+    },
+    /// The CPU reference tracer.
+    Cpu,
+}
+
+impl Backend {
+    /// Opens the backend `choice` asks for. With `auto` and no usable adapter, prints
+    /// a one-line note (unless `quiet`) and falls back to the CPU. An explicit
+    /// `--adapter` demands a GPU (except with `cpu`, which the caller refuses earlier).
+    pub fn open(choice: BackendArg, adapter: Option<&AdapterArg>, quiet: bool) -> Result<Self> {
+        let adapter_choice = match adapter {
+            None => AdapterChoice::Default,
+            Some(AdapterArg::Index(index)) => AdapterChoice::Index(*index),
+            Some(AdapterArg::Name(name)) => AdapterChoice::NameContains(name.clone()),
+            Some(AdapterArg::List) => bail!("--adapter list does not select an adapter"),
+        };
+        match choice {
+            BackendArg::Cpu => Ok(Backend::Cpu),
+            BackendArg::Gpu => Self::open_gpu(&adapter_choice),
+            BackendArg::Auto if adapter.is_some() => Self::open_gpu(&adapter_choice),
+            BackendArg::Auto => match HeadlessGpu::new(&adapter_choice) {
+                Ok(gpu) => Self::with_device(gpu),
+                Err(e) => {
+                    if !quiet {
+                        eprintln!("no GPU adapter found ({e}); rendering on the CPU reference");
+                    }
+                    Ok(Backend::Cpu)
+                }
+            },
+        }
+    }
+
+    fn open_gpu(choice: &AdapterChoice) -> Result<Self> {
+        let gpu = HeadlessGpu::new(choice).with_context(|| match choice {
+            AdapterChoice::Default => {
+                "cannot open a GPU (use --backend cpu to render on the CPU)".to_owned()
+            }
+            AdapterChoice::Index(i) => format!("cannot open GPU adapter {i} (see --adapter list)"),
+            AdapterChoice::NameContains(name) => {
+                format!("cannot open a GPU adapter named like {name:?} (see --adapter list)")
+            }
+        })?;
+        Self::with_device(gpu)
+    }
+
+    fn with_device(gpu: HeadlessGpu) -> Result<Self> {
+        let adapter_name = gpu.adapter_info().name;
+        let renderer = GpuRenderer::new(&gpu.device)
+            .with_context(|| format!("cannot set up the GPU tracer on {adapter_name}"))?;
+        Ok(Backend::Gpu {
+            gpu: Box::new(gpu),
+            renderer,
+            adapter_name,
+        })
+    }
+
+    /// A short description for the summary: `GPU (name)` or `CPU reference`.
+    pub fn describe(&self) -> String {
+        match self {
+            Backend::Gpu { adapter_name, .. } => format!("GPU ({adapter_name})"),
+            Backend::Cpu => "CPU reference".to_owned(),
+        }
+    }
+
+    /// Renders `scene`, reporting rows done to `progress`.
+    pub fn render(&self, scene: &Scene, progress: ProgressFn<'_>) -> Result<Frame> {
+        match self {
+            Backend::Gpu { gpu, renderer, .. } => {
+                let rendered = renderer
+                    .render(&gpu.device, &gpu.queue, scene, Some(progress))
+                    .context("GPU render failed")?;
+                Ok(Frame {
+                    image: rendered.image,
+                    display_rgba8: rendered.display_rgba8,
+                    stats: rendered.stats,
+                })
+            }
+            Backend::Cpu => {
+                let rendered = cpu::render(scene, Some(progress));
+                let display_rgba8 = rendered
+                    .image
+                    .to_display_rgba8(scene.display_encodes_srgb());
+                Ok(Frame {
+                    image: rendered.image,
+                    display_rgba8,
+                    stats: rendered.stats,
+                })
+            }
+        }
+    }
+}
+
+/// Prints the GPU adapters wgpu can see, one a line, on stdout.
+pub fn print_adapters() -> Result<()> {
+    let adapters = gpu::list_adapters();
+    let mut out = std::io::stdout().lock();
+    let result = if adapters.is_empty() {
+        writeln!(out, "no GPU adapters found")
+    } else {
+        adapters.iter().enumerate().try_for_each(|(index, info)| {
+            let driver = if info.driver.is_empty() {
+                String::new()
+            } else {
+                format!(", driver {}", info.driver)
+            };
+            writeln!(
+                out,
+                "{index}: {} ({}, {:?}{driver})",
+                info.name, info.backend, info.device_type
+            )
+        })
+    };
+    match result.and_then(|()| out.flush()) {
+        // `gpu-render --adapter list | head -1` is fine.
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => other.context("cannot write the adapter list to stdout"),
+    }
+}

@@ -1,0 +1,166 @@
+//! `gpu-render SCENE -o OUT`: renders a scene file to an image.
+//!
+//! Cheap checks (output format and directory, command-line settings, the scene file)
+//! all happen before a device is opened or a ray traced. Errors are printed as
+//! `error: ...` with their causes and exit with status 1; usage errors are clap's
+//! (status 2).
+
+mod args;
+mod backend;
+mod compare;
+mod progress;
+mod summary;
+
+use std::borrow::Cow;
+use std::path::Path;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Result, anyhow, bail};
+use clap::{CommandFactory, Parser, error::ErrorKind};
+use gpu_render::output::{self, OutputFormat};
+use gpu_render::scene::{self, LightingSpace, RenderSettings, Scene};
+
+use crate::args::{AdapterArg, BackendArg, Cli, RenderArgs};
+use crate::backend::{Backend, Frame};
+use crate::progress::Progress;
+use crate::summary::Summary;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    if let Some(command) = cli.command {
+        match command {}
+    }
+    let args = cli.render;
+    if args.adapter == Some(AdapterArg::List) {
+        return backend::print_adapters();
+    }
+    let (Some(scene_path), Some(output_path)) = (args.scene.as_deref(), args.output.as_deref())
+    else {
+        Cli::command()
+            .error(
+                ErrorKind::MissingRequiredArgument,
+                "a render needs a SCENE and --output <PATH>; only `--adapter list` runs without them",
+            )
+            .exit()
+    };
+    render(&args, scene_path, output_path)
+}
+
+/// Validates everything cheap, then renders and writes the image.
+fn render(args: &RenderArgs, scene_path: &Path, output_path: &Path) -> Result<()> {
+    let format = output::check_output_path(output_path)?;
+    if args.compare_gamma && format != OutputFormat::Png {
+        bail!(
+            "{}: --compare-gamma writes a side-by-side 8-bit display image, so the output must be a .png",
+            output_path.display()
+        );
+    }
+    if args.backend == BackendArg::Cpu && args.adapter.is_some() {
+        bail!("--adapter selects a GPU adapter; it cannot be used with --backend cpu");
+    }
+    // Values out of range whatever the scene says (`--width 0`) fail before loading it.
+    apply_overrides(args, minimal_settings(), None)?;
+
+    let mut scene = scene::load_scene(scene_path)?;
+    scene.render = apply_overrides(args, scene.render, Some(scene_path))?;
+
+    let backend = Backend::open(args.backend, args.adapter.as_ref(), args.quiet)?;
+    let started = Instant::now();
+    let frame = if args.compare_gamma {
+        let linear = render_pass(&backend, &scene, Some(LightingSpace::Linear), args.quiet)?;
+        let naive = render_pass(
+            &backend,
+            &scene,
+            Some(LightingSpace::NaiveGamma),
+            args.quiet,
+        )?;
+        compare::side_by_side(&linear, &naive)?
+    } else {
+        render_pass(&backend, &scene, None, args.quiet)?
+    };
+    let wall = started.elapsed();
+
+    output::write_image(output_path, &frame.image, &frame.display_rgba8)?;
+
+    if !args.quiet {
+        let summary = Summary {
+            settings: &scene.render,
+            passes: if args.compare_gamma { 2 } else { 1 },
+            backend: &backend.describe(),
+            wall,
+            stats: frame.stats,
+            output: output_path,
+        };
+        eprintln!("{summary}");
+    }
+    Ok(())
+}
+
+/// Renders `scene`, in `lighting` space if given, with progress on stderr.
+fn render_pass(
+    backend: &Backend,
+    scene: &Scene,
+    lighting: Option<LightingSpace>,
+    quiet: bool,
+) -> Result<Frame> {
+    let label = match lighting {
+        None => "rendering",
+        Some(LightingSpace::Linear) => "rendering (linear)",
+        Some(LightingSpace::NaiveGamma) => "rendering (naive gamma)",
+    };
+    let scene = match lighting {
+        Some(space) if space != scene.render.lighting_space => {
+            let mut changed = scene.clone();
+            changed.render.lighting_space = space;
+            Cow::Owned(changed)
+        }
+        _ => Cow::Borrowed(scene),
+    };
+    let progress = Progress::new(label, !quiet);
+    let report = |done: u32, total: u32| progress.update(done, total);
+    let frame = backend.render(&scene, &report);
+    progress.finish();
+    frame
+}
+
+/// The smallest valid settings, to range-check the command-line values on their own.
+fn minimal_settings() -> RenderSettings {
+    RenderSettings {
+        width: 1,
+        height: 1,
+        samples_per_pixel: 1,
+        max_depth: 0,
+        stack_size: 1,
+        lighting_space: LightingSpace::Linear,
+    }
+}
+
+/// Applies the command-line overrides to `base`, naming the offending flag on error.
+fn apply_overrides(
+    args: &RenderArgs,
+    base: RenderSettings,
+    scene_path: Option<&Path>,
+) -> Result<RenderSettings> {
+    base.with_overrides(&args.overrides())
+        .map_err(|message| match args.flag_for_setting_message(&message) {
+            Some(flag) => anyhow!("invalid {flag}: {message}"),
+            None => match scene_path {
+                Some(path) => anyhow!(
+                    "{}: the render settings with the command-line overrides are invalid: {message}",
+                    path.display()
+                ),
+                None => anyhow!("invalid command-line render settings: {message}"),
+            },
+        })
+}

@@ -1,0 +1,104 @@
+//! The one-line summary printed after a render.
+
+use std::path::Path;
+use std::time::Duration;
+
+use gpu_render::film::RenderStats;
+use gpu_render::scene::RenderSettings;
+
+/// What the summary line reports.
+pub struct Summary<'a> {
+    /// The settings rendered with (after the command-line overrides).
+    pub settings: &'a RenderSettings,
+    /// How many images were rendered (2 for `--compare-gamma`).
+    pub passes: u32,
+    /// `GPU (adapter)` or `CPU reference`.
+    pub backend: &'a str,
+    /// Wall time of the render call(s), without loading or writing.
+    pub wall: Duration,
+    /// Statistics summed over the passes.
+    pub stats: RenderStats,
+    /// The file written.
+    pub output: &'a Path,
+}
+
+impl std::fmt::Display for Summary<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let s = self.settings;
+        let passes = if self.passes > 1 {
+            format!("{} x ", self.passes)
+        } else {
+            String::new()
+        };
+        write!(
+            f,
+            "rendered {passes}{}x{}, {} spp, max depth {} on {} in {:.2} s: {} rays, {:.1} Mrays/s -> {}",
+            s.width,
+            s.height,
+            s.samples_per_pixel,
+            s.max_depth,
+            self.backend,
+            self.wall.as_secs_f64(),
+            format_count(self.stats.rays_traced),
+            self.stats.rays_per_second() / 1e6,
+            self.output.display()
+        )
+    }
+}
+
+/// `1234567` as `1.23 M`, small counts as they are.
+fn format_count(count: u64) -> String {
+    match count {
+        0..1_000_000 => count.to_string(),
+        1_000_000..1_000_000_000 => format!("{:.2} M", count as f64 / 1e6),
+        _ => format!("{:.2} G", count as f64 / 1e9),
+    }
+}
+
+/// Adds the statistics of two passes.
+pub fn add_stats(a: RenderStats, b: RenderStats) -> RenderStats {
+    RenderStats {
+        rays_traced: a.rays_traced + b.rays_traced,
+        elapsed: a.elapsed + b.elapsed,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gpu_render::scene::LightingSpace;
+
+    #[test]
+    fn counts() {
+        assert_eq!(format_count(999_999), "999999");
+        assert_eq!(format_count(1_234_567), "1.23 M");
+        assert_eq!(format_count(4_560_000_000), "4.56 G");
+    }
+
+    #[test]
+    fn line_names_everything() {
+        let settings = RenderSettings {
+            width: 32,
+            height: 24,
+            samples_per_pixel: 4,
+            max_depth: 5,
+            stack_size: 6,
+            lighting_space: LightingSpace::Linear,
+        };
+        let summary = Summary {
+            settings: &settings,
+            passes: 1,
+            backend: "GPU (Test)",
+            wall: Duration::from_millis(1500),
+            stats: RenderStats {
+                rays_traced: 3_000_000,
+                elapsed: Duration::from_secs(1),
+            },
+            output: Path::new("out.png"),
+        };
+        assert_eq!(
+            summary.to_string(),
+            "rendered 32x24, 4 spp, max depth 5 on GPU (Test) in 1.50 s: 3.00 M rays, 3.0 Mrays/s -> out.png"
+        );
+    }
+}
