@@ -1,12 +1,13 @@
 //! Every scene shipped in `scenes/` rendered on the GPU (lavapipe in CI) and on the CPU
 //! reference, compared per pixel in linear float.
 //!
-//! Tolerance: a channel passes when `|gpu - cpu| <= 2e-3 + 1e-2·|cpu|`: the GPU works in
+//! Tolerance: a channel passes when `|gpu - cpu| <= 1e-3 + 5e-3·|cpu|`: the GPU works in
 //! f32 and the reference in f64, and a refracted ray that has crossed a few interfaces
-//! lands a little elsewhere. At most 1% of the pixels may fail: those are samples that
+//! lands a little elsewhere (measured on lavapipe: RMSE below 5e-4 on every scene, most
+//! pixels within 1e-5). At most 0.5% of the pixels may fail: those are samples that
 //! graze a silhouette, a shadow boundary or the critical angle and fall on the other side
-//! in the other precision. Scenes are rendered at 120 pixels wide with 2 samples per
-//! pixel to keep the CPU reference fast.
+//! in the other precision. Scenes are rendered 200 pixels wide with 2 samples per pixel
+//! to keep the CPU reference fast.
 
 mod common;
 
@@ -16,9 +17,9 @@ use common::compare::{Tolerance, assert_images_match};
 use gpu_render::scene::{LightingSpace, RenderOverrides, Scene, load_scene};
 
 const TOLERANCE: Tolerance = Tolerance {
-    absolute: 2e-3,
-    relative: 1e-2,
-    outlier_fraction: 0.01,
+    absolute: 1e-3,
+    relative: 5e-3,
+    outlier_fraction: 0.005,
 };
 
 fn shipped_scenes() -> Vec<PathBuf> {
@@ -38,7 +39,7 @@ fn shipped_scenes() -> Vec<PathBuf> {
 }
 
 fn reduced(scene: Scene, lighting_space: LightingSpace) -> Scene {
-    let width = 120;
+    let width = 200;
     let height = (u64::from(scene.render.height) * u64::from(width) / u64::from(scene.render.width))
         .max(1) as u32;
     let render = scene
