@@ -94,7 +94,8 @@ fn shade_hit(ray: Ray, hit: Hit) -> ShadedHit {
 
 // Radiance arriving along `primary`: every reflected or refracted ray is pushed on a
 // stack of STACK_SIZE entries and popped until none is left. Refraction is pushed
-// first so reflection is traced first; a branch that finds the stack full is dropped.
+// first so reflection is traced first; a branch that finds the stack full, or whose
+// weight is not above frame.min_ray_weight, is dropped.
 fn trace_radiance(primary: Ray) -> vec3<f32> {
     var stack: array<StackEntry, STACK_SIZE>;
     stack[0] = StackEntry(primary, vec3<f32>(1.0), 0u);
@@ -116,12 +117,12 @@ fn trace_radiance(primary: Ray) -> vec3<f32> {
             continue;
         }
         let transmit_weight = entry.weight * shaded.transmit_weight;
-        if max(transmit_weight.x, max(transmit_weight.y, transmit_weight.z)) > 0.0 && stack_length < STACK_SIZE {
+        if max(transmit_weight.x, max(transmit_weight.y, transmit_weight.z)) > frame.min_ray_weight && stack_length < STACK_SIZE {
             stack[stack_length] = StackEntry(shaded.transmitted, transmit_weight, entry.depth + 1u);
             stack_length += 1u;
         }
         let reflect_weight = entry.weight * shaded.reflect_weight;
-        if max(reflect_weight.x, max(reflect_weight.y, reflect_weight.z)) > 0.0 && stack_length < STACK_SIZE {
+        if max(reflect_weight.x, max(reflect_weight.y, reflect_weight.z)) > frame.min_ray_weight && stack_length < STACK_SIZE {
             stack[stack_length] = StackEntry(shaded.reflected, reflect_weight, entry.depth + 1u);
             stack_length += 1u;
         }

@@ -22,7 +22,7 @@ struct FrameUniforms {
     light_count: u32,
     row_offset: u32,
     row_count: u32,
-    _pad: u32,
+    min_ray_weight: f32,
 }
 
 struct Sphere {

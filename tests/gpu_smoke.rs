@@ -29,6 +29,7 @@ fn scene(samples_per_pixel: u32) -> Scene {
             max_depth: 2,
             stack_size: 3,
             lighting_space: LightingSpace::Linear,
+            min_ray_weight: 0.0,
         },
         camera: Camera {
             eye: DVec3::new(0.0, 1.0, 4.0),

@@ -102,3 +102,38 @@ fn gpu_matches_cpu_reference_on_every_shipped_scene() {
         }
     }
 }
+
+#[test]
+fn ray_weight_cutoff_traces_fewer_rays_alike_on_both_backends() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/glass.toml");
+    let full = reduced(
+        load_scene(&path).unwrap_or_else(|e| panic!("{e}")),
+        LightingSpace::Linear,
+    );
+    let mut cut = full.clone();
+    cut.render.min_ray_weight = 0.2;
+    let cpu_full = gpu_render::cpu::render(&full, None);
+    let cpu_cut = gpu_render::cpu::render(&cut, None);
+    assert!(
+        cpu_cut.stats.rays_traced < cpu_full.stats.rays_traced * 9 / 10,
+        "a 0.2 cutoff should skip the weak Fresnel reflections: {} vs {} rays",
+        cpu_cut.stats.rays_traced,
+        cpu_full.stats.rays_traced
+    );
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let renderer = common::gpu::renderer(&gpu);
+    let gpu_cut = renderer
+        .render(&gpu.device, &gpu.queue, &cut, None)
+        .unwrap_or_else(|e| panic!("GPU render failed: {e}"));
+    assert_images_match("glass-cutoff", &cpu_cut.image, &gpu_cut.image, TOLERANCE);
+    let (c, g) = (
+        cpu_cut.stats.rays_traced as f64,
+        gpu_cut.stats.rays_traced as f64,
+    );
+    assert!(
+        (c - g).abs() <= 0.01 * c,
+        "ray counts differ: CPU {c}, GPU {g}"
+    );
+}

@@ -41,7 +41,7 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 light_count,
                 row_offset,
                 row_count,
-                _pad,
+                min_ray_weight,
             }),
         ),
         (

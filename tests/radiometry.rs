@@ -18,6 +18,7 @@ fn furnace_scene(albedo: f64, radius: f64, intensity: f64) -> Scene {
             max_depth: 0,
             stack_size: 1,
             lighting_space: LightingSpace::Linear,
+            min_ray_weight: 0.0,
         },
         camera: Camera {
             eye: DVec3::new(0.1, -0.2, 0.05) * radius,

@@ -119,10 +119,11 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
             continue;
         }
         // Refraction is pushed first so that reflection is traced first; a branch that
-        // finds the stack full is dropped (both backends do the same).
+        // finds the stack full, or carries no more than the weight cutoff, is dropped
+        // (both backends do the same).
         for (weight, ray) in [shaded.transmitted, shaded.reflected] {
             let weight = entry.weight * weight;
-            if weight.max_element() > 0.0 && stack.len() < capacity {
+            if weight.max_element() > scene.settings.min_ray_weight && stack.len() < capacity {
                 stack.push(StackEntry {
                     ray,
                     weight,

@@ -47,8 +47,8 @@ pub struct FrameUniforms {
     pub row_offset: u32,
     /// Number of rows this dispatch traces.
     pub row_count: u32,
-    /// Padding to a 16-byte multiple.
-    pub _pad: u32,
+    /// Branches whose weight is not above this are not traced.
+    pub min_ray_weight: f32,
 }
 
 /// A sphere (`Sphere` in WGSL).

@@ -207,7 +207,7 @@ pub fn frame_uniforms(scene: &Scene, records: &SceneRecords) -> FrameUniforms {
         light_count: count(records.lights.len()),
         row_offset: 0,
         row_count: settings.height,
-        _pad: 0,
+        min_ray_weight: settings.min_ray_weight as f32,
     }
 }
 
@@ -227,6 +227,7 @@ mod tests {
                 max_depth: 3,
                 stack_size: 4,
                 lighting_space: LightingSpace::Linear,
+                min_ray_weight: 0.0,
             },
             camera: Camera {
                 eye: DVec3::new(0.0, 0.0, 5.0),

@@ -28,7 +28,7 @@ pub struct Scene {
 }
 
 /// How the image is sampled and how deep rays recurse.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RenderSettings {
     /// Image width in pixels (at least 1).
     pub width: u32,
@@ -46,6 +46,26 @@ pub struct RenderSettings {
     /// Whether lighting is done correctly in linear space or, for the lecture's
     /// comparison, naively on sRGB-encoded values.
     pub lighting_space: LightingSpace,
+    /// Ray-weight cutoff in [0, 1]: a reflected or refracted branch whose accumulated
+    /// weight (largest channel) is not above it is not traced. 0 traces every branch
+    /// that carries any light; larger values trade accuracy for speed.
+    pub min_ray_weight: f64,
+}
+
+impl Default for RenderSettings {
+    /// The scene-file defaults: 640x480, 1 sample, depth 5, a sufficient stack, linear
+    /// lighting, no weight cutoff.
+    fn default() -> Self {
+        Self {
+            width: 640,
+            height: 480,
+            samples_per_pixel: 1,
+            max_depth: 5,
+            stack_size: Self::sufficient_stack_size(5),
+            lighting_space: LightingSpace::Linear,
+            min_ray_weight: 0.0,
+        }
+    }
 }
 
 impl RenderSettings {
@@ -238,7 +258,7 @@ pub const MAX_DEPTH_LIMIT: u32 = 64;
 pub const MAX_STACK_SIZE: u32 = 128;
 
 /// Settings a user may override on the command line, on top of the scene file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RenderOverrides {
     /// Image width in pixels.
     pub width: Option<u32>,
@@ -252,6 +272,8 @@ pub struct RenderOverrides {
     pub stack_size: Option<u32>,
     /// Lighting space.
     pub lighting_space: Option<LightingSpace>,
+    /// Ray-weight cutoff.
+    pub min_ray_weight: Option<f64>,
 }
 
 impl RenderSettings {
@@ -278,6 +300,9 @@ impl RenderSettings {
         }
         if let Some(space) = overrides.lighting_space {
             self.lighting_space = space;
+        }
+        if let Some(cutoff) = overrides.min_ray_weight {
+            self.min_ray_weight = cutoff;
         }
         self.check()?;
         Ok(self)
@@ -309,6 +334,12 @@ impl RenderSettings {
             return Err(format!(
                 "max_depth must be at most {MAX_DEPTH_LIMIT}, got {}",
                 self.max_depth
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.min_ray_weight) {
+            return Err(format!(
+                "min_ray_weight must be between 0 and 1, got {}",
+                self.min_ray_weight
             ));
         }
         if self.stack_size == 0 || self.stack_size > MAX_STACK_SIZE {

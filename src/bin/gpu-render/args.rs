@@ -80,6 +80,11 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N", help_heading = "Render settings")]
     pub stack_size: Option<u32>,
 
+    /// Do not trace reflected/refracted branches whose weight is at most this, in
+    /// [0, 1]: faster, slightly darker glass and mirrors [default: the scene's, or 0].
+    #[arg(long, value_name = "W", help_heading = "Render settings")]
+    pub min_ray_weight: Option<f64>,
+
     /// Shade in linear space (correct) or naively on gamma-encoded colours
     /// [default: the scene's].
     #[arg(
@@ -125,6 +130,7 @@ impl RenderArgs {
             max_depth: self.max_depth,
             stack_size: self.stack_size,
             lighting_space: self.lighting.map(LightingSpace::from),
+            min_ray_weight: self.min_ray_weight,
         }
     }
 

@@ -143,6 +143,7 @@ fn minimal_settings() -> RenderSettings {
         max_depth: 0,
         stack_size: 1,
         lighting_space: LightingSpace::Linear,
+        min_ray_weight: 0.0,
     }
 }
 

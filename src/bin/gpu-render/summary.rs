@@ -84,6 +84,7 @@ mod tests {
             max_depth: 5,
             stack_size: 6,
             lighting_space: LightingSpace::Linear,
+            min_ray_weight: 0.0,
         };
         let summary = Summary {
             settings: &settings,

@@ -46,6 +46,7 @@ pub struct RawRender {
     pub max_depth: Option<u32>,
     pub stack_size: Option<u32>,
     pub lighting: Option<RawLighting>,
+    pub min_ray_weight: Option<f64>,
 }
 
 /// `render.lighting`.

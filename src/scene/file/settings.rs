@@ -38,6 +38,7 @@ pub fn render(
             None | Some(RawLighting::Linear) => LightingSpace::Linear,
             Some(RawLighting::NaiveGamma) => LightingSpace::NaiveGamma,
         },
+        min_ray_weight: raw.min_ray_weight.unwrap_or(0.0),
     };
     let item = source.item("render".into(), span);
     settings.check().map_err(|message| item.fail(message))?;

@@ -28,6 +28,7 @@ fn defaults_are_applied() {
             max_depth: 5,
             stack_size: 6,
             lighting_space: LightingSpace::Linear,
+            min_ray_weight: 0.0,
         }
     );
     assert_eq!(scene.camera.up, DVec3::Y);
