@@ -13,6 +13,9 @@
 @group(0) @binding(8) var linear_output: texture_storage_2d<rgba32float, write>;
 // One counter per image row: the rays each pixel of the row traced.
 @group(0) @binding(9) var<storage, read_write> ray_counts: array<atomic<u32>>;
+// Running radiance sums of the dispatched rows (row - row_offset, column), carried
+// from one sample's dispatch to the next.
+@group(0) @binding(10) var<storage, read_write> accumulation: array<vec4<f32>>;
 
 // Rays traced by this invocation (camera, shadow and secondary).
 var<private> rays_traced: u32;
@@ -130,8 +133,14 @@ fn trace_radiance(primary: Ray) -> vec3<f32> {
     return radiance;
 }
 
-// One invocation per pixel of the dispatched row chunk; all samples of the pixel are
-// averaged (box filter) into the linear output.
+// One invocation per pixel of the dispatched rows, tracing sample frame.sample_index.
+// Samples are summed in the accumulation buffer in index order, as the CPU sums them;
+// the dispatch of the last sample writes the mean (box filter) into the linear output.
+//
+// One sample per dispatch, not a loop over samples: Mesa's llvmpipe/lavapipe ends
+// every loop of an invocation once all loops together have run 65535 iterations
+// (LP_MAX_TGSI_LOOP_ITERATIONS in gallivm), which a pixel with many samples of deep
+// glass paths exceeds, silently losing rays.
 @compute @workgroup_size(8, 8, 1)
 fn trace_pixels(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= frame.width || id.y >= frame.row_count {
@@ -139,14 +148,18 @@ fn trace_pixels(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let x = id.x;
     let y = frame.row_offset + id.y;
+    let slot = id.y * frame.width + x;
     rays_traced = 0u;
-    var sum = vec3<f32>(0.0);
-    for (var index = 0u; index < frame.samples_per_pixel; index += 1u) {
-        let offset = sample_offset(x, y, index);
-        let direction = camera_ray_direction(f32(x) + offset.x, f32(y) + offset.y);
-        sum += trace_radiance(Ray(frame.eye, direction));
+    let offset = sample_offset(x, y, frame.sample_index);
+    let direction = camera_ray_direction(f32(x) + offset.x, f32(y) + offset.y);
+    var sum = trace_radiance(Ray(frame.eye, direction));
+    if frame.sample_index > 0u {
+        sum = accumulation[slot].xyz + sum;
     }
-    let radiance = sum / f32(frame.samples_per_pixel);
-    textureStore(linear_output, vec2<u32>(x, y), vec4<f32>(radiance, 1.0));
+    if frame.sample_index + 1u == frame.samples_per_pixel {
+        textureStore(linear_output, vec2<u32>(x, y), vec4<f32>(sum / f32(frame.samples_per_pixel), 1.0));
+    } else {
+        accumulation[slot] = vec4<f32>(sum, 0.0);
+    }
     atomicAdd(&ray_counts[y], rays_traced);
 }

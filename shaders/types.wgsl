@@ -23,6 +23,10 @@ struct FrameUniforms {
     row_offset: u32,
     row_count: u32,
     min_ray_weight: f32,
+    sample_index: u32,
+    accumulation_rows: u32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 struct Sphere {

@@ -137,3 +137,39 @@ fn ray_weight_cutoff_traces_fewer_rays_alike_on_both_backends() {
         "ray counts differ: CPU {c}, GPU {g}"
     );
 }
+
+/// Many samples of deep glass paths per pixel: lavapipe ends all loops of an
+/// invocation after 65535 iterations in total, which once silently dropped rays here
+/// (the GPU now traces one sample per dispatch). Ray counts must agree closely.
+#[test]
+fn many_deep_samples_per_pixel_lose_no_rays() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let renderer = common::gpu::renderer(&gpu);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/showcase.toml");
+    let mut scene = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+    scene.render = scene
+        .render
+        .with_overrides(&RenderOverrides {
+            width: Some(64),
+            height: Some(36),
+            samples_per_pixel: Some(64),
+            max_depth: Some(10),
+            ..RenderOverrides::default()
+        })
+        .expect("valid overrides");
+    let cpu = gpu_render::cpu::render(&scene, None);
+    let gpu_image = renderer
+        .render(&gpu.device, &gpu.queue, &scene, None)
+        .unwrap_or_else(|e| panic!("GPU render failed: {e}"));
+    assert_images_match("showcase-64spp", &cpu.image, &gpu_image.image, TOLERANCE);
+    let (c, g) = (
+        cpu.stats.rays_traced as f64,
+        gpu_image.stats.rays_traced as f64,
+    );
+    assert!(
+        (c - g).abs() <= 1e-3 * c,
+        "ray counts differ: CPU {c}, GPU {g}"
+    );
+}

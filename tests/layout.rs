@@ -42,6 +42,8 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 row_offset,
                 row_count,
                 min_ray_weight,
+                sample_index,
+                accumulation_rows,
             }),
         ),
         (

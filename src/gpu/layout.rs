@@ -49,6 +49,15 @@ pub struct FrameUniforms {
     pub row_count: u32,
     /// Branches whose weight is not above this are not traced.
     pub min_ray_weight: f32,
+    /// The sample this dispatch traces in every pixel: one dispatch per sample index
+    /// (see `docs/model.md`, "One sample per dispatch").
+    pub sample_index: u32,
+    /// Pixel rows the accumulation buffer holds (the dispatch's rows fit in it).
+    pub accumulation_rows: u32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
 }
 
 /// A sphere (`Sphere` in WGSL).

@@ -87,6 +87,8 @@ pub struct PreparedScene {
     materials: wgpu::Buffer,
     lights: wgpu::Buffer,
     ray_counts: wgpu::Buffer,
+    /// Running sums of one sample dispatch to the next, for up to `accumulation_rows`.
+    accumulation: wgpu::Buffer,
 }
 
 impl PreparedScene {
@@ -259,6 +261,7 @@ impl GpuRenderer {
                     storage_entry(7, true),
                     storage_texture_entry(8, LINEAR_FORMAT),
                     storage_entry(9, false),
+                    storage_entry(10, false),
                 ],
             });
         let trace_pipeline_layout =
@@ -436,8 +439,27 @@ impl GpuRenderer {
                 mapped_at_creation: false,
             })
         })?;
+        // Radiance sums for as many rows as one storage binding holds; larger row
+        // ranges are traced in bands of that many rows.
+        let row_bytes = u64::from(frame.width) * 16;
+        let accumulation_rows = (max_binding.min(max_buffer) / row_bytes)
+            .min(u64::from(frame.height))
+            .max(1) as u32;
+        let accumulation = capture(device, "accumulation", Caught::Resource, || {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("gpu-render accumulation"),
+                size: row_bytes * u64::from(accumulation_rows),
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            })
+        })?;
+        let frame = FrameUniforms {
+            accumulation_rows,
+            ..frame
+        };
         Ok(PreparedScene {
             frame,
+            accumulation,
             stack_size: scene.render.stack_size,
             encode_srgb: scene.display_encodes_srgb(),
             spheres,
@@ -451,13 +473,15 @@ impl GpuRenderer {
         })
     }
 
-    /// Records one trace dispatch of image rows `rows` into `encoder`, writing
-    /// linear radiance into `target` and adding to the prepared scene's ray counters.
+    /// Records the trace of image rows `rows` into `encoder`, writing linear radiance
+    /// into `target` and adding to the prepared scene's ray counters: one dispatch per
+    /// sample index (each adds one sample of every pixel to a running sum; the last
+    /// writes the mean), in bands of rows that fit the accumulation buffer.
     ///
     /// `target` must view an [`LINEAR_FORMAT`] (`Rgba32Float`) texture with
     /// `STORAGE_BINDING` usage, at least as large as the image. Each call creates a
-    /// small uniform buffer holding the frame constants with this chunk's
-    /// `row_offset`/`row_count`, initialised at creation: unlike `Queue::write_buffer`
+    /// small uniform buffer per dispatch holding the frame constants with its
+    /// `row_offset`/`row_count`/`sample_index`, initialised at creation: unlike `Queue::write_buffer`
     /// (which lands before the whole submission), this lets several chunks be recorded
     /// into one encoder. wgpu keeps the buffer alive until the work completes. An empty
     /// range records nothing.
@@ -515,15 +539,41 @@ impl GpuRenderer {
             prepared.height(),
         )?;
         let pipeline = self.trace_pipeline(device, prepared.stack_size)?;
-        let chunk = FrameUniforms {
-            row_offset: rows.start,
-            row_count: rows.end - rows.start,
-            ..prepared.frame
-        };
+        let band_rows = prepared.frame.accumulation_rows.max(1);
+        let mut band_start = rows.start;
+        while band_start < rows.end {
+            let band_end = rows.end.min(band_start.saturating_add(band_rows));
+            for sample_index in 0..prepared.samples_per_pixel() {
+                let dispatch = FrameUniforms {
+                    row_offset: band_start,
+                    row_count: band_end - band_start,
+                    sample_index,
+                    ..prepared.frame
+                };
+                self.encode_trace_dispatch(
+                    device, encoder, prepared, target, &pipeline, &dispatch,
+                )?;
+            }
+            band_start = band_end;
+        }
+        Ok(())
+    }
+
+    /// Records one dispatch of the trace pass: one sample of every pixel in the rows
+    /// `dispatch` names.
+    fn encode_trace_dispatch(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        prepared: &PreparedScene,
+        target: &wgpu::TextureView,
+        pipeline: &wgpu::ComputePipeline,
+        dispatch: &FrameUniforms,
+    ) -> Result<(), GpuError> {
         let bind_group = capture(device, "trace bind group", Caught::Resource, || {
             let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("gpu-render chunk uniforms"),
-                contents: bytemuck::bytes_of(&chunk),
+                label: Some("gpu-render dispatch uniforms"),
+                contents: bytemuck::bytes_of(dispatch),
                 usage: wgpu::BufferUsages::UNIFORM,
             });
             device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -543,6 +593,7 @@ impl GpuRenderer {
                         resource: wgpu::BindingResource::TextureView(target),
                     },
                     buffer_binding(9, &prepared.ray_counts),
+                    buffer_binding(10, &prepared.accumulation),
                 ],
             })
         })?;
@@ -550,11 +601,11 @@ impl GpuRenderer {
             label: Some("gpu-render trace"),
             timestamp_writes: None,
         });
-        pass.set_pipeline(&pipeline);
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.dispatch_workgroups(
             prepared.width().div_ceil(WORKGROUP_SIZE),
-            chunk.row_count.div_ceil(WORKGROUP_SIZE),
+            dispatch.row_count.div_ceil(WORKGROUP_SIZE),
             1,
         );
         Ok(())

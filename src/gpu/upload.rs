@@ -208,6 +208,10 @@ pub fn frame_uniforms(scene: &Scene, records: &SceneRecords) -> FrameUniforms {
         row_offset: 0,
         row_count: settings.height,
         min_ray_weight: settings.min_ray_weight as f32,
+        sample_index: 0,
+        accumulation_rows: 0,
+        _pad0: 0,
+        _pad1: 0,
     }
 }
 
