@@ -10,6 +10,7 @@
 //! - [`cpu`]: the reference tracer (f64).
 //! - [`gpu`]: the wgpu backend, built from the caller's `Device` and `Queue`.
 //! - [`output`]: writing PNG, EXR and HDR files atomically.
+//! - [`tradeoff`]: measuring time against error for the speed/accuracy knobs.
 
 pub mod camera;
 pub mod color;
@@ -18,3 +19,4 @@ pub mod film;
 pub mod gpu;
 pub mod output;
 pub mod scene;
+pub mod tradeoff;

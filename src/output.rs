@@ -197,6 +197,41 @@ pub fn write_image(
     })
 }
 
+/// Writes an 8-bit RGBA image (a plot, say) to the PNG file `path`, atomically.
+pub fn write_png_rgba8(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgba8: Vec<u8>,
+) -> Result<(), OutputError> {
+    let image = RgbaImage::from_raw(width, height, rgba8).ok_or_else(|| OutputError::BadImage {
+        path: path.to_path_buf(),
+        message: format!("the buffer does not hold a {width}x{height} RGBA8 image"),
+    })?;
+    write_atomically(path, |writer| {
+        image
+            .write_to(writer, ImageFormat::Png)
+            .map_err(|source| OutputError::Encode {
+                path: path.to_path_buf(),
+                format: OutputFormat::Png,
+                source,
+            })
+    })
+}
+
+/// Writes `text` to `path` atomically (a CSV table, say).
+pub fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
+    write_atomically(path, |writer| {
+        writer
+            .write_all(text.as_bytes())
+            .map_err(|source| OutputError::Io {
+                path: path.to_path_buf(),
+                action: "write the file".to_owned(),
+                source,
+            })
+    })
+}
+
 /// Converts the render to the pixel layout `format` stores, checking buffer sizes.
 fn to_dynamic_image(
     path: &Path,
@@ -287,13 +322,13 @@ fn write_atomically(
         encode(&mut writer)?;
         writer
             .flush()
-            .map_err(io_error("write the image".to_owned()))?;
+            .map_err(io_error("write the file".to_owned()))?;
     }
     temp.as_file()
         .sync_all()
-        .map_err(io_error("sync the image to disk".to_owned()))?;
+        .map_err(io_error("sync the file to disk".to_owned()))?;
     temp.persist(path)
-        .map_err(|e| io_error("move the finished image into place".to_owned())(e.error))?;
+        .map_err(|e| io_error("move the finished file into place".to_owned())(e.error))?;
     Ok(())
 }
 

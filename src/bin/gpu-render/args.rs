@@ -32,7 +32,7 @@ Examples:
     subcommand_negates_reqs = true
 )]
 pub struct Cli {
-    /// A tool other than rendering (none yet; rendering is the default).
+    /// A tool other than rendering (rendering is the default).
     #[command(subcommand)]
     pub command: Option<Command>,
 
@@ -43,9 +43,47 @@ pub struct Cli {
 
 /// Subcommands. Rendering needs none: `gpu-render SCENE -o OUT`.
 ///
-/// Tools such as `brdf-check FILE` or `tradeoff SCENE` go here as variants.
+/// Tools such as `brdf-check FILE` go here as variants.
 #[derive(Debug, Subcommand)]
-pub enum Command {}
+pub enum Command {
+    /// Measure the speed/accuracy trade: render a converged reference, sweep samples
+    /// per pixel, maximum depth and the ray-weight cutoff, and report each setting's
+    /// time and error (linear RMSE and FLIP) with the Pareto front, as a table, a CSV
+    /// and a PNG plot.
+    Tradeoff(TradeoffArgs),
+}
+
+/// The arguments of `gpu-render tradeoff`.
+#[derive(Debug, Args)]
+pub struct TradeoffArgs {
+    /// The scene file (TOML).
+    #[arg(value_name = "SCENE")]
+    pub scene: PathBuf,
+
+    /// Directory for tradeoff.csv, tradeoff.png and reference.png (created if missing).
+    #[arg(long, value_name = "DIR", default_value = "tradeoff")]
+    pub out_dir: PathBuf,
+
+    /// Width of every render in pixels; the height keeps the scene's aspect ratio.
+    #[arg(long, value_name = "N", default_value_t = 320)]
+    pub width: u32,
+
+    /// Samples per pixel of the converged reference.
+    #[arg(long, value_name = "N", default_value_t = 256)]
+    pub reference_spp: u32,
+
+    /// Maximum depth of the converged reference.
+    #[arg(long, value_name = "N", default_value_t = 16)]
+    pub reference_depth: u32,
+
+    /// Timed runs per setting; the fastest counts.
+    #[arg(long, value_name = "N", default_value_t = 2)]
+    pub repeats: u32,
+
+    /// Where to trace (see the render options).
+    #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
+    pub backend: BackendArg,
+}
 
 /// The arguments of a render.
 #[derive(Debug, Args)]

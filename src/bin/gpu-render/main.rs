@@ -10,6 +10,7 @@ mod backend;
 mod compare;
 mod progress;
 mod summary;
+mod tradeoff;
 
 use std::borrow::Cow;
 use std::path::Path;
@@ -39,7 +40,9 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> Result<()> {
     if let Some(command) = cli.command {
-        match command {}
+        return match command {
+            args::Command::Tradeoff(args) => tradeoff::run(&args),
+        };
     }
     let args = cli.render;
     if args.adapter == Some(AdapterArg::List) {
