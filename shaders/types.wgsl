@@ -22,7 +22,11 @@ struct FrameUniforms {
     light_count: u32,
     row_offset: u32,
     row_count: u32,
-    _pad: u32,
+    column_offset: u32,
+    column_count: u32,
+    target_x: u32,
+    target_y: u32,
+    offset_scale: f32,
 }
 
 struct Sphere {

@@ -41,7 +41,11 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 light_count,
                 row_offset,
                 row_count,
-                _pad,
+                column_offset,
+                column_count,
+                target_x,
+                target_y,
+                offset_scale,
             }),
         ),
         (
