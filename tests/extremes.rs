@@ -21,8 +21,7 @@ use glam::DVec3;
 use gpu_render::film::LinearImage;
 use gpu_render::gpu::{GpuError, GpuRenderer, HeadlessGpu};
 use gpu_render::scene::{
-    Camera, Environment, Light, LightingSpace, Material, MaterialKind, RenderSettings, Scene,
-    Shape,
+    Camera, Environment, Light, LightingSpace, Material, MaterialKind, RenderSettings, Scene, Shape,
 };
 
 /// Panics unless every channel of every pixel is finite.
@@ -601,7 +600,11 @@ fn camera_inside_glass_sees_the_background() {
             }
         }
     };
-    check("inside glass (CPU)", &cpu_render("inside glass", &scene), 1e-6);
+    check(
+        "inside glass (CPU)",
+        &cpu_render("inside glass", &scene),
+        1e-6,
+    );
     if let Some(g) = gpu() {
         check(
             "inside glass (GPU)",
@@ -784,7 +787,11 @@ fn degenerate_lights_never_produce_nan_or_infinity() {
         fov_y_degrees: 40.0,
     };
     scene.render = settings(17, 17, 1);
-    for position in [DVec3::ZERO, DVec3::new(0.0, 1e-30, 0.0), DVec3::new(0.0, 1e-40, 0.0)] {
+    for position in [
+        DVec3::ZERO,
+        DVec3::new(0.0, 1e-30, 0.0),
+        DVec3::new(0.0, 1e-40, 0.0),
+    ] {
         scene.lights = vec![
             Light::Point {
                 position,

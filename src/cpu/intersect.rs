@@ -145,9 +145,7 @@ impl PreparedShape {
     /// projected orthogonally onto its plane, `p - (N·p - d)·N`.
     pub fn surface_point(&self, point: DVec3) -> DVec3 {
         match self {
-            Self::Sphere { center, radius, .. } => {
-                project_onto_sphere(point, *center, *radius)
-            }
+            Self::Sphere { center, radius, .. } => project_onto_sphere(point, *center, *radius),
             Self::Plane { normal, offset, .. } => project_onto_plane(point, *normal, *offset),
             Self::Polygon { plane, .. } => project_onto_plane(point, plane.normal, plane.offset),
             Self::Triangle { vertices, .. } => {
@@ -553,7 +551,11 @@ mod tests {
             DVec3::new(2.0, -1.0, 0.0),
             DVec3::new(-1.0, 2.0, 0.0),
         ];
-        for direction in [DVec3::NEG_Z, DVec3::new(0.3, -0.2, -1.0), DVec3::new(-0.2, 0.1, -1.0)] {
+        for direction in [
+            DVec3::NEG_Z,
+            DVec3::new(0.3, -0.2, -1.0),
+            DVec3::new(-0.2, 0.1, -1.0),
+        ] {
             let r = ray(DVec3::new(0.1, 0.2, 3.0), direction);
             let t = intersect_triangle(&r, &tri, f64::INFINITY).expect("hit");
             assert!(r.at(t).z.abs() < 1e-14, "{direction}");
@@ -562,7 +564,9 @@ mod tests {
             assert_eq!(intersect_triangle(&r, &flipped, f64::INFINITY), Some(t));
         }
         // A ray in the triangle's plane misses; so does one aimed away.
-        assert!(intersect_triangle(&ray(DVec3::new(-5.0, 0.0, 0.0), DVec3::X), &tri, 1e9).is_none());
+        assert!(
+            intersect_triangle(&ray(DVec3::new(-5.0, 0.0, 0.0), DVec3::X), &tri, 1e9).is_none()
+        );
         assert!(intersect_triangle(&ray(DVec3::new(0.0, 0.0, 3.0), DVec3::Z), &tri, 1e9).is_none());
     }
 
@@ -597,7 +601,10 @@ mod tests {
                         let hit = cube
                             .iter()
                             .any(|tri| intersect_triangle(&r, tri, f64::INFINITY).is_some());
-                        assert!(hit, "scale {scale}: ray {origin} -> {target} slipped through");
+                        assert!(
+                            hit,
+                            "scale {scale}: ray {origin} -> {target} slipped through"
+                        );
                     }
                 }
             }

@@ -769,7 +769,8 @@ impl GpuRenderer {
             let linear_view = linear.create_view(&wgpu::TextureViewDescriptor::default());
             let display_view = display.create_view(&wgpu::TextureViewDescriptor::default());
 
-            elapsed += self.trace_region_chunks(device, queue, &prepared, &linear_view, tile, &report)?;
+            elapsed +=
+                self.trace_region_chunks(device, queue, &prepared, &linear_view, tile, &report)?;
 
             let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("gpu-render display pass"),
@@ -856,7 +857,8 @@ impl GpuRenderer {
                 progress(done, prepared.height());
             }
         };
-        let elapsed = self.trace_region_chunks(device, queue, &prepared, target, &whole, &row_report)?;
+        let elapsed =
+            self.trace_region_chunks(device, queue, &prepared, target, &whole, &row_report)?;
         Ok(RenderStats {
             rays_traced: self.read_ray_count(device, queue, &prepared)?,
             elapsed,
