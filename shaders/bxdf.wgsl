@@ -11,8 +11,12 @@ fn reflect_direction(u: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 
 // Refraction with k = eta_i / eta_t, n facing the incident side (lecture, Snell's law):
 // T = k·u + (k·cos θi - sqrt(1 - k²(1 - cos² θi)))·N, cos θi = N·(-u).
-// Returns the zero vector under total internal reflection.
+// Returns the zero vector under total internal reflection, and u itself at an
+// index-matched interface (k = 1), so such a dielectric vanishes exactly.
 fn refract_direction(u: vec3<f32>, n: vec3<f32>, k: f32) -> vec3<f32> {
+    if k == 1.0 {
+        return u;
+    }
     let cos_i = clamp(-dot(u, n), -1.0, 1.0);
     let radicand = 1.0 - k * k * (1.0 - cos_i * cos_i);
     if radicand < 0.0 {
@@ -22,8 +26,12 @@ fn refract_direction(u: vec3<f32>, n: vec3<f32>, k: f32) -> vec3<f32> {
 }
 
 // Fresnel reflectances (R_s, R_p) at a smooth dielectric interface (Fresnel equations;
-// Hecht, "Optics", §4.6.2; pbrt-v4 §9.3.4). Both are 1 beyond the critical angle.
+// Hecht, "Optics", §4.6.2; pbrt-v4 §9.3.4). Both are 1 beyond the critical angle and
+// exactly 0 at an index-matched interface (eta_i = eta_t).
 fn fresnel_dielectric_polarized(cos_i_in: f32, eta_i: f32, eta_t: f32) -> vec2<f32> {
+    if eta_i == eta_t {
+        return vec2<f32>(0.0, 0.0);
+    }
     let cos_i = clamp(cos_i_in, 0.0, 1.0);
     let ratio = eta_i / eta_t;
     let sin_t_squared = ratio * ratio * (1.0 - cos_i * cos_i);
@@ -81,8 +89,9 @@ struct SurfaceResponse {
 }
 
 // The weights for a ray along `direction` hitting `material` where the normal facing
-// the ray is n; `entering` tells whether it arrives from the geometric outside.
-fn surface_response(material: Material, direction: vec3<f32>, n: vec3<f32>, entering: bool) -> SurfaceResponse {
+// the ray is n; `entering` tells whether it arrives from the geometric outside, and
+// outside_ior is the index of the medium on the surface's outside (1 for air).
+fn surface_response(material: Material, direction: vec3<f32>, n: vec3<f32>, entering: bool, outside_ior: f32) -> SurfaceResponse {
     let cos_o = clamp(-dot(direction, n), 0.0, 1.0);
     var response = SurfaceResponse(0.0, vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     switch material.kind {
@@ -90,7 +99,7 @@ fn surface_response(material: Material, direction: vec3<f32>, n: vec3<f32>, ente
             // A clear coat reflects F and lets 1 - F reach the base.
             var coat = 0.0;
             if material.coat_ior > 0.0 {
-                coat = fresnel_dielectric(cos_o, 1.0, material.coat_ior);
+                coat = fresnel_dielectric(cos_o, outside_ior, material.coat_ior);
             }
             response.base = 1.0 - coat;
             response.reflect = vec3<f32>(coat);
@@ -100,9 +109,9 @@ fn surface_response(material: Material, direction: vec3<f32>, n: vec3<f32>, ente
         }
         case MATERIAL_DIELECTRIC: {
             var eta_i = material.ior;
-            var eta_t = 1.0;
+            var eta_t = outside_ior;
             if entering {
-                eta_i = 1.0;
+                eta_i = outside_ior;
                 eta_t = material.ior;
             }
             let t = refract_direction(direction, n, eta_i / eta_t);

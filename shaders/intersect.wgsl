@@ -14,10 +14,34 @@ struct Hit {
     normal: vec3<f32>,
     material: u32,
     found: bool,
+    // The hit point re-projected onto the surface (Ray Tracing Gems, ch. 6, §6.2.1).
+    position: vec3<f32>,
 }
 
 fn ray_at(ray: Ray, t: f32) -> vec3<f32> {
     return ray.origin + ray.direction * t;
+}
+
+// The unit normal (v1 - v0) × (v2 - v0), normalized.
+fn triangle_normal(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> vec3<f32> {
+    return normalize(cross(v1 - v0, v2 - v0));
+}
+
+// A point moved radially onto the sphere, c + r·normalize(p - c) (Wächter and Binder,
+// Ray Tracing Gems, ch. 6, §6.2.1): its error is then relative to its own magnitude,
+// not to the length of the ray that found it, as the ulp-scaled offset assumes.
+fn project_onto_sphere(p: vec3<f32>, center: vec3<f32>, radius: f32) -> vec3<f32> {
+    let from_center = p - center;
+    let length_squared = dot(from_center, from_center);
+    if length_squared > 0.0 {
+        return center + from_center * (radius / sqrt(length_squared));
+    }
+    return p;
+}
+
+// A point projected orthogonally onto the plane N·p = d: p - (N·p - d)·N (ibid.).
+fn project_onto_plane(p: vec3<f32>, normal: vec3<f32>, offset: f32) -> vec3<f32> {
+    return p - normal * (dot(normal, p) - offset);
 }
 
 // Picks the nearest root in (0, t_max) of two sorted roots.
@@ -40,7 +64,7 @@ fn intersect_sphere(ray: Ray, center: vec3<f32>, radius: f32, t_max: f32) -> f32
     let b = -dot(f, ray.direction);
     let closest = f + ray.direction * b;
     let discriminant = radius * radius - dot(closest, closest);
-    if discriminant < 0.0 {
+    if !(discriminant >= 0.0) {
         return NO_HIT;
     }
     let c = dot(f, f) - radius * radius;
@@ -53,7 +77,8 @@ fn intersect_sphere(ray: Ray, center: vec3<f32>, radius: f32, t_max: f32) -> f32
     return nearest_root(min(r0, q), max(r0, q), t_max);
 }
 
-// Ray/plane from the lecture: with N·P = d, s = (d - N·P0) / (N·u); parallel rays miss.
+// Ray/plane from the lecture: with N·P = d, s = (d - N·P0) / (N·u); parallel rays miss,
+// and a nearly parallel ray whose s overflows fails the range test 0 < s < t_max.
 fn intersect_plane(ray: Ray, normal: vec3<f32>, offset: f32, t_max: f32) -> f32 {
     let denominator = dot(normal, ray.direction);
     if denominator == 0.0 {
@@ -106,28 +131,53 @@ fn intersect_polygon(ray: Ray, polygon: Polygon, t_max: f32) -> f32 {
     return t;
 }
 
-// Möller–Trumbore ray/triangle ("Fast, Minimum Storage Ray/Triangle Intersection",
-// JGT 1997).
+// Watertight ray/triangle of Woop, Benthin and Wald, "Watertight Ray/Triangle
+// Intersection" (JCGT 2(1), 2013), Listing 1: shear the triangle so the ray becomes
+// the +z axis of a permuted frame, then test the signs of the 2D edge functions U, V, W.
+// Triangles sharing an edge get exactly opposite values for it, and 0 counts as
+// inside, so no ray slips between them. The paper's double-precision re-test of zero
+// edge functions is left out (WGSL has no f64); see the CPU twin's notes.
 fn intersect_triangle(ray: Ray, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, t_max: f32) -> f32 {
-    let edge1 = v1 - v0;
-    let edge2 = v2 - v0;
-    let p = cross(ray.direction, edge2);
-    let determinant = dot(edge1, p);
+    let d = ray.direction;
+    let m = abs(d);
+    var kz = 2u;
+    if m.x > m.y {
+        if m.x > m.z {
+            kz = 0u;
+        }
+    } else if m.y > m.z {
+        kz = 1u;
+    }
+    var kx = (kz + 1u) % 3u;
+    var ky = (kx + 1u) % 3u;
+    if d[kz] < 0.0 {
+        let swap = kx;
+        kx = ky;
+        ky = swap;
+    }
+    let shear_x = d[kx] / d[kz];
+    let shear_y = d[ky] / d[kz];
+    let shear_z = 1.0 / d[kz];
+    let a = v0 - ray.origin;
+    let b = v1 - ray.origin;
+    let c = v2 - ray.origin;
+    let ax = a[kx] - shear_x * a[kz];
+    let ay = a[ky] - shear_y * a[kz];
+    let bx = b[kx] - shear_x * b[kz];
+    let by = b[ky] - shear_y * b[kz];
+    let cx = c[kx] - shear_x * c[kz];
+    let cy = c[ky] - shear_y * c[kz];
+    let u = cx * by - cy * bx;
+    let v = ax * cy - ay * cx;
+    let w = bx * ay - by * ax;
+    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        return NO_HIT;
+    }
+    let determinant = u + v + w;
     if determinant == 0.0 {
         return NO_HIT;
     }
-    let inverse = 1.0 / determinant;
-    let s = ray.origin - v0;
-    let u = dot(s, p) * inverse;
-    if u < 0.0 || u > 1.0 {
-        return NO_HIT;
-    }
-    let q = cross(s, edge1);
-    let v = dot(ray.direction, q) * inverse;
-    if v < 0.0 || u + v > 1.0 {
-        return NO_HIT;
-    }
-    let t = dot(edge2, q) * inverse;
+    let t = shear_z * (u * a[kz] + v * b[kz] + w * c[kz]) / determinant;
     if t > 0.0 && t < t_max {
         return t;
     }
@@ -137,34 +187,39 @@ fn intersect_triangle(ray: Ray, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, t_m
 // The nearest hit along `ray` in (0, t_max) over all shapes. Shapes are visited by
 // type, not in file order as on the CPU: only exact ties in t can resolve differently.
 fn intersect_scene(ray: Ray, t_max: f32) -> Hit {
-    var hit = Hit(t_max, vec3<f32>(0.0), 0u, false);
+    var hit = Hit(t_max, vec3<f32>(0.0), 0u, false, vec3<f32>(0.0));
     for (var i = 0u; i < frame.sphere_count; i += 1u) {
         let sphere = spheres[i];
         let t = intersect_sphere(ray, sphere.center, sphere.radius, hit.t);
         if t != NO_HIT {
-            hit = Hit(t, (ray_at(ray, t) - sphere.center) / sphere.radius, sphere.material, true);
+            let p = ray_at(ray, t);
+            hit = Hit(t, normalize(p - sphere.center), sphere.material, true,
+                      project_onto_sphere(p, sphere.center, sphere.radius));
         }
     }
     for (var i = 0u; i < frame.plane_count; i += 1u) {
         let plane = planes[i];
         let t = intersect_plane(ray, plane.normal, plane.offset, hit.t);
         if t != NO_HIT {
-            hit = Hit(t, plane.normal, plane.material, true);
+            hit = Hit(t, plane.normal, plane.material, true,
+                      project_onto_plane(ray_at(ray, t), plane.normal, plane.offset));
         }
     }
     for (var i = 0u; i < frame.polygon_count; i += 1u) {
         let polygon = polygons[i];
         let t = intersect_polygon(ray, polygon, hit.t);
         if t != NO_HIT {
-            hit = Hit(t, polygon.normal, polygon.material, true);
+            hit = Hit(t, polygon.normal, polygon.material, true,
+                      project_onto_plane(ray_at(ray, t), polygon.normal, polygon.offset));
         }
     }
     for (var i = 0u; i < frame.triangle_count; i += 1u) {
         let triangle = triangles[i];
         let t = intersect_triangle(ray, triangle.v0, triangle.v1, triangle.v2, hit.t);
         if t != NO_HIT {
-            let normal = normalize(cross(triangle.v1 - triangle.v0, triangle.v2 - triangle.v0));
-            hit = Hit(t, normal, triangle.material, true);
+            let normal = triangle_normal(triangle.v0, triangle.v1, triangle.v2);
+            hit = Hit(t, normal, triangle.material, true,
+                      project_onto_plane(ray_at(ray, t), normal, dot(normal, triangle.v0)));
         }
     }
     return hit;
@@ -199,10 +254,12 @@ fn occluded(ray: Ray, t_max: f32) -> bool {
 // Moves a ray origin off a surface: Wächter and Binder, "A Fast and Robust Method for
 // Avoiding Self-Intersection" (Ray Tracing Gems, ch. 6). `n` points to the side the new
 // ray leaves on. Each coordinate moves by 256·n units in the last place of its f32 bit
-// pattern, so the offset scales with the point's magnitude; within 1/32 of the origin,
-// where ulps shrink towards zero, a fixed 1/65536·n is added instead.
-fn offset_ray_origin(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+// pattern, so the offset scales with the point's magnitude; within scale/32 of the
+// origin, where ulps shrink towards zero, a fixed scale/65536·n is added instead, with
+// `scale` = frame.offset_scale (ray_offset_scale on the CPU: the scene's size, capped
+// at 1, so the offset shrinks with scenes smaller than the unit).
+fn offset_ray_origin(p: vec3<f32>, n: vec3<f32>, scale: f32) -> vec3<f32> {
     let ulps = vec3<i32>(256.0 * n);
     let moved = bitcast<vec3<f32>>(bitcast<vec3<i32>>(p) + select(ulps, -ulps, p < vec3<f32>(0.0)));
-    return select(moved, p + (1.0 / 65536.0) * n, abs(p) < vec3<f32>(1.0 / 32.0));
+    return select(moved, p + ((1.0 / 65536.0) * scale) * n, abs(p) < vec3<f32>((1.0 / 32.0) * scale));
 }

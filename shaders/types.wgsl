@@ -22,11 +22,15 @@ struct FrameUniforms {
     light_count: u32,
     row_offset: u32,
     row_count: u32,
+    column_offset: u32,
+    column_count: u32,
+    target_x: u32,
+    target_y: u32,
+    offset_scale: f32,
     min_ray_weight: f32,
     sample_index: u32,
     accumulation_rows: u32,
     _pad0: u32,
-    _pad1: u32,
 }
 
 struct Sphere {

@@ -198,11 +198,15 @@ fn bad_input_is_an_error_not_a_panic() {
         Err(GpuError::Validation(_))
     ));
 
+    // An image wider than one texture can be: `render` tiles it (tests/extremes.rs),
+    // `render_to_texture`, which has a single target, refuses it clearly.
     let too_wide = device.limits().max_texture_dimension_2d.checked_add(1);
     if let Some(width) = too_wide.filter(|&w| w <= gpu_render::scene::MAX_IMAGE_DIMENSION) {
         let mut wide = scene(1);
         wide.render.width = width;
-        match renderer.prepare(device, queue, &wide) {
+        let target = linear_target(device);
+        let view = target.create_view(&Default::default());
+        match renderer.render_to_texture(device, queue, &wide, &view, None) {
             Err(GpuError::DeviceLimit { value, limit, .. }) => {
                 assert_eq!((value, limit), (u64::from(width), u64::from(width - 1)));
             }

@@ -16,8 +16,13 @@ pub fn reflect_direction(u: DVec3, n: DVec3) -> DVec3 {
 /// Refraction of the unit incident direction `u` through a surface with unit normal
 /// `n` facing the incident side, with `k = η_i / η_t` (lecture, Snell's law):
 /// `T = k·u + (k·cos θ_i - sqrt(1 - k²(1 - cos² θ_i)))·N`, `cos θ_i = N·(-u)`.
-/// Returns `None` under total internal reflection (negative radicand).
+/// Returns `None` under total internal reflection (negative radicand). An
+/// index-matched interface (`k = 1`) returns `u` exactly, so that a dielectric whose
+/// index equals its surroundings' vanishes without a trace of rounding.
 pub fn refract_direction(u: DVec3, n: DVec3, k: f64) -> Option<DVec3> {
+    if k == 1.0 {
+        return Some(u);
+    }
     let cos_i = (-u.dot(n)).clamp(-1.0, 1.0);
     let radicand = 1.0 - k * k * (1.0 - cos_i * cos_i);
     if radicand < 0.0 {
@@ -29,8 +34,13 @@ pub fn refract_direction(u: DVec3, n: DVec3, k: f64) -> Option<DVec3> {
 /// Fresnel reflectances `(R_s, R_p)` of the s- and p-polarised components at a smooth
 /// dielectric interface (the Fresnel equations; e.g. Hecht, "Optics", §4.6.2, or pbrt-v4
 /// §9.3.4), for `cos_i` the cosine of the incidence angle on the side of index `eta_i`.
-/// Both are 1 beyond the critical angle (total internal reflection).
+/// Both are 1 beyond the critical angle (total internal reflection), and both are
+/// exactly 0 at an index-matched interface (`eta_i = eta_t`), where `cos_t` rounded
+/// would leave a reflectance of about 1e-17 instead.
 pub fn fresnel_dielectric_polarized(cos_i: f64, eta_i: f64, eta_t: f64) -> (f64, f64) {
+    if eta_i == eta_t {
+        return (0.0, 0.0);
+    }
     let cos_i = cos_i.clamp(0.0, 1.0);
     let sin_t_squared = (eta_i / eta_t).powi(2) * (1.0 - cos_i * cos_i);
     if sin_t_squared >= 1.0 {
@@ -96,12 +106,15 @@ pub struct SurfaceResponse {
 /// The weights of [`SurfaceResponse`] for a ray travelling along `direction` that hits
 /// `material` where the unit normal facing the ray is `n`; `entering` tells whether
 /// the ray arrives from the outside of the surface (the side its geometric normal
-/// points to).
+/// points to), and `outside_ior` is the index of refraction of the medium on the
+/// surface's outside (1 for air; see `MediumStack` in `trace.rs` for nested
+/// dielectrics).
 pub fn surface_response(
     material: &Material,
     direction: DVec3,
     n: DVec3,
     entering: bool,
+    outside_ior: f64,
 ) -> SurfaceResponse {
     let cos_o = (-direction.dot(n)).clamp(0.0, 1.0);
     let mut response = SurfaceResponse {
@@ -114,7 +127,7 @@ pub fn surface_response(
         MaterialKind::Lambert | MaterialKind::BlinnPhong => {
             // A clear coat reflects F and lets 1 - F reach the base.
             let coat = if material.coat_ior > 0.0 {
-                fresnel_dielectric(cos_o, 1.0, material.coat_ior)
+                fresnel_dielectric(cos_o, outside_ior, material.coat_ior)
             } else {
                 0.0
             };
@@ -124,9 +137,9 @@ pub fn surface_response(
         MaterialKind::Mirror => response.reflect = material.reflectance,
         MaterialKind::Dielectric => {
             let (eta_i, eta_t) = if entering {
-                (1.0, material.ior)
+                (outside_ior, material.ior)
             } else {
-                (material.ior, 1.0)
+                (material.ior, outside_ior)
             };
             match refract_direction(direction, n, eta_i / eta_t) {
                 Some(t) => {
@@ -208,7 +221,7 @@ mod tests {
                 .min(std::f64::consts::FRAC_PI_2 - 1e-9);
             let dir = DVec3::new(theta.sin(), -theta.cos(), 0.0);
             for entering in [true, false] {
-                let r = surface_response(&glass, dir, DVec3::Y, entering);
+                let r = surface_response(&glass, dir, DVec3::Y, entering, 1.0);
                 let total = r.reflect.x + r.transmit.x;
                 assert!((total - 1.0).abs() < 1e-12, "θ={i}° entering={entering}");
             }

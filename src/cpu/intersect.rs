@@ -32,6 +32,8 @@ pub struct Hit {
     pub normal: DVec3,
     /// Material index.
     pub material: u32,
+    /// The hit point, re-projected onto the surface (see [`PreparedShape::surface_point`]).
+    pub position: DVec3,
 }
 
 /// A shape with the per-shape constants the intersection routines need.
@@ -118,7 +120,7 @@ impl PreparedShape {
         match self {
             Self::Sphere { center, radius, .. } => {
                 let t = intersect_sphere(ray, *center, *radius, t_max)?;
-                Some((t, (ray.at(t) - *center) / *radius))
+                Some((t, (ray.at(t) - *center).normalize()))
             }
             Self::Plane { normal, offset, .. } => {
                 intersect_plane(ray, *normal, *offset, t_max).map(|t| (t, *normal))
@@ -128,10 +130,27 @@ impl PreparedShape {
             } => intersect_polygon(ray, plane, vertices, t_max).map(|t| (t, plane.normal)),
             Self::Triangle { vertices, .. } => {
                 let t = intersect_triangle(ray, vertices, t_max)?;
-                let normal = (vertices[1] - vertices[0])
-                    .cross(vertices[2] - vertices[0])
-                    .normalize();
-                Some((t, normal))
+                Some((t, triangle_normal(vertices)))
+            }
+        }
+    }
+
+    /// The hit point `ray.at(t)` moved back onto the surface, as Wächter and Binder
+    /// recommend before offsetting a new ray origin ("A Fast and Robust Method for
+    /// Avoiding Self-Intersection", Ray Tracing Gems, ch. 6, §6.2.1): `ray.at(t)` is off
+    /// the surface by the rounding error of `t` times the ray length, which grows with
+    /// the distance from the ray origin, while the re-projected point's error is relative
+    /// to its own magnitude, which is what the ulp-scaled offset assumes. A sphere point
+    /// becomes `c + r·normalize(p - c)`; a point of a plane, polygon or triangle is
+    /// projected orthogonally onto its plane, `p - (N·p - d)·N`.
+    pub fn surface_point(&self, point: DVec3) -> DVec3 {
+        match self {
+            Self::Sphere { center, radius, .. } => project_onto_sphere(point, *center, *radius),
+            Self::Plane { normal, offset, .. } => project_onto_plane(point, *normal, *offset),
+            Self::Polygon { plane, .. } => project_onto_plane(point, plane.normal, plane.offset),
+            Self::Triangle { vertices, .. } => {
+                let normal = triangle_normal(vertices);
+                project_onto_plane(point, normal, normal.dot(vertices[0]))
             }
         }
     }
@@ -147,6 +166,31 @@ impl PreparedShape {
     }
 }
 
+/// The unit normal `(v1 - v0) × (v2 - v0)` of a triangle, normalized.
+pub fn triangle_normal(vertices: &[DVec3; 3]) -> DVec3 {
+    (vertices[1] - vertices[0])
+        .cross(vertices[2] - vertices[0])
+        .normalize()
+}
+
+/// `point` moved radially onto the sphere: `c + r·normalize(p - c)` (Ray Tracing
+/// Gems, ch. 6, §6.2.1). A point at the centre (never a hit) is returned unchanged.
+pub fn project_onto_sphere(point: DVec3, center: DVec3, radius: f64) -> DVec3 {
+    let from_center = point - center;
+    let length_squared = from_center.dot(from_center);
+    if length_squared > 0.0 {
+        center + from_center * (radius / length_squared.sqrt())
+    } else {
+        point
+    }
+}
+
+/// `point` projected orthogonally onto the plane `N·p = d`: `p - (N·p - d)·N`
+/// (Ray Tracing Gems, ch. 6, §6.2.1).
+pub fn project_onto_plane(point: DVec3, normal: DVec3, offset: f64) -> DVec3 {
+    point - normal * (normal.dot(point) - offset)
+}
+
 /// Ray/sphere intersection in the numerically stable form of Haines, Günther and
 /// Akenine-Möller, "Precision Improvements for Ray/Sphere Intersection" (Ray Tracing
 /// Gems, ch. 7). It solves the lecture's `s = -u·ΔP ± sqrt((u·ΔP)² - |ΔP|² + r²)`, but
@@ -158,7 +202,8 @@ pub fn intersect_sphere(ray: &Ray, center: DVec3, radius: f64, t_max: f64) -> Op
     let b = -f.dot(ray.direction);
     let closest = f + ray.direction * b;
     let discriminant = radius * radius - closest.dot(closest);
-    if discriminant < 0.0 {
+    // NaN (from an overflowing square) is a miss, like a negative discriminant.
+    if discriminant.is_nan() || discriminant < 0.0 {
         return None;
     }
     let c = f.dot(f) - radius * radius;
@@ -181,7 +226,9 @@ pub fn intersect_sphere(ray: &Ray, center: DVec3, radius: f64, t_max: f64) -> Op
 }
 
 /// Ray/plane intersection from the lecture: with `N · P = d`, `s = (d - N·P0) / (N·u)`.
-/// A ray parallel to the plane (`N·u = 0`) misses it.
+/// A ray parallel to the plane (`N·u = 0`) misses it, and so does a nearly parallel one
+/// whose `s` overflows: an infinite or NaN `s` fails the range test `0 < s < t_max`
+/// (with `t_max` at most +∞), so no division blow-up becomes a hit.
 pub fn intersect_plane(ray: &Ray, normal: DVec3, offset: f64, t_max: f64) -> Option<f64> {
     let denominator = normal.dot(ray.direction);
     if denominator == 0.0 {
@@ -234,46 +281,82 @@ pub fn point_in_polygon(point: DVec3, vertices: &[DVec3], dropped_axis: u32) -> 
     inside
 }
 
-/// Möller–Trumbore ray/triangle intersection (Möller and Trumbore, "Fast, Minimum
-/// Storage Ray/Triangle Intersection", JGT 1997).
+/// Watertight ray/triangle intersection of Woop, Benthin and Wald, "Watertight
+/// Ray/Triangle Intersection" (JCGT 2(1), 2013), Listing 1.
+///
+/// The triangle is translated to the ray origin and sheared so that the ray becomes
+/// the +z axis of a permuted coordinate frame (`kz` = the largest direction
+/// component). The 2D edge functions `U`, `V`, `W` of the sheared vertices then decide
+/// the hit. Two triangles sharing an edge evaluate that edge's function from the same
+/// sheared vertices with the same operations in swapped order, so they get exactly
+/// opposite values: a ray can never pass between them. A value of exactly 0 counts as
+/// inside (the test rejects only mixed signs), so a ray through a shared edge or
+/// vertex hits every triangle there and the nearest `t` wins. The paper re-evaluates
+/// zero edge functions in double precision to learn their true sign; neither backend
+/// has a wider type (the CPU already works in `f64`, WGSL has no `f64`), and treating 0
+/// as inside keeps the test watertight without it.
+///
+/// Returns the ray parameter in (0, `t_max`); a non-finite `t` is a miss.
 pub fn intersect_triangle(ray: &Ray, vertices: &[DVec3; 3], t_max: f64) -> Option<f64> {
-    let edge1 = vertices[1] - vertices[0];
-    let edge2 = vertices[2] - vertices[0];
-    let p = ray.direction.cross(edge2);
-    let determinant = edge1.dot(p);
+    let d = ray.direction;
+    // The largest component of the direction becomes z; x and y follow it cyclically,
+    // swapped when d.z' < 0 to keep the winding (Woop et al., §3).
+    let abs = d.abs();
+    let kz = if abs.x > abs.y {
+        if abs.x > abs.z { 0 } else { 2 }
+    } else if abs.y > abs.z {
+        1
+    } else {
+        2
+    };
+    let mut kx = (kz + 1) % 3;
+    let mut ky = (kx + 1) % 3;
+    if d[kz] < 0.0 {
+        std::mem::swap(&mut kx, &mut ky);
+    }
+    // Shear constants.
+    let shear_x = d[kx] / d[kz];
+    let shear_y = d[ky] / d[kz];
+    let shear_z = 1.0 / d[kz];
+    let a = vertices[0] - ray.origin;
+    let b = vertices[1] - ray.origin;
+    let c = vertices[2] - ray.origin;
+    let (ax, ay) = (a[kx] - shear_x * a[kz], a[ky] - shear_y * a[kz]);
+    let (bx, by) = (b[kx] - shear_x * b[kz], b[ky] - shear_y * b[kz]);
+    let (cx, cy) = (c[kx] - shear_x * c[kz], c[ky] - shear_y * c[kz]);
+    // Scaled barycentric coordinates (2D edge functions).
+    let u = cx * by - cy * bx;
+    let v = ax * cy - ay * cx;
+    let w = bx * ay - by * ax;
+    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        return None;
+    }
+    let determinant = u + v + w;
     if determinant == 0.0 {
         return None;
     }
-    let inverse = 1.0 / determinant;
-    let s = ray.origin - vertices[0];
-    let u = s.dot(p) * inverse;
-    if !(0.0..=1.0).contains(&u) {
-        return None;
-    }
-    let q = s.cross(edge1);
-    let v = ray.direction.dot(q) * inverse;
-    if v < 0.0 || u + v > 1.0 {
-        return None;
-    }
-    let t = edge2.dot(q) * inverse;
+    let t_scaled = shear_z * (u * a[kz] + v * b[kz] + w * c[kz]);
+    let t = t_scaled / determinant;
     (t > 0.0 && t < t_max).then_some(t)
 }
 
-/// The nearest hit along `ray` in (0, `t_max`) over all shapes.
+/// The nearest hit along `ray` in (0, `t_max`) over all shapes, its point re-projected
+/// onto the shape ([`PreparedShape::surface_point`]).
 pub fn intersect_scene(shapes: &[PreparedShape], ray: &Ray, t_max: f64) -> Option<Hit> {
-    let mut nearest: Option<Hit> = None;
+    let mut nearest: Option<(f64, DVec3, &PreparedShape)> = None;
     let mut limit = t_max;
     for shape in shapes {
         if let Some((t, normal)) = shape.intersect(ray, limit) {
             limit = t;
-            nearest = Some(Hit {
-                t,
-                normal,
-                material: shape.material(),
-            });
+            nearest = Some((t, normal, shape));
         }
     }
-    nearest
+    nearest.map(|(t, normal, shape)| Hit {
+        t,
+        normal,
+        material: shape.material(),
+        position: shape.surface_point(ray.at(t)),
+    })
 }
 
 /// Whether anything lies along `ray` in (0, `t_max`): the shadow-ray query.
@@ -283,22 +366,53 @@ pub fn occluded(shapes: &[PreparedShape], ray: &Ray, t_max: f64) -> bool {
         .any(|shape| shape.intersect(ray, t_max).is_some())
 }
 
+/// The length scale of [`offset_ray_origin`]'s near-origin branch for `scene`:
+/// the largest absolute coordinate of its geometry (sphere centres ± radii, plane
+/// offsets, vertices), capped at 1.
+///
+/// Wächter and Binder's constants (`1/32` for "near the origin", `1/65536` for the
+/// absolute offset there) assume a scene of about unit size. In a scene 10^-4 across
+/// that absolute offset would be 15% of the scene, so both constants are multiplied by
+/// this scale, which makes the offset, like every other length, scale with the scene.
+/// Larger scenes keep the published constants (scale 1): there the ulp branch covers
+/// every coordinate beyond 1/32, and a larger near-origin offset would lift rays off a
+/// small object lying near the origin of a large world.
+pub fn ray_offset_scale(scene: &Scene) -> f64 {
+    let mut extent = 0.0f64;
+    let mut include = |v: DVec3| extent = extent.max(v.abs().max_element());
+    for shape in &scene.shapes {
+        match shape {
+            Shape::Sphere { center, radius, .. } => include(center.abs() + DVec3::splat(*radius)),
+            Shape::Plane { offset, .. } => include(DVec3::splat(*offset)),
+            Shape::Polygon { vertices, .. } => vertices.iter().copied().for_each(&mut include),
+            Shape::Triangle { vertices, .. } => vertices.iter().copied().for_each(&mut include),
+        }
+    }
+    if extent > 0.0 && extent < 1.0 {
+        extent
+    } else {
+        1.0
+    }
+}
+
 /// Moves a ray origin off a surface so the new ray does not hit that surface again:
 /// the method of Wächter and Binder, "A Fast and Robust Method for Avoiding
 /// Self-Intersection" (Ray Tracing Gems, ch. 6). The point moves along `normal` (which
 /// must point to the side the new ray leaves on) by a fixed number of units in the last
 /// place of each coordinate, so the offset scales with the point's magnitude; near the
-/// origin, where ulps become tiny, a small absolute offset is used instead.
+/// origin (within `scale/32`), where ulps become tiny, a small absolute offset
+/// `scale/65536` is used instead, `scale` being [`ray_offset_scale`] (1 in scenes of
+/// unit size and beyond: the published constants).
 ///
 /// The GPU applies the constants to `f32` bit patterns; here they apply to `f64` bit
 /// patterns, so the CPU offset is the same number of ulps of its own, finer, precision.
-pub fn offset_ray_origin(point: DVec3, normal: DVec3) -> DVec3 {
+pub fn offset_ray_origin(point: DVec3, normal: DVec3, scale: f64) -> DVec3 {
     const ORIGIN: f64 = 1.0 / 32.0;
     const FLOAT_SCALE: f64 = 1.0 / 65_536.0;
     const INT_SCALE: f64 = 256.0;
     let offset_component = |p: f64, n: f64| -> f64 {
-        if p.abs() < ORIGIN {
-            return p + FLOAT_SCALE * n;
+        if p.abs() < ORIGIN * scale {
+            return p + FLOAT_SCALE * scale * n;
         }
         let ulps = (INT_SCALE * n) as i64;
         let bits = p.to_bits() as i64;
@@ -401,14 +515,110 @@ mod tests {
         assert!(intersect_triangle(&outside, &tri, f64::INFINITY).is_none());
     }
 
+    /// The 12 triangles of the cube [-1, 1]³, wound outwards.
+    fn cube_triangles(scale: f64) -> Vec<[DVec3; 3]> {
+        let corner = |i: usize| {
+            DVec3::new(
+                if i & 1 == 0 { -1.0 } else { 1.0 },
+                if i & 2 == 0 { -1.0 } else { 1.0 },
+                if i & 4 == 0 { -1.0 } else { 1.0 },
+            ) * scale
+        };
+        // Each face as four corner indices in counter-clockwise order seen from outside.
+        let faces = [
+            [0, 2, 6, 4],
+            [1, 5, 7, 3],
+            [0, 4, 5, 1],
+            [2, 3, 7, 6],
+            [0, 1, 3, 2],
+            [4, 6, 7, 5],
+        ];
+        faces
+            .iter()
+            .flat_map(|f| {
+                [
+                    [corner(f[0]), corner(f[1]), corner(f[2])],
+                    [corner(f[0]), corner(f[2]), corner(f[3])],
+                ]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn triangle_hit_matches_the_exact_parameter() {
+        let tri = [
+            DVec3::new(-1.0, -1.0, 0.0),
+            DVec3::new(2.0, -1.0, 0.0),
+            DVec3::new(-1.0, 2.0, 0.0),
+        ];
+        for direction in [
+            DVec3::NEG_Z,
+            DVec3::new(0.3, -0.2, -1.0),
+            DVec3::new(-0.2, 0.1, -1.0),
+        ] {
+            let r = ray(DVec3::new(0.1, 0.2, 3.0), direction);
+            let t = intersect_triangle(&r, &tri, f64::INFINITY).expect("hit");
+            assert!(r.at(t).z.abs() < 1e-14, "{direction}");
+            // Both windings hit (no back-face culling).
+            let flipped = [tri[0], tri[2], tri[1]];
+            assert_eq!(intersect_triangle(&r, &flipped, f64::INFINITY), Some(t));
+        }
+        // A ray in the triangle's plane misses; so does one aimed away.
+        assert!(
+            intersect_triangle(&ray(DVec3::new(-5.0, 0.0, 0.0), DVec3::X), &tri, 1e9).is_none()
+        );
+        assert!(intersect_triangle(&ray(DVec3::new(0.0, 0.0, 3.0), DVec3::Z), &tri, 1e9).is_none());
+    }
+
+    #[test]
+    fn rays_through_shared_edges_and_vertices_never_slip_through_a_closed_cube() {
+        for scale in [1e-4, 1.0, 1e4] {
+            let cube = cube_triangles(scale);
+            // Targets exactly on edges (midpoints and off-centre points) and vertices.
+            let mut targets = Vec::new();
+            for i in 0..8usize {
+                let c = |bit: usize| if i & bit == 0 { -scale } else { scale };
+                targets.push(DVec3::new(c(1), c(2), c(4)));
+                for fraction in [0.0, 0.3, -0.7] {
+                    targets.push(DVec3::new(fraction * scale, c(2), c(4)));
+                    targets.push(DVec3::new(c(1), fraction * scale, c(4)));
+                    targets.push(DVec3::new(c(1), c(2), fraction * scale));
+                }
+            }
+            // From inside every ray must hit; from outside, rays come from beyond the
+            // target on a line through an interior point, so they enter the cube there
+            // (a silhouette edge could be missed legitimately).
+            let interior = [
+                DVec3::ZERO,
+                DVec3::new(0.31, -0.52, 0.13),
+                DVec3::new(-0.77, 0.05, 0.6),
+            ];
+            for inside in interior {
+                let inside = inside * scale;
+                for target in &targets {
+                    for origin in [inside, *target + (*target - inside) * 3.7] {
+                        let r = ray(origin, *target - origin);
+                        let hit = cube
+                            .iter()
+                            .any(|tri| intersect_triangle(&r, tri, f64::INFINITY).is_some());
+                        assert!(
+                            hit,
+                            "scale {scale}: ray {origin} -> {target} slipped through"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn offset_moves_off_the_surface_at_every_scale() {
         for scale in [1e-6, 1e-3, 1.0, 1e3, 1e6] {
             let p = DVec3::new(scale, -scale, 0.5 * scale);
-            let moved = offset_ray_origin(p, DVec3::Y);
+            let moved = offset_ray_origin(p, DVec3::Y, 1.0);
             assert!(moved.y > p.y, "scale {scale}");
             assert_eq!(moved.x, p.x);
-            let back = offset_ray_origin(p, DVec3::NEG_Y);
+            let back = offset_ray_origin(p, DVec3::NEG_Y, 1.0);
             assert!(back.y < p.y, "scale {scale}");
         }
     }

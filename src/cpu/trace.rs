@@ -7,6 +7,7 @@ use glam::DVec3;
 use super::bxdf::{eval_brdf, reflect_direction, surface_response};
 use super::intersect::{
     Hit, PreparedShape, Ray, intersect_scene, occluded, offset_ray_origin, prepare_shapes,
+    ray_offset_scale,
 };
 use crate::camera::{CameraFrame, sample_offset};
 use crate::scene::{Light, Material, MaterialKind, RenderSettings, Scene};
@@ -29,6 +30,8 @@ pub struct PreparedScene {
     pub lights: Vec<Light>,
     /// Shapes with precomputed constants.
     pub shapes: Vec<PreparedShape>,
+    /// Length scale of the self-intersection offset ([`ray_offset_scale`]).
+    pub offset_scale: f64,
 }
 
 impl PreparedScene {
@@ -43,8 +46,95 @@ impl PreparedScene {
             materials: scene.materials.clone(),
             lights: scene.lights.clone(),
             shapes: prepare_shapes(&scene),
+            offset_scale: ray_offset_scale(&scene),
         }
     }
+}
+
+/// How many nested dielectrics a [`MediumStack`] remembers.
+pub const MEDIUM_STACK_SIZE: usize = 4;
+
+/// Squared distances to a point light below this (the smallest normal `f32`, 2^-126)
+/// contribute nothing: at zero or denormal distance `I / r²` is infinite or NaN in
+/// `f32`, and the light is inside the surface it would light. Both backends use the
+/// same threshold.
+pub const MIN_LIGHT_DISTANCE_SQUARED: f64 = f32::MIN_POSITIVE as f64;
+
+/// The dielectrics a ray is inside, innermost last: the per-path medium stack that
+/// lets dielectrics nest (glass in water, the camera inside glass).
+///
+/// The rule, for closed, properly nested (non-overlapping) dielectric surfaces:
+/// - every path starts in air (index 1, an empty stack);
+/// - a refracted ray that *enters* a dielectric (arrives on the side its geometric
+///   normal points to) pushes the dielectric's index; the interface is
+///   `eta_i` = the current medium's index, `eta_t` = the dielectric's;
+/// - a refracted ray that *leaves* one pops the innermost entry; the interface is
+///   `eta_i` = the dielectric's index, `eta_t` = the enclosing medium's, the entry below
+///   the innermost (air when there is none, which is also the rule when leaving a
+///   dielectric the path never entered, such as one around the camera);
+/// - reflected and shadow rays keep the stack of the ray that spawned them.
+///
+/// Only the [`MEDIUM_STACK_SIZE`] outermost indices are stored; deeper nesting keeps
+/// counting, and reads past the stored entries return the innermost one stored.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MediumStack {
+    /// Indices of refraction, outermost first; entries at `depth` and beyond are unused.
+    pub iors: [f64; MEDIUM_STACK_SIZE],
+    /// Number of dielectrics the ray is inside.
+    pub depth: u32,
+}
+
+impl MediumStack {
+    /// The stack of a camera ray: in air, inside nothing.
+    pub const AIR: Self = Self {
+        iors: [1.0; MEDIUM_STACK_SIZE],
+        depth: 0,
+    };
+
+    /// The index of refraction `level` dielectrics deep (0 = air, index 1).
+    pub fn medium_ior_at(&self, level: u32) -> f64 {
+        if level == 0 {
+            1.0
+        } else {
+            self.iors[(level as usize).min(MEDIUM_STACK_SIZE) - 1]
+        }
+    }
+
+    /// The index of the medium on the outside of a dielectric surface hit by a ray
+    /// with this stack: the current medium when `entering`, else the enclosing one.
+    pub fn medium_outside_ior(&self, entering: bool) -> f64 {
+        if entering {
+            self.medium_ior_at(self.depth)
+        } else {
+            self.medium_ior_at(self.depth.saturating_sub(1))
+        }
+    }
+
+    /// The stack of the refracted ray: `ior` pushed when `entering`, else popped.
+    pub fn medium_after_refraction(&self, entering: bool, ior: f64) -> Self {
+        let mut next = *self;
+        if entering {
+            if (next.depth as usize) < MEDIUM_STACK_SIZE {
+                next.iors[next.depth as usize] = ior;
+            }
+            next.depth = next.depth.saturating_add(1);
+        } else {
+            next.depth = next.depth.saturating_sub(1);
+        }
+        next
+    }
+}
+
+/// Whether a radiance value is finite and stays finite when rounded to `f32`: the
+/// final guard of [`trace_radiance`]. A contribution that fails it (an overflowing
+/// product, a NaN from some unforeseen 0·∞) is dropped rather than allowed to poison
+/// the pixel; the GPU twin `finite_radiance` tests the `f32` exponent bits, which no
+/// compiler's fast-math assumptions can fold away.
+pub fn finite_radiance(c: DVec3) -> bool {
+    // Written per component: a NaN fails each comparison (glam's max_element would
+    // skip it).
+    let limit = f64::from(f32::MAX);
+    c.x.abs() <= limit && c.y.abs() <= limit && c.z.abs() <= limit
 }
 
 /// One pending ray on the bounce stack.
@@ -55,6 +145,8 @@ struct StackEntry {
     weight: DVec3,
     /// Bounces since the primary ray.
     depth: u32,
+    /// The dielectrics the ray travels inside.
+    medium: MediumStack,
 }
 
 /// Radiance and ray count of one pixel.
@@ -87,8 +179,15 @@ pub fn trace_pixel(scene: &PreparedScene, x: u32, y: u32) -> PixelResult {
         sum += radiance;
         rays += sample_rays;
     }
+    let radiance = sum / f64::from(settings.samples_per_pixel);
     PixelResult {
-        radiance: sum / f64::from(settings.samples_per_pixel),
+        // The sum of finite contributions may still overflow: the pixel is then black
+        // (and on both backends alike, since the GPU's f32 overflows first).
+        radiance: if finite_radiance(radiance) {
+            radiance
+        } else {
+            DVec3::ZERO
+        },
         rays,
     }
 }
@@ -96,6 +195,8 @@ pub fn trace_pixel(scene: &PreparedScene, x: u32, y: u32) -> PixelResult {
 /// Radiance arriving along `primary`, traced iteratively: every reflected or refracted
 /// ray is pushed on a stack of `stack_size` entries and popped until none is left.
 /// Returns the radiance and the number of rays traced (camera, shadow and secondary).
+/// Each contribution (background or shaded hit, times the path weight) is added only
+/// when [`finite_radiance`]; no NaN or infinity reaches the image.
 pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
     let capacity = scene.settings.stack_size as usize;
     let mut stack: Vec<StackEntry> = Vec::with_capacity(capacity);
@@ -103,17 +204,24 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
         ray: primary,
         weight: DVec3::ONE,
         depth: 0,
+        medium: MediumStack::AIR,
     });
     let mut radiance = DVec3::ZERO;
     let mut rays = 0u64;
     while let Some(entry) = stack.pop() {
         rays += 1;
         let Some(hit) = intersect_scene(&scene.shapes, &entry.ray, f64::INFINITY) else {
-            radiance += entry.weight * scene.background;
+            let contribution = entry.weight * scene.background;
+            if finite_radiance(contribution) {
+                radiance += contribution;
+            }
             continue;
         };
-        let shaded = shade_hit(scene, &entry.ray, &hit);
-        radiance += entry.weight * shaded.radiance;
+        let shaded = shade_hit(scene, &entry.ray, &hit, &entry.medium);
+        let contribution = entry.weight * shaded.radiance;
+        if finite_radiance(contribution) {
+            radiance += contribution;
+        }
         rays += shaded.shadow_rays;
         if entry.depth >= scene.settings.max_depth {
             continue;
@@ -121,13 +229,18 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
         // Refraction is pushed first so that reflection is traced first; a branch that
         // finds the stack full, or carries no more than the weight cutoff, is dropped
         // (both backends do the same).
-        for (weight, ray) in [shaded.transmitted, shaded.reflected] {
+        let branches = [
+            (shaded.transmitted, shaded.transmitted_medium),
+            (shaded.reflected, entry.medium),
+        ];
+        for ((weight, ray), medium) in branches {
             let weight = entry.weight * weight;
             if weight.max_element() > scene.settings.min_ray_weight && stack.len() < capacity {
                 stack.push(StackEntry {
                     ray,
                     weight,
                     depth: entry.depth + 1,
+                    medium,
                 });
             }
         }
@@ -146,18 +259,24 @@ pub struct ShadedHit {
     pub reflected: (DVec3, Ray),
     /// Weight and ray of the refracted branch (weight zero when there is none).
     pub transmitted: (DVec3, Ray),
+    /// The medium stack of the refracted ray.
+    pub transmitted_medium: MediumStack,
 }
 
 /// Shades `hit` for a ray travelling along `ray.direction`: emission, ambient and
-/// direct light with one shadow ray per light, and the secondary rays.
-pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit) -> ShadedHit {
+/// direct light with one shadow ray per light, and the secondary rays, for a ray
+/// travelling inside the dielectrics of `medium`. Every new ray starts at the
+/// re-projected hit point moved off the surface by [`offset_ray_origin`], to the side
+/// the ray leaves on.
+pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumStack) -> ShadedHit {
     let material = &scene.materials[hit.material as usize];
-    let position = ray.at(hit.t);
+    let position = hit.position;
     let entering = ray.direction.dot(hit.normal) < 0.0;
     // Shading happens on the side the ray came from.
     let n = if entering { hit.normal } else { -hit.normal };
     let wo = -ray.direction;
-    let response = surface_response(material, ray.direction, n, entering);
+    let outside_ior = medium.medium_outside_ior(entering);
+    let response = surface_response(material, ray.direction, n, entering, outside_ior);
 
     let mut radiance = material.emission;
     let mut shadow_rays = 0;
@@ -167,7 +286,7 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit) -> ShadedHit {
     );
     if has_base && response.base > 0.0 {
         let mut direct = material.diffuse * scene.ambient;
-        let shadow_origin = offset_ray_origin(position, n);
+        let shadow_origin = offset_ray_origin(position, n, scene.offset_scale);
         for light in &scene.lights {
             let (lit, traced) = direct_light(scene, light, material, shadow_origin, n, wo);
             direct += lit;
@@ -177,11 +296,11 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit) -> ShadedHit {
     }
 
     let reflected = Ray {
-        origin: offset_ray_origin(position, n),
+        origin: offset_ray_origin(position, n, scene.offset_scale),
         direction: reflect_direction(ray.direction, n).normalize(),
     };
     let transmitted = Ray {
-        origin: offset_ray_origin(position, -n),
+        origin: offset_ray_origin(position, -n, scene.offset_scale),
         direction: response.transmit_direction,
     };
     ShadedHit {
@@ -189,6 +308,7 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit) -> ShadedHit {
         shadow_rays,
         reflected: (response.reflect, reflected),
         transmitted: (response.transmit, transmitted),
+        transmitted_medium: medium.medium_after_refraction(entering, material.ior),
     }
 }
 
@@ -210,7 +330,8 @@ pub fn direct_light(
         } => {
             let to_light = position - origin;
             let distance_squared = to_light.length_squared();
-            if distance_squared == 0.0 {
+            // Zero, denormal or NaN distance: no contribution (see the constant).
+            if distance_squared.is_nan() || distance_squared < MIN_LIGHT_DISTANCE_SQUARED {
                 return (DVec3::ZERO, 0);
             }
             let distance = distance_squared.sqrt();

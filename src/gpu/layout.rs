@@ -47,6 +47,18 @@ pub struct FrameUniforms {
     pub row_offset: u32,
     /// Number of rows this dispatch traces.
     pub row_count: u32,
+    /// First image column this dispatch traces (images wider than the device's
+    /// texture limit are traced in tiles).
+    pub column_offset: u32,
+    /// Number of columns this dispatch traces.
+    pub column_count: u32,
+    /// Image column stored at texel x = 0 of the target texture (the tile's left edge).
+    pub target_x: u32,
+    /// Image row stored at texel y = 0 of the target texture (the tile's top edge).
+    pub target_y: u32,
+    /// Length scale of the self-intersection offset's near-origin branch (see
+    /// `crate::cpu::intersect::ray_offset_scale`).
+    pub offset_scale: f32,
     /// Branches whose weight is not above this are not traced.
     pub min_ray_weight: f32,
     /// The sample this dispatch traces in every pixel: one dispatch per sample index
@@ -56,8 +68,6 @@ pub struct FrameUniforms {
     pub accumulation_rows: u32,
     /// Padding.
     pub _pad0: u32,
-    /// Padding.
-    pub _pad1: u32,
 }
 
 /// A sphere (`Sphere` in WGSL).

@@ -31,4 +31,4 @@ pub mod upload;
 pub use context::{AdapterChoice, HeadlessGpu, list_adapters};
 pub use error::GpuError;
 pub use readback::read_texture;
-pub use renderer::{GpuRendered, GpuRenderer, PreparedScene};
+pub use renderer::{GpuRendered, GpuRenderer, PreparedScene, TraceRegion, image_tiles};

@@ -373,21 +373,9 @@ impl GpuRenderer {
                 Ok(())
             }
         };
-        let max_dim = u64::from(limits.max_texture_dimension_2d);
-        over("image width", u64::from(frame.width), max_dim)?;
-        over("image height", u64::from(frame.height), max_dim)?;
-        let max_groups = u64::from(limits.max_compute_workgroups_per_dimension);
-        let groups = |n: u32| u64::from(n.div_ceil(WORKGROUP_SIZE));
-        over(
-            "workgroups across the width",
-            groups(frame.width),
-            max_groups,
-        )?;
-        over(
-            "workgroups down the height",
-            groups(frame.height),
-            max_groups,
-        )?;
+        // The image may exceed max_texture_dimension_2d: render() then traces it in
+        // tiles (see `image_tiles`). What one dispatch covers is checked against the
+        // workgroup-count limit in encode_trace_region.
 
         let padded = records.padded();
         let max_binding = limits.max_storage_buffer_binding_size;
@@ -521,13 +509,54 @@ impl GpuRenderer {
         target: &wgpu::TextureView,
         rows: Range<u32>,
     ) -> Result<(), GpuError> {
+        let region = TraceRegion {
+            columns: 0..prepared.width(),
+            rows,
+            target_origin: (0, 0),
+        };
+        self.encode_trace_region(device, encoder, prepared, target, &region)
+    }
+
+    /// Records one trace dispatch of the image pixels in `region` into `encoder`,
+    /// writing each pixel (x, y) to texel (x, y) − `region.target_origin` of `target`,
+    /// which must be large enough for that. This is how images larger than the device's
+    /// texture limit are traced, one tile-sized target at a time.
+    ///
+    /// Errors: as [`GpuRenderer::encode_trace`], and [`GpuError::DeviceLimit`] when the
+    /// region needs more workgroups than `max_compute_workgroups_per_dimension`.
+    pub fn encode_trace_region(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        prepared: &PreparedScene,
+        target: &wgpu::TextureView,
+        region: &TraceRegion,
+    ) -> Result<(), GpuError> {
+        let TraceRegion {
+            columns,
+            rows,
+            target_origin: (origin_x, origin_y),
+        } = region.clone();
         if rows.start > rows.end || rows.end > prepared.height() {
             return Err(GpuError::Validation(format!(
                 "row range {rows:?} is outside the image's {} rows",
                 prepared.height()
             )));
         }
-        if rows.is_empty() {
+        if columns.start > columns.end || columns.end > prepared.width() {
+            return Err(GpuError::Validation(format!(
+                "column range {columns:?} is outside the image's {} columns",
+                prepared.width()
+            )));
+        }
+        if origin_x > columns.start || origin_y > rows.start {
+            return Err(GpuError::Validation(format!(
+                "target origin ({origin_x}, {origin_y}) lies after the region's first pixel \
+                 ({}, {})",
+                columns.start, rows.start
+            )));
+        }
+        if rows.is_empty() || columns.is_empty() {
             return Ok(());
         }
         check_texture(
@@ -535,9 +564,21 @@ impl GpuRenderer {
             "trace target",
             LINEAR_FORMAT,
             wgpu::TextureUsages::STORAGE_BINDING,
-            prepared.width(),
-            prepared.height(),
+            columns.end - origin_x,
+            rows.end - origin_y,
         )?;
+        let max_groups = device.limits().max_compute_workgroups_per_dimension;
+        let groups_x = (columns.end - columns.start).div_ceil(WORKGROUP_SIZE);
+        let groups_y = (rows.end - rows.start).div_ceil(WORKGROUP_SIZE);
+        for (what, groups) in [("columns", groups_x), ("rows", groups_y)] {
+            if groups > max_groups {
+                return Err(GpuError::DeviceLimit {
+                    what: format!("workgroups for the {what} of one trace dispatch"),
+                    value: u64::from(groups),
+                    limit: u64::from(max_groups),
+                });
+            }
+        }
         let pipeline = self.trace_pipeline(device, prepared.stack_size)?;
         let band_rows = prepared.frame.accumulation_rows.max(1);
         let mut band_start = rows.start;
@@ -547,6 +588,10 @@ impl GpuRenderer {
                 let dispatch = FrameUniforms {
                     row_offset: band_start,
                     row_count: band_end - band_start,
+                    column_offset: columns.start,
+                    column_count: columns.end - columns.start,
+                    target_x: origin_x,
+                    target_y: origin_y,
                     sample_index,
                     ..prepared.frame
                 };
@@ -559,7 +604,7 @@ impl GpuRenderer {
         Ok(())
     }
 
-    /// Records one dispatch of the trace pass: one sample of every pixel in the rows
+    /// Records one dispatch of the trace pass: one sample of every pixel in the region
     /// `dispatch` names.
     fn encode_trace_dispatch(
         &self,
@@ -604,7 +649,7 @@ impl GpuRenderer {
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.dispatch_workgroups(
-            prepared.width().div_ceil(WORKGROUP_SIZE),
+            dispatch.column_count.div_ceil(WORKGROUP_SIZE),
             dispatch.row_count.div_ceil(WORKGROUP_SIZE),
             1,
         );
@@ -715,6 +760,9 @@ impl GpuRenderer {
 
     /// Renders `scene` completely: traces it in row chunks (see [`MAX_CHUNK_SAMPLES`]),
     /// each submitted and waited for, calling `progress(rows_done, height)` after each;
+    /// an image wider or taller than the device's `max_texture_dimension_2d` is traced
+    /// in tiles ([`image_tiles`]), each into a texture of its own, display-encoded and
+    /// read back into its place (`rows_done` then counts finished pixels / width);
     /// runs the display pass; reads back both images and the ray counters.
     /// `stats.elapsed` covers the tracing submissions only (not upload, display pass or
     /// readback); the trace pipeline is built before the clock starts.
@@ -730,46 +778,85 @@ impl GpuRenderer {
     ) -> Result<GpuRendered, GpuError> {
         let prepared = self.prepare(device, queue, scene)?;
         let (width, height) = (prepared.width(), prepared.height());
-        let linear = create_texture(
-            device,
-            "gpu-render linear image",
-            width,
-            height,
-            LINEAR_FORMAT,
-            wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-        )?;
-        let display = create_texture(
-            device,
-            "gpu-render display image",
-            width,
-            height,
-            DISPLAY_FORMAT,
-            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
-        )?;
-        let linear_view = linear.create_view(&wgpu::TextureViewDescriptor::default());
-        let display_view = display.create_view(&wgpu::TextureViewDescriptor::default());
+        let limits = device.limits();
+        // A tile must fit one texture and one dispatch's workgroup count.
+        let tile_limit = limits.max_texture_dimension_2d.min(
+            limits
+                .max_compute_workgroups_per_dimension
+                .saturating_mul(WORKGROUP_SIZE),
+        );
+        let tiles = image_tiles(width, height, tile_limit);
+        let mut pixels = vec![[0.0f32; 4]; width as usize * height as usize];
+        let mut display_rgba8 = vec![0u8; width as usize * height as usize * 4];
+        // Progress is reported in image rows: pixels finished / width, so that a tiled
+        // image reports like an untiled one.
+        let pixels_done = std::sync::atomic::AtomicU64::new(0);
+        let report = |pixels: u64| {
+            let done = pixels_done.fetch_add(pixels, std::sync::atomic::Ordering::Relaxed) + pixels;
+            if let Some(progress) = progress {
+                progress((done / u64::from(width)) as u32, height);
+            }
+        };
+        let mut elapsed = Duration::ZERO;
+        for tile in &tiles {
+            let (tile_width, tile_height) = (
+                tile.columns.end - tile.columns.start,
+                tile.rows.end - tile.rows.start,
+            );
+            let linear = create_texture(
+                device,
+                "gpu-render linear image",
+                tile_width,
+                tile_height,
+                LINEAR_FORMAT,
+                wgpu::TextureUsages::STORAGE_BINDING
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+            )?;
+            let display = create_texture(
+                device,
+                "gpu-render display image",
+                tile_width,
+                tile_height,
+                DISPLAY_FORMAT,
+                wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            )?;
+            let linear_view = linear.create_view(&wgpu::TextureViewDescriptor::default());
+            let display_view = display.create_view(&wgpu::TextureViewDescriptor::default());
 
-        let mut stats = self.trace_chunks(device, queue, &prepared, &linear_view, progress)?;
+            elapsed +=
+                self.trace_region_chunks(device, queue, &prepared, &linear_view, tile, &report)?;
 
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("gpu-render display pass"),
-        });
-        self.encode_display(
-            device,
-            &mut encoder,
-            &linear_view,
-            &display_view,
-            prepared.display_encodes_srgb(),
-        )?;
-        submit_and_wait(device, queue, encoder, "display pass", self.poll_timeout)?;
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("gpu-render display pass"),
+            });
+            self.encode_display(
+                device,
+                &mut encoder,
+                &linear_view,
+                &display_view,
+                prepared.display_encodes_srgb(),
+            )?;
+            submit_and_wait(device, queue, encoder, "display pass", self.poll_timeout)?;
 
-        let linear_bytes = read_texture(device, queue, &linear, 16, self.poll_timeout)?;
-        let display_rgba8 = read_texture(device, queue, &display, 4, self.poll_timeout)?;
-        stats.rays_traced = self.read_ray_count(device, queue, &prepared)?;
-        // pod_collect_to_vec copies, so the byte vector's alignment does not matter.
-        let pixels: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&linear_bytes);
+            let linear_bytes = read_texture(device, queue, &linear, 16, self.poll_timeout)?;
+            let display_bytes = read_texture(device, queue, &display, 4, self.poll_timeout)?;
+            // pod_collect_to_vec copies, so the byte vector's alignment does not matter.
+            let tile_pixels: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&linear_bytes);
+            let tile_width = tile_width as usize;
+            for (row, y) in tile.rows.clone().enumerate() {
+                let start = y as usize * width as usize + tile.columns.start as usize;
+                pixels[start..start + tile_width]
+                    .copy_from_slice(&tile_pixels[row * tile_width..(row + 1) * tile_width]);
+                display_rgba8[start * 4..(start + tile_width) * 4].copy_from_slice(
+                    &display_bytes[row * tile_width * 4..(row + 1) * tile_width * 4],
+                );
+            }
+        }
+        let stats = RenderStats {
+            rays_traced: self.read_ray_count(device, queue, &prepared)?,
+            elapsed,
+        };
         Ok(GpuRendered {
             image: LinearImage {
                 width,
@@ -785,6 +872,10 @@ impl GpuRenderer {
     /// `STORAGE_BINDING`, at least image-sized), chunked and timed like
     /// [`GpuRenderer::render`], without the display pass or image readback. Returns the
     /// ray count and trace time.
+    ///
+    /// Errors: as [`GpuRenderer::render`], and [`GpuError::DeviceLimit`] for an image
+    /// larger than `max_texture_dimension_2d`, which no single target can hold (use
+    /// [`GpuRenderer::render`], which tiles, or [`GpuRenderer::encode_trace_region`]).
     pub fn render_to_texture(
         &self,
         device: &wgpu::Device,
@@ -794,44 +885,130 @@ impl GpuRenderer {
         progress: Option<ProgressFn<'_>>,
     ) -> Result<RenderStats, GpuError> {
         let prepared = self.prepare(device, queue, scene)?;
-        let mut stats = self.trace_chunks(device, queue, &prepared, target, progress)?;
-        stats.rays_traced = self.read_ray_count(device, queue, &prepared)?;
-        Ok(stats)
+        let max_dimension = device.limits().max_texture_dimension_2d;
+        for (what, value) in [
+            ("image width (one target texture)", prepared.width()),
+            ("image height (one target texture)", prepared.height()),
+        ] {
+            if value > max_dimension {
+                return Err(GpuError::DeviceLimit {
+                    what: what.to_string(),
+                    value: u64::from(value),
+                    limit: u64::from(max_dimension),
+                });
+            }
+        }
+        let whole = TraceRegion {
+            columns: 0..prepared.width(),
+            rows: 0..prepared.height(),
+            target_origin: (0, 0),
+        };
+        let rows_done = std::sync::atomic::AtomicU32::new(0);
+        let width = u64::from(prepared.width());
+        let row_report = |pixels: u64| {
+            let rows = (pixels / width) as u32;
+            let done = rows_done.fetch_add(rows, std::sync::atomic::Ordering::Relaxed) + rows;
+            if let Some(progress) = progress {
+                progress(done, prepared.height());
+            }
+        };
+        let elapsed =
+            self.trace_region_chunks(device, queue, &prepared, target, &whole, &row_report)?;
+        Ok(RenderStats {
+            rays_traced: self.read_ray_count(device, queue, &prepared)?,
+            elapsed,
+        })
     }
 
-    /// Traces every row chunk, one submission and wait each; returns the elapsed time
-    /// (ray count left 0 for the caller to fill).
-    fn trace_chunks(
+    /// Traces the rows of `region` in chunks (see [`row_chunks`], split further to stay
+    /// within `max_compute_workgroups_per_dimension`), one submission and
+    /// wait each, calling `report(pixels)` after each chunk with the pixels it traced;
+    /// returns the time spent tracing.
+    fn trace_region_chunks(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         prepared: &PreparedScene,
         target: &wgpu::TextureView,
-        progress: Option<ProgressFn<'_>>,
-    ) -> Result<RenderStats, GpuError> {
+        region: &TraceRegion,
+        report: &dyn Fn(u64),
+    ) -> Result<Duration, GpuError> {
         // Compile before timing: shader and pipeline creation is not tracing.
         self.trace_pipeline(device, prepared.stack_size)?;
         let start = Instant::now();
-        for rows in row_chunks(
-            prepared.width(),
-            prepared.height(),
+        let region_width = region.columns.end - region.columns.start;
+        // Rows per dispatch are also bounded by the workgroup-count limit.
+        let max_rows = device
+            .limits()
+            .max_compute_workgroups_per_dimension
+            .saturating_mul(WORKGROUP_SIZE)
+            .max(1);
+        let chunks = row_chunks(
+            region_width,
+            region.rows.end - region.rows.start,
             prepared.samples_per_pixel(),
-        ) {
-            let done = rows.end;
+        )
+        .into_iter()
+        .flat_map(|chunk| {
+            chunk
+                .clone()
+                .step_by(max_rows as usize)
+                .map(move |start| start..chunk.end.min(start.saturating_add(max_rows)))
+        });
+        for chunk in chunks {
+            let rows = region.rows.start + chunk.start..region.rows.start + chunk.end;
+            let pixels = u64::from(rows.end - rows.start) * u64::from(region_width);
             let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("gpu-render trace chunk"),
             });
-            self.encode_trace(device, &mut encoder, prepared, target, rows)?;
+            let chunk_region = TraceRegion {
+                rows,
+                ..region.clone()
+            };
+            self.encode_trace_region(device, &mut encoder, prepared, target, &chunk_region)?;
             submit_and_wait(device, queue, encoder, "trace chunk", self.poll_timeout)?;
-            if let Some(progress) = progress {
-                progress(done, prepared.height());
-            }
+            report(pixels);
         }
-        Ok(RenderStats {
-            rays_traced: 0,
-            elapsed: start.elapsed(),
-        })
+        Ok(start.elapsed())
     }
+}
+
+/// A rectangle of image pixels traced by one dispatch, and where it lands in the
+/// target texture.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TraceRegion {
+    /// Image columns traced.
+    pub columns: Range<u32>,
+    /// Image rows traced.
+    pub rows: Range<u32>,
+    /// The image pixel stored at texel (0, 0) of the target.
+    pub target_origin: (u32, u32),
+}
+
+/// The tiles [`GpuRenderer::render`] traces an image of `width × height` in: one tile
+/// when the image fits `max_dimension` (the device's `max_texture_dimension_2d`), else a
+/// grid of tiles of at most `max_dimension` on a side, in row-major order, covering
+/// every pixel once. Each tile's `target_origin` is its own top-left pixel: it is traced
+/// into a texture of its own size and stitched into the image on readback.
+pub fn image_tiles(width: u32, height: u32, max_dimension: u32) -> Vec<TraceRegion> {
+    let step = max_dimension.max(1);
+    let mut tiles = Vec::new();
+    let mut y = 0;
+    while y < height {
+        let rows = y..height.min(y.saturating_add(step));
+        let mut x = 0;
+        while x < width {
+            let columns = x..width.min(x.saturating_add(step));
+            tiles.push(TraceRegion {
+                target_origin: (columns.start, rows.start),
+                columns: columns.clone(),
+                rows: rows.clone(),
+            });
+            x = columns.end;
+        }
+        y = rows.end;
+    }
+    tiles
 }
 
 /// Creates a shader module and a compute pipeline inside error scopes, so that WGSL or
@@ -909,5 +1086,26 @@ mod tests {
         // 1920 x 16 spp = 30720 samples per row: 68 rows per chunk.
         assert_eq!(row_chunks(1920, 1080, 16)[0], 0..68);
         assert!(row_chunks(1, 0, 1).is_empty());
+    }
+
+    #[test]
+    fn tiles_cover_every_pixel_once_within_the_limit() {
+        assert_eq!(image_tiles(100, 50, 16384).len(), 1);
+        for &(w, h, max) in &[(16500, 3, 16384), (40, 33, 16), (17, 17, 17), (1, 1, 1)] {
+            let tiles = image_tiles(w, h, max);
+            let mut covered = vec![0u8; (w * h) as usize];
+            for tile in &tiles {
+                assert!(tile.columns.end - tile.columns.start <= max);
+                assert!(tile.rows.end - tile.rows.start <= max);
+                assert_eq!(tile.target_origin, (tile.columns.start, tile.rows.start));
+                for y in tile.rows.clone() {
+                    for x in tile.columns.clone() {
+                        covered[(y * w + x) as usize] += 1;
+                    }
+                }
+            }
+            assert!(covered.iter().all(|&c| c == 1), "{w}x{h} max {max}");
+        }
+        assert_eq!(image_tiles(16500, 3, 16384).len(), 2);
     }
 }

@@ -181,8 +181,8 @@ pub fn light_record(light: &Light) -> GpuLight {
 }
 
 /// The frame constants for `scene` (in lighting space) and its `records`, covering the
-/// whole image (`row_offset` 0, `row_count` = height); chunked dispatches override the
-/// two row fields.
+/// whole image (`row_offset` 0, `row_count` = height, all columns, target origin 0);
+/// chunked and tiled dispatches override the row, column and target fields.
 pub fn frame_uniforms(scene: &Scene, records: &SceneRecords) -> FrameUniforms {
     let settings = &scene.render;
     let camera = CameraFrame::new(&scene.camera, settings.width, settings.height);
@@ -207,11 +207,15 @@ pub fn frame_uniforms(scene: &Scene, records: &SceneRecords) -> FrameUniforms {
         light_count: count(records.lights.len()),
         row_offset: 0,
         row_count: settings.height,
+        column_offset: 0,
+        column_count: settings.width,
+        target_x: 0,
+        target_y: 0,
+        offset_scale: crate::cpu::intersect::ray_offset_scale(scene) as f32,
         min_ray_weight: settings.min_ray_weight as f32,
         sample_index: 0,
         accumulation_rows: 0,
         _pad0: 0,
-        _pad1: 0,
     }
 }
 
