@@ -4,12 +4,13 @@
 
 use glam::DVec3;
 
-use super::bxdf::{eval_brdf, reflect_direction, surface_response};
+use super::bxdf::{eval_brdf, has_base_brdf, reflect_direction, surface_response};
 use super::intersect::{
     Hit, PreparedShape, Ray, intersect_scene, occluded, offset_ray_origin, prepare_shapes,
 };
+use super::texture::shading_albedo;
 use crate::camera::{CameraFrame, sample_offset};
-use crate::scene::{Light, Material, MaterialKind, RenderSettings, Scene};
+use crate::scene::{Image, Light, Material, RenderSettings, Scene};
 
 /// The scene in the form the tracer reads: colours in the lighting space, polygons with
 /// their planes, the camera basis.
@@ -29,6 +30,8 @@ pub struct PreparedScene {
     pub lights: Vec<Light>,
     /// Shapes with precomputed constants.
     pub shapes: Vec<PreparedShape>,
+    /// Albedo textures and BRDF maps.
+    pub images: Vec<Image>,
 }
 
 impl PreparedScene {
@@ -43,6 +46,7 @@ impl PreparedScene {
             materials: scene.materials.clone(),
             lights: scene.lights.clone(),
             shapes: prepare_shapes(&scene),
+            images: scene.images,
         }
     }
 }
@@ -150,8 +154,10 @@ pub struct ShadedHit {
 /// Shades `hit` for a ray travelling along `ray.direction`: emission, ambient and
 /// direct light with one shadow ray per light, and the secondary rays.
 pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit) -> ShadedHit {
-    let material = &scene.materials[hit.material as usize];
     let position = ray.at(hit.t);
+    let mut material = scene.materials[hit.material as usize];
+    material.diffuse = shading_albedo(&material, &scene.images, position, hit.normal);
+    let material = &material;
     let entering = ray.direction.dot(hit.normal) < 0.0;
     // Shading happens on the side the ray came from.
     let n = if entering { hit.normal } else { -hit.normal };
@@ -160,11 +166,7 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit) -> ShadedHit {
 
     let mut radiance = material.emission;
     let mut shadow_rays = 0;
-    let has_base = matches!(
-        material.kind,
-        MaterialKind::Lambert | MaterialKind::BlinnPhong
-    );
-    if has_base && response.base > 0.0 {
+    if has_base_brdf(material.kind) && response.base > 0.0 {
         let mut direct = material.diffuse * scene.ambient;
         let shadow_origin = offset_ray_origin(position, n);
         for light in &scene.lights {
@@ -232,5 +234,8 @@ pub fn direct_light(
     if occluded(&scene.shapes, &shadow, distance) {
         return (DVec3::ZERO, 1);
     }
-    (eval_brdf(material, n, wi, wo) * irradiance * cos_i, 1)
+    (
+        eval_brdf(material, &scene.images, n, wi, wo) * irradiance * cos_i,
+        1,
+    )
 }
