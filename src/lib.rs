@@ -17,4 +17,5 @@ pub mod cpu;
 pub mod film;
 pub mod gpu;
 pub mod output;
+pub mod plausibility;
 pub mod scene;

@@ -32,7 +32,7 @@ Examples:
     subcommand_negates_reqs = true
 )]
 pub struct Cli {
-    /// A tool other than rendering (none yet; rendering is the default).
+    /// A tool other than rendering (rendering is the default).
     #[command(subcommand)]
     pub command: Option<Command>,
 
@@ -45,7 +45,17 @@ pub struct Cli {
 ///
 /// Tools such as `brdf-check FILE` or `tradeoff SCENE` go here as variants.
 #[derive(Debug, Subcommand)]
-pub enum Command {}
+pub enum Command {
+    /// Reports whether a tabulated BRDF map (a square image, θi across, θr down,
+    /// texels holding π·f) is physically plausible: positivity, energy conservation
+    /// and Helmholtz reciprocity, with the worst violation of each. Exits with status 1
+    /// when it is not.
+    BrdfCheck {
+        /// The map: an 8-bit sRGB PNG (linearised) or a float OpenEXR (linear).
+        #[arg(value_name = "FILE")]
+        file: PathBuf,
+    },
+}
 
 /// The arguments of a render.
 #[derive(Debug, Args)]
