@@ -52,7 +52,10 @@ fn materials() -> Vec<Material> {
         });
     }
     for roughness in [0.2, 0.5, 0.9] {
-        for distribution in [MicrofacetDistribution::Ggx, MicrofacetDistribution::Beckmann] {
+        for distribution in [
+            MicrofacetDistribution::Ggx,
+            MicrofacetDistribution::Beckmann,
+        ] {
             for fresnel in [FresnelModel::Exact, FresnelModel::Schlick] {
                 for (_, eta, k) in CONDUCTOR_PRESETS {
                     list.push(Material {
@@ -92,7 +95,11 @@ fn materials() -> Vec<Material> {
 }
 
 fn direction(theta: f64, phi: f64) -> DVec3 {
-    DVec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
+    DVec3::new(
+        theta.sin() * phi.cos(),
+        theta.cos(),
+        theta.sin() * phi.sin(),
+    )
 }
 
 fn f32x4(v: DVec3) -> [f32; 4] {
@@ -122,8 +129,8 @@ fn wgsl_brdfs_match_the_cpu_reference() {
             for b in 0..8 {
                 for p in 0..3 {
                     let wi = to_world * direction(f64::from(a) * 0.19 + 0.05, 0.3);
-                    let wo = to_world
-                        * direction(f64::from(b) * 0.19 + 0.07, 0.3 + f64::from(p) * 1.2);
+                    let wo =
+                        to_world * direction(f64::from(b) * 0.19 + 0.07, 0.3 + f64::from(p) * 1.2);
                     cases.push(BrdfCase {
                         material: index as u32,
                         _pad: [0; 3],
@@ -144,7 +151,13 @@ fn wgsl_brdfs_match_the_cpu_reference() {
     let mut worst_relative: f64 = 0.0;
     for (case, value) in cases.iter().zip(&gpu_values) {
         let m = &materials[case.material as usize];
-        let cpu = eval_brdf(m, &images, rounded(case.n), rounded(case.wi), rounded(case.wo));
+        let cpu = eval_brdf(
+            m,
+            &images,
+            rounded(case.n),
+            rounded(case.wi),
+            rounded(case.wo),
+        );
         for c in 0..3 {
             let (g, e) = (f64::from(value[c]), cpu[c]);
             let error = (g - e).abs();
@@ -270,7 +283,9 @@ fn evaluate(
     }
     encoder.copy_buffer_to_buffer(&values, 0, &readback, 0, size);
     queue.submit([encoder.finish()]);
-    readback.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("maps"));
+    readback
+        .slice(..)
+        .map_async(wgpu::MapMode::Read, |r| r.expect("maps"));
     device
         .poll(wgpu::PollType::wait_indefinitely())
         .expect("device polls");

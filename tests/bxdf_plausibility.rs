@@ -125,17 +125,18 @@ fn images() -> Vec<Image> {
 }
 
 fn direction(theta: f64, phi: f64) -> DVec3 {
-    DVec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
+    DVec3::new(
+        theta.sin() * phi.cos(),
+        theta.cos(),
+        theta.sin() * phi.sin(),
+    )
 }
 
 /// `∫ f(ωi, ωo) cos θi dωi` per channel, midpoint rule in (θ, φ).
 fn directional_albedo(m: &Material, images: &[Image], wo: DVec3) -> DVec3 {
     const THETA_STEPS: usize = 256;
     const PHI_STEPS: usize = 128;
-    let (dt, dp) = (
-        0.5 * PI / THETA_STEPS as f64,
-        2.0 * PI / PHI_STEPS as f64,
-    );
+    let (dt, dp) = (0.5 * PI / THETA_STEPS as f64, 2.0 * PI / PHI_STEPS as f64);
     let mut sum = DVec3::ZERO;
     for i in 0..THETA_STEPS {
         let theta = (i as f64 + 0.5) * dt;
@@ -292,7 +293,12 @@ fn conductor_presets_reflect_the_published_normal_incidence_colours() {
         eprintln!("{name:10} F0 = {f0:.3}, published {published:?}, max |Δ| {error:.3}");
         assert!(error < tolerance, "{name}: F0 {f0} vs {published:?}");
         // A conductor reflects everything at grazing incidence.
-        assert!((fresnel_conductor(0.0, eta, k) - DVec3::ONE).abs().max_element() < 1e-9);
+        assert!(
+            (fresnel_conductor(0.0, eta, k) - DVec3::ONE)
+                .abs()
+                .max_element()
+                < 1e-9
+        );
     }
 }
 
@@ -314,8 +320,8 @@ fn schlick_error_against_the_exact_equations_is_measured() {
     for i in 0..=900 {
         let theta = f64::from(i) / 10.0;
         let cos = theta.to_radians().cos();
-        let glass = (fresnel_schlick(cos, DVec3::splat(0.04)).x - fresnel_dielectric(cos, 1.0, 1.5))
-            .abs();
+        let glass =
+            (fresnel_schlick(cos, DVec3::splat(0.04)).x - fresnel_dielectric(cos, 1.0, 1.5)).abs();
         let gold = (fresnel_schlick(cos, f0_gold) - fresnel_conductor(cos, eta, k))
             .abs()
             .max_element();

@@ -7,9 +7,8 @@ use gpu_render::scene::parse_scene;
 
 /// Parses a scene in `scenes/` (so image paths resolve there) with one material.
 fn error_for(material: &str) -> String {
-    let text = format!(
-        "[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\n\n[materials.m]\n{material}\n"
-    );
+    let text =
+        format!("[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\n\n[materials.m]\n{material}\n");
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/inline.toml");
     match parse_scene(&text, &path) {
         Ok(_) => panic!("accepted: {material}"),
@@ -19,7 +18,10 @@ fn error_for(material: &str) -> String {
 
 fn assert_error(material: &str, fragments: &[&str]) {
     let message = error_for(material);
-    assert!(message.contains("inline.toml:5:1: materials.m"), "{message}");
+    assert!(
+        message.contains("inline.toml:5:1: materials.m"),
+        "{message}"
+    );
     for fragment in fragments {
         assert!(message.contains(fragment), "{message} lacks {fragment}");
     }
@@ -77,7 +79,11 @@ fn ior_and_fresnel_sources() {
 fn missing_unreadable_and_wrong_shaped_images() {
     assert_error(
         "type = \"tabulated\"\nbrdf_map = \"brdf/missing.png\"",
-        &["brdf_map `brdf/missing.png`", "missing.png", "cannot read the file"],
+        &[
+            "brdf_map `brdf/missing.png`",
+            "missing.png",
+            "cannot read the file",
+        ],
     );
     // A TOML file is not an image.
     assert_error(

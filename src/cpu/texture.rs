@@ -41,7 +41,11 @@ pub fn texture_coordinates(material: &Material, position: DVec3, normal: DVec3) 
 /// The tangent `t` and bitangent `b` of the planar mapping for unit normal `n`:
 /// `t = normalize(n × a)`, `b = t × n`, with `a = z` if `|n.y| ≥ 0.999` else `y`.
 pub fn tangent_frame(n: DVec3) -> (DVec3, DVec3) {
-    let a = if n.y.abs() >= 0.999 { DVec3::Z } else { DVec3::Y };
+    let a = if n.y.abs() >= 0.999 {
+        DVec3::Z
+    } else {
+        DVec3::Y
+    };
     let t = n.cross(a).normalize();
     (t, t.cross(n))
 }

@@ -6,8 +6,8 @@
 use glam::DVec3;
 
 use super::layout::{
-    FrameUniforms, GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle,
-    DISTRIBUTION_BECKMANN, DISTRIBUTION_GGX, FRESNEL_EXACT, FRESNEL_SCHLICK, LIGHT_DIRECTIONAL,
+    DISTRIBUTION_BECKMANN, DISTRIBUTION_GGX, FRESNEL_EXACT, FRESNEL_SCHLICK, FrameUniforms,
+    GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle, LIGHT_DIRECTIONAL,
     LIGHT_POINT, MAPPING_PLANAR, MAPPING_SPHERICAL, MATERIAL_BLINN_PHONG, MATERIAL_COOK_TORRANCE,
     MATERIAL_DIELECTRIC, MATERIAL_EMISSIVE, MATERIAL_LAMBERT, MATERIAL_MIRROR, MATERIAL_OREN_NAYAR,
     MATERIAL_PBR, MATERIAL_TABULATED, NO_IMAGE,
@@ -160,10 +160,11 @@ pub fn material_kind_code(kind: MaterialKind) -> u32 {
 /// The record of one material; `images` are the scene's, whose index is the layer in
 /// the image array ([`image_layers`]).
 pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
-    let image = |index: Option<u32>| match index.and_then(|i| images.get(i as usize).map(|m| (i, m))) {
-        Some((i, m)) => (i, m.width, m.height),
-        None => (NO_IMAGE, 0, 0),
-    };
+    let image =
+        |index: Option<u32>| match index.and_then(|i| images.get(i as usize).map(|m| (i, m))) {
+            Some((i, m)) => (i, m.width, m.height),
+            None => (NO_IMAGE, 0, 0),
+        };
     let (texture_layer, texture_width, texture_height) = image(material.albedo_texture);
     let (brdf_map_layer, brdf_map_size, _) = image(material.brdf_map);
     GpuMaterial {

@@ -34,11 +34,9 @@ pub fn load_image(path: &Path) -> Result<Image, String> {
         .map_err(|e| format!("not a readable image: {e}"))?;
     let (width, height) = (decoded.width(), decoded.height());
     let texels: Vec<[f32; 4]> = match &decoded {
-        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_) => decoded
-            .to_rgba32f()
-            .pixels()
-            .map(|p| p.0)
-            .collect(),
+        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_) => {
+            decoded.to_rgba32f().pixels().map(|p| p.0).collect()
+        }
         DynamicImage::ImageLuma16(_)
         | DynamicImage::ImageLumaA16(_)
         | DynamicImage::ImageRgb16(_)

@@ -225,7 +225,8 @@ pub struct Material {
 }
 
 impl Material {
-    /// A material of `kind` with every parameter zero except transmittance = 1.
+    /// A material of `kind` with every parameter zero except transmittance, `eta` and
+    /// `texture_scale` (1), GGX and exact Fresnel, no images.
     pub fn blank(kind: MaterialKind) -> Self {
         Self {
             kind,

@@ -104,7 +104,10 @@ fn brdf_check(file: &Path) -> Result<()> {
         channel(r)
     );
     if !report.plausible() {
-        bail!("{}: the BRDF map is not physically plausible", file.display());
+        bail!(
+            "{}: the BRDF map is not physically plausible",
+            file.display()
+        );
     }
     println!("{}: physically plausible", file.display());
     Ok(())

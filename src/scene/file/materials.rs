@@ -71,9 +71,21 @@ const KINDS: &str =
 /// `tests/bxdf_plausibility.rs`).
 pub const CONDUCTOR_PRESETS: &[(&str, [f64; 3], [f64; 3])] = &[
     ("gold", [0.18299, 0.42108, 1.3734], [3.4242, 2.3459, 1.7704]),
-    ("silver", [0.15943, 0.14512, 0.13547], [3.9291, 3.1900, 2.3808]),
-    ("copper", [0.27105, 0.67693, 1.3164], [3.6092, 2.6248, 2.2921]),
-    ("aluminium", [1.3456, 0.96521, 0.61722], [7.4746, 6.3995, 5.3031]),
+    (
+        "silver",
+        [0.15943, 0.14512, 0.13547],
+        [3.9291, 3.1900, 2.3808],
+    ),
+    (
+        "copper",
+        [0.27105, 0.67693, 1.3164],
+        [3.6092, 2.6248, 2.2921],
+    ),
+    (
+        "aluminium",
+        [1.3456, 0.96521, 0.61722],
+        [7.4746, 6.3995, 5.3031],
+    ),
 ];
 
 /// The images a scene's materials load, and where relative paths start.
@@ -258,9 +270,9 @@ fn cook_torrance(
         }
     }
     if raw.diffuse.is_some() || raw.albedo_texture.is_some() {
-        return Err(item.fail(
-            "a conductor has no diffuse base: `diffuse` and `albedo_texture` need `ior`",
-        ));
+        return Err(
+            item.fail("a conductor has no diffuse base: `diffuse` and `albedo_texture` need `ior`")
+        );
     }
     Ok(material)
 }

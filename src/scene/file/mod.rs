@@ -15,8 +15,8 @@ mod settings;
 use std::io::Read;
 use std::path::Path;
 
-pub use self::materials::CONDUCTOR_PRESETS;
 use self::check::Source;
+pub use self::materials::CONDUCTOR_PRESETS;
 use self::objects::MaterialTable;
 use self::raw::RawScene;
 use super::{Scene, SceneError};
