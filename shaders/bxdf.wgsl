@@ -70,13 +70,252 @@ fn brdf_blinn_phong(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f3
     return material.diffuse / PI + material.specular * lobe;
 }
 
-// The base layer's BRDF for light from wi leaving towards wo (both on n's side).
+// Smallest microfacet alpha, so that D's peak 1/(π α²) stays finite (≈ 3.2e5).
+const MIN_ALPHA: f32 = 1e-3;
+
+// alpha = roughness² (Burley 2012, §5.4; glTF), clamped below at MIN_ALPHA.
+fn microfacet_alpha(roughness: f32) -> f32 {
+    return max(roughness * roughness, MIN_ALPHA);
+}
+
+// GGX: D = α² / (π ((n·h)²(α² - 1) + 1)²) (Walter et al. 2007, eq. 33).
+fn distribution_ggx(cos_h: f32, alpha: f32) -> f32 {
+    if cos_h <= 0.0 {
+        return 0.0;
+    }
+    let a2 = alpha * alpha;
+    let d = cos_h * cos_h * (a2 - 1.0) + 1.0;
+    return a2 / (PI * d * d);
+}
+
+// Beckmann: D = exp(-tan²θh/α²) / (π α² cos⁴θh) (Walter et al. 2007, eq. 25).
+fn distribution_beckmann(cos_h: f32, alpha: f32) -> f32 {
+    if cos_h <= 0.0 {
+        return 0.0;
+    }
+    let c2 = cos_h * cos_h;
+    let a2 = alpha * alpha;
+    let tan2 = (1.0 - c2) / c2;
+    return exp(-tan2 / a2) / (PI * a2 * c2 * c2);
+}
+
+// Smith Λ for GGX: (-1 + sqrt(1 + α² tan²θ)) / 2 (Heitz 2014, eq. 86).
+fn smith_lambda_ggx(cos: f32, alpha: f32) -> f32 {
+    let c2 = cos * cos;
+    let tan2 = max(1.0 - c2, 0.0) / c2;
+    return 0.5 * (-1.0 + sqrt(1.0 + alpha * alpha * tan2));
+}
+
+// Smith Λ for Beckmann, Walter et al.'s rational approximation (2007, eq. 27).
+fn smith_lambda_beckmann(cos: f32, alpha: f32) -> f32 {
+    let c2 = cos * cos;
+    let tan = sqrt(max(1.0 - c2, 0.0) / c2);
+    if tan == 0.0 {
+        return 0.0;
+    }
+    let a = 1.0 / (alpha * tan);
+    if a >= 1.6 {
+        return 0.0;
+    }
+    return (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a);
+}
+
+// Height-correlated Smith G2 = 1 / (1 + Λ(ωo) + Λ(ωi)) (Heitz 2014, eq. 99).
+fn smith_g2_height_correlated(cos_i: f32, cos_o: f32, alpha: f32, distribution: u32) -> f32 {
+    if distribution == DISTRIBUTION_BECKMANN {
+        return 1.0 / (1.0 + smith_lambda_beckmann(cos_i, alpha) + smith_lambda_beckmann(cos_o, alpha));
+    }
+    return 1.0 / (1.0 + smith_lambda_ggx(cos_i, alpha) + smith_lambda_ggx(cos_o, alpha));
+}
+
+fn microfacet_distribution(cos_h: f32, alpha: f32, distribution: u32) -> f32 {
+    if distribution == DISTRIBUTION_BECKMANN {
+        return distribution_beckmann(cos_h, alpha);
+    }
+    return distribution_ggx(cos_h, alpha);
+}
+
+// Complex numbers as vec2 (re, im), for the conductor Fresnel equations.
+fn complex_mul(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(a.x * b.x - a.y * b.y, a.x * b.y + a.y * b.x);
+}
+
+fn complex_div(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
+    let d = b.x * b.x + b.y * b.y;
+    return vec2<f32>(a.x * b.x + a.y * b.y, a.y * b.x - a.x * b.y) / d;
+}
+
+fn complex_norm(a: vec2<f32>) -> f32 {
+    return a.x * a.x + a.y * a.y;
+}
+
+// Principal square root (pbrt-v4 pstd::sqrt for complex numbers).
+fn complex_sqrt(z: vec2<f32>) -> vec2<f32> {
+    let n = sqrt(complex_norm(z));
+    if n == 0.0 {
+        return vec2<f32>(0.0);
+    }
+    let t1 = sqrt(0.5 * (n + abs(z.x)));
+    let t2 = 0.5 * z.y / t1;
+    if z.x >= 0.0 {
+        return vec2<f32>(t1, t2);
+    }
+    return vec2<f32>(abs(t2), select(-t1, t1, z.y >= 0.0));
+}
+
+// Conductor Fresnel reflectance for complex index eta + i·k (pbrt-v4 §9.3.6 FrComplex).
+fn fresnel_conductor_channel(cos_i_in: f32, eta_re: f32, k: f32) -> f32 {
+    let cos_i = clamp(cos_i_in, 0.0, 1.0);
+    let eta = vec2<f32>(eta_re, k);
+    let sin2_i = 1.0 - cos_i * cos_i;
+    let sin2_t = complex_div(vec2<f32>(sin2_i, 0.0), complex_mul(eta, eta));
+    let cos_t = complex_sqrt(vec2<f32>(1.0 - sin2_t.x, -sin2_t.y));
+    let ci = vec2<f32>(cos_i, 0.0);
+    let eta_ci = complex_mul(eta, ci);
+    let eta_ct = complex_mul(eta, cos_t);
+    let r_parallel = complex_div(eta_ci - cos_t, eta_ci + cos_t);
+    let r_perpendicular = complex_div(ci - eta_ct, ci + eta_ct);
+    return 0.5 * (complex_norm(r_parallel) + complex_norm(r_perpendicular));
+}
+
+fn fresnel_conductor(cos_i: f32, eta: vec3<f32>, k: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(
+        fresnel_conductor_channel(cos_i, eta.x, k.x),
+        fresnel_conductor_channel(cos_i, eta.y, k.y),
+        fresnel_conductor_channel(cos_i, eta.z, k.z),
+    );
+}
+
+// Schlick 1994, eq. 15: F = F0 + (1 - F0)(1 - cos θ)^5.
+fn fresnel_schlick(cos: f32, f0: vec3<f32>) -> vec3<f32> {
+    let m = 1.0 - clamp(cos, 0.0, 1.0);
+    let m2 = m * m;
+    return f0 + (vec3<f32>(1.0) - f0) * (m2 * m2 * m);
+}
+
+fn microfacet_fresnel_exact(material: Material, cos: f32) -> vec3<f32> {
+    if material.conductor != 0u {
+        return fresnel_conductor(cos, material.eta, material.k);
+    }
+    return vec3<f32>(fresnel_dielectric(cos, 1.0, material.ior));
+}
+
+// The Cook-Torrance Fresnel: exact, or Schlick with the exact F0.
+fn microfacet_fresnel(material: Material, cos: f32) -> vec3<f32> {
+    if material.fresnel == FRESNEL_SCHLICK {
+        return fresnel_schlick(cos, microfacet_fresnel_exact(material, 1.0));
+    }
+    return microfacet_fresnel_exact(material, cos);
+}
+
+// F·D·G2 / (4 cos θi cos θo) (Cook and Torrance 1982; Walter et al. 2007, eq. 20).
+fn microfacet_specular(fresnel: vec3<f32>, alpha: f32, distribution: u32, cos_i: f32, cos_o: f32, cos_h: f32) -> vec3<f32> {
+    let d = microfacet_distribution(cos_h, alpha, distribution);
+    let g = smith_g2_height_correlated(cos_i, cos_o, alpha, distribution);
+    return fresnel * (d * g / (4.0 * cos_i * cos_o));
+}
+
+// (n·wi, n·wo, n·h, wi·h); x = 0 when the pair gives no reflection.
+fn microfacet_cosines(n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec4<f32> {
+    let cos_i = dot(n, wi);
+    let cos_o = dot(n, wo);
+    let half_sum = wi + wo;
+    let length_squared = dot(half_sum, half_sum);
+    if cos_i <= 0.0 || cos_o <= 0.0 || length_squared == 0.0 {
+        return vec4<f32>(0.0);
+    }
+    let h = half_sum * inverseSqrt(length_squared);
+    return vec4<f32>(cos_i, cos_o, dot(n, h), clamp(dot(wi, h), 0.0, 1.0));
+}
+
+// Cook-Torrance: specular lobe, plus for a dielectric kd/π·(1 - F(θi))(1 - F(θo))
+// (Shirley et al. 1997, §4).
+fn brdf_cook_torrance(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
+    let c = microfacet_cosines(n, wi, wo);
+    if c.x == 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let alpha = microfacet_alpha(material.roughness);
+    let specular = microfacet_specular(microfacet_fresnel(material, c.w), alpha, material.distribution, c.x, c.y, c.z);
+    if material.conductor != 0u {
+        return specular;
+    }
+    let through = (vec3<f32>(1.0) - microfacet_fresnel(material, c.x)) * (vec3<f32>(1.0) - microfacet_fresnel(material, c.y));
+    return specular + material.diffuse / PI * through;
+}
+
+// Oren and Nayar 1994, eq. 30: A = 1 - 0.5σ²/(σ² + 0.33), B = 0.45σ²/(σ² + 0.09).
+fn oren_nayar_coefficients(sigma: f32) -> vec2<f32> {
+    let s2 = sigma * sigma;
+    return vec2<f32>(1.0 - 0.5 * s2 / (s2 + 0.33), 0.45 * s2 / (s2 + 0.09));
+}
+
+// ρ/π·(A + B·max(0, cos(φi - φo))·sin α·tan β), α = max(θi, θo), β = min(θi, θo).
+fn brdf_oren_nayar(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
+    let ab = oren_nayar_coefficients(material.sigma);
+    let cos_i = clamp(dot(n, wi), 0.0, 1.0);
+    let cos_o = clamp(dot(n, wo), 0.0, 1.0);
+    let sin_i = sqrt(max(1.0 - cos_i * cos_i, 0.0));
+    let sin_o = sqrt(max(1.0 - cos_o * cos_o, 0.0));
+    let projected = dot(wi - n * cos_i, wo - n * cos_o);
+    let sines = sin_i * sin_o;
+    var cos_phi = 0.0;
+    if sines > 1e-6 {
+        cos_phi = clamp(projected / sines, -1.0, 1.0);
+    }
+    var sin_alpha = sin_o;
+    var tan_beta = 0.0;
+    if cos_i < cos_o {
+        sin_alpha = sin_i;
+        tan_beta = sin_o / cos_o;
+    } else if cos_i > 0.0 {
+        tan_beta = sin_i / cos_i;
+    }
+    return material.diffuse / PI * (ab.x + ab.y * max(cos_phi, 0.0) * sin_alpha * tan_beta);
+}
+
+// The tabulated BRDF at the angles of wi and wo from the normal (isotropic).
+fn brdf_tabulated(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
+    if material.brdf_map_layer == NO_IMAGE {
+        return vec3<f32>(0.0);
+    }
+    let theta_i = acos(clamp(dot(n, wi), -1.0, 1.0));
+    let theta_r = acos(clamp(dot(n, wo), -1.0, 1.0));
+    return sample_brdf_map(material.brdf_map_layer, material.brdf_map_size, theta_i, theta_r);
+}
+
+// glTF 2.0 Appendix B: F0 = mix(0.04, base, metallic), Schlick F at h·wi, GGX D with
+// α = roughness², height-correlated Smith G2, diffuse (1 - F)(1 - metallic)·base/π.
+fn brdf_pbr(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
+    let c = microfacet_cosines(n, wi, wo);
+    if c.x == 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let base = material.diffuse;
+    let f0 = mix(vec3<f32>(0.04), base, material.metallic);
+    let fresnel = fresnel_schlick(c.w, f0);
+    let alpha = microfacet_alpha(material.roughness);
+    let specular = microfacet_specular(fresnel, alpha, DISTRIBUTION_GGX, c.x, c.y, c.z);
+    return specular + (vec3<f32>(1.0) - fresnel) * (1.0 - material.metallic) * base / PI;
+}
+
+// The base layer's BRDF for light from wi leaving towards wo (both on n's side);
+// material.diffuse is the (textured) albedo at the hit.
 fn eval_brdf(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     switch material.kind {
         case MATERIAL_LAMBERT: { return brdf_lambert(material.diffuse); }
         case MATERIAL_BLINN_PHONG: { return brdf_blinn_phong(material, n, wi, wo); }
+        case MATERIAL_COOK_TORRANCE: { return brdf_cook_torrance(material, n, wi, wo); }
+        case MATERIAL_OREN_NAYAR: { return brdf_oren_nayar(material, n, wi, wo); }
+        case MATERIAL_TABULATED: { return brdf_tabulated(material, n, wi, wo); }
+        case MATERIAL_PBR: { return brdf_pbr(material, n, wi, wo); }
         default: { return vec3<f32>(0.0); }
     }
+}
+
+// Whether the kind has a base BRDF lit by the lights (and the ambient term).
+fn has_base_brdf(kind: u32) -> bool {
+    return kind != MATERIAL_MIRROR && kind != MATERIAL_DIELECTRIC && kind != MATERIAL_EMISSIVE;
 }
 
 // Whitted's combination (documented in docs/scene-format.md):
@@ -95,7 +334,8 @@ fn surface_response(material: Material, direction: vec3<f32>, n: vec3<f32>, ente
     let cos_o = clamp(-dot(direction, n), 0.0, 1.0);
     var response = SurfaceResponse(0.0, vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     switch material.kind {
-        case MATERIAL_LAMBERT, MATERIAL_BLINN_PHONG: {
+        // The glossy models light only through the base BRDF: no perfect mirror ray.
+        case MATERIAL_LAMBERT, MATERIAL_BLINN_PHONG, MATERIAL_COOK_TORRANCE, MATERIAL_OREN_NAYAR, MATERIAL_TABULATED, MATERIAL_PBR: {
             // A clear coat reflects F and lets 1 - F reach the base.
             var coat = 0.0;
             if material.coat_ior > 0.0 {

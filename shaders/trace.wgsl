@@ -128,8 +128,9 @@ fn direct_light(light: Light, material: Material, origin: vec3<f32>, n: vec3<f32
 // the reflected and refracted rays with their weights, for a ray inside `medium`. New
 // rays start at the re-projected hit point moved off the surface (offset_ray_origin).
 fn shade_hit(ray: Ray, hit: Hit, medium: MediumStack) -> ShadedHit {
-    let material = materials[hit.material];
     let position = hit.position;
+    var material = materials[hit.material];
+    material.diffuse = shading_albedo(material, position, hit.normal);
     let entering = dot(ray.direction, hit.normal) < 0.0;
     // Shading happens on the side the ray came from.
     let n = select(-hit.normal, hit.normal, entering);
@@ -138,8 +139,7 @@ fn shade_hit(ray: Ray, hit: Hit, medium: MediumStack) -> ShadedHit {
     let response = surface_response(material, ray.direction, n, entering, outside_ior);
 
     var radiance = material.emission;
-    let has_base = material.kind == MATERIAL_LAMBERT || material.kind == MATERIAL_BLINN_PHONG;
-    if has_base && response.base > 0.0 {
+    if has_base_brdf(material.kind) && response.base > 0.0 {
         var direct = material.diffuse * frame.ambient;
         let shadow_origin = offset_ray_origin(position, n, frame.offset_scale);
         for (var i = 0u; i < frame.light_count; i += 1u) {

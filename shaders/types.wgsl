@@ -73,6 +73,17 @@ const MATERIAL_BLINN_PHONG: u32 = 1u;
 const MATERIAL_MIRROR: u32 = 2u;
 const MATERIAL_DIELECTRIC: u32 = 3u;
 const MATERIAL_EMISSIVE: u32 = 4u;
+const MATERIAL_COOK_TORRANCE: u32 = 5u;
+const MATERIAL_OREN_NAYAR: u32 = 6u;
+const MATERIAL_TABULATED: u32 = 7u;
+const MATERIAL_PBR: u32 = 8u;
+const DISTRIBUTION_GGX: u32 = 0u;
+const DISTRIBUTION_BECKMANN: u32 = 1u;
+const FRESNEL_EXACT: u32 = 0u;
+const FRESNEL_SCHLICK: u32 = 1u;
+const MAPPING_PLANAR: u32 = 0u;
+const MAPPING_SPHERICAL: u32 = 1u;
+const NO_IMAGE: u32 = 0xffffffffu;
 
 struct Material {
     diffuse: vec3<f32>,
@@ -84,7 +95,24 @@ struct Material {
     transmittance: vec3<f32>,
     coat_ior: f32,
     emission: vec3<f32>,
-    _pad: f32,
+    roughness: f32,
+    eta: vec3<f32>,
+    metallic: f32,
+    k: vec3<f32>,
+    sigma: f32,
+    distribution: u32,
+    fresnel: u32,
+    conductor: u32,
+    texture_mapping: u32,
+    texture_layer: u32,
+    texture_width: u32,
+    texture_height: u32,
+    texture_scale: f32,
+    brdf_map_layer: u32,
+    brdf_map_size: u32,
+    // Scalars, not vec2<u32>/vec3<u32>, so the padding never changes the alignment.
+    _pad0: u32,
+    _pad1: u32,
 }
 
 const LIGHT_POINT: u32 = 0u;

@@ -18,5 +18,6 @@ pub mod cpu;
 pub mod film;
 pub mod gpu;
 pub mod output;
+pub mod plausibility;
 pub mod scene;
 pub mod tradeoff;

@@ -123,6 +123,7 @@ fn scaled_scene(s: f64) -> Scene {
                 ..Material::blank(MaterialKind::BlinnPhong)
             },
         ],
+        images: Vec::new(),
         material_names: ["floor", "red", "mirror", "glass", "coated"]
             .map(String::from)
             .to_vec(),
@@ -254,6 +255,7 @@ fn floor_scene(huge_sphere: bool) -> Scene {
             Material::lambert(DVec3::splat(0.7)),
             Material::lambert(DVec3::new(0.8, 0.1, 0.1)),
         ],
+        images: Vec::new(),
         material_names: vec!["floor".into(), "ball".into()],
         lights: vec![Light::Point {
             position: DVec3::new(1.0, 4.0, 2.0),
@@ -324,6 +326,7 @@ fn grazing_and_tangent_rays_are_finite_and_acne_free() {
         },
         environment: Environment::default(),
         materials: vec![Material::lambert(DVec3::splat(0.7))],
+        images: Vec::new(),
         material_names: vec!["floor".into()],
         lights: vec![Light::Point {
             position: DVec3::new(0.0, 50.0, -600.0),
@@ -348,6 +351,7 @@ fn grazing_and_tangent_rays_are_finite_and_acne_free() {
             ambient: DVec3::ZERO,
         },
         materials: vec![Material::lambert(DVec3::splat(0.7)), dielectric(1.5)],
+        images: Vec::new(),
         material_names: vec!["matte".into(), "glass".into()],
         lights: vec![Light::Point {
             position: DVec3::new(0.0, 0.0, 5.0),
@@ -511,6 +515,7 @@ fn mesh_scene(mesh: &[[DVec3; 3]], eye: DVec3, look_at: DVec3, fov_y_degrees: f6
         },
         environment: Environment::default(),
         materials: vec![emissive(1.0)],
+        images: Vec::new(),
         material_names: vec!["glow".into()],
         lights: Vec::new(),
         shapes: mesh
@@ -583,6 +588,7 @@ fn camera_inside_glass_sees_the_background() {
             ambient: DVec3::ZERO,
         },
         materials: vec![dielectric(1.5)],
+        images: Vec::new(),
         material_names: vec!["glass".into()],
         lights: Vec::new(),
         shapes: vec![Shape::Sphere {
@@ -664,6 +670,7 @@ fn glass_scene(outer_ior: f64, inner_ior: Option<f64>) -> Scene {
             dielectric(outer_ior),
             dielectric(inner_ior.unwrap_or(1.0)),
         ],
+        images: Vec::new(),
         material_names: ["white", "stripe", "outer", "inner"]
             .map(String::from)
             .to_vec(),

@@ -6,7 +6,9 @@ use std::collections::BTreeMap;
 use std::mem::{offset_of, size_of};
 
 use gpu_render::gpu::layout::*;
-use gpu_render::gpu::shaders::{TYPES_WGSL, display_shader_source, trace_shader_source};
+use gpu_render::gpu::shaders::{
+    TYPES_WGSL, bxdf_eval_shader_source, display_shader_source, trace_shader_source,
+};
 
 /// Rust twin of one WGSL struct: size and (member name, offset) pairs.
 type Twin = (usize, Vec<(&'static str, usize)>);
@@ -103,7 +105,23 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 transmittance,
                 coat_ior,
                 emission,
-                _pad,
+                roughness,
+                eta,
+                metallic,
+                k,
+                sigma,
+                distribution,
+                fresnel,
+                conductor,
+                texture_mapping,
+                texture_layer,
+                texture_width,
+                texture_height,
+                texture_scale,
+                brdf_map_layer,
+                brdf_map_size,
+                _pad0,
+                _pad1,
             }),
         ),
         (
@@ -187,6 +205,17 @@ fn constants_match() {
         ("MATERIAL_MIRROR", MATERIAL_MIRROR),
         ("MATERIAL_DIELECTRIC", MATERIAL_DIELECTRIC),
         ("MATERIAL_EMISSIVE", MATERIAL_EMISSIVE),
+        ("MATERIAL_COOK_TORRANCE", MATERIAL_COOK_TORRANCE),
+        ("MATERIAL_OREN_NAYAR", MATERIAL_OREN_NAYAR),
+        ("MATERIAL_TABULATED", MATERIAL_TABULATED),
+        ("MATERIAL_PBR", MATERIAL_PBR),
+        ("DISTRIBUTION_GGX", DISTRIBUTION_GGX),
+        ("DISTRIBUTION_BECKMANN", DISTRIBUTION_BECKMANN),
+        ("FRESNEL_EXACT", FRESNEL_EXACT),
+        ("FRESNEL_SCHLICK", FRESNEL_SCHLICK),
+        ("MAPPING_PLANAR", MAPPING_PLANAR),
+        ("MAPPING_SPHERICAL", MAPPING_SPHERICAL),
+        ("NO_IMAGE", NO_IMAGE),
         ("LIGHT_POINT", LIGHT_POINT),
         ("LIGHT_DIRECTIONAL", LIGHT_DIRECTIONAL),
     ]);
@@ -247,4 +276,9 @@ fn composed_display_shader_validates() {
         .find(|e| e.name == "encode_display")
         .expect("entry point encode_display");
     assert_eq!(entry.workgroup_size, [8, 8, 1]);
+}
+
+#[test]
+fn composed_bxdf_eval_shader_validates() {
+    validate("bxdf eval shader", &bxdf_eval_shader_source());
 }

@@ -5,7 +5,13 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
-use crate::scene::{Material, MaterialKind};
+use super::texture::sample_brdf_map;
+use crate::scene::{FresnelModel, Image, Material, MaterialKind, MicrofacetDistribution};
+
+/// Smallest microfacet `alpha`: roughness 0 is clamped here so that the distribution's
+/// peak `1/(π α²)` stays finite (≈ 3.2e5, far inside `f32`) instead of becoming a
+/// delta function that a point light can never hit.
+pub const MIN_ALPHA: f64 = 1e-3;
 
 /// Mirror reflection of the incident direction `u` about the unit normal `n`
 /// (lecture: `R = u - 2(u·N)N`).
@@ -78,13 +84,332 @@ pub fn brdf_blinn_phong(material: &Material, n: DVec3, wi: DVec3, wo: DVec3) -> 
     material.diffuse / PI + material.specular * lobe
 }
 
+/// The distribution's `alpha` for a perceptual roughness in [0, 1]:
+/// `alpha = roughness²` (Burley 2012, "Physically-Based Shading at Disney", §5.4; the
+/// glTF 2.0 convention), clamped below at [`MIN_ALPHA`].
+pub fn microfacet_alpha(roughness: f64) -> f64 {
+    (roughness * roughness).max(MIN_ALPHA)
+}
+
+/// Trowbridge-Reitz (GGX) normal distribution for `cos_h = n·h`:
+/// `D = α² / (π ((n·h)²(α² - 1) + 1)²)` (Walter et al. 2007, "Microfacet Models for
+/// Refraction through Rough Surfaces", eq. 33). Zero for `cos_h ≤ 0`.
+pub fn distribution_ggx(cos_h: f64, alpha: f64) -> f64 {
+    if cos_h <= 0.0 {
+        return 0.0;
+    }
+    let a2 = alpha * alpha;
+    let d = cos_h * cos_h * (a2 - 1.0) + 1.0;
+    a2 / (PI * d * d)
+}
+
+/// Beckmann normal distribution: `D = exp(-tan²θh/α²) / (π α² cos⁴θh)` (Walter et al.
+/// 2007, eq. 25). Zero for `cos_h ≤ 0`.
+pub fn distribution_beckmann(cos_h: f64, alpha: f64) -> f64 {
+    if cos_h <= 0.0 {
+        return 0.0;
+    }
+    let c2 = cos_h * cos_h;
+    let a2 = alpha * alpha;
+    let tan2 = (1.0 - c2) / c2;
+    (-tan2 / a2).exp() / (PI * a2 * c2 * c2)
+}
+
+/// Smith's `Λ` for GGX at a direction with `cos θ = cos`:
+/// `Λ = (-1 + sqrt(1 + α² tan²θ)) / 2` (Heitz 2014, "Understanding the
+/// Masking-Shadowing Function in Microfacet-Based BRDFs", eq. 86).
+pub fn smith_lambda_ggx(cos: f64, alpha: f64) -> f64 {
+    let c2 = cos * cos;
+    let tan2 = (1.0 - c2).max(0.0) / c2;
+    0.5 * (-1.0 + (1.0 + alpha * alpha * tan2).sqrt())
+}
+
+/// Smith's `Λ` for Beckmann, with Walter et al.'s rational approximation (2007,
+/// eq. 27) of the exact `(erf(a) - 1)/2 + exp(-a²)/(2a√π)`, `a = 1/(α tanθ)`: WGSL has
+/// no `erf`, and both backends use the same formula.
+pub fn smith_lambda_beckmann(cos: f64, alpha: f64) -> f64 {
+    let c2 = cos * cos;
+    let tan = ((1.0 - c2).max(0.0) / c2).sqrt();
+    if tan == 0.0 {
+        return 0.0;
+    }
+    let a = 1.0 / (alpha * tan);
+    if a >= 1.6 {
+        return 0.0;
+    }
+    (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a)
+}
+
+/// The height-correlated Smith masking-shadowing function
+/// `G2 = 1 / (1 + Λ(ωo) + Λ(ωi))` (Heitz 2014, eq. 99), for both distributions.
+pub fn smith_g2_height_correlated(
+    cos_i: f64,
+    cos_o: f64,
+    alpha: f64,
+    distribution: MicrofacetDistribution,
+) -> f64 {
+    let lambda = |c| match distribution {
+        MicrofacetDistribution::Ggx => smith_lambda_ggx(c, alpha),
+        MicrofacetDistribution::Beckmann => smith_lambda_beckmann(c, alpha),
+    };
+    1.0 / (1.0 + lambda(cos_i) + lambda(cos_o))
+}
+
+/// The normal distribution `D(h)` of `distribution`.
+pub fn microfacet_distribution(
+    cos_h: f64,
+    alpha: f64,
+    distribution: MicrofacetDistribution,
+) -> f64 {
+    match distribution {
+        MicrofacetDistribution::Ggx => distribution_ggx(cos_h, alpha),
+        MicrofacetDistribution::Beckmann => distribution_beckmann(cos_h, alpha),
+    }
+}
+
+/// Fresnel reflectance of a conductor of complex index `eta + i·k` (light arriving
+/// from a medium of index 1) for unpolarised light: pbrt-v4 §9.3.6 `FrComplex`,
+/// `r⊥ = (cos_i - η cos_t)/(cos_i + η cos_t)`, `r∥ = (η cos_i - cos_t)/(η cos_i +
+/// cos_t)`, `cos_t = sqrt(1 - sin²θi/η²)` in complex arithmetic; `F = (|r⊥|² + |r∥|²)/2`.
+pub fn fresnel_conductor_channel(cos_i: f64, eta: f64, k: f64) -> f64 {
+    let cos_i = cos_i.clamp(0.0, 1.0);
+    let eta = Complex::new(eta, k);
+    let sin2_i = 1.0 - cos_i * cos_i;
+    let sin2_t = Complex::new(sin2_i, 0.0).div(eta.mul(eta));
+    let cos_t = Complex::new(1.0 - sin2_t.re, -sin2_t.im).sqrt();
+    let ci = Complex::new(cos_i, 0.0);
+    let r_parallel = eta.mul(ci).sub(cos_t).div(eta.mul(ci).add(cos_t));
+    let r_perpendicular = ci.sub(eta.mul(cos_t)).div(ci.add(eta.mul(cos_t)));
+    0.5 * (r_parallel.norm() + r_perpendicular.norm())
+}
+
+/// [`fresnel_conductor_channel`] per RGB channel.
+pub fn fresnel_conductor(cos_i: f64, eta: DVec3, k: DVec3) -> DVec3 {
+    DVec3::new(
+        fresnel_conductor_channel(cos_i, eta.x, k.x),
+        fresnel_conductor_channel(cos_i, eta.y, k.y),
+        fresnel_conductor_channel(cos_i, eta.z, k.z),
+    )
+}
+
+/// Schlick's approximation `F = F0 + (1 - F0)(1 - cos θ)^5` (Schlick 1994, "An
+/// Inexpensive BRDF Model for Physically-based Rendering", eq. 15).
+pub fn fresnel_schlick(cos: f64, f0: DVec3) -> DVec3 {
+    let m = (1.0 - cos.clamp(0.0, 1.0)).powi(5);
+    f0 + (DVec3::ONE - f0) * m
+}
+
+/// The Fresnel reflectance a Cook-Torrance material uses at `cos` (conductor or
+/// dielectric, exact or Schlick with the exact `F0`).
+pub fn microfacet_fresnel(material: &Material, cos: f64) -> DVec3 {
+    let exact = |c: f64| {
+        if material.conductor {
+            fresnel_conductor(c, material.eta, material.k)
+        } else {
+            DVec3::splat(fresnel_dielectric(c, 1.0, material.ior))
+        }
+    };
+    match material.fresnel {
+        FresnelModel::Exact => exact(cos),
+        FresnelModel::Schlick => fresnel_schlick(cos, exact(1.0)),
+    }
+}
+
+/// The specular microfacet lobe `F·D·G2 / (4 cos θi cos θo)` (Cook and Torrance 1982;
+/// Walter et al. 2007, eq. 20) with `F = fresnel` already evaluated at `h·wi`.
+fn microfacet_specular(
+    fresnel: DVec3,
+    alpha: f64,
+    distribution: MicrofacetDistribution,
+    cos_i: f64,
+    cos_o: f64,
+    cos_h: f64,
+) -> DVec3 {
+    let d = microfacet_distribution(cos_h, alpha, distribution);
+    let g = smith_g2_height_correlated(cos_i, cos_o, alpha, distribution);
+    fresnel * (d * g / (4.0 * cos_i * cos_o))
+}
+
+/// The cosines the microfacet models need: `(n·wi, n·wo, n·h, wi·h)`, or `None` when
+/// either direction is below the surface or they cancel out.
+fn microfacet_cosines(n: DVec3, wi: DVec3, wo: DVec3) -> Option<(f64, f64, f64, f64)> {
+    let cos_i = n.dot(wi);
+    let cos_o = n.dot(wo);
+    let h = (wi + wo).normalize_or_zero();
+    if cos_i <= 0.0 || cos_o <= 0.0 || h == DVec3::ZERO {
+        return None;
+    }
+    Some((cos_i, cos_o, n.dot(h), wi.dot(h).clamp(0.0, 1.0)))
+}
+
+/// Cook-Torrance BRDF: the specular lobe [`microfacet_fresnel`]·D·G2/(4 cos θi cos θo),
+/// plus, for a dielectric, a diffuse base `kd/π · (1 - F(θi))(1 - F(θo))` weighted by
+/// the light that passes the interface on the way in and out (Shirley et al. 1997,
+/// "A Practitioners' Assessment of Light Reflection Models", §4), which keeps the
+/// sum reciprocal and near energy conserving. `material.diffuse` is the (textured)
+/// albedo.
+pub fn brdf_cook_torrance(material: &Material, n: DVec3, wi: DVec3, wo: DVec3) -> DVec3 {
+    let Some((cos_i, cos_o, cos_h, cos_d)) = microfacet_cosines(n, wi, wo) else {
+        return DVec3::ZERO;
+    };
+    let alpha = microfacet_alpha(material.roughness);
+    let specular = microfacet_specular(
+        microfacet_fresnel(material, cos_d),
+        alpha,
+        material.distribution,
+        cos_i,
+        cos_o,
+        cos_h,
+    );
+    if material.conductor {
+        return specular;
+    }
+    let through = (DVec3::ONE - microfacet_fresnel(material, cos_i))
+        * (DVec3::ONE - microfacet_fresnel(material, cos_o));
+    specular + material.diffuse / PI * through
+}
+
+/// Oren-Nayar's `A` and `B` for a facet-slope deviation `sigma` in radians:
+/// `A = 1 - 0.5 σ²/(σ² + 0.33)`, `B = 0.45 σ²/(σ² + 0.09)` (Oren and Nayar 1994,
+/// "Generalization of Lambert's Reflectance Model", eq. 30, the qualitative model).
+pub fn oren_nayar_coefficients(sigma: f64) -> (f64, f64) {
+    let s2 = sigma * sigma;
+    (1.0 - 0.5 * s2 / (s2 + 0.33), 0.45 * s2 / (s2 + 0.09))
+}
+
+/// Oren-Nayar BRDF `ρ/π · (A + B·max(0, cos(φi - φo))·sin α·tan β)`, `α = max(θi, θo)`,
+/// `β = min(θi, θo)` (Oren and Nayar 1994, eq. 30). With σ = 0, `A = 1` and `B = 0`:
+/// exactly Lambert.
+pub fn brdf_oren_nayar(material: &Material, n: DVec3, wi: DVec3, wo: DVec3) -> DVec3 {
+    let (a, b) = oren_nayar_coefficients(material.sigma);
+    let cos_i = n.dot(wi).clamp(0.0, 1.0);
+    let cos_o = n.dot(wo).clamp(0.0, 1.0);
+    let sin_i = (1.0 - cos_i * cos_i).max(0.0).sqrt();
+    let sin_o = (1.0 - cos_o * cos_o).max(0.0).sqrt();
+    // cos(φi - φo) from the directions projected on the tangent plane.
+    let projected = (wi - n * cos_i).dot(wo - n * cos_o);
+    let sines = sin_i * sin_o;
+    let cos_phi = if sines > 1e-6 {
+        (projected / sines).clamp(-1.0, 1.0)
+    } else {
+        0.0
+    };
+    // α is the larger angle (smaller cosine), β the smaller angle (larger cosine).
+    let (sin_alpha, tan_beta) = if cos_i < cos_o {
+        (sin_i, sin_o / cos_o)
+    } else {
+        (sin_o, if cos_i > 0.0 { sin_i / cos_i } else { 0.0 })
+    };
+    material.diffuse / PI * (a + b * cos_phi.max(0.0) * sin_alpha * tan_beta)
+}
+
+/// The tabulated BRDF at the angles of `wi` and `wo` from the normal (isotropic,
+/// independent of azimuth; see [`sample_brdf_map`]).
+pub fn brdf_tabulated(map: &Image, n: DVec3, wi: DVec3, wo: DVec3) -> DVec3 {
+    let theta_i = n.dot(wi).clamp(-1.0, 1.0).acos();
+    let theta_r = n.dot(wo).clamp(-1.0, 1.0).acos();
+    sample_brdf_map(map, theta_i, theta_r)
+}
+
+/// The glTF 2.0 metal/roughness BRDF (glTF 2.0 specification, Appendix B):
+/// `F0 = mix(0.04, base, metallic)`, `F = F0 + (1 - F0)(1 - |h·wi|)^5`,
+/// `f = F·D·G2/(4 cos θi cos θo) + (1 - F)(1 - metallic)·base/π` with GGX `D`,
+/// `α = roughness²` and height-correlated Smith `G2` (as the Khronos sample viewer;
+/// the specification's text writes the separable form). `material.diffuse` is the
+/// (textured) base colour.
+pub fn brdf_pbr(material: &Material, n: DVec3, wi: DVec3, wo: DVec3) -> DVec3 {
+    let Some((cos_i, cos_o, cos_h, cos_d)) = microfacet_cosines(n, wi, wo) else {
+        return DVec3::ZERO;
+    };
+    let base = material.diffuse;
+    let f0 = DVec3::splat(0.04).lerp(base, material.metallic);
+    let fresnel = fresnel_schlick(cos_d, f0);
+    let alpha = microfacet_alpha(material.roughness);
+    let specular = microfacet_specular(
+        fresnel,
+        alpha,
+        MicrofacetDistribution::Ggx,
+        cos_i,
+        cos_o,
+        cos_h,
+    );
+    specular + (DVec3::ONE - fresnel) * (1.0 - material.metallic) * base / PI
+}
+
 /// The BRDF of `material`'s base layer for light arriving from `wi` and leaving
-/// towards `wo`, both unit and on the side of the unit normal `n`.
-pub fn eval_brdf(material: &Material, n: DVec3, wi: DVec3, wo: DVec3) -> DVec3 {
+/// towards `wo`, both unit and on the side of the unit normal `n`. `images` are the
+/// scene's (for tabulated maps); `material.diffuse` is the albedo at the hit (see
+/// [`super::texture::shading_albedo`]).
+pub fn eval_brdf(material: &Material, images: &[Image], n: DVec3, wi: DVec3, wo: DVec3) -> DVec3 {
     match material.kind {
         MaterialKind::Lambert => brdf_lambert(material.diffuse),
         MaterialKind::BlinnPhong => brdf_blinn_phong(material, n, wi, wo),
+        MaterialKind::CookTorrance => brdf_cook_torrance(material, n, wi, wo),
+        MaterialKind::OrenNayar => brdf_oren_nayar(material, n, wi, wo),
+        MaterialKind::Pbr => brdf_pbr(material, n, wi, wo),
+        MaterialKind::Tabulated => match material.brdf_map {
+            Some(map) => brdf_tabulated(&images[map as usize], n, wi, wo),
+            None => DVec3::ZERO,
+        },
         MaterialKind::Mirror | MaterialKind::Dielectric | MaterialKind::Emissive => DVec3::ZERO,
+    }
+}
+
+/// Whether `kind` has a base BRDF lit by the lights (and the ambient term).
+pub fn has_base_brdf(kind: MaterialKind) -> bool {
+    !matches!(
+        kind,
+        MaterialKind::Mirror | MaterialKind::Dielectric | MaterialKind::Emissive
+    )
+}
+
+/// Just enough complex arithmetic for [`fresnel_conductor_channel`].
+#[derive(Debug, Clone, Copy)]
+struct Complex {
+    re: f64,
+    im: f64,
+}
+
+impl Complex {
+    fn new(re: f64, im: f64) -> Self {
+        Self { re, im }
+    }
+    fn add(self, o: Self) -> Self {
+        Self::new(self.re + o.re, self.im + o.im)
+    }
+    fn sub(self, o: Self) -> Self {
+        Self::new(self.re - o.re, self.im - o.im)
+    }
+    fn mul(self, o: Self) -> Self {
+        Self::new(
+            self.re * o.re - self.im * o.im,
+            self.re * o.im + self.im * o.re,
+        )
+    }
+    fn div(self, o: Self) -> Self {
+        let d = o.re * o.re + o.im * o.im;
+        Self::new(
+            (self.re * o.re + self.im * o.im) / d,
+            (self.im * o.re - self.re * o.im) / d,
+        )
+    }
+    /// `|z|²`.
+    fn norm(self) -> f64 {
+        self.re * self.re + self.im * self.im
+    }
+    /// The principal square root (pbrt-v4 `pstd::sqrt` for complex numbers).
+    fn sqrt(self) -> Self {
+        let n = self.norm().sqrt();
+        if n == 0.0 {
+            return Self::new(0.0, 0.0);
+        }
+        let t1 = (0.5 * (n + self.re.abs())).sqrt();
+        let t2 = 0.5 * self.im / t1;
+        if self.re >= 0.0 {
+            Self::new(t1, t2)
+        } else {
+            Self::new(t2.abs(), t1.copysign(self.im))
+        }
     }
 }
 
@@ -124,7 +449,13 @@ pub fn surface_response(
         transmit_direction: DVec3::ZERO,
     };
     match material.kind {
-        MaterialKind::Lambert | MaterialKind::BlinnPhong => {
+        // The glossy models light only through the base BRDF: no perfect mirror ray.
+        MaterialKind::Lambert
+        | MaterialKind::BlinnPhong
+        | MaterialKind::CookTorrance
+        | MaterialKind::OrenNayar
+        | MaterialKind::Tabulated
+        | MaterialKind::Pbr => {
             // A clear coat reflects F and lets 1 - F reach the base.
             let coat = if material.coat_ior > 0.0 {
                 fresnel_dielectric(cos_o, outside_ior, material.coat_ior)

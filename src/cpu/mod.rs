@@ -7,6 +7,7 @@
 
 pub mod bxdf;
 pub mod intersect;
+pub mod texture;
 pub mod trace;
 
 use std::sync::Mutex;

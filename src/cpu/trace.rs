@@ -4,13 +4,14 @@
 
 use glam::DVec3;
 
-use super::bxdf::{eval_brdf, reflect_direction, surface_response};
+use super::bxdf::{eval_brdf, has_base_brdf, reflect_direction, surface_response};
 use super::intersect::{
     Hit, PreparedShape, Ray, intersect_scene, occluded, offset_ray_origin, prepare_shapes,
     ray_offset_scale,
 };
+use super::texture::shading_albedo;
 use crate::camera::{CameraFrame, sample_offset};
-use crate::scene::{Light, Material, MaterialKind, RenderSettings, Scene};
+use crate::scene::{Image, Light, Material, RenderSettings, Scene};
 
 /// The scene in the form the tracer reads: colours in the lighting space, polygons with
 /// their planes, the camera basis.
@@ -32,6 +33,8 @@ pub struct PreparedScene {
     pub shapes: Vec<PreparedShape>,
     /// Length scale of the self-intersection offset ([`ray_offset_scale`]).
     pub offset_scale: f64,
+    /// Albedo textures and BRDF maps.
+    pub images: Vec<Image>,
 }
 
 impl PreparedScene {
@@ -47,6 +50,7 @@ impl PreparedScene {
             lights: scene.lights.clone(),
             shapes: prepare_shapes(&scene),
             offset_scale: ray_offset_scale(&scene),
+            images: scene.images,
         }
     }
 }
@@ -269,8 +273,10 @@ pub struct ShadedHit {
 /// re-projected hit point moved off the surface by [`offset_ray_origin`], to the side
 /// the ray leaves on.
 pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumStack) -> ShadedHit {
-    let material = &scene.materials[hit.material as usize];
     let position = hit.position;
+    let mut material = scene.materials[hit.material as usize];
+    material.diffuse = shading_albedo(&material, &scene.images, position, hit.normal);
+    let material = &material;
     let entering = ray.direction.dot(hit.normal) < 0.0;
     // Shading happens on the side the ray came from.
     let n = if entering { hit.normal } else { -hit.normal };
@@ -280,11 +286,7 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumSta
 
     let mut radiance = material.emission;
     let mut shadow_rays = 0;
-    let has_base = matches!(
-        material.kind,
-        MaterialKind::Lambert | MaterialKind::BlinnPhong
-    );
-    if has_base && response.base > 0.0 {
+    if has_base_brdf(material.kind) && response.base > 0.0 {
         let mut direct = material.diffuse * scene.ambient;
         let shadow_origin = offset_ray_origin(position, n, scene.offset_scale);
         for light in &scene.lights {
@@ -354,5 +356,8 @@ pub fn direct_light(
     if occluded(&scene.shapes, &shadow, distance) {
         return (DVec3::ZERO, 1);
     }
-    (eval_brdf(material, n, wi, wo) * irradiance * cos_i, 1)
+    (
+        eval_brdf(material, &scene.images, n, wi, wo) * irradiance * cos_i,
+        1,
+    )
 }

@@ -156,8 +156,40 @@ pub struct GpuMaterial {
     pub coat_ior: f32,
     /// Emitted radiance.
     pub emission: [f32; 3],
+    /// Perceptual roughness (Cook-Torrance, PBR).
+    pub roughness: f32,
+    /// Conductor index of refraction, real part.
+    pub eta: [f32; 3],
+    /// PBR metalness.
+    pub metallic: f32,
+    /// Conductor index of refraction, imaginary part.
+    pub k: [f32; 3],
+    /// Oren-Nayar slope deviation in radians.
+    pub sigma: f32,
+    /// One of the `DISTRIBUTION_*` constants.
+    pub distribution: u32,
+    /// One of the `FRESNEL_*` constants.
+    pub fresnel: u32,
+    /// 1 for a conductor's Fresnel (`eta`, `k`), 0 for a dielectric's (`ior`).
+    pub conductor: u32,
+    /// One of the `MAPPING_*` constants.
+    pub texture_mapping: u32,
+    /// Layer of the albedo texture in the image array, or [`NO_IMAGE`].
+    pub texture_layer: u32,
+    /// Width of the albedo texture in texels.
+    pub texture_width: u32,
+    /// Height of the albedo texture in texels.
+    pub texture_height: u32,
+    /// Scene units per repeat of the planar mapping.
+    pub texture_scale: f32,
+    /// Layer of the BRDF map in the image array, or [`NO_IMAGE`].
+    pub brdf_map_layer: u32,
+    /// Side of the (square) BRDF map in texels.
+    pub brdf_map_size: u32,
+    /// Padding (scalars: a `vec3<u32>` would be 16-byte aligned in WGSL).
+    pub _pad0: u32,
     /// Padding.
-    pub _pad: f32,
+    pub _pad1: u32,
 }
 
 /// A light (`Light` in WGSL).
@@ -194,6 +226,28 @@ pub const MATERIAL_MIRROR: u32 = 2;
 pub const MATERIAL_DIELECTRIC: u32 = 3;
 /// `Material.kind` value for a pure emitter.
 pub const MATERIAL_EMISSIVE: u32 = 4;
+/// `Material.kind` value for Cook-Torrance.
+pub const MATERIAL_COOK_TORRANCE: u32 = 5;
+/// `Material.kind` value for Oren-Nayar.
+pub const MATERIAL_OREN_NAYAR: u32 = 6;
+/// `Material.kind` value for a tabulated BRDF map.
+pub const MATERIAL_TABULATED: u32 = 7;
+/// `Material.kind` value for glTF metal/roughness PBR.
+pub const MATERIAL_PBR: u32 = 8;
+/// `Material.distribution` value for GGX.
+pub const DISTRIBUTION_GGX: u32 = 0;
+/// `Material.distribution` value for Beckmann.
+pub const DISTRIBUTION_BECKMANN: u32 = 1;
+/// `Material.fresnel` value for the exact equations.
+pub const FRESNEL_EXACT: u32 = 0;
+/// `Material.fresnel` value for Schlick's approximation.
+pub const FRESNEL_SCHLICK: u32 = 1;
+/// `Material.texture_mapping` value for the planar mapping.
+pub const MAPPING_PLANAR: u32 = 0;
+/// `Material.texture_mapping` value for the spherical mapping.
+pub const MAPPING_SPHERICAL: u32 = 1;
+/// `texture_layer` / `brdf_map_layer` value meaning "no image".
+pub const NO_IMAGE: u32 = u32::MAX;
 /// `Light.kind` value for a point light.
 pub const LIGHT_POINT: u32 = 0;
 /// `Light.kind` value for a directional light.

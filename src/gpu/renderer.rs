@@ -23,7 +23,7 @@ use super::shaders::{
     DISPLAY_ENTRY_POINT, TRACE_ENTRY_POINT, WORKGROUP_SIZE, display_shader_source,
     trace_shader_source,
 };
-use super::upload::{SceneRecords, frame_uniforms};
+use super::upload::{SceneRecords, frame_uniforms, image_layers};
 use crate::film::{LinearImage, ProgressFn, RenderStats};
 use crate::scene::Scene;
 
@@ -89,6 +89,8 @@ pub struct PreparedScene {
     ray_counts: wgpu::Buffer,
     /// Running sums of one sample dispatch to the next, for up to `accumulation_rows`.
     accumulation: wgpu::Buffer,
+    /// Albedo textures and BRDF maps, one layer each (see [`image_layers`]).
+    images: wgpu::TextureView,
 }
 
 impl PreparedScene {
@@ -262,6 +264,14 @@ impl GpuRenderer {
                     storage_texture_entry(8, LINEAR_FORMAT),
                     storage_entry(9, false),
                     storage_entry(10, false),
+                    compute_entry(
+                        11,
+                        wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                            view_dimension: wgpu::TextureViewDimension::D2Array,
+                            multisampled: false,
+                        },
+                    ),
                 ],
             });
         let trace_pipeline_layout =
@@ -445,6 +455,7 @@ impl GpuRenderer {
             accumulation_rows,
             ..frame
         };
+        let images = upload_images(device, queue, &scene, &limits)?;
         Ok(PreparedScene {
             frame,
             accumulation,
@@ -458,6 +469,7 @@ impl GpuRenderer {
             materials,
             lights,
             ray_counts,
+            images,
         })
     }
 
@@ -639,6 +651,10 @@ impl GpuRenderer {
                     },
                     buffer_binding(9, &prepared.ray_counts),
                     buffer_binding(10, &prepared.accumulation),
+                    wgpu::BindGroupEntry {
+                        binding: 11,
+                        resource: wgpu::BindingResource::TextureView(&prepared.images),
+                    },
                 ],
             })
         })?;
@@ -1034,6 +1050,55 @@ fn build_pipeline(
             cache: None,
         })
     })
+}
+
+/// Uploads the scene's images as one `Rgba32Float` 2D array texture (one layer per
+/// image, see [`image_layers`]) and returns its view.
+fn upload_images(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    scene: &Scene,
+    limits: &wgpu::Limits,
+) -> Result<wgpu::TextureView, GpuError> {
+    let (width, height, layers, texels) = image_layers(&scene.images);
+    if layers > limits.max_texture_array_layers {
+        return Err(GpuError::DeviceLimit {
+            what: "images (texture array layers)".to_string(),
+            value: u64::from(layers),
+            limit: u64::from(limits.max_texture_array_layers),
+        });
+    }
+    let size = wgpu::Extent3d {
+        width,
+        height,
+        depth_or_array_layers: layers,
+    };
+    let texture = capture(device, "image array", Caught::Resource, || {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("gpu-render images"),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        })
+    })?;
+    queue.write_texture(
+        texture.as_image_copy(),
+        bytemuck::cast_slice(&texels),
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(width * 16),
+            rows_per_image: Some(height),
+        },
+        size,
+    );
+    Ok(texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    }))
 }
 
 /// Creates a 2D texture inside error scopes (allocation failure becomes

@@ -11,8 +11,15 @@ pub const DISPLAY_WGSL: &str = include_str!("../../shaders/display.wgsl");
 pub const SAMPLING_WGSL: &str = include_str!("../../shaders/sampling.wgsl");
 /// Ray/shape intersection.
 pub const INTERSECT_WGSL: &str = include_str!("../../shaders/intersect.wgsl");
+/// Texture coordinates and bilinear lookups (the `images` binding), twin of
+/// [`crate::cpu::texture`].
+pub const TEXTURE_WGSL: &str = include_str!("../../shaders/texture.wgsl");
 /// Materials.
 pub const BXDF_WGSL: &str = include_str!("../../shaders/bxdf.wgsl");
+/// The BRDF test kernel (`eval_brdfs`), composed by [`bxdf_eval_shader_source`].
+pub const BXDF_EVAL_WGSL: &str = include_str!("../../shaders/bxdf_eval.wgsl");
+/// Entry point of the BRDF test kernel.
+pub const BXDF_EVAL_ENTRY_POINT: &str = "eval_brdfs";
 /// The tracing kernel (`trace_pixels`).
 pub const TRACE_WGSL: &str = include_str!("../../shaders/trace.wgsl");
 
@@ -24,7 +31,7 @@ pub const DISPLAY_ENTRY_POINT: &str = "encode_display";
 pub const WORKGROUP_SIZE: u32 = 8;
 
 /// The complete trace module for a bounce stack of `stack_size` entries: the
-/// `STACK_SIZE` constant, then types, sampling, intersect, bxdf and trace.
+/// `STACK_SIZE` constant, then types, sampling, intersect, texture, bxdf and trace.
 ///
 /// The stack size is a `const` rather than a pipeline-overridable constant because
 /// WGSL array sizes in function address space must be creation-time constants; each
@@ -39,6 +46,7 @@ pub fn trace_shader_source(stack_size: u32) -> String {
         TYPES_WGSL,
         SAMPLING_WGSL,
         INTERSECT_WGSL,
+        TEXTURE_WGSL,
         BXDF_WGSL,
         TRACE_WGSL,
     ];
@@ -46,6 +54,25 @@ pub fn trace_shader_source(stack_size: u32) -> String {
     for part in parts {
         source.push_str(part);
         // A missing final newline in one file must not glue a comment to the next.
+        if !part.ends_with('\n') {
+            source.push('\n');
+        }
+    }
+    source
+}
+
+/// The BRDF test kernel: types, texture, bxdf and `shaders/bxdf_eval.wgsl`, which
+/// evaluates [`crate::cpu::bxdf::eval_brdf`]'s twin on a list of (material, n, wi, wo)
+/// cases so that tests can compare it with the CPU.
+///
+/// ```
+/// let src = gpu_render::gpu::shaders::bxdf_eval_shader_source();
+/// assert!(src.contains("fn eval_brdfs"));
+/// ```
+pub fn bxdf_eval_shader_source() -> String {
+    let mut source = String::new();
+    for part in [TYPES_WGSL, TEXTURE_WGSL, BXDF_WGSL, BXDF_EVAL_WGSL] {
+        source.push_str(part);
         if !part.ends_with('\n') {
             source.push('\n');
         }

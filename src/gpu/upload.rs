@@ -6,12 +6,17 @@
 use glam::DVec3;
 
 use super::layout::{
-    FrameUniforms, GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle,
-    LIGHT_DIRECTIONAL, LIGHT_POINT, MATERIAL_BLINN_PHONG, MATERIAL_DIELECTRIC, MATERIAL_EMISSIVE,
-    MATERIAL_LAMBERT, MATERIAL_MIRROR,
+    DISTRIBUTION_BECKMANN, DISTRIBUTION_GGX, FRESNEL_EXACT, FRESNEL_SCHLICK, FrameUniforms,
+    GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle, LIGHT_DIRECTIONAL,
+    LIGHT_POINT, MAPPING_PLANAR, MAPPING_SPHERICAL, MATERIAL_BLINN_PHONG, MATERIAL_COOK_TORRANCE,
+    MATERIAL_DIELECTRIC, MATERIAL_EMISSIVE, MATERIAL_LAMBERT, MATERIAL_MIRROR, MATERIAL_OREN_NAYAR,
+    MATERIAL_PBR, MATERIAL_TABULATED, NO_IMAGE,
 };
 use crate::camera::CameraFrame;
-use crate::scene::{Light, Material, MaterialKind, PolygonPlane, Scene, Shape, polygon_plane};
+use crate::scene::{
+    FresnelModel, Image, Light, Material, MaterialKind, MicrofacetDistribution, PolygonPlane,
+    Scene, Shape, TextureMapping, polygon_plane,
+};
 
 /// Every record list of a scene, ready for upload. The lists hold exactly the scene's
 /// items (possibly none); [`SceneRecords::padded`] adds the padding record WGSL needs.
@@ -80,7 +85,11 @@ impl SceneRecords {
                 }),
             }
         }
-        records.materials = scene.materials.iter().map(material_record).collect();
+        records.materials = scene
+            .materials
+            .iter()
+            .map(|m| material_record(m, &scene.images))
+            .collect();
         records.lights = scene.lights.iter().map(light_record).collect();
         records
     }
@@ -141,11 +150,23 @@ pub fn material_kind_code(kind: MaterialKind) -> u32 {
         MaterialKind::Mirror => MATERIAL_MIRROR,
         MaterialKind::Dielectric => MATERIAL_DIELECTRIC,
         MaterialKind::Emissive => MATERIAL_EMISSIVE,
+        MaterialKind::CookTorrance => MATERIAL_COOK_TORRANCE,
+        MaterialKind::OrenNayar => MATERIAL_OREN_NAYAR,
+        MaterialKind::Tabulated => MATERIAL_TABULATED,
+        MaterialKind::Pbr => MATERIAL_PBR,
     }
 }
 
-/// The record of one material.
-pub fn material_record(material: &Material) -> GpuMaterial {
+/// The record of one material; `images` are the scene's, whose index is the layer in
+/// the image array ([`image_layers`]).
+pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
+    let image =
+        |index: Option<u32>| match index.and_then(|i| images.get(i as usize).map(|m| (i, m))) {
+            Some((i, m)) => (i, m.width, m.height),
+            None => (NO_IMAGE, 0, 0),
+        };
+    let (texture_layer, texture_width, texture_height) = image(material.albedo_texture);
+    let (brdf_map_layer, brdf_map_size, _) = image(material.brdf_map);
     GpuMaterial {
         diffuse: vec3(material.diffuse),
         shininess: material.shininess as f32,
@@ -156,8 +177,53 @@ pub fn material_record(material: &Material) -> GpuMaterial {
         transmittance: vec3(material.transmittance),
         coat_ior: material.coat_ior as f32,
         emission: vec3(material.emission),
-        _pad: 0.0,
+        roughness: material.roughness as f32,
+        eta: vec3(material.eta),
+        metallic: material.metallic as f32,
+        k: vec3(material.k),
+        sigma: material.sigma as f32,
+        distribution: match material.distribution {
+            MicrofacetDistribution::Ggx => DISTRIBUTION_GGX,
+            MicrofacetDistribution::Beckmann => DISTRIBUTION_BECKMANN,
+        },
+        fresnel: match material.fresnel {
+            FresnelModel::Exact => FRESNEL_EXACT,
+            FresnelModel::Schlick => FRESNEL_SCHLICK,
+        },
+        conductor: u32::from(material.conductor),
+        texture_mapping: match material.texture_mapping {
+            TextureMapping::Planar => MAPPING_PLANAR,
+            TextureMapping::Spherical => MAPPING_SPHERICAL,
+        },
+        texture_layer,
+        texture_width,
+        texture_height,
+        texture_scale: material.texture_scale as f32,
+        brdf_map_layer,
+        brdf_map_size,
+        _pad0: 0,
+        _pad1: 0,
     }
+}
+
+/// The scene's images as the layers of one `Rgba32Float` texture array: every layer is
+/// as large as the largest image, each image in its layer's top-left corner (the
+/// shaders only read texels inside the image's own width and height), the rest zero.
+/// Returns `(width, height, layers, texels)` with texels layer by layer, row-major; a
+/// scene without images gets one 1×1 zero layer (WGSL needs a bound texture).
+pub fn image_layers(images: &[Image]) -> (u32, u32, u32, Vec<[f32; 4]>) {
+    let width = images.iter().map(|i| i.width).max().unwrap_or(1);
+    let height = images.iter().map(|i| i.height).max().unwrap_or(1);
+    let layers = images.len().max(1);
+    let mut texels = vec![[0.0; 4]; width as usize * height as usize * layers];
+    for (layer, image) in images.iter().enumerate() {
+        for y in 0..image.height as usize {
+            let row = &image.texels[y * image.width as usize..(y + 1) * image.width as usize];
+            let start = (layer * height as usize + y) * width as usize;
+            texels[start..start + row.len()].copy_from_slice(row);
+        }
+    }
+    (width, height, layers as u32, texels)
 }
 
 /// The record of one light.
@@ -251,6 +317,7 @@ mod tests {
             material_names: vec!["grey".into()],
             lights,
             shapes,
+            images: vec![],
         }
     }
 
@@ -433,7 +500,7 @@ mod tests {
             let mut m = Material::blank(kind);
             m.ior = 1.5;
             m.emission = DVec3::new(1.0, 2.0, 3.0);
-            let rec = material_record(&m);
+            let rec = material_record(&m, &[]);
             assert_eq!(rec.kind, code);
             assert_eq!(rec.ior, 1.5);
             assert_eq!(rec.emission, [1.0, 2.0, 3.0]);

@@ -3,8 +3,10 @@
 
 mod error;
 mod file;
+mod image;
 mod model;
 
 pub use error::SceneError;
-pub use file::{load_scene, parse_scene};
+pub use file::{CONDUCTOR_PRESETS, load_scene, parse_scene};
+pub use image::{MAX_IMAGE_SIDE, load_image};
 pub use model::*;

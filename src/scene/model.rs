@@ -6,6 +6,8 @@
 //! are linear RGB, and the CPU reference works on these `f64` values directly while the
 //! GPU backend rounds them to `f32` on upload.
 
+use std::path::PathBuf;
+
 use glam::DVec3;
 
 /// A complete scene: image settings, camera, environment, materials, lights and shapes.
@@ -25,6 +27,30 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Geometry.
     pub shapes: Vec<Shape>,
+    /// Images (albedo textures and tabulated BRDF maps), indexed by
+    /// [`Material::albedo_texture`] and [`Material::brdf_map`].
+    pub images: Vec<Image>,
+}
+
+/// An image loaded from a file, in linear RGBA `f32` (8-bit sRGB files are linearised
+/// on load with the exact sRGB curve; float files are taken as linear).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image {
+    /// The file it was read from (for messages).
+    pub path: PathBuf,
+    /// Width in texels (at least 1).
+    pub width: u32,
+    /// Height in texels (at least 1).
+    pub height: u32,
+    /// `width × height` texels, row-major, top row first.
+    pub texels: Vec<[f32; 4]>,
+}
+
+impl Image {
+    /// The texel at column `x`, row `y` (both in range).
+    pub fn texel(&self, x: u32, y: u32) -> [f32; 4] {
+        self.texels[(y * self.width + x) as usize]
+    }
 }
 
 /// How the image is sampled and how deep rays recurse.
@@ -123,6 +149,47 @@ pub enum MaterialKind {
     Dielectric,
     /// Pure emitter: adds its emission, reflects nothing.
     Emissive,
+    /// Cook-Torrance microfacet reflection (GGX or Beckmann, height-correlated Smith,
+    /// conductor or dielectric Fresnel) over an optional Fresnel-weighted diffuse base.
+    CookTorrance,
+    /// Oren-Nayar rough diffuse reflection (the qualitative model of the 1994 paper).
+    OrenNayar,
+    /// A tabulated, isotropic BRDF `f(θi, θr)` read from an image.
+    Tabulated,
+    /// The glTF 2.0 metal/roughness model (glTF specification, Appendix B).
+    Pbr,
+}
+
+/// The normal distribution of a microfacet material.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MicrofacetDistribution {
+    /// Trowbridge-Reitz (GGX).
+    #[default]
+    Ggx,
+    /// Beckmann.
+    Beckmann,
+}
+
+/// Which Fresnel reflectance a microfacet material uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FresnelModel {
+    /// The exact Fresnel equations (dielectric or conductor).
+    #[default]
+    Exact,
+    /// Schlick's approximation `F0 + (1 - F0)(1 - cos θ)^5` with `F0` from the exact
+    /// equations at normal incidence.
+    Schlick,
+}
+
+/// How a hit point is mapped to texture coordinates (see `docs/materials.md`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TextureMapping {
+    /// Projection onto the tangent frame of the geometric normal, scaled by
+    /// [`Material::texture_scale`] (for planes and polygons).
+    #[default]
+    Planar,
+    /// Longitude/latitude of the geometric normal (for spheres).
+    Spherical,
 }
 
 /// A material. One flat record for all kinds (fields a kind does not use are zero),
@@ -149,10 +216,37 @@ pub struct Material {
     pub coat_ior: f64,
     /// Emitted radiance, added wherever a ray hits the surface.
     pub emission: DVec3,
+    /// Perceptual roughness in [0, 1] (Cook-Torrance, PBR); the distribution's
+    /// `alpha = max(roughness², MIN_ALPHA)`.
+    pub roughness: f64,
+    /// Microfacet normal distribution (Cook-Torrance; PBR is always GGX).
+    pub distribution: MicrofacetDistribution,
+    /// Exact or Schlick Fresnel (Cook-Torrance).
+    pub fresnel: FresnelModel,
+    /// Whether the Cook-Torrance Fresnel is a conductor's (`eta`, `k`) rather than a
+    /// dielectric's (`ior`).
+    pub conductor: bool,
+    /// Real part of a conductor's complex index of refraction, per channel.
+    pub eta: DVec3,
+    /// Imaginary part (extinction coefficient) of a conductor's index, per channel.
+    pub k: DVec3,
+    /// glTF metalness in [0, 1] (PBR).
+    pub metallic: f64,
+    /// Oren-Nayar roughness: standard deviation of the facet slope angle, in radians.
+    pub sigma: f64,
+    /// Index into [`Scene::images`] of a texture multiplying `diffuse`, if any.
+    pub albedo_texture: Option<u32>,
+    /// How hit points map to texture coordinates.
+    pub texture_mapping: TextureMapping,
+    /// Scene units per texture repeat of the planar mapping (> 0).
+    pub texture_scale: f64,
+    /// Index into [`Scene::images`] of the tabulated BRDF (Tabulated).
+    pub brdf_map: Option<u32>,
 }
 
 impl Material {
-    /// A material of `kind` with every parameter zero except transmittance = 1.
+    /// A material of `kind` with every parameter zero except transmittance, `eta` and
+    /// `texture_scale` (1), GGX and exact Fresnel, no images.
     pub fn blank(kind: MaterialKind) -> Self {
         Self {
             kind,
@@ -164,6 +258,18 @@ impl Material {
             transmittance: DVec3::ONE,
             coat_ior: 0.0,
             emission: DVec3::ZERO,
+            roughness: 0.0,
+            distribution: MicrofacetDistribution::Ggx,
+            fresnel: FresnelModel::Exact,
+            conductor: false,
+            eta: DVec3::ONE,
+            k: DVec3::ZERO,
+            metallic: 0.0,
+            sigma: 0.0,
+            albedo_texture: None,
+            texture_mapping: TextureMapping::Planar,
+            texture_scale: 1.0,
+            brdf_map: None,
         }
     }
 

@@ -51,6 +51,16 @@ pub enum Command {
     /// time and error (linear RMSE and FLIP) with the Pareto front, as a table, a CSV
     /// and a PNG plot.
     Tradeoff(TradeoffArgs),
+
+    /// Reports whether a tabulated BRDF map (a square image, θi across, θr down,
+    /// texels holding π·f) is physically plausible: positivity, energy conservation
+    /// and Helmholtz reciprocity, with the worst violation of each. Exits with status 1
+    /// when it is not.
+    BrdfCheck {
+        /// The map: an 8-bit sRGB PNG (linearised) or a float OpenEXR (linear).
+        #[arg(value_name = "FILE")]
+        file: PathBuf,
+    },
 }
 
 /// The arguments of `gpu-render tradeoff`.

@@ -42,6 +42,7 @@ fn run(cli: Cli) -> Result<()> {
     if let Some(command) = cli.command {
         return match command {
             args::Command::Tradeoff(args) => tradeoff::run(&args),
+            args::Command::BrdfCheck { file } => brdf_check(&file),
         };
     }
     let args = cli.render;
@@ -58,6 +59,60 @@ fn run(cli: Cli) -> Result<()> {
             .exit()
     };
     render(&args, scene_path, output_path)
+}
+
+/// `gpu-render brdf-check FILE`: prints the worst case of each plausibility rule and
+/// fails when one is broken.
+fn brdf_check(file: &Path) -> Result<()> {
+    use gpu_render::plausibility::{
+        ENERGY_TOLERANCE, RECIPROCITY_TOLERANCE, Worst, check_brdf_map,
+    };
+    let map = scene::load_image(file).map_err(|e| anyhow!("{}: {e}", file.display()))?;
+    if map.width != map.height || map.width < 2 {
+        bail!(
+            "{}: a BRDF map must be square and at least 2x2 (θi across, θr down), got {}x{}",
+            file.display(),
+            map.width,
+            map.height
+        );
+    }
+    let report = check_brdf_map(&map);
+    let channel = |w: &Worst| ["R", "G", "B"][w.channel];
+    let verdict = |w: &Worst| if w.holds { "ok" } else { "VIOLATED" };
+    let p = &report.positivity;
+    println!(
+        "positivity:   {:8}  smallest f = {:.6} /sr at θi = {:.1}°, θr = {:.1}° ({})",
+        verdict(p),
+        p.value,
+        p.theta_i_degrees,
+        p.theta_r_degrees,
+        channel(p)
+    );
+    let e = &report.energy;
+    println!(
+        "energy:       {:8}  largest ∫ f cos θr dω = {:.6} at θi = {:.1}° ({}; allowed 1 + {ENERGY_TOLERANCE:e})",
+        verdict(e),
+        e.value,
+        e.theta_i_degrees,
+        channel(e)
+    );
+    let r = &report.reciprocity;
+    println!(
+        "reciprocity:  {:8}  largest |f(θi,θr) - f(θr,θi)| = {:.6} /sr at θi = {:.1}°, θr = {:.1}° ({}; allowed {RECIPROCITY_TOLERANCE:e} × max f)",
+        verdict(r),
+        r.value,
+        r.theta_i_degrees,
+        r.theta_r_degrees,
+        channel(r)
+    );
+    if !report.plausible() {
+        bail!(
+            "{}: the BRDF map is not physically plausible",
+            file.display()
+        );
+    }
+    println!("{}: physically plausible", file.display());
+    Ok(())
 }
 
 /// Validates everything cheap, then renders and writes the image.

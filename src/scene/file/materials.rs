@@ -1,27 +1,107 @@
 //! `[materials.NAME]` tables.
 
+use std::path::Path;
+
 use glam::DVec3;
 use toml::Spanned;
 
 use super::check::{ColourRange, Item, Source};
 use super::raw::RawMaterial;
-use crate::scene::{Material, MaterialKind, SceneError};
+use crate::scene::{
+    FresnelModel, Image, Material, MaterialKind, MicrofacetDistribution, SceneError,
+    TextureMapping, load_image,
+};
 
 /// Largest accepted Blinn-Phong exponent.
 const MAX_SHININESS: f64 = 1e6;
 
-const LAMBERT_FIELDS: &[&str] = &["albedo", "coat_ior", "emission"];
+const LAMBERT_FIELDS: &[&str] = &[
+    "albedo",
+    "coat_ior",
+    "emission",
+    "albedo_texture",
+    "texture_mapping",
+    "texture_scale",
+];
 const BLINN_PHONG_FIELDS: &[&str] = &["diffuse", "specular", "shininess", "coat_ior", "emission"];
 const MIRROR_FIELDS: &[&str] = &["reflectance", "emission"];
 const DIELECTRIC_FIELDS: &[&str] = &["ior", "transmittance", "emission"];
 const EMISSIVE_FIELDS: &[&str] = &["radiance"];
-const KINDS: &str = "lambert, blinn_phong, mirror, dielectric, emissive";
+const COOK_TORRANCE_FIELDS: &[&str] = &[
+    "roughness",
+    "distribution",
+    "fresnel",
+    "conductor",
+    "eta",
+    "k",
+    "ior",
+    "diffuse",
+    "albedo_texture",
+    "texture_mapping",
+    "texture_scale",
+    "emission",
+];
+const OREN_NAYAR_FIELDS: &[&str] = &[
+    "albedo",
+    "sigma_degrees",
+    "albedo_texture",
+    "texture_mapping",
+    "texture_scale",
+    "emission",
+];
+const PBR_FIELDS: &[&str] = &[
+    "base_color",
+    "metallic",
+    "roughness",
+    "albedo_texture",
+    "texture_mapping",
+    "texture_scale",
+    "emission",
+];
+const TABULATED_FIELDS: &[&str] = &["brdf_map", "emission"];
+const KINDS: &str =
+    "lambert, blinn_phong, mirror, dielectric, emissive, cook_torrance, oren_nayar, pbr, tabulated";
+
+/// A conductor's complex index of refraction `(eta, k)` at the R, G and B wavelengths.
+///
+/// The values are the RGB table of the LabPBR Material Standard ("hardcoded metals",
+/// <https://shaderlabs.org/wiki/LabPBR_Material_Standard>), measured `n` and `k` at
+/// red, green and blue wavelengths (refractiveindex.info data); their normal-incidence
+/// reflectances agree with Real-Time Rendering, 4th ed., Table 9.2 (see
+/// `tests/bxdf_plausibility.rs`).
+pub const CONDUCTOR_PRESETS: &[(&str, [f64; 3], [f64; 3])] = &[
+    ("gold", [0.18299, 0.42108, 1.3734], [3.4242, 2.3459, 1.7704]),
+    (
+        "silver",
+        [0.15943, 0.14512, 0.13547],
+        [3.9291, 3.1900, 2.3808],
+    ),
+    (
+        "copper",
+        [0.27105, 0.67693, 1.3164],
+        [3.6092, 2.6248, 2.2921],
+    ),
+    (
+        "aluminium",
+        [1.3456, 0.96521, 0.61722],
+        [7.4746, 6.3995, 5.3031],
+    ),
+];
+
+/// The images a scene's materials load, and where relative paths start.
+pub struct ImageTable<'a> {
+    /// The directory of the scene file.
+    pub base: &'a Path,
+    /// Images loaded so far, indexed by `Material::albedo_texture` / `brdf_map`.
+    pub images: Vec<Image>,
+}
 
 /// One material, checked and turned into the flat model record.
 pub fn material(
     source: &Source<'_>,
     name: &str,
     raw: Spanned<RawMaterial>,
+    images: &mut ImageTable<'_>,
 ) -> Result<Material, SceneError> {
     let span = raw.span();
     let raw = raw.into_inner();
@@ -32,7 +112,7 @@ pub fn material(
     match kind.as_str() {
         "lambert" => {
             item.only_fields(&kind, LAMBERT_FIELDS, &given)?;
-            lambert(&item, &raw)
+            lambert(&item, &raw, images)
         }
         "blinn_phong" => {
             item.only_fields(&kind, BLINN_PHONG_FIELDS, &given)?;
@@ -50,20 +130,261 @@ pub fn material(
             item.only_fields(&kind, EMISSIVE_FIELDS, &given)?;
             emissive(&item, &raw)
         }
+        "cook_torrance" => {
+            item.only_fields(&kind, COOK_TORRANCE_FIELDS, &given)?;
+            cook_torrance(&item, &raw, images)
+        }
+        "oren_nayar" => {
+            item.only_fields(&kind, OREN_NAYAR_FIELDS, &given)?;
+            oren_nayar(&item, &raw, images)
+        }
+        "pbr" => {
+            item.only_fields(&kind, PBR_FIELDS, &given)?;
+            pbr(&item, &raw, images)
+        }
+        "tabulated" => {
+            item.only_fields(&kind, TABULATED_FIELDS, &given)?;
+            tabulated(&item, &raw, images)
+        }
         other => Err(untyped.fail(format_args!(
             "unknown material type `{other}` (expected one of: {KINDS})"
         ))),
     }
 }
 
-fn lambert(item: &Item<'_>, raw: &RawMaterial) -> Result<Material, SceneError> {
-    let albedo = item.require("albedo", raw.albedo)?;
-    Ok(Material {
-        diffuse: item.colour("albedo", albedo, ColourRange::Fraction)?,
+fn lambert(
+    item: &Item<'_>,
+    raw: &RawMaterial,
+    images: &mut ImageTable<'_>,
+) -> Result<Material, SceneError> {
+    let material = Material {
+        diffuse: albedo(item, "albedo", raw.albedo, raw)?,
         coat_ior: coat_ior(item, raw.coat_ior)?,
         emission: emission(item, raw)?,
         ..Material::blank(MaterialKind::Lambert)
+    };
+    texture(item, raw, images, material)
+}
+
+/// A colour that a texture multiplies: required without `albedo_texture`, 1 with one.
+fn albedo(
+    item: &Item<'_>,
+    field: &str,
+    value: Option<super::raw::RawColor>,
+    raw: &RawMaterial,
+) -> Result<DVec3, SceneError> {
+    match (value, raw.albedo_texture.is_some()) {
+        (Some(colour), _) => item.colour(field, colour, ColourRange::Fraction),
+        (None, true) => Ok(DVec3::ONE),
+        (None, false) => Err(item.fail(format_args!(
+            "missing required field `{field}` (or `albedo_texture`)"
+        ))),
+    }
+}
+
+/// Roughness in [0, 1].
+fn roughness(item: &Item<'_>, value: f64) -> Result<f64, SceneError> {
+    let value = item.number("roughness", value)?;
+    if !(0.0..=1.0).contains(&value) {
+        return Err(item.fail(format_args!("roughness must be in [0, 1], got {value}")));
+    }
+    Ok(value)
+}
+
+fn cook_torrance(
+    item: &Item<'_>,
+    raw: &RawMaterial,
+    images: &mut ImageTable<'_>,
+) -> Result<Material, SceneError> {
+    let roughness = roughness(item, item.require("roughness", raw.roughness)?)?;
+    let distribution = match raw.distribution.as_deref() {
+        None | Some("ggx") => MicrofacetDistribution::Ggx,
+        Some("beckmann") => MicrofacetDistribution::Beckmann,
+        Some(other) => {
+            return Err(item.fail(format_args!(
+                "unknown distribution `{other}` (expected ggx or beckmann)"
+            )));
+        }
+    };
+    let fresnel = match raw.fresnel.as_deref() {
+        None | Some("exact") => FresnelModel::Exact,
+        Some("schlick") => FresnelModel::Schlick,
+        Some(other) => {
+            return Err(item.fail(format_args!(
+                "unknown fresnel `{other}` (expected exact or schlick)"
+            )));
+        }
+    };
+    let mut material = Material {
+        roughness,
+        distribution,
+        fresnel,
+        emission: emission(item, raw)?,
+        ..Material::blank(MaterialKind::CookTorrance)
+    };
+    let explicit = raw.eta.is_some() || raw.k.is_some();
+    match (&raw.conductor, explicit, raw.ior) {
+        (Some(name), false, None) => {
+            let Some((_, eta, k)) = CONDUCTOR_PRESETS.iter().find(|(n, _, _)| n == name) else {
+                let names: Vec<&str> = CONDUCTOR_PRESETS.iter().map(|p| p.0).collect();
+                return Err(item.fail(format_args!(
+                    "unknown conductor `{name}` (expected one of: {})",
+                    names.join(", ")
+                )));
+            };
+            material.conductor = true;
+            material.eta = DVec3::from_array(*eta);
+            material.k = DVec3::from_array(*k);
+        }
+        (None, true, None) => {
+            let eta = item.require("eta", raw.eta)?;
+            let k = item.require("k", raw.k)?;
+            material.conductor = true;
+            material.eta = item.colour("eta", eta, ColourRange::Radiance)?;
+            material.k = item.colour("k", k, ColourRange::Radiance)?;
+            if material.eta.min_element() <= 0.0 {
+                return Err(item.fail(format_args!(
+                    "every channel of eta must be > 0, got {}",
+                    material.eta
+                )));
+            }
+        }
+        (None, false, Some(ior)) => {
+            let ior = item.number("ior", ior)?;
+            if ior <= 0.0 {
+                return Err(item.fail(format_args!("ior must be > 0, got {ior}")));
+            }
+            material.ior = ior;
+            material.diffuse = match raw.diffuse {
+                Some(colour) => item.colour("diffuse", colour, ColourRange::Fraction)?,
+                None if raw.albedo_texture.is_some() => DVec3::ONE,
+                None => DVec3::ZERO,
+            };
+            return texture(item, raw, images, material);
+        }
+        _ => {
+            return Err(item.fail(
+                "give exactly one Fresnel source: `conductor` (a preset), `eta` and `k` \
+                 (a conductor), or `ior` (a dielectric)",
+            ));
+        }
+    }
+    if raw.diffuse.is_some() || raw.albedo_texture.is_some() {
+        return Err(
+            item.fail("a conductor has no diffuse base: `diffuse` and `albedo_texture` need `ior`")
+        );
+    }
+    Ok(material)
+}
+
+fn oren_nayar(
+    item: &Item<'_>,
+    raw: &RawMaterial,
+    images: &mut ImageTable<'_>,
+) -> Result<Material, SceneError> {
+    let sigma = item.non_negative(
+        "sigma_degrees",
+        item.require("sigma_degrees", raw.sigma_degrees)?,
+    )?;
+    if sigma > 90.0 {
+        return Err(item.fail(format_args!(
+            "sigma_degrees must be in [0, 90], got {sigma}"
+        )));
+    }
+    let material = Material {
+        diffuse: albedo(item, "albedo", raw.albedo, raw)?,
+        sigma: sigma.to_radians(),
+        emission: emission(item, raw)?,
+        ..Material::blank(MaterialKind::OrenNayar)
+    };
+    texture(item, raw, images, material)
+}
+
+fn pbr(
+    item: &Item<'_>,
+    raw: &RawMaterial,
+    images: &mut ImageTable<'_>,
+) -> Result<Material, SceneError> {
+    // glTF 2.0 defaults: metallicFactor = roughnessFactor = 1.
+    let metallic = item.non_negative("metallic", raw.metallic.unwrap_or(1.0))?;
+    if metallic > 1.0 {
+        return Err(item.fail(format_args!("metallic must be in [0, 1], got {metallic}")));
+    }
+    let material = Material {
+        diffuse: albedo(item, "base_color", raw.base_color, raw)?,
+        metallic,
+        roughness: roughness(item, raw.roughness.unwrap_or(1.0))?,
+        emission: emission(item, raw)?,
+        ..Material::blank(MaterialKind::Pbr)
+    };
+    texture(item, raw, images, material)
+}
+
+fn tabulated(
+    item: &Item<'_>,
+    raw: &RawMaterial,
+    images: &mut ImageTable<'_>,
+) -> Result<Material, SceneError> {
+    let file = item.require("brdf_map", raw.brdf_map.as_deref())?;
+    let image = load(item, "brdf_map", file, images.base)?;
+    if image.width != image.height || image.width < 2 {
+        return Err(item.fail(format_args!(
+            "brdf_map `{file}` ({}): the map must be square and at least 2x2 (θi across, \
+             θr down), got {}x{}",
+            image.path.display(),
+            image.width,
+            image.height
+        )));
+    }
+    let index = images.images.len() as u32;
+    images.images.push(image);
+    Ok(Material {
+        brdf_map: Some(index),
+        emission: emission(item, raw)?,
+        ..Material::blank(MaterialKind::Tabulated)
     })
+}
+
+/// Loads an image named by `field`, relative to the scene file's directory.
+fn load(item: &Item<'_>, field: &str, file: &str, base: &Path) -> Result<Image, SceneError> {
+    let path = base.join(file);
+    load_image(&path)
+        .map_err(|e| item.fail(format_args!("{field} `{file}` ({}): {e}", path.display())))
+}
+
+/// The optional albedo texture and its mapping.
+fn texture(
+    item: &Item<'_>,
+    raw: &RawMaterial,
+    images: &mut ImageTable<'_>,
+    mut material: Material,
+) -> Result<Material, SceneError> {
+    let Some(file) = raw.albedo_texture.as_deref() else {
+        if raw.texture_mapping.is_some() || raw.texture_scale.is_some() {
+            return Err(item.fail("texture_mapping and texture_scale need an albedo_texture"));
+        }
+        return Ok(material);
+    };
+    material.texture_mapping = match raw.texture_mapping.as_deref() {
+        None | Some("planar") => TextureMapping::Planar,
+        Some("spherical") => TextureMapping::Spherical,
+        Some(other) => {
+            return Err(item.fail(format_args!(
+                "unknown texture_mapping `{other}` (expected planar or spherical)"
+            )));
+        }
+    };
+    if let Some(scale) = raw.texture_scale {
+        let scale = item.number("texture_scale", scale)?;
+        if scale <= 0.0 {
+            return Err(item.fail(format_args!("texture_scale must be > 0, got {scale}")));
+        }
+        material.texture_scale = scale;
+    }
+    let image = load(item, "albedo_texture", file, images.base)?;
+    material.albedo_texture = Some(images.images.len() as u32);
+    images.images.push(image);
+    Ok(material)
 }
 
 fn blinn_phong(item: &Item<'_>, raw: &RawMaterial) -> Result<Material, SceneError> {

@@ -16,6 +16,7 @@ use std::io::Read;
 use std::path::Path;
 
 use self::check::Source;
+pub use self::materials::CONDUCTOR_PRESETS;
 use self::objects::MaterialTable;
 use self::raw::RawScene;
 use super::{Scene, SceneError};
@@ -134,8 +135,12 @@ fn build_scene(source: &Source<'_>, raw: RawScene) -> Result<Scene, SceneError> 
     let environment = settings::environment(source, raw.environment)?;
     let mut material_names = Vec::with_capacity(raw.materials.len());
     let mut materials = Vec::with_capacity(raw.materials.len());
+    let mut images = materials::ImageTable {
+        base: source.path.parent().unwrap_or(std::path::Path::new("")),
+        images: Vec::new(),
+    };
     for (name, material) in raw.materials {
-        materials.push(materials::material(source, &name, material)?);
+        materials.push(materials::material(source, &name, material, &mut images)?);
         material_names.push(name);
     }
     let lights = raw
@@ -159,6 +164,7 @@ fn build_scene(source: &Source<'_>, raw: RawScene) -> Result<Scene, SceneError> 
         material_names,
         lights,
         shapes,
+        images: images.images,
     })
 }
 

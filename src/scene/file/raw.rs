@@ -91,6 +91,19 @@ pub struct RawMaterial {
     pub radiance: Option<RawColor>,
     pub coat_ior: Option<f64>,
     pub emission: Option<RawColor>,
+    pub roughness: Option<f64>,
+    pub distribution: Option<String>,
+    pub fresnel: Option<String>,
+    pub conductor: Option<String>,
+    pub eta: Option<RawColor>,
+    pub k: Option<RawColor>,
+    pub base_color: Option<RawColor>,
+    pub metallic: Option<f64>,
+    pub sigma_degrees: Option<f64>,
+    pub albedo_texture: Option<String>,
+    pub texture_mapping: Option<String>,
+    pub texture_scale: Option<f64>,
+    pub brdf_map: Option<String>,
 }
 
 impl RawMaterial {
@@ -107,6 +120,19 @@ impl RawMaterial {
             ("radiance", self.radiance.is_some()),
             ("coat_ior", self.coat_ior.is_some()),
             ("emission", self.emission.is_some()),
+            ("roughness", self.roughness.is_some()),
+            ("distribution", self.distribution.is_some()),
+            ("fresnel", self.fresnel.is_some()),
+            ("conductor", self.conductor.is_some()),
+            ("eta", self.eta.is_some()),
+            ("k", self.k.is_some()),
+            ("base_color", self.base_color.is_some()),
+            ("metallic", self.metallic.is_some()),
+            ("sigma_degrees", self.sigma_degrees.is_some()),
+            ("albedo_texture", self.albedo_texture.is_some()),
+            ("texture_mapping", self.texture_mapping.is_some()),
+            ("texture_scale", self.texture_scale.is_some()),
+            ("brdf_map", self.brdf_map.is_some()),
         ])
     }
 }

@@ -1,0 +1,49 @@
+//! Writes the images the shipped scenes use: `scenes/brdf/plausible.png`,
+//! `scenes/brdf/implausible.exr` and `scenes/textures/checker.png`.
+//!
+//! ```sh
+//! cargo run --example make_material_images
+//! ```
+//!
+//! A BRDF map texel `(x, y)` of an `N × N` map holds `π·f(θi, θr)` at
+//! `θi = x/(N-1)·π/2`, `θr = y/(N-1)·π/2` (see `docs/materials.md`).
+
+use std::f64::consts::FRAC_PI_2;
+
+use gpu_render::color::{quantize_unorm8, srgb_encode};
+use image::{ImageBuffer, Rgb, Rgb32FImage};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let n = 32u32;
+    let angle = |i: u32, n: u32| f64::from(i) / f64::from(n - 1) * FRAC_PI_2;
+    // Plausible: π·f = tint·(0.5 + 0.4 sin θi sin θr), symmetric and at most 0.9, so
+    // the directional albedo 2∫π·f cos θr sin θr dθr is at most 0.9.
+    let tint = [1.0, 0.85, 0.7];
+    let plausible = ImageBuffer::from_fn(n, n, |x, y| {
+        let (a, b) = (angle(x.min(y), n), angle(x.max(y), n));
+        let value = 0.5 + 0.4 * a.sin() * b.sin();
+        Rgb(tint.map(|t| quantize_unorm8(srgb_encode(t * value))))
+    });
+    plausible.save(root.join("brdf/plausible.png"))?;
+    // Implausible: negative near normal incidence, brighter than 1 (albedo up to ~1.6)
+    // and not symmetric in θi and θr.
+    let m = 16u32;
+    let implausible = Rgb32FImage::from_fn(m, m, |x, y| {
+        let (ti, tr) = (angle(x, m), angle(y, m));
+        let value = (1.2 + 0.6 * ti - 0.3 * tr - if x + y < 2 { 1.5 } else { 0.0 }) as f32;
+        Rgb([value, value, value])
+    });
+    implausible.save(root.join("brdf/implausible.exr"))?;
+    // An 8×8 checkerboard of two colours, 8 texels per square.
+    let checker = ImageBuffer::from_fn(64, 64, |x, y| {
+        let colour: [f64; 3] = if (x / 8 + y / 8) % 2 == 0 {
+            [0.8, 0.75, 0.6]
+        } else {
+            [0.15, 0.2, 0.35]
+        };
+        Rgb(colour.map(|c| quantize_unorm8(srgb_encode(c))))
+    });
+    checker.save(root.join("textures/checker.png"))?;
+    Ok(())
+}

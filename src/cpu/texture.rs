@@ -1,0 +1,105 @@
+//! Texture coordinates and bilinear image lookups: the CPU twin of
+//! `shaders/texture.wgsl` (same function names, `f64` arithmetic on the same `f32`
+//! texels).
+//!
+//! Conventions (also in `docs/materials.md`): texture coordinates `(u, v)` run from
+//! the image's left edge to its right (`u`) and from its top row to its bottom (`v`);
+//! texel `(x, y)` has its centre at `((x + ½)/W, (y + ½)/H)`. Albedo textures repeat;
+//! BRDF maps are sampled on a corner-aligned grid and clamp.
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use glam::DVec3;
+
+use crate::scene::{Image, Material, TextureMapping};
+
+/// Texture coordinates of a hit at `position` with unit geometric normal `normal`
+/// (as the shape defines it, not flipped towards the ray).
+///
+/// - Spherical: longitude and latitude of the normal, which on a sphere is the
+///   direction from its centre: `u = ½ - atan2(n.z, n.x)/(2π)`, `v = acos(n.y)/π`
+///   (`v = 0` at the north pole, the seam `u = 0 = 1` on the −x side).
+/// - Planar: the position projected on the tangent frame of the normal
+///   ([`tangent_frame`]): `u = p·t / scale`, `v = p·b / scale`; on a floor with
+///   `n = +y` that is `u = x / scale`, `v = z / scale`.
+pub fn texture_coordinates(material: &Material, position: DVec3, normal: DVec3) -> (f64, f64) {
+    match material.texture_mapping {
+        TextureMapping::Spherical => {
+            let y = normal.y.clamp(-1.0, 1.0);
+            (0.5 - normal.z.atan2(normal.x) / (2.0 * PI), y.acos() / PI)
+        }
+        TextureMapping::Planar => {
+            let (t, b) = tangent_frame(normal);
+            (
+                position.dot(t) / material.texture_scale,
+                position.dot(b) / material.texture_scale,
+            )
+        }
+    }
+}
+
+/// The tangent `t` and bitangent `b` of the planar mapping for unit normal `n`:
+/// `t = normalize(n × a)`, `b = t × n`, with `a = z` if `|n.y| ≥ 0.999` else `y`.
+pub fn tangent_frame(n: DVec3) -> (DVec3, DVec3) {
+    let a = if n.y.abs() >= 0.999 {
+        DVec3::Z
+    } else {
+        DVec3::Y
+    };
+    let t = n.cross(a).normalize();
+    (t, t.cross(n))
+}
+
+/// Bilinear lookup with repeat wrapping at texture coordinates `(u, v)`.
+pub fn sample_texture(image: &Image, u: f64, v: f64) -> DVec3 {
+    let (w, h) = (f64::from(image.width), f64::from(image.height));
+    let x = u * w - 0.5;
+    let y = v * h - 0.5;
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let wrap = |i: f64, n: u32| -> u32 { (i as i64).rem_euclid(i64::from(n)) as u32 };
+    let (xa, xb) = (wrap(x0, image.width), wrap(x0 + 1.0, image.width));
+    let (ya, yb) = (wrap(y0, image.height), wrap(y0 + 1.0, image.height));
+    bilinear(image, [xa, xb], [ya, yb], fx, fy)
+}
+
+/// The tabulated BRDF `f(θi, θr)` (per channel, in 1/sr) from a square map whose
+/// texel `(x, y)` holds `π·f` at `θi = x/(N-1)·π/2` and `θr = y/(N-1)·π/2`
+/// (a corner-aligned grid; bilinear between the four nearest samples, clamped).
+/// Storing `π·f` makes a map of constant 1 a white Lambertian surface.
+pub fn sample_brdf_map(image: &Image, theta_i: f64, theta_r: f64) -> DVec3 {
+    let last = f64::from(image.width - 1);
+    let x = (theta_i / FRAC_PI_2).clamp(0.0, 1.0) * last;
+    let y = (theta_r / FRAC_PI_2).clamp(0.0, 1.0) * last;
+    let (x0, y0) = (x.floor().min(last - 1.0), y.floor().min(last - 1.0));
+    let (fx, fy) = (x - x0, y - y0);
+    let (xa, ya) = (x0 as u32, y0 as u32);
+    bilinear(image, [xa, xa + 1], [ya, ya + 1], fx, fy) / PI
+}
+
+fn bilinear(image: &Image, xs: [u32; 2], ys: [u32; 2], fx: f64, fy: f64) -> DVec3 {
+    let texel = |x: u32, y: u32| {
+        let t = image.texel(x, y);
+        DVec3::new(f64::from(t[0]), f64::from(t[1]), f64::from(t[2]))
+    };
+    let top = texel(xs[0], ys[0]) * (1.0 - fx) + texel(xs[1], ys[0]) * fx;
+    let bottom = texel(xs[0], ys[1]) * (1.0 - fx) + texel(xs[1], ys[1]) * fx;
+    top * (1.0 - fy) + bottom * fy
+}
+
+/// The albedo at a hit: `material.diffuse`, times the albedo texture where there is
+/// one.
+pub fn shading_albedo(
+    material: &Material,
+    images: &[Image],
+    position: DVec3,
+    normal: DVec3,
+) -> DVec3 {
+    match material.albedo_texture {
+        Some(index) => {
+            let (u, v) = texture_coordinates(material, position, normal);
+            material.diffuse * sample_texture(&images[index as usize], u, v)
+        }
+        None => material.diffuse,
+    }
+}
