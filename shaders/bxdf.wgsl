@@ -9,6 +9,7 @@ fn reflect_direction(u: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     return u - n * (2.0 * dot(u, n));
 }
 
+//#if REFRACTION
 // Refraction with k = eta_i / eta_t, n facing the incident side (lecture, Snell's law):
 // T = k·u + (k·cos θi - sqrt(1 - k²(1 - cos² θi)))·N, cos θi = N·(-u).
 // Returns the zero vector under total internal reflection, and u itself at an
@@ -24,6 +25,7 @@ fn refract_direction(u: vec3<f32>, n: vec3<f32>, k: f32) -> vec3<f32> {
     }
     return u * k + n * (k * cos_i - sqrt(radicand));
 }
+//#endif
 
 // Fresnel reflectances (R_s, R_p) at a smooth dielectric interface (Fresnel equations;
 // Hecht, "Optics", §4.6.2; pbrt-v4 §9.3.4). Both are 1 beyond the critical angle and
@@ -55,6 +57,7 @@ fn brdf_lambert(albedo: vec3<f32>) -> vec3<f32> {
     return albedo / PI;
 }
 
+//#if BLINN_PHONG
 // Normalized Blinn-Phong kd/π + ks·(n+8)/(8π)·(N·H)^n (Real-Time Rendering, 3rd ed.,
 // §7.6, eq. 7.49). Zero where N·H ≤ 0, which keeps pow(0, 0) (undefined in WGSL) away.
 fn brdf_blinn_phong(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
@@ -69,15 +72,19 @@ fn brdf_blinn_phong(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f3
     }
     return material.diffuse / PI + material.specular * lobe;
 }
+//#endif
 
 // Smallest microfacet alpha, so that D's peak 1/(π α²) stays finite (≈ 3.2e5).
 const MIN_ALPHA: f32 = 1e-3;
 
+//#if COOK_TORRANCE || PBR
 // alpha = roughness² (Burley 2012, §5.4; glTF), clamped below at MIN_ALPHA.
 fn microfacet_alpha(roughness: f32) -> f32 {
     return max(roughness * roughness, MIN_ALPHA);
 }
+//#endif
 
+//#if COOK_TORRANCE || PBR
 // GGX: D = α² / (π ((n·h)²(α² - 1) + 1)²) (Walter et al. 2007, eq. 33).
 fn distribution_ggx(cos_h: f32, alpha: f32) -> f32 {
     if cos_h <= 0.0 {
@@ -87,7 +94,9 @@ fn distribution_ggx(cos_h: f32, alpha: f32) -> f32 {
     let d = cos_h * cos_h * (a2 - 1.0) + 1.0;
     return a2 / (PI * d * d);
 }
+//#endif
 
+//#if COOK_TORRANCE || PBR
 // Beckmann: D = exp(-tan²θh/α²) / (π α² cos⁴θh) (Walter et al. 2007, eq. 25).
 fn distribution_beckmann(cos_h: f32, alpha: f32) -> f32 {
     if cos_h <= 0.0 {
@@ -98,14 +107,18 @@ fn distribution_beckmann(cos_h: f32, alpha: f32) -> f32 {
     let tan2 = (1.0 - c2) / c2;
     return exp(-tan2 / a2) / (PI * a2 * c2 * c2);
 }
+//#endif
 
+//#if COOK_TORRANCE || PBR
 // Smith Λ for GGX: (-1 + sqrt(1 + α² tan²θ)) / 2 (Heitz 2014, eq. 86).
 fn smith_lambda_ggx(cos: f32, alpha: f32) -> f32 {
     let c2 = cos * cos;
     let tan2 = max(1.0 - c2, 0.0) / c2;
     return 0.5 * (-1.0 + sqrt(1.0 + alpha * alpha * tan2));
 }
+//#endif
 
+//#if COOK_TORRANCE || PBR
 // Smith Λ for Beckmann, Walter et al.'s rational approximation (2007, eq. 27).
 fn smith_lambda_beckmann(cos: f32, alpha: f32) -> f32 {
     let c2 = cos * cos;
@@ -119,7 +132,9 @@ fn smith_lambda_beckmann(cos: f32, alpha: f32) -> f32 {
     }
     return (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a);
 }
+//#endif
 
+//#if COOK_TORRANCE || PBR
 // Height-correlated Smith G2 = 1 / (1 + Λ(ωo) + Λ(ωi)) (Heitz 2014, eq. 99).
 fn smith_g2_height_correlated(cos_i: f32, cos_o: f32, alpha: f32, distribution: u32) -> f32 {
     if distribution == DISTRIBUTION_BECKMANN {
@@ -127,28 +142,38 @@ fn smith_g2_height_correlated(cos_i: f32, cos_o: f32, alpha: f32, distribution: 
     }
     return 1.0 / (1.0 + smith_lambda_ggx(cos_i, alpha) + smith_lambda_ggx(cos_o, alpha));
 }
+//#endif
 
+//#if COOK_TORRANCE || PBR
 fn microfacet_distribution(cos_h: f32, alpha: f32, distribution: u32) -> f32 {
     if distribution == DISTRIBUTION_BECKMANN {
         return distribution_beckmann(cos_h, alpha);
     }
     return distribution_ggx(cos_h, alpha);
 }
+//#endif
 
+//#if COOK_TORRANCE
 // Complex numbers as vec2 (re, im), for the conductor Fresnel equations.
 fn complex_mul(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(a.x * b.x - a.y * b.y, a.x * b.y + a.y * b.x);
 }
+//#endif
 
+//#if COOK_TORRANCE
 fn complex_div(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
     let d = b.x * b.x + b.y * b.y;
     return vec2<f32>(a.x * b.x + a.y * b.y, a.y * b.x - a.x * b.y) / d;
 }
+//#endif
 
+//#if COOK_TORRANCE
 fn complex_norm(a: vec2<f32>) -> f32 {
     return a.x * a.x + a.y * a.y;
 }
+//#endif
 
+//#if COOK_TORRANCE
 // Principal square root (pbrt-v4 pstd::sqrt for complex numbers).
 fn complex_sqrt(z: vec2<f32>) -> vec2<f32> {
     let n = sqrt(complex_norm(z));
@@ -162,7 +187,9 @@ fn complex_sqrt(z: vec2<f32>) -> vec2<f32> {
     }
     return vec2<f32>(abs(t2), select(-t1, t1, z.y >= 0.0));
 }
+//#endif
 
+//#if COOK_TORRANCE
 // Conductor Fresnel reflectance for complex index eta + i·k (pbrt-v4 §9.3.6 FrComplex).
 fn fresnel_conductor_channel(cos_i_in: f32, eta_re: f32, k: f32) -> f32 {
     let cos_i = clamp(cos_i_in, 0.0, 1.0);
@@ -177,7 +204,9 @@ fn fresnel_conductor_channel(cos_i_in: f32, eta_re: f32, k: f32) -> f32 {
     let r_perpendicular = complex_div(ci - eta_ct, ci + eta_ct);
     return 0.5 * (complex_norm(r_parallel) + complex_norm(r_perpendicular));
 }
+//#endif
 
+//#if COOK_TORRANCE
 fn fresnel_conductor(cos_i: f32, eta: vec3<f32>, k: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(
         fresnel_conductor_channel(cos_i, eta.x, k.x),
@@ -185,21 +214,27 @@ fn fresnel_conductor(cos_i: f32, eta: vec3<f32>, k: vec3<f32>) -> vec3<f32> {
         fresnel_conductor_channel(cos_i, eta.z, k.z),
     );
 }
+//#endif
 
+//#if COOK_TORRANCE || PBR
 // Schlick 1994, eq. 15: F = F0 + (1 - F0)(1 - cos θ)^5.
 fn fresnel_schlick(cos: f32, f0: vec3<f32>) -> vec3<f32> {
     let m = 1.0 - clamp(cos, 0.0, 1.0);
     let m2 = m * m;
     return f0 + (vec3<f32>(1.0) - f0) * (m2 * m2 * m);
 }
+//#endif
 
+//#if COOK_TORRANCE
 fn microfacet_fresnel_exact(material: Material, cos: f32) -> vec3<f32> {
     if material.conductor != 0u {
         return fresnel_conductor(cos, material.eta, material.k);
     }
     return vec3<f32>(fresnel_dielectric(cos, 1.0, material.ior));
 }
+//#endif
 
+//#if COOK_TORRANCE
 // The Cook-Torrance Fresnel: exact, or Schlick with the exact F0.
 fn microfacet_fresnel(material: Material, cos: f32) -> vec3<f32> {
     if material.fresnel == FRESNEL_SCHLICK {
@@ -207,14 +242,18 @@ fn microfacet_fresnel(material: Material, cos: f32) -> vec3<f32> {
     }
     return microfacet_fresnel_exact(material, cos);
 }
+//#endif
 
+//#if COOK_TORRANCE || PBR
 // F·D·G2 / (4 cos θi cos θo) (Cook and Torrance 1982; Walter et al. 2007, eq. 20).
 fn microfacet_specular(fresnel: vec3<f32>, alpha: f32, distribution: u32, cos_i: f32, cos_o: f32, cos_h: f32) -> vec3<f32> {
     let d = microfacet_distribution(cos_h, alpha, distribution);
     let g = smith_g2_height_correlated(cos_i, cos_o, alpha, distribution);
     return fresnel * (d * g / (4.0 * cos_i * cos_o));
 }
+//#endif
 
+//#if COOK_TORRANCE || PBR
 // (n·wi, n·wo, n·h, wi·h); x = 0 when the pair gives no reflection.
 fn microfacet_cosines(n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec4<f32> {
     let cos_i = dot(n, wi);
@@ -227,7 +266,9 @@ fn microfacet_cosines(n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec4<f32> {
     let h = half_sum * inverseSqrt(length_squared);
     return vec4<f32>(cos_i, cos_o, dot(n, h), clamp(dot(wi, h), 0.0, 1.0));
 }
+//#endif
 
+//#if COOK_TORRANCE
 // Cook-Torrance: specular lobe, plus for a dielectric kd/π·(1 - F(θi))(1 - F(θo))
 // (Shirley et al. 1997, §4).
 fn brdf_cook_torrance(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
@@ -243,13 +284,17 @@ fn brdf_cook_torrance(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<
     let through = (vec3<f32>(1.0) - microfacet_fresnel(material, c.x)) * (vec3<f32>(1.0) - microfacet_fresnel(material, c.y));
     return specular + material.diffuse / PI * through;
 }
+//#endif
 
+//#if OREN_NAYAR
 // Oren and Nayar 1994, eq. 30: A = 1 - 0.5σ²/(σ² + 0.33), B = 0.45σ²/(σ² + 0.09).
 fn oren_nayar_coefficients(sigma: f32) -> vec2<f32> {
     let s2 = sigma * sigma;
     return vec2<f32>(1.0 - 0.5 * s2 / (s2 + 0.33), 0.45 * s2 / (s2 + 0.09));
 }
+//#endif
 
+//#if OREN_NAYAR
 // ρ/π·(A + B·max(0, cos(φi - φo))·sin α·tan β), α = max(θi, θo), β = min(θi, θo).
 fn brdf_oren_nayar(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     let ab = oren_nayar_coefficients(material.sigma);
@@ -273,7 +318,9 @@ fn brdf_oren_nayar(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32
     }
     return material.diffuse / PI * (ab.x + ab.y * max(cos_phi, 0.0) * sin_alpha * tan_beta);
 }
+//#endif
 
+//#if TABULATED
 // The tabulated BRDF at the angles of wi and wo from the normal (isotropic).
 fn brdf_tabulated(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     if material.brdf_map_layer == NO_IMAGE {
@@ -283,7 +330,9 @@ fn brdf_tabulated(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>
     let theta_r = acos(clamp(dot(n, wo), -1.0, 1.0));
     return sample_brdf_map(material.brdf_map_layer, material.brdf_map_size, theta_i, theta_r);
 }
+//#endif
 
+//#if PBR
 // glTF 2.0 Appendix B: F0 = mix(0.04, base, metallic), Schlick F at h·wi, GGX D with
 // α = roughness², height-correlated Smith G2, diffuse (1 - F)(1 - metallic)·base/π.
 fn brdf_pbr(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
@@ -298,17 +347,28 @@ fn brdf_pbr(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> v
     let specular = microfacet_specular(fresnel, alpha, DISTRIBUTION_GGX, c.x, c.y, c.z);
     return specular + (vec3<f32>(1.0) - fresnel) * (1.0 - material.metallic) * base / PI;
 }
+//#endif
 
 // The base layer's BRDF for light from wi leaving towards wo (both on n's side);
 // material.diffuse is the (textured) albedo at the hit.
 fn eval_brdf(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     switch material.kind {
         case MATERIAL_LAMBERT: { return brdf_lambert(material.diffuse); }
+        //#if BLINN_PHONG
         case MATERIAL_BLINN_PHONG: { return brdf_blinn_phong(material, n, wi, wo); }
+        //#endif
+        //#if COOK_TORRANCE
         case MATERIAL_COOK_TORRANCE: { return brdf_cook_torrance(material, n, wi, wo); }
+        //#endif
+        //#if OREN_NAYAR
         case MATERIAL_OREN_NAYAR: { return brdf_oren_nayar(material, n, wi, wo); }
+        //#endif
+        //#if TABULATED
         case MATERIAL_TABULATED: { return brdf_tabulated(material, n, wi, wo); }
+        //#endif
+        //#if PBR
         case MATERIAL_PBR: { return brdf_pbr(material, n, wi, wo); }
+        //#endif
         default: { return vec3<f32>(0.0); }
     }
 }
@@ -347,6 +407,7 @@ fn surface_response(material: Material, direction: vec3<f32>, n: vec3<f32>, ente
         case MATERIAL_MIRROR: {
             response.reflect = material.reflectance;
         }
+        //#if REFRACTION
         case MATERIAL_DIELECTRIC: {
             var eta_i = material.ior;
             var eta_t = outside_ior;
@@ -365,6 +426,7 @@ fn surface_response(material: Material, direction: vec3<f32>, n: vec3<f32>, ente
                 response.transmit_direction = normalize(t);
             }
         }
+        //#endif
         default: {}
     }
     return response;

@@ -22,11 +22,14 @@ fn ray_at(ray: Ray, t: f32) -> vec3<f32> {
     return ray.origin + ray.direction * t;
 }
 
+//#if TRIANGLES
 // The unit normal (v1 - v0) × (v2 - v0), normalized.
 fn triangle_normal(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> vec3<f32> {
     return normalize(cross(v1 - v0, v2 - v0));
 }
+//#endif
 
+//#if SPHERES
 // A point moved radially onto the sphere, c + r·normalize(p - c) (Wächter and Binder,
 // Ray Tracing Gems, ch. 6, §6.2.1): its error is then relative to its own magnitude,
 // not to the length of the ray that found it, as the ulp-scaled offset assumes.
@@ -38,12 +41,14 @@ fn project_onto_sphere(p: vec3<f32>, center: vec3<f32>, radius: f32) -> vec3<f32
     }
     return p;
 }
+//#endif
 
 // A point projected orthogonally onto the plane N·p = d: p - (N·p - d)·N (ibid.).
 fn project_onto_plane(p: vec3<f32>, normal: vec3<f32>, offset: f32) -> vec3<f32> {
     return p - normal * (dot(normal, p) - offset);
 }
 
+//#if SPHERES
 // Picks the nearest root in (0, t_max) of two sorted roots.
 fn nearest_root(t0: f32, t1: f32, t_max: f32) -> f32 {
     if t0 > 0.0 && t0 < t_max {
@@ -54,7 +59,9 @@ fn nearest_root(t0: f32, t1: f32, t_max: f32) -> f32 {
     }
     return NO_HIT;
 }
+//#endif
 
+//#if SPHERES
 // Ray/sphere in the stable form of Haines, Günther and Akenine-Möller, "Precision
 // Improvements for Ray/Sphere Intersection" (Ray Tracing Gems, ch. 7): the lecture's
 // s = -u·ΔP ± sqrt((u·ΔP)² - |ΔP|² + r²), with the discriminant taken from the distance
@@ -76,7 +83,9 @@ fn intersect_sphere(ray: Ray, center: vec3<f32>, radius: f32, t_max: f32) -> f32
     let r0 = c / q;
     return nearest_root(min(r0, q), max(r0, q), t_max);
 }
+//#endif
 
+//#if PLANES || POLYGONS
 // Ray/plane from the lecture: with N·P = d, s = (d - N·P0) / (N·u); parallel rays miss,
 // and a nearly parallel ray whose s overflows fails the range test 0 < s < t_max.
 fn intersect_plane(ray: Ray, normal: vec3<f32>, offset: f32, t_max: f32) -> f32 {
@@ -90,7 +99,9 @@ fn intersect_plane(ray: Ray, normal: vec3<f32>, offset: f32, t_max: f32) -> f32 
     }
     return NO_HIT;
 }
+//#endif
 
+//#if POLYGONS
 // The two coordinates left when `dropped_axis` (0 = x, 1 = y, 2 = z) is removed.
 fn project_to_plane(p: vec3<f32>, dropped_axis: u32) -> vec2<f32> {
     switch dropped_axis {
@@ -99,7 +110,9 @@ fn project_to_plane(p: vec3<f32>, dropped_axis: u32) -> vec2<f32> {
         default: { return p.xy; }
     }
 }
+//#endif
 
+//#if POLYGONS
 // Even-odd (crossing number) inside test in the projection that drops the polygon's
 // dominant axis (Haines, "Point in Polygon Strategies", Graphics Gems IV).
 fn point_in_polygon(p: vec3<f32>, polygon: Polygon) -> bool {
@@ -121,7 +134,9 @@ fn point_in_polygon(p: vec3<f32>, polygon: Polygon) -> bool {
     }
     return inside;
 }
+//#endif
 
+//#if POLYGONS
 // Ray/polygon as in the lecture: the plane first, then the inside test.
 fn intersect_polygon(ray: Ray, polygon: Polygon, t_max: f32) -> f32 {
     let t = intersect_plane(ray, polygon.normal, polygon.offset, t_max);
@@ -130,7 +145,9 @@ fn intersect_polygon(ray: Ray, polygon: Polygon, t_max: f32) -> f32 {
     }
     return t;
 }
+//#endif
 
+//#if TRIANGLES
 // Watertight ray/triangle of Woop, Benthin and Wald, "Watertight Ray/Triangle
 // Intersection" (JCGT 2(1), 2013), Listing 1: shear the triangle so the ray becomes
 // the +z axis of a permuted frame, then test the signs of the 2D edge functions U, V, W.
@@ -183,11 +200,13 @@ fn intersect_triangle(ray: Ray, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, t_m
     }
     return NO_HIT;
 }
+//#endif
 
 // The nearest hit along `ray` in (0, t_max) over all shapes. Shapes are visited by
 // type, not in file order as on the CPU: only exact ties in t can resolve differently.
 fn intersect_scene(ray: Ray, t_max: f32) -> Hit {
     var hit = Hit(t_max, vec3<f32>(0.0), 0u, false, vec3<f32>(0.0));
+    //#if SPHERES
     for (var i = 0u; i < frame.sphere_count; i += 1u) {
         let sphere = spheres[i];
         let t = intersect_sphere(ray, sphere.center, sphere.radius, hit.t);
@@ -197,6 +216,8 @@ fn intersect_scene(ray: Ray, t_max: f32) -> Hit {
                       project_onto_sphere(p, sphere.center, sphere.radius));
         }
     }
+    //#endif
+    //#if PLANES
     for (var i = 0u; i < frame.plane_count; i += 1u) {
         let plane = planes[i];
         let t = intersect_plane(ray, plane.normal, plane.offset, hit.t);
@@ -205,6 +226,8 @@ fn intersect_scene(ray: Ray, t_max: f32) -> Hit {
                       project_onto_plane(ray_at(ray, t), plane.normal, plane.offset));
         }
     }
+    //#endif
+    //#if POLYGONS
     for (var i = 0u; i < frame.polygon_count; i += 1u) {
         let polygon = polygons[i];
         let t = intersect_polygon(ray, polygon, hit.t);
@@ -213,6 +236,8 @@ fn intersect_scene(ray: Ray, t_max: f32) -> Hit {
                       project_onto_plane(ray_at(ray, t), polygon.normal, polygon.offset));
         }
     }
+    //#endif
+    //#if TRIANGLES
     for (var i = 0u; i < frame.triangle_count; i += 1u) {
         let triangle = triangles[i];
         let t = intersect_triangle(ray, triangle.v0, triangle.v1, triangle.v2, hit.t);
@@ -222,32 +247,41 @@ fn intersect_scene(ray: Ray, t_max: f32) -> Hit {
                       project_onto_plane(ray_at(ray, t), normal, dot(normal, triangle.v0)));
         }
     }
+    //#endif
     return hit;
 }
 
 // Whether anything lies along `ray` in (0, t_max): the shadow-ray query.
 fn occluded(ray: Ray, t_max: f32) -> bool {
+    //#if SPHERES
     for (var i = 0u; i < frame.sphere_count; i += 1u) {
         if intersect_sphere(ray, spheres[i].center, spheres[i].radius, t_max) != NO_HIT {
             return true;
         }
     }
+    //#endif
+    //#if PLANES
     for (var i = 0u; i < frame.plane_count; i += 1u) {
         if intersect_plane(ray, planes[i].normal, planes[i].offset, t_max) != NO_HIT {
             return true;
         }
     }
+    //#endif
+    //#if POLYGONS
     for (var i = 0u; i < frame.polygon_count; i += 1u) {
         if intersect_polygon(ray, polygons[i], t_max) != NO_HIT {
             return true;
         }
     }
+    //#endif
+    //#if TRIANGLES
     for (var i = 0u; i < frame.triangle_count; i += 1u) {
         let triangle = triangles[i];
         if intersect_triangle(ray, triangle.v0, triangle.v1, triangle.v2, t_max) != NO_HIT {
             return true;
         }
     }
+    //#endif
     return false;
 }
 

@@ -12,11 +12,14 @@ fn image_texel(layer: u32, x: u32, y: u32) -> vec3<f32> {
     return textureLoad(images, vec2<u32>(x, y), layer, 0).rgb;
 }
 
+//#if TEXTURES
 struct TangentFrame {
     t: vec3<f32>,
     b: vec3<f32>,
 }
+//#endif
 
+//#if TEXTURES
 // t = normalize(n × a), b = t × n, with a = z if |n.y| ≥ 0.999 else y.
 fn tangent_frame(n: vec3<f32>) -> TangentFrame {
     var a = vec3<f32>(0.0, 1.0, 0.0);
@@ -26,7 +29,9 @@ fn tangent_frame(n: vec3<f32>) -> TangentFrame {
     let t = normalize(cross(n, a));
     return TangentFrame(t, cross(t, n));
 }
+//#endif
 
+//#if TEXTURES
 // Spherical: u = ½ - atan2(n.z, n.x)/(2π), v = acos(n.y)/π. Planar: u = p·t/scale,
 // v = p·b/scale on the tangent frame of the geometric normal.
 fn texture_coordinates(material: Material, position: vec3<f32>, normal: vec3<f32>) -> vec2<f32> {
@@ -37,11 +42,14 @@ fn texture_coordinates(material: Material, position: vec3<f32>, normal: vec3<f32
     let frame = tangent_frame(normal);
     return vec2<f32>(dot(position, frame.t), dot(position, frame.b)) / material.texture_scale;
 }
+//#endif
 
+//#if TEXTURES
 fn wrap_index(i: f32, n: u32) -> u32 {
     let m = i32(n);
     return u32(((i32(i) % m) + m) % m);
 }
+//#endif
 
 fn bilinear(layer: u32, xs: vec2<u32>, ys: vec2<u32>, f: vec2<f32>) -> vec3<f32> {
     let top = image_texel(layer, xs.x, ys.x) * (1.0 - f.x) + image_texel(layer, xs.y, ys.x) * f.x;
@@ -49,6 +57,7 @@ fn bilinear(layer: u32, xs: vec2<u32>, ys: vec2<u32>, f: vec2<f32>) -> vec3<f32>
     return top * (1.0 - f.y) + bottom * f.y;
 }
 
+//#if TEXTURES
 // Bilinear lookup with repeat wrapping; texel (x, y) is centred at ((x+½)/W, (y+½)/H).
 fn sample_texture(layer: u32, width: u32, height: u32, uv: vec2<f32>) -> vec3<f32> {
     let p = uv * vec2<f32>(f32(width), f32(height)) - 0.5;
@@ -57,7 +66,9 @@ fn sample_texture(layer: u32, width: u32, height: u32, uv: vec2<f32>) -> vec3<f3
     let ys = vec2<u32>(wrap_index(p0.y, height), wrap_index(p0.y + 1.0, height));
     return bilinear(layer, xs, ys, p - p0);
 }
+//#endif
 
+//#if TABULATED
 // The tabulated BRDF f(θi, θr): texel (x, y) of the N×N map holds π·f at
 // θi = x/(N-1)·π/2, θr = y/(N-1)·π/2; bilinear, clamped.
 fn sample_brdf_map(layer: u32, size: u32, theta_i: f32, theta_r: f32) -> vec3<f32> {
@@ -67,12 +78,15 @@ fn sample_brdf_map(layer: u32, size: u32, theta_i: f32, theta_r: f32) -> vec3<f3
     let i = vec2<u32>(p0);
     return bilinear(layer, vec2<u32>(i.x, i.x + 1u), vec2<u32>(i.y, i.y + 1u), p - p0) / TEXTURE_PI;
 }
+//#endif
 
 // The albedo at a hit: material.diffuse, times the albedo texture where there is one.
 fn shading_albedo(material: Material, position: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
-    if material.texture_layer == NO_IMAGE {
-        return material.diffuse;
+    //#if TEXTURES
+    if material.texture_layer != NO_IMAGE {
+        let uv = texture_coordinates(material, position, normal);
+        return material.diffuse * sample_texture(material.texture_layer, material.texture_width, material.texture_height, uv);
     }
-    let uv = texture_coordinates(material, position, normal);
-    return material.diffuse * sample_texture(material.texture_layer, material.texture_width, material.texture_height, uv);
+    //#endif
+    return material.diffuse;
 }

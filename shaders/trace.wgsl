@@ -33,6 +33,7 @@ struct MediumStack {
     depth: u32,
 }
 
+//#if REFRACTION
 // The index of refraction `level` dielectrics deep (0 = air, index 1).
 fn medium_ior_at(medium: MediumStack, level: u32) -> f32 {
     if level == 0u {
@@ -40,7 +41,9 @@ fn medium_ior_at(medium: MediumStack, level: u32) -> f32 {
     }
     return medium.iors[min(level, 4u) - 1u];
 }
+//#endif
 
+//#if REFRACTION
 // The index on the outside of a dielectric surface: the current medium when entering,
 // else the enclosing one.
 fn medium_outside_ior(medium: MediumStack, entering: bool) -> f32 {
@@ -49,7 +52,9 @@ fn medium_outside_ior(medium: MediumStack, entering: bool) -> f32 {
     }
     return medium_ior_at(medium, max(medium.depth, 1u) - 1u);
 }
+//#endif
 
+//#if REFRACTION
 // The stack of the refracted ray: `ior` pushed when entering, else popped.
 fn medium_after_refraction(medium: MediumStack, entering: bool, ior: f32) -> MediumStack {
     var next = medium;
@@ -63,6 +68,7 @@ fn medium_after_refraction(medium: MediumStack, entering: bool, ior: f32) -> Med
     }
     return next;
 }
+//#endif
 
 // Whether every component is finite, read from the exponent bits so that no
 // fast-math assumption of the shader compiler can fold the test away. The final guard
@@ -135,7 +141,12 @@ fn shade_hit(ray: Ray, hit: Hit, medium: MediumStack) -> ShadedHit {
     // Shading happens on the side the ray came from.
     let n = select(-hit.normal, hit.normal, entering);
     let wo = -ray.direction;
+    //#if REFRACTION
     let outside_ior = medium_outside_ior(medium, entering);
+    //#else
+    // Without dielectrics every ray travels in air.
+    let outside_ior = 1.0;
+    //#endif
     let response = surface_response(material, ray.direction, n, entering, outside_ior);
 
     var radiance = material.emission;
@@ -148,9 +159,16 @@ fn shade_hit(ray: Ray, hit: Hit, medium: MediumStack) -> ShadedHit {
         radiance += direct * response.base;
     }
     let reflected = Ray(offset_ray_origin(position, n, frame.offset_scale), normalize(reflect_direction(ray.direction, n)));
+    //#if REFRACTION
     let transmitted = Ray(offset_ray_origin(position, -n, frame.offset_scale), response.transmit_direction);
+    let transmitted_medium = medium_after_refraction(medium, entering, material.ior);
+    //#else
+    // No dielectric, no refracted ray (its weight is zero).
+    let transmitted = reflected;
+    let transmitted_medium = medium;
+    //#endif
     return ShadedHit(radiance, response.reflect, reflected, response.transmit, transmitted,
-                     medium_after_refraction(medium, entering, material.ior));
+                     transmitted_medium);
 }
 
 // Radiance arriving along `primary`: every reflected or refracted ray is pushed on a
@@ -184,12 +202,14 @@ fn trace_radiance(primary: Ray) -> vec3<f32> {
         if entry.depth >= frame.max_depth {
             continue;
         }
+        //#if REFRACTION
         let transmit_weight = entry.weight * shaded.transmit_weight;
         if max(transmit_weight.x, max(transmit_weight.y, transmit_weight.z)) > frame.min_ray_weight && stack_length < STACK_SIZE {
             stack[stack_length] = StackEntry(shaded.transmitted, transmit_weight, entry.depth + 1u,
                                              shaded.transmitted_medium);
             stack_length += 1u;
         }
+        //#endif
         let reflect_weight = entry.weight * shaded.reflect_weight;
         if max(reflect_weight.x, max(reflect_weight.y, reflect_weight.z)) > frame.min_ray_weight && stack_length < STACK_SIZE {
             stack[stack_length] = StackEntry(shaded.reflected, reflect_weight, entry.depth + 1u,

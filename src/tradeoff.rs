@@ -179,6 +179,9 @@ pub fn plot_png(
             .configure_mesh()
             .x_desc("trace time (s, log scale)")
             .y_desc("mean FLIP error vs reference")
+            .x_labels(10)
+            .x_label_formatter(&|seconds| format_seconds(*seconds))
+            .light_line_style(RGBColor(235, 235, 235))
             .label_style(("sans-serif", 14))
             .draw()
             .map_err(|e| draw(&e))?;
@@ -227,6 +230,16 @@ pub fn plot_png(
         .collect();
     output::write_png_rgba8(path, width, height, rgba)?;
     Ok(())
+}
+
+/// Seconds as a short axis label: "0.05", "0.5", "2".
+fn format_seconds(seconds: f64) -> String {
+    let digits = if seconds >= 1.0 {
+        0
+    } else {
+        (-seconds.log10().floor()) as usize
+    };
+    format!("{seconds:.digits$}")
 }
 
 #[cfg(test)]

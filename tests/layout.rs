@@ -5,6 +5,7 @@
 use std::collections::BTreeMap;
 use std::mem::{offset_of, size_of};
 
+use gpu_render::gpu::ShaderFeatures;
 use gpu_render::gpu::layout::*;
 use gpu_render::gpu::shaders::{
     TYPES_WGSL, bxdf_eval_shader_source, display_shader_source, trace_shader_source,
@@ -252,7 +253,7 @@ fn validate(name: &str, source: &str) {
 #[test]
 fn composed_trace_shader_validates() {
     for stack_size in [1, 9] {
-        let source = trace_shader_source(stack_size);
+        let source = trace_shader_source(stack_size, &ShaderFeatures::ALL).expect("directives");
         validate(&format!("trace shader (stack size {stack_size})"), &source);
         let module = naga::front::wgsl::parse_str(&source).expect("parsed above");
         let entry = module

@@ -6,7 +6,7 @@
 //!   [`GpuRenderer::render`] and low-level `prepare`/`encode_trace`/`encode_display`
 //!   for apps that own their frame.
 //! - [`upload`]: pure conversion of a [`crate::scene::Scene`] into the GPU records.
-//! - [`shaders`]: composition of the WGSL sources.
+//! - [`shaders`]: composition of the WGSL sources, specialised by [`features`].
 //! - [`layout`]: the `#[repr(C)]` records shared with `shaders/types.wgsl`.
 //!
 //! ```no_run
@@ -22,6 +22,7 @@
 
 pub mod context;
 mod error;
+pub mod features;
 pub mod layout;
 mod readback;
 pub mod renderer;
@@ -30,5 +31,6 @@ pub mod upload;
 
 pub use context::{AdapterChoice, HeadlessGpu, list_adapters};
 pub use error::GpuError;
+pub use features::ShaderFeatures;
 pub use readback::read_texture;
 pub use renderer::{GpuRendered, GpuRenderer, PreparedScene, TraceRegion, image_tiles};

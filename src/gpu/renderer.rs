@@ -17,6 +17,7 @@ use std::time::{Duration, Instant};
 use wgpu::util::DeviceExt;
 
 use super::GpuError;
+use super::features::ShaderFeatures;
 use super::layout::{DisplayUniforms, FrameUniforms};
 use super::readback::{Caught, capture, read_buffer, read_texture, submit_and_wait};
 use super::shaders::{
@@ -63,10 +64,13 @@ pub struct GpuRenderer {
     trace_pipeline_layout: wgpu::PipelineLayout,
     display_bind_group_layout: wgpu::BindGroupLayout,
     display_pipeline: wgpu::ComputePipeline,
-    /// Trace pipelines by bounce-stack size, built on first use: the stack size is a
-    /// shader constant, and most runs need only one.
-    trace_pipelines: Mutex<HashMap<u32, wgpu::ComputePipeline>>,
+    /// Trace pipelines by bounce-stack size and shader features, built on first use:
+    /// both are compiled into the module, and most runs need only one.
+    trace_pipelines: Mutex<HashMap<(u32, ShaderFeatures), wgpu::ComputePipeline>>,
     poll_timeout: Duration,
+    /// Whether trace modules are specialised to each scene's features (the default)
+    /// or always contain every feature.
+    specialise: bool,
 }
 
 /// A scene uploaded to one device: the storage buffers, the per-row ray counters and
@@ -78,6 +82,7 @@ pub struct GpuRenderer {
 pub struct PreparedScene {
     frame: FrameUniforms,
     stack_size: u32,
+    features: ShaderFeatures,
     encode_srgb: bool,
     spheres: wgpu::Buffer,
     planes: wgpu::Buffer,
@@ -112,6 +117,11 @@ impl PreparedScene {
     /// Bounce-stack capacity, which selects the trace pipeline.
     pub fn stack_size(&self) -> u32 {
         self.stack_size
+    }
+
+    /// The shader features the trace pipeline for this scene contains.
+    pub fn features(&self) -> ShaderFeatures {
+        self.features
     }
 
     /// Whether the display pass should apply the sRGB curve for this scene (false in
@@ -318,6 +328,7 @@ impl GpuRenderer {
             display_pipeline,
             trace_pipelines: Mutex::new(HashMap::new()),
             poll_timeout: DEFAULT_POLL_TIMEOUT,
+            specialise: true,
         })
     }
 
@@ -329,30 +340,49 @@ impl GpuRenderer {
         self
     }
 
-    /// The trace pipeline for `stack_size`, built and cached on first use.
+    /// With `false`, every trace module contains every feature (the general shader)
+    /// instead of only what each scene uses. For measurements and tests; the default,
+    /// `true`, is faster to run and to compile.
+    pub fn with_specialisation(mut self, specialise: bool) -> Self {
+        self.specialise = specialise;
+        self
+    }
+
+    /// The trace pipeline for `stack_size` and `features`, built and cached on first
+    /// use. Prepared scenes carry their features ([`PreparedScene::features`]).
     ///
     /// Errors: [`GpuError::Shader`] if the composed trace shader does not compile.
     pub fn trace_pipeline(
         &self,
         device: &wgpu::Device,
         stack_size: u32,
+        features: &ShaderFeatures,
     ) -> Result<wgpu::ComputePipeline, GpuError> {
         let mut cache = self
             .trace_pipelines
             .lock()
             .unwrap_or_else(PoisonError::into_inner);
-        if let Some(pipeline) = cache.get(&stack_size) {
+        if let Some(pipeline) = cache.get(&(stack_size, *features)) {
             return Ok(pipeline.clone());
         }
+        let source = trace_shader_source(stack_size, features).map_err(GpuError::Shader)?;
         let pipeline = build_pipeline(
             device,
-            &format!("trace (stack size {stack_size})"),
-            trace_shader_source(stack_size),
+            &format!("trace (stack size {stack_size}, {})", features.label()),
+            source,
             &self.trace_pipeline_layout,
             TRACE_ENTRY_POINT,
         )?;
-        cache.insert(stack_size, pipeline.clone());
+        cache.insert((stack_size, *features), pipeline.clone());
         Ok(pipeline)
+    }
+
+    /// How many trace pipelines have been built and cached so far.
+    pub fn cached_pipeline_count(&self) -> usize {
+        self.trace_pipelines
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .len()
     }
 
     /// Uploads `scene` (converted with [`Scene::in_lighting_space`] here, so pass the
@@ -460,6 +490,11 @@ impl GpuRenderer {
             frame,
             accumulation,
             stack_size: scene.render.stack_size,
+            features: if self.specialise {
+                ShaderFeatures::for_scene(&scene)
+            } else {
+                ShaderFeatures::ALL
+            },
             encode_srgb: scene.display_encodes_srgb(),
             spheres,
             planes,
@@ -591,7 +626,7 @@ impl GpuRenderer {
                 });
             }
         }
-        let pipeline = self.trace_pipeline(device, prepared.stack_size)?;
+        let pipeline = self.trace_pipeline(device, prepared.stack_size, &prepared.features)?;
         let band_rows = prepared.frame.accumulation_rows.max(1);
         let mut band_start = rows.start;
         while band_start < rows.end {
@@ -950,7 +985,7 @@ impl GpuRenderer {
         report: &dyn Fn(u64),
     ) -> Result<Duration, GpuError> {
         // Compile before timing: shader and pipeline creation is not tracing.
-        self.trace_pipeline(device, prepared.stack_size)?;
+        self.trace_pipeline(device, prepared.stack_size, &prepared.features)?;
         let start = Instant::now();
         let region_width = region.columns.end - region.columns.start;
         // Rows per dispatch are also bounded by the workgroup-count limit.

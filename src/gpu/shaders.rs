@@ -1,5 +1,8 @@
 //! Composition of the WGSL sources. WGSL has no `#include`, so the modules are
 //! concatenated in dependency order; every source file is embedded at compile time.
+//! Optional code is kept or dropped by [`specialise`] (see [`super::features`]).
+
+use super::features::{ShaderFeatures, specialise};
 
 /// The shared records (`FrameUniforms`, `Sphere`, ...), twins of [`super::layout`].
 pub const TYPES_WGSL: &str = include_str!("../../shaders/types.wgsl");
@@ -30,18 +33,23 @@ pub const DISPLAY_ENTRY_POINT: &str = "encode_display";
 /// Workgroup size (x and y) of both compute entry points, `@workgroup_size(8, 8, 1)`.
 pub const WORKGROUP_SIZE: u32 = 8;
 
-/// The complete trace module for a bounce stack of `stack_size` entries: the
-/// `STACK_SIZE` constant, then types, sampling, intersect, texture, bxdf and trace.
+/// The complete trace module for a bounce stack of `stack_size` entries, specialised
+/// to `features` (see [`super::features`]): the `STACK_SIZE` constant, then types,
+/// sampling, intersect, texture, bxdf and trace.
 ///
 /// The stack size is a `const` rather than a pipeline-overridable constant because
 /// WGSL array sizes in function address space must be creation-time constants; each
-/// stack size therefore gets its own pipeline (cached by the renderer).
+/// stack size and feature set therefore gets its own pipeline (cached by the renderer).
+///
+/// Errors: a message if the sources' feature directives are malformed.
 ///
 /// ```
-/// let src = gpu_render::gpu::shaders::trace_shader_source(9);
+/// use gpu_render::gpu::ShaderFeatures;
+/// let src = gpu_render::gpu::shaders::trace_shader_source(9, &ShaderFeatures::ALL).unwrap();
 /// assert!(src.starts_with("const STACK_SIZE: u32 = 9u;\n"));
+/// assert!(src.contains("fn refract_direction"));
 /// ```
-pub fn trace_shader_source(stack_size: u32) -> String {
+pub fn trace_shader_source(stack_size: u32, features: &ShaderFeatures) -> Result<String, String> {
     let parts = [
         TYPES_WGSL,
         SAMPLING_WGSL,
@@ -52,13 +60,9 @@ pub fn trace_shader_source(stack_size: u32) -> String {
     ];
     let mut source = format!("const STACK_SIZE: u32 = {stack_size}u;\n");
     for part in parts {
-        source.push_str(part);
-        // A missing final newline in one file must not glue a comment to the next.
-        if !part.ends_with('\n') {
-            source.push('\n');
-        }
+        source.push_str(&specialise(part, features)?);
     }
-    source
+    Ok(source)
 }
 
 /// The BRDF test kernel: types, texture, bxdf and `shaders/bxdf_eval.wgsl`, which
@@ -72,10 +76,9 @@ pub fn trace_shader_source(stack_size: u32) -> String {
 pub fn bxdf_eval_shader_source() -> String {
     let mut source = String::new();
     for part in [TYPES_WGSL, TEXTURE_WGSL, BXDF_WGSL, BXDF_EVAL_WGSL] {
-        source.push_str(part);
-        if !part.ends_with('\n') {
-            source.push('\n');
-        }
+        // Every feature is on: the directives are only stripped, which cannot fail
+        // for our own sources (the layout tests check that it does not).
+        source.push_str(&specialise(part, &ShaderFeatures::ALL).unwrap_or_default());
     }
     source
 }

@@ -1,0 +1,203 @@
+//! Specialising the trace shader to a scene: code for primitive types, material models
+//! and effects that the scene does not use is left out of the compiled module.
+//!
+//! The WGSL sources mark such code with line directives, `//#if NAME` (or
+//! `//#if A || B`), `//#else` and `//#endif`, which may nest. [`specialise`] keeps or
+//! drops the lines between them. This is plain source composition, chosen over WGSL
+//! `override` constants because overrides only fold branches: the code (and the
+//! registers it needs) stays in the module, and naga has no dead-function elimination
+//! to remove it. Dropping the text means a module for a scene without glass really
+//! has no refraction code, which `tests/specialisation.rs` checks on the naga module.
+
+use crate::scene::{MaterialKind, Scene, Shape};
+
+/// Which optional parts of the trace shader a module contains.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct ShaderFeatures {
+    /// Ray/sphere intersection (`SPHERES`).
+    pub spheres: bool,
+    /// Ray/plane intersection (`PLANES`).
+    pub planes: bool,
+    /// Ray/polygon intersection (`POLYGONS`).
+    pub polygons: bool,
+    /// Ray/triangle intersection (`TRIANGLES`).
+    pub triangles: bool,
+    /// Refraction through dielectrics and the medium stack (`REFRACTION`).
+    pub refraction: bool,
+    /// The normalized Blinn-Phong BRDF (`BLINN_PHONG`).
+    pub blinn_phong: bool,
+    /// The Cook-Torrance microfacet BRDF (`COOK_TORRANCE`).
+    pub cook_torrance: bool,
+    /// The Oren-Nayar BRDF (`OREN_NAYAR`).
+    pub oren_nayar: bool,
+    /// Tabulated BRDF maps (`TABULATED`).
+    pub tabulated: bool,
+    /// The glTF metal/roughness BRDF (`PBR`).
+    pub pbr: bool,
+    /// Albedo textures (`TEXTURES`).
+    pub textures: bool,
+}
+
+impl ShaderFeatures {
+    /// Every feature: the general module that renders any scene.
+    pub const ALL: Self = Self {
+        spheres: true,
+        planes: true,
+        polygons: true,
+        triangles: true,
+        refraction: true,
+        blinn_phong: true,
+        cook_torrance: true,
+        oren_nayar: true,
+        tabulated: true,
+        pbr: true,
+        textures: true,
+    };
+
+    /// Exactly the features `scene` uses.
+    pub fn for_scene(scene: &Scene) -> Self {
+        let has_shape = |wanted: fn(&Shape) -> bool| scene.shapes.iter().any(wanted);
+        let has_kind = |kind: MaterialKind| scene.materials.iter().any(|m| m.kind == kind);
+        Self {
+            spheres: has_shape(|s| matches!(s, Shape::Sphere { .. })),
+            planes: has_shape(|s| matches!(s, Shape::Plane { .. })),
+            polygons: has_shape(|s| matches!(s, Shape::Polygon { .. })),
+            triangles: has_shape(|s| matches!(s, Shape::Triangle { .. })),
+            refraction: has_kind(MaterialKind::Dielectric),
+            blinn_phong: has_kind(MaterialKind::BlinnPhong),
+            cook_torrance: has_kind(MaterialKind::CookTorrance),
+            oren_nayar: has_kind(MaterialKind::OrenNayar),
+            tabulated: has_kind(MaterialKind::Tabulated),
+            pbr: has_kind(MaterialKind::Pbr),
+            textures: scene.materials.iter().any(|m| m.albedo_texture.is_some()),
+        }
+    }
+
+    /// Whether the feature called `name` in the WGSL directives is on.
+    fn named(&self, name: &str) -> Option<bool> {
+        Some(match name {
+            "SPHERES" => self.spheres,
+            "PLANES" => self.planes,
+            "POLYGONS" => self.polygons,
+            "TRIANGLES" => self.triangles,
+            "REFRACTION" => self.refraction,
+            "BLINN_PHONG" => self.blinn_phong,
+            "COOK_TORRANCE" => self.cook_torrance,
+            "OREN_NAYAR" => self.oren_nayar,
+            "TABULATED" => self.tabulated,
+            "PBR" => self.pbr,
+            "TEXTURES" => self.textures,
+            _ => return None,
+        })
+    }
+
+    /// A short label for pipeline names, listing the features that are on.
+    pub fn label(&self) -> String {
+        let names = [
+            "SPHERES",
+            "PLANES",
+            "POLYGONS",
+            "TRIANGLES",
+            "REFRACTION",
+            "BLINN_PHONG",
+            "COOK_TORRANCE",
+            "OREN_NAYAR",
+            "TABULATED",
+            "PBR",
+            "TEXTURES",
+        ];
+        let on: Vec<&str> = names
+            .into_iter()
+            .filter(|name| self.named(name) == Some(true))
+            .collect();
+        if on.is_empty() {
+            "none".into()
+        } else {
+            on.join("+").to_lowercase()
+        }
+    }
+}
+
+/// Keeps the lines of `source` whose enclosing `//#if` directives hold for `features`
+/// and removes the directive lines. An unknown feature name or unbalanced directives
+/// are errors (they are bugs in our own shaders, caught by the tests).
+pub fn specialise(source: &str, features: &ShaderFeatures) -> Result<String, String> {
+    // One entry per open `//#if`: whether its branch currently being read is kept.
+    let mut open: Vec<(bool, bool)> = Vec::new(); // (condition, in_else)
+    let mut output = String::with_capacity(source.len());
+    for (index, line) in source.lines().enumerate() {
+        let directive = line.trim_start();
+        if let Some(condition) = directive.strip_prefix("//#if ") {
+            let mut value = false;
+            for name in condition.split("||").map(str::trim) {
+                value |= features.named(name).ok_or_else(|| {
+                    format!("line {}: unknown shader feature `{name}`", index + 1)
+                })?;
+            }
+            open.push((value, false));
+        } else if directive.starts_with("//#else") {
+            let top = open
+                .last_mut()
+                .ok_or_else(|| format!("line {}: //#else without //#if", index + 1))?;
+            top.1 = true;
+        } else if directive.starts_with("//#endif") {
+            open.pop()
+                .ok_or_else(|| format!("line {}: //#endif without //#if", index + 1))?;
+        } else if open
+            .iter()
+            .all(|&(condition, in_else)| condition != in_else)
+        {
+            output.push_str(line);
+            output.push('\n');
+        }
+    }
+    if open.is_empty() {
+        Ok(output)
+    } else {
+        Err(format!("{} //#if without //#endif", open.len()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keeps_and_drops_nested_blocks() {
+        let source = "a\n//#if REFRACTION\nb\n//#if SPHERES || PLANES\nc\n//#else\nd\n//#endif\n//#else\ne\n//#endif\nf\n";
+        let none = ShaderFeatures {
+            refraction: false,
+            spheres: false,
+            planes: false,
+            ..ShaderFeatures::ALL
+        };
+        assert_eq!(
+            specialise(source, &ShaderFeatures::ALL).as_deref(),
+            Ok("a\nb\nc\nf\n")
+        );
+        assert_eq!(specialise(source, &none).as_deref(), Ok("a\ne\nf\n"));
+        let planes_only = ShaderFeatures {
+            spheres: false,
+            ..ShaderFeatures::ALL
+        };
+        assert_eq!(
+            specialise(source, &planes_only).as_deref(),
+            Ok("a\nb\nc\nf\n")
+        );
+        let no_shapes = ShaderFeatures {
+            refraction: true,
+            ..none
+        };
+        assert_eq!(
+            specialise(source, &no_shapes).as_deref(),
+            Ok("a\nb\nd\nf\n")
+        );
+    }
+
+    #[test]
+    fn rejects_unknown_names_and_unbalanced_directives() {
+        assert!(specialise("//#if GLITTER\n//#endif\n", &ShaderFeatures::ALL).is_err());
+        assert!(specialise("//#if PBR\n", &ShaderFeatures::ALL).is_err());
+        assert!(specialise("//#endif\n", &ShaderFeatures::ALL).is_err());
+    }
+}

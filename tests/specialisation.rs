@@ -1,0 +1,206 @@
+//! The trace shader is specialised to each scene: what a scene does not use is not in
+//! the compiled module, and leaving it out changes no pixel.
+
+mod common;
+
+use std::collections::BTreeSet;
+use std::path::Path;
+
+use gpu_render::gpu::shaders::trace_shader_source;
+use gpu_render::gpu::{GpuRenderer, ShaderFeatures};
+use gpu_render::scene::{RenderOverrides, Scene, load_scene};
+
+fn scene(name: &str) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name);
+    load_scene(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The names of the functions in the naga module built for `features`.
+fn function_names(features: &ShaderFeatures) -> BTreeSet<String> {
+    let source = trace_shader_source(5, features).expect("well-formed directives");
+    let module = naga::front::wgsl::parse_str(&source)
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::default(),
+    )
+    .validate(&module)
+    .unwrap_or_else(|e| panic!("{:?}: {}", features, e.emit_to_string(&source)));
+    module
+        .functions
+        .iter()
+        .filter_map(|(_, f)| f.name.clone())
+        .collect()
+}
+
+const REFRACTION_CODE: [&str; 3] = [
+    "refract_direction",
+    "medium_after_refraction",
+    "medium_outside_ior",
+];
+
+#[test]
+fn a_scene_without_dielectrics_gets_no_refraction_code() {
+    let diffuse = scene("linear-vs-gamma.toml");
+    let features = ShaderFeatures::for_scene(&diffuse);
+    assert!(!features.refraction);
+    let names = function_names(&features);
+    for function in REFRACTION_CODE {
+        assert!(!names.contains(function), "{function} is in the module");
+    }
+    // Nor code for the shapes and models it does not use.
+    for function in [
+        "intersect_triangle",
+        "point_in_polygon",
+        "brdf_cook_torrance",
+        "brdf_oren_nayar",
+        "brdf_pbr",
+        "sample_texture",
+    ] {
+        assert!(!names.contains(function), "{function} is in the module");
+    }
+    assert!(names.contains("intersect_sphere") && names.contains("brdf_blinn_phong"));
+
+    let glass = ShaderFeatures::for_scene(&scene("showcase.toml"));
+    assert!(glass.refraction);
+    let names = function_names(&glass);
+    for function in REFRACTION_CODE {
+        assert!(names.contains(function), "{function} is missing");
+    }
+}
+
+#[test]
+fn every_feature_alone_and_every_feature_left_out_validates() {
+    let none = ShaderFeatures {
+        spheres: false,
+        planes: false,
+        polygons: false,
+        triangles: false,
+        refraction: false,
+        blinn_phong: false,
+        cook_torrance: false,
+        oren_nayar: false,
+        tabulated: false,
+        pbr: false,
+        textures: false,
+    };
+    type Toggle = fn(&mut ShaderFeatures, bool);
+    let toggles: [Toggle; 11] = [
+        |f, v| f.spheres = v,
+        |f, v| f.planes = v,
+        |f, v| f.polygons = v,
+        |f, v| f.triangles = v,
+        |f, v| f.refraction = v,
+        |f, v| f.blinn_phong = v,
+        |f, v| f.cook_torrance = v,
+        |f, v| f.oren_nayar = v,
+        |f, v| f.tabulated = v,
+        |f, v| f.pbr = v,
+        |f, v| f.textures = v,
+    ];
+    let all = function_names(&ShaderFeatures::ALL).len();
+    let bare = function_names(&none).len();
+    assert!(
+        bare < all,
+        "the bare module should be smaller: {bare} vs {all}"
+    );
+    for toggle in toggles {
+        let mut alone = none;
+        toggle(&mut alone, true);
+        function_names(&alone);
+        let mut without = ShaderFeatures::ALL;
+        toggle(&mut without, false);
+        function_names(&without);
+        let source_length = |f: &ShaderFeatures| {
+            trace_shader_source(5, f)
+                .expect("well-formed directives")
+                .len()
+        };
+        assert!(
+            source_length(&without) < source_length(&ShaderFeatures::ALL),
+            "leaving out a feature should remove code: {without:?}"
+        );
+    }
+}
+
+fn reduced(scene: Scene) -> Scene {
+    let width = 96;
+    let height = (scene.render.height * width / scene.render.width).max(1);
+    let render = scene
+        .render
+        .with_overrides(&RenderOverrides {
+            width: Some(width),
+            height: Some(height),
+            samples_per_pixel: Some(2),
+            ..RenderOverrides::default()
+        })
+        .expect("valid overrides");
+    Scene { render, ..scene }
+}
+
+#[test]
+fn specialised_and_general_modules_render_the_same_pixels() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let specialised = common::gpu::renderer(&gpu);
+    let general = GpuRenderer::new(&gpu.device)
+        .expect("renderer")
+        .with_specialisation(false);
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .expect("scenes/")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    names.sort();
+    for path in names {
+        let scene = reduced(load_scene(&path).unwrap_or_else(|e| panic!("{e}")));
+        let a = specialised
+            .render(&gpu.device, &gpu.queue, &scene, None)
+            .expect("specialised render");
+        let b = general
+            .render(&gpu.device, &gpu.queue, &scene, None)
+            .expect("general render");
+        let worst = a
+            .image
+            .pixels
+            .iter()
+            .zip(&b.image.pixels)
+            .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
+            .fold(0.0f32, f32::max);
+        // The same arithmetic in the same order; only code the scene never runs differs.
+        assert!(worst <= 1e-6, "{}: max |Δ| {worst}", path.display());
+        assert_eq!(
+            a.stats.rays_traced,
+            b.stats.rays_traced,
+            "{}",
+            path.display()
+        );
+    }
+}
+
+#[test]
+fn pipelines_are_cached_by_stack_size_and_feature_set() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let renderer = common::gpu::renderer(&gpu);
+    let showcase = reduced(scene("showcase.toml"));
+    let diffuse = reduced(scene("linear-vs-gamma.toml"));
+    let render = |s: &Scene| {
+        renderer
+            .render(&gpu.device, &gpu.queue, s, None)
+            .expect("render");
+    };
+    render(&showcase);
+    render(&showcase);
+    assert_eq!(renderer.cached_pipeline_count(), 1);
+    render(&diffuse);
+    assert_eq!(renderer.cached_pipeline_count(), 2);
+    render(&showcase);
+    render(&diffuse);
+    assert_eq!(renderer.cached_pipeline_count(), 2);
+}
