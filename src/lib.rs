@@ -10,6 +10,7 @@
 //! - [`cpu`]: the reference tracer (f64).
 //! - [`gpu`]: the wgpu backend, built from the caller's `Device` and `Queue`.
 //! - [`output`]: writing PNG, EXR and HDR files atomically.
+//! - [`quality`]: the named presets chosen from the measured front.
 //! - [`tradeoff`]: measuring time against error for the speed/accuracy knobs.
 
 pub mod camera;
@@ -19,5 +20,6 @@ pub mod film;
 pub mod gpu;
 pub mod output;
 pub mod plausibility;
+pub mod quality;
 pub mod scene;
 pub mod tradeoff;

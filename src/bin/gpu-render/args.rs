@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use gpu_render::quality::QualityPreset;
 use gpu_render::scene::{LightingSpace, RenderOverrides};
 
 const AFTER_HELP: &str = "\
@@ -128,6 +129,16 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N", help_heading = "Render settings")]
     pub stack_size: Option<u32>,
 
+    /// A measured speed/accuracy preset (samples, depth, cutoff); explicit --spp,
+    /// --max-depth and --min-ray-weight win over it. See docs/quality.md.
+    #[arg(
+        long,
+        value_enum,
+        value_name = "PRESET",
+        help_heading = "Render settings"
+    )]
+    pub quality: Option<QualityArg>,
+
     /// Do not trace reflected/refracted branches whose weight is at most this, in
     /// [0, 1]: faster, slightly darker glass and mirrors [default: the scene's, or 0].
     #[arg(long, value_name = "W", help_heading = "Render settings")]
@@ -171,14 +182,24 @@ pub struct RenderArgs {
 impl RenderArgs {
     /// The command-line settings that override the scene file's.
     pub fn overrides(&self) -> RenderOverrides {
+        let preset = self
+            .quality
+            .map(|quality| QualityPreset::from(quality).overrides())
+            .unwrap_or_default();
+        // An explicit depth without an explicit stack size lets the stack grow to fit.
+        let preset_stack = if self.max_depth.is_some() {
+            None
+        } else {
+            preset.stack_size
+        };
         RenderOverrides {
             width: self.width,
             height: self.height,
-            samples_per_pixel: self.spp,
-            max_depth: self.max_depth,
-            stack_size: self.stack_size,
+            samples_per_pixel: self.spp.or(preset.samples_per_pixel),
+            max_depth: self.max_depth.or(preset.max_depth),
+            stack_size: self.stack_size.or(preset_stack),
             lighting_space: self.lighting.map(LightingSpace::from),
-            min_ray_weight: self.min_ray_weight,
+            min_ray_weight: self.min_ray_weight.or(preset.min_ray_weight),
         }
     }
 
@@ -201,6 +222,27 @@ impl RenderArgs {
                 _ => None,
             }
         })
+    }
+}
+
+/// `--quality` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum QualityArg {
+    /// 1 sample, depth 4, cutoff 0.05.
+    Draft,
+    /// 4 samples, depth 4.
+    Preview,
+    /// 16 samples, depth 8.
+    Final,
+}
+
+impl From<QualityArg> for QualityPreset {
+    fn from(arg: QualityArg) -> Self {
+        match arg {
+            QualityArg::Draft => QualityPreset::Draft,
+            QualityArg::Preview => QualityPreset::Preview,
+            QualityArg::Final => QualityPreset::Final,
+        }
     }
 }
 
@@ -300,5 +342,26 @@ mod tests {
         assert_eq!(cli.render.adapter, Some(AdapterArg::List));
         assert!(Cli::try_parse_from(["gpu-render", "s.toml"]).is_err());
         assert!(Cli::try_parse_from(["gpu-render", "-o", "x.png"]).is_err());
+    }
+
+    #[test]
+    fn quality_presets_yield_to_explicit_flags() {
+        let parse = |extra: &[&str]| {
+            let mut argv = vec!["gpu-render", "s.toml", "-o", "o.png"];
+            argv.extend_from_slice(extra);
+            Cli::try_parse_from(argv)
+                .expect("parses")
+                .render
+                .overrides()
+        };
+        let draft = parse(&["--quality", "draft"]);
+        assert_eq!(draft.samples_per_pixel, Some(1));
+        assert_eq!(draft.min_ray_weight, Some(0.05));
+        let tuned = parse(&["--quality", "final", "--spp", "3", "--max-depth", "12"]);
+        assert_eq!(tuned.samples_per_pixel, Some(3));
+        assert_eq!(tuned.max_depth, Some(12));
+        // The stack grows with the explicit depth instead of keeping the preset's.
+        assert_eq!(tuned.stack_size, None);
+        assert_eq!(parse(&[]).samples_per_pixel, None);
     }
 }
