@@ -11,8 +11,6 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
-
 use common::compare::{Tolerance, assert_images_match};
 use gpu_render::scene::{LightingSpace, RenderOverrides, Scene, load_scene};
 
@@ -22,37 +20,13 @@ const TOLERANCE: Tolerance = Tolerance {
     outlier_fraction: 0.005,
 };
 
-fn shipped_scenes() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
-    let mut scenes: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("scenes/ exists")
-        .map(|entry| entry.expect("readable entry").path())
-        .filter(|path| path.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    scenes.sort();
-    assert!(
-        scenes.len() >= 3,
-        "expected the shipped scenes in {}",
-        dir.display()
-    );
-    scenes
-}
-
 fn reduced(scene: Scene, lighting_space: LightingSpace) -> Scene {
-    let width = 200;
-    let height = (u64::from(scene.render.height) * u64::from(width) / u64::from(scene.render.width))
-        .max(1) as u32;
-    let render = scene
-        .render
-        .with_overrides(&RenderOverrides {
-            width: Some(width),
-            height: Some(height),
-            samples_per_pixel: Some(2),
-            lighting_space: Some(lighting_space),
-            ..RenderOverrides::default()
-        })
-        .expect("valid overrides");
-    Scene { render, ..scene }
+    let overrides = RenderOverrides {
+        samples_per_pixel: Some(2),
+        lighting_space: Some(lighting_space),
+        ..RenderOverrides::default()
+    };
+    common::scenes::reduced(scene, 200, overrides)
 }
 
 #[test]
@@ -61,7 +35,7 @@ fn gpu_matches_cpu_reference_on_every_shipped_scene() {
         return;
     };
     let renderer = common::gpu::renderer(&gpu);
-    for path in shipped_scenes() {
+    for path in common::scenes::shipped_scenes() {
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
         let scene = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
         let spaces: &[LightingSpace] = if name == "linear-vs-gamma" {
@@ -105,11 +79,7 @@ fn gpu_matches_cpu_reference_on_every_shipped_scene() {
 
 #[test]
 fn ray_weight_cutoff_traces_fewer_rays_alike_on_both_backends() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/glass.toml");
-    let full = reduced(
-        load_scene(&path).unwrap_or_else(|e| panic!("{e}")),
-        LightingSpace::Linear,
-    );
+    let full = reduced(common::scenes::shipped("glass.toml"), LightingSpace::Linear);
     let mut cut = full.clone();
     cut.render.min_ray_weight = 0.2;
     let cpu_full = gpu_render::cpu::render(&full, None);
@@ -147,8 +117,7 @@ fn many_deep_samples_per_pixel_lose_no_rays() {
         return;
     };
     let renderer = common::gpu::renderer(&gpu);
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/showcase.toml");
-    let mut scene = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+    let mut scene = common::scenes::shipped("showcase.toml");
     scene.render = scene
         .render
         .with_overrides(&RenderOverrides {

@@ -4,18 +4,12 @@
 mod common;
 
 use std::collections::BTreeSet;
-use std::path::Path;
 
 use gpu_render::gpu::shaders::trace_shader_source;
 use gpu_render::gpu::{GpuRenderer, ShaderFeatures};
 use gpu_render::scene::{RenderOverrides, Scene, load_scene};
 
-fn scene(name: &str) -> Scene {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
-        .join(name);
-    load_scene(&path).unwrap_or_else(|e| panic!("{e}"))
-}
+use common::scenes::shipped as scene;
 
 /// The names of the functions in the naga module built for `features`.
 fn function_names(features: &ShaderFeatures) -> BTreeSet<String> {
@@ -126,18 +120,11 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
 }
 
 fn reduced(scene: Scene) -> Scene {
-    let width = 96;
-    let height = (scene.render.height * width / scene.render.width).max(1);
-    let render = scene
-        .render
-        .with_overrides(&RenderOverrides {
-            width: Some(width),
-            height: Some(height),
-            samples_per_pixel: Some(2),
-            ..RenderOverrides::default()
-        })
-        .expect("valid overrides");
-    Scene { render, ..scene }
+    let overrides = RenderOverrides {
+        samples_per_pixel: Some(2),
+        ..RenderOverrides::default()
+    };
+    common::scenes::reduced(scene, 96, overrides)
 }
 
 #[test]
@@ -149,14 +136,7 @@ fn specialised_and_general_modules_render_the_same_pixels() {
     let general = GpuRenderer::new(&gpu.device)
         .expect("renderer")
         .with_specialisation(false);
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
-    let mut names: Vec<_> = std::fs::read_dir(&dir)
-        .expect("scenes/")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    names.sort();
-    for path in names {
+    for path in common::scenes::shipped_scenes() {
         let scene = reduced(load_scene(&path).unwrap_or_else(|e| panic!("{e}")));
         let a = specialised
             .render(&gpu.device, &gpu.queue, &scene, None)
