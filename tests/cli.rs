@@ -307,3 +307,35 @@ fn compare_gamma_is_twice_as_wide() {
     assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
     assert_eq!(read_png_size(&ws.path("out.png")), (64, 24));
 }
+
+fn shipped_path(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+#[test]
+fn brdf_check_accepts_a_plausible_map() {
+    let run = gpu_render(&["brdf-check", &shipped_path("scenes/brdf/plausible.png")]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    for rule in ["positivity:", "energy:", "reciprocity:"] {
+        let line = run
+            .stdout
+            .lines()
+            .find(|l| l.starts_with(rule))
+            .unwrap_or_else(|| panic!("no {rule} line in:\n{}", run.stdout));
+        assert!(line.contains(" ok "), "{line}");
+    }
+}
+
+#[test]
+fn brdf_check_reports_every_violated_rule() {
+    let path = shipped_path("scenes/brdf/implausible.exr");
+    let run = gpu_render(&["brdf-check", &path]);
+    assert_eq!(run.status, Some(1), "stderr:\n{}", run.stderr);
+    assert_eq!(run.stdout.matches("VIOLATED").count(), 3, "{}", run.stdout);
+    assert!(run.stderr.contains("implausible.exr"), "{}", run.stderr);
+    let missing = gpu_render(&["brdf-check", "/nonexistent/map.png"]);
+    assert_fails_with(&missing, &["/nonexistent/map.png", "cannot read"]);
+}
