@@ -5,9 +5,20 @@
 //! cargo run --release --example bench -- scenes/showcase.toml --width 1920 --height 1080 --runs 3
 //! ```
 //!
-//! "trace" is the tracing work alone (`RenderStats::elapsed`: GPU submissions of the
-//! trace pass, or the CPU threads); "total" adds the display pass and readback on the
-//! GPU. Rays are counted by the tracers as they trace them, not estimated.
+//! With `--specialisation`, it instead compares the trace pipeline specialised to the
+//! scene with the general one that contains every feature: pipeline creation, time to
+//! the first (tiny) frame, which on lavapipe includes the LLVM compile that happens at
+//! the first dispatch, and the median trace time of alternating runs.
+//!
+//! ```sh
+//! cargo run --release --example bench -- scenes/glass.toml --width 640 --height 480 --specialisation
+//! ```
+//!
+//! "trace" is the tracing work alone (`RenderStats::elapsed`: wall time of the GPU
+//! submissions of the trace pass, or of the CPU threads); "GPU timestamps" is the GPU's
+//! own time of the trace passes (`RenderStats::gpu_time`), printed where the device has
+//! timestamp queries; "total" adds the display pass and readback on the GPU. Rays are
+//! counted by the tracers as they trace them, not estimated.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -36,6 +47,9 @@ struct Args {
     /// Skip the CPU reference.
     #[arg(long)]
     gpu_only: bool,
+    /// Compare the specialised trace pipeline with the general one.
+    #[arg(long)]
+    specialisation: bool,
 }
 
 fn median(mut values: Vec<f64>) -> f64 {
@@ -69,18 +83,24 @@ fn main() -> Result<()> {
         info.backend,
         std::thread::available_parallelism().map_or(1, usize::from)
     );
+    if args.specialisation {
+        return compare_specialisation(&gpu, &scene, args.runs);
+    }
     // Warm-up: the first dispatch compiles the pipeline (lavapipe runs LLVM then).
     renderer.render(&gpu.device, &gpu.queue, &scene, None)?;
     if !args.gpu_only {
         gpu_render::cpu::render(&scene, None);
     }
     let (mut gpu_trace, mut gpu_total, mut cpu_trace) = (vec![], vec![], vec![]);
+    // GPU timestamp times, `None` for a run without them.
+    let mut gpu_timestamps = vec![];
     let (mut gpu_rays, mut cpu_rays) = (0, 0);
     for _ in 0..args.runs {
         let started = Instant::now();
         let rendered = renderer.render(&gpu.device, &gpu.queue, &scene, None)?;
         gpu_total.push(started.elapsed().as_secs_f64());
         gpu_trace.push(rendered.stats.elapsed.as_secs_f64());
+        gpu_timestamps.push(rendered.stats.gpu_time.map(|t| t.as_secs_f64()));
         gpu_rays = rendered.stats.rays_traced;
         if !args.gpu_only {
             let rendered = gpu_render::cpu::render(&scene, None);
@@ -91,7 +111,7 @@ fn main() -> Result<()> {
     let report = |name: &str, trace: f64, total: Option<f64>, rays: u64| {
         let total = total.map_or(String::new(), |t| format!(", total {:.3} s", t));
         println!(
-            "{name}: trace {:.3} s{total}; {rays} rays; {:.1} Mrays/s",
+            "{name}: trace {:.3} s (wall clock){total}; {rays} rays; {:.1} Mrays/s",
             trace,
             rays as f64 / trace / 1e6
         );
@@ -102,6 +122,18 @@ fn main() -> Result<()> {
         Some(median(gpu_total)),
         gpu_rays,
     );
+    // Timestamps come from the device's features, so every run has them or none does.
+    match gpu_timestamps.into_iter().collect::<Option<Vec<f64>>>() {
+        Some(times) if !times.is_empty() => {
+            let gpu = median(times);
+            println!(
+                "GPU: trace passes {:.3} s (GPU timestamps); {:.1} Mrays/s",
+                gpu,
+                gpu_rays as f64 / gpu / 1e6
+            );
+        }
+        _ => println!("GPU: no GPU timestamps (the device lacks TIMESTAMP_QUERY)"),
+    }
     if !args.gpu_only {
         report("CPU reference", median(cpu_trace.clone()), None, cpu_rays);
         println!(
@@ -110,5 +142,67 @@ fn main() -> Result<()> {
             args.runs
         );
     }
+    Ok(())
+}
+
+/// Times the specialised and the general trace pipeline on `scene`.
+fn compare_specialisation(
+    gpu: &HeadlessGpu,
+    scene: &gpu_render::scene::Scene,
+    runs: usize,
+) -> Result<()> {
+    let features = gpu_render::gpu::ShaderFeatures::for_scene(scene);
+    println!("scene features: {}", features.label());
+    let tiny = gpu_render::scene::Scene {
+        render: scene
+            .render
+            .with_overrides(&RenderOverrides {
+                width: Some(8),
+                height: Some(8),
+                samples_per_pixel: Some(1),
+                ..RenderOverrides::default()
+            })
+            .map_err(anyhow::Error::msg)?,
+        ..scene.clone()
+    };
+    let mut renderers = Vec::new();
+    for (name, specialise) in [("specialised", true), ("general", false)] {
+        let renderer = GpuRenderer::new(&gpu.device)?.with_specialisation(specialise);
+        let used = if specialise {
+            features
+        } else {
+            gpu_render::gpu::ShaderFeatures::ALL
+        };
+        let started = Instant::now();
+        renderer.trace_pipeline(&gpu.device, scene.render.stack_size, &used)?;
+        let create = started.elapsed().as_secs_f64();
+        let started = Instant::now();
+        renderer.render(&gpu.device, &gpu.queue, &tiny, None)?;
+        let first = started.elapsed().as_secs_f64();
+        let source = gpu_render::gpu::shaders::trace_shader_source(scene.render.stack_size, &used)
+            .map_err(anyhow::Error::msg)?;
+        println!(
+            "{name}: {} lines of WGSL; create_compute_pipeline {:.1} ms; first 8x8 frame {:.1} ms",
+            source.lines().count(),
+            create * 1e3,
+            first * 1e3
+        );
+        renderers.push((name, renderer));
+    }
+    let mut times = [Vec::new(), Vec::new()];
+    for _ in 0..runs {
+        for (index, (_, renderer)) in renderers.iter().enumerate() {
+            let rendered = renderer.render(&gpu.device, &gpu.queue, scene, None)?;
+            times[index].push(rendered.stats.elapsed.as_secs_f64());
+        }
+    }
+    let specialised = median(times[0].clone());
+    let general = median(times[1].clone());
+    println!(
+        "trace time, median of {runs} alternating runs: specialised {:.3} s, general {:.3} s, ratio {:.2}",
+        specialised,
+        general,
+        specialised / general
+    );
     Ok(())
 }

@@ -58,17 +58,66 @@ pub struct RenderStats {
     pub rays_traced: u64,
     /// Wall time of the render (tracing only, without scene loading or file output).
     pub elapsed: Duration,
+    /// GPU time of the trace passes, measured with timestamp queries: for each
+    /// submitted chunk, from the start of its first trace pass to the end of its last,
+    /// summed over the chunks. `None` where the device lacks
+    /// [`wgpu::Features::TIMESTAMP_QUERY`], for the CPU reference, and where the
+    /// timestamps could not be trusted (see [`crate::gpu::GpuRenderer::render`]).
+    pub gpu_time: Option<Duration>,
+}
+
+/// Where a trace time came from; see [`RenderStats::trace_time`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum TimingSource {
+    /// GPU timestamp queries around the trace passes ([`RenderStats::gpu_time`]).
+    GpuTimestamps,
+    /// Host wall-clock time around the tracing ([`RenderStats::elapsed`]).
+    WallClock,
+}
+
+impl std::fmt::Display for TimingSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            TimingSource::GpuTimestamps => "GPU timestamps",
+            TimingSource::WallClock => "wall clock",
+        })
+    }
 }
 
 impl RenderStats {
-    /// Rays traced per second of wall time.
+    /// Rays traced per second of wall time ([`RenderStats::elapsed`]).
     pub fn rays_per_second(&self) -> f64 {
-        let seconds = self.elapsed.as_secs_f64();
-        if seconds > 0.0 {
-            self.rays_traced as f64 / seconds
-        } else {
-            0.0
+        per_second(self.rays_traced, self.elapsed.as_secs_f64())
+    }
+
+    /// The best measure of the tracing time: [`RenderStats::gpu_time`] where it was
+    /// measured, else the wall time [`RenderStats::elapsed`], and which one it is.
+    pub fn trace_time(&self) -> (Duration, TimingSource) {
+        match self.gpu_time {
+            Some(gpu) => (gpu, TimingSource::GpuTimestamps),
+            None => (self.elapsed, TimingSource::WallClock),
         }
+    }
+
+    /// [`RenderStats::trace_time`] in seconds.
+    pub fn trace_seconds(&self) -> (f64, TimingSource) {
+        let (time, source) = self.trace_time();
+        (time.as_secs_f64(), source)
+    }
+
+    /// Rays traced per second of [`RenderStats::trace_time`], and which time that is.
+    pub fn trace_rays_per_second(&self) -> (f64, TimingSource) {
+        let (seconds, source) = self.trace_seconds();
+        (per_second(self.rays_traced, seconds), source)
+    }
+}
+
+/// `count / seconds`, or 0 for a zero time.
+fn per_second(count: u64, seconds: f64) -> f64 {
+    if seconds > 0.0 {
+        count as f64 / seconds
+    } else {
+        0.0
     }
 }
 
@@ -80,6 +129,6 @@ pub type ProgressFn<'a> = &'a (dyn Fn(u32, u32) + Sync);
 pub struct Rendered {
     /// The linear float image.
     pub image: LinearImage,
-    /// Ray count and time.
+    /// Ray count and times.
     pub stats: RenderStats,
 }

@@ -246,3 +246,61 @@ fn bad_input_is_an_error_not_a_panic() {
     );
     assert!(matches!(result, Err(GpuError::Validation(_))), "{result:?}");
 }
+
+#[test]
+fn timestamp_queries_time_the_trace_passes() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let info = gpu.adapter_info();
+    if !gpu
+        .device
+        .features()
+        .contains(wgpu::Features::TIMESTAMP_QUERY)
+    {
+        // lavapipe offers timestamp queries, so CI (which runs on it) must time with them.
+        assert!(
+            std::env::var_os("CI").is_none() || !info.name.contains("llvmpipe"),
+            "CI on {} must have TIMESTAMP_QUERY",
+            info.name
+        );
+        eprintln!(
+            "note: skipping the GPU timestamp test, {} lacks TIMESTAMP_QUERY",
+            info.name
+        );
+        return;
+    }
+    let renderer = common::gpu::renderer(&gpu);
+    // Several chunks, so the per-chunk times are summed.
+    assert!(row_chunks(WIDTH, HEIGHT, SPP).len() > 1);
+    let out = renderer
+        .render(&gpu.device, &gpu.queue, &scene(SPP), None)
+        .expect("render succeeds");
+    let slack = Duration::from_millis(50);
+    let gpu_time = out
+        .stats
+        .gpu_time
+        .expect("a device with timestamps reports GPU time");
+    assert!(
+        gpu_time > Duration::ZERO && gpu_time <= out.stats.elapsed + slack,
+        "GPU time {gpu_time:?}, wall time {:?}",
+        out.stats.elapsed
+    );
+    assert_eq!(
+        out.stats.trace_time(),
+        (gpu_time, gpu_render::film::TimingSource::GpuTimestamps)
+    );
+    eprintln!(
+        "trace on {}: GPU timestamps {gpu_time:?}, wall {:?}",
+        info.name, out.stats.elapsed
+    );
+
+    // render_to_texture times its chunks the same way.
+    let target = linear_target(&gpu.device);
+    let view = target.create_view(&Default::default());
+    let stats = renderer
+        .render_to_texture(&gpu.device, &gpu.queue, &scene(4), &view, None)
+        .expect("render_to_texture succeeds");
+    let gpu_time = stats.gpu_time.expect("render_to_texture reports GPU time");
+    assert!(gpu_time > Duration::ZERO && gpu_time <= stats.elapsed + slack);
+}

@@ -82,6 +82,7 @@ pub fn render(scene: &Scene, progress: Option<ProgressFn<'_>>) -> Rendered {
         stats: RenderStats {
             rays_traced: rays.into_inner(),
             elapsed: started.elapsed(),
+            gpu_time: None,
         },
     }
 }

@@ -60,7 +60,9 @@ pub fn list_adapters() -> Vec<wgpu::AdapterInfo> {
 /// A wgpu instance, adapter, device and queue without any window.
 ///
 /// The device is created with the adapter's own limits (not [`wgpu::Limits::default`]),
-/// so large storage buffers and image sizes the hardware supports are usable.
+/// so large storage buffers and image sizes the hardware supports are usable, and with
+/// [`wgpu::Features::TIMESTAMP_QUERY`] where the adapter offers it, so that renders
+/// report GPU time ([`crate::film::RenderStats::gpu_time`]).
 pub struct HeadlessGpu {
     /// The instance the adapter came from.
     pub instance: wgpu::Instance,
@@ -144,9 +146,12 @@ impl HeadlessGpu {
                     })?
             }
         };
+        // Timestamp queries time the trace passes on the GPU itself (see
+        // `RenderStats::gpu_time`); request them only where the adapter offers them.
+        let required_features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
         let desc = wgpu::DeviceDescriptor {
             label: Some("gpu-render headless device"),
-            required_features: wgpu::Features::empty(),
+            required_features,
             required_limits: adapter.limits(),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,

@@ -19,7 +19,9 @@ use wgpu::util::DeviceExt;
 use super::GpuError;
 use super::features::ShaderFeatures;
 use super::layout::{DisplayUniforms, FrameUniforms};
-use super::readback::{Caught, capture, read_buffer, read_texture, submit_and_wait};
+use super::readback::{
+    Caught, align_up, capture, map_read, read_buffer, read_texture, submit_and_wait,
+};
 use super::shaders::{
     DISPLAY_ENTRY_POINT, TRACE_ENTRY_POINT, WORKGROUP_SIZE, display_shader_source,
     trace_shader_source,
@@ -149,7 +151,8 @@ pub struct GpuRendered {
     /// The display pass's output: `width × height` RGBA8 pixels, row-major, top row
     /// first, sRGB-encoded unless the scene is in naive gamma mode.
     pub display_rgba8: Vec<u8>,
-    /// Rays traced (summed from the per-row counters) and the wall time of tracing.
+    /// Rays traced (summed from the per-row counters), the wall time of tracing and,
+    /// where the device has timestamp queries, its GPU time.
     pub stats: RenderStats,
 }
 
@@ -567,7 +570,9 @@ impl GpuRenderer {
     /// Records one trace dispatch of the image pixels in `region` into `encoder`,
     /// writing each pixel (x, y) to texel (x, y) − `region.target_origin` of `target`,
     /// which must be large enough for that. This is how images larger than the device's
-    /// texture limit are traced, one tile-sized target at a time.
+    /// texture limit are traced, one tile-sized target at a time. Like
+    /// [`GpuRenderer::encode_trace`], it writes no timestamps: time the caller's own
+    /// passes or submissions if needed.
     ///
     /// Errors: as [`GpuRenderer::encode_trace`], and [`GpuError::DeviceLimit`] when the
     /// region needs more workgroups than `max_compute_workgroups_per_dimension`.
@@ -579,6 +584,23 @@ impl GpuRenderer {
         target: &wgpu::TextureView,
         region: &TraceRegion,
     ) -> Result<(), GpuError> {
+        self.encode_timed_trace_region(device, encoder, prepared, target, region, None)
+            .map(|_| ())
+    }
+
+    /// [`GpuRenderer::encode_trace_region`], and with `timestamps` writes a timestamp
+    /// at the beginning of the first trace pass it records and at the end of the last.
+    /// Returns how many passes it recorded (none for an empty region, and then no
+    /// timestamps are written).
+    fn encode_timed_trace_region(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        prepared: &PreparedScene,
+        target: &wgpu::TextureView,
+        region: &TraceRegion,
+        timestamps: Option<ChunkTimestamps<'_>>,
+    ) -> Result<u64, GpuError> {
         let TraceRegion {
             columns,
             rows,
@@ -604,7 +626,7 @@ impl GpuRenderer {
             )));
         }
         if rows.is_empty() || columns.is_empty() {
-            return Ok(());
+            return Ok(0);
         }
         check_texture(
             target,
@@ -628,10 +650,12 @@ impl GpuRenderer {
         }
         let pipeline = self.trace_pipeline(device, prepared.stack_size, &prepared.features)?;
         let band_rows = prepared.frame.accumulation_rows.max(1);
+        let samples = prepared.samples_per_pixel();
+        let mut passes = 0;
         let mut band_start = rows.start;
         while band_start < rows.end {
             let band_end = rows.end.min(band_start.saturating_add(band_rows));
-            for sample_index in 0..prepared.samples_per_pixel() {
+            for sample_index in 0..samples {
                 let dispatch = FrameUniforms {
                     row_offset: band_start,
                     row_count: band_end - band_start,
@@ -642,17 +666,36 @@ impl GpuRenderer {
                     sample_index,
                     ..prepared.frame
                 };
+                let first = band_start == rows.start && sample_index == 0;
+                let last = band_end == rows.end && sample_index + 1 == samples;
+                // Only the chunk's first and last pass write (wgpu rejects a pass
+                // timestamp write with neither index).
+                let timestamp_writes = timestamps.filter(|_| first || last).map(|chunk| {
+                    wgpu::ComputePassTimestampWrites {
+                        query_set: chunk.query_set,
+                        beginning_of_pass_write_index: first.then_some(chunk.begin),
+                        end_of_pass_write_index: last.then_some(chunk.begin + 1),
+                    }
+                });
                 self.encode_trace_dispatch(
-                    device, encoder, prepared, target, &pipeline, &dispatch,
+                    device,
+                    encoder,
+                    prepared,
+                    target,
+                    &pipeline,
+                    &dispatch,
+                    timestamp_writes,
                 )?;
+                passes += 1;
             }
             band_start = band_end;
         }
-        Ok(())
+        Ok(passes)
     }
 
     /// Records one dispatch of the trace pass: one sample of every pixel in the region
-    /// `dispatch` names.
+    /// `dispatch` names, writing the timestamps `timestamp_writes` asks for.
+    #[allow(clippy::too_many_arguments)]
     fn encode_trace_dispatch(
         &self,
         device: &wgpu::Device,
@@ -661,6 +704,7 @@ impl GpuRenderer {
         target: &wgpu::TextureView,
         pipeline: &wgpu::ComputePipeline,
         dispatch: &FrameUniforms,
+        timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) -> Result<(), GpuError> {
         let bind_group = capture(device, "trace bind group", Caught::Resource, || {
             let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -695,7 +739,7 @@ impl GpuRenderer {
         })?;
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("gpu-render trace"),
-            timestamp_writes: None,
+            timestamp_writes,
         });
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
@@ -818,6 +862,16 @@ impl GpuRenderer {
     /// `stats.elapsed` covers the tracing submissions only (not upload, display pass or
     /// readback); the trace pipeline is built before the clock starts.
     ///
+    /// Where `device` has [`wgpu::Features::TIMESTAMP_QUERY`] (which
+    /// [`super::HeadlessGpu`] requests when the adapter offers it), `stats.gpu_time` is
+    /// the GPU's own time of the trace passes: each chunk writes a timestamp at the
+    /// beginning of its first pass and at the end of its last, into query sets of up to
+    /// [`wgpu::QUERY_SET_MAX_QUERIES`] (as many as the chunks need), resolved and read
+    /// back once after the last chunk; the tick differences, times
+    /// [`wgpu::Queue::get_timestamp_period`], are summed over chunks. It is `None` on
+    /// other devices, and where the timestamps cannot be trusted (one went backwards, or
+    /// the period is not a positive number).
+    ///
     /// Errors: see [`GpuRenderer::prepare`]; [`GpuError::DeviceLost`] if the device
     /// fails or a chunk exceeds the poll timeout; [`GpuError::Readback`].
     pub fn render(
@@ -848,6 +902,7 @@ impl GpuRenderer {
                 progress((done / u64::from(width)) as u32, height);
             }
         };
+        let mut timer = TraceTimer::for_device(device);
         let mut elapsed = Duration::ZERO;
         for tile in &tiles {
             let (tile_width, tile_height) = (
@@ -875,8 +930,15 @@ impl GpuRenderer {
             let linear_view = linear.create_view(&wgpu::TextureViewDescriptor::default());
             let display_view = display.create_view(&wgpu::TextureViewDescriptor::default());
 
-            elapsed +=
-                self.trace_region_chunks(device, queue, &prepared, &linear_view, tile, &report)?;
+            elapsed += self.trace_region_chunks(
+                device,
+                queue,
+                &prepared,
+                &linear_view,
+                tile,
+                &report,
+                timer.as_mut(),
+            )?;
 
             let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("gpu-render display pass"),
@@ -904,9 +966,14 @@ impl GpuRenderer {
                 );
             }
         }
+        let gpu_time = match timer {
+            Some(timer) => timer.read(device, queue, self.poll_timeout)?,
+            None => None,
+        };
         let stats = RenderStats {
             rays_traced: self.read_ray_count(device, queue, &prepared)?,
             elapsed,
+            gpu_time,
         };
         Ok(GpuRendered {
             image: LinearImage {
@@ -922,7 +989,7 @@ impl GpuRenderer {
     /// Traces `scene` into the caller's `target` (an `Rgba32Float` texture with
     /// `STORAGE_BINDING`, at least image-sized), chunked and timed like
     /// [`GpuRenderer::render`], without the display pass or image readback. Returns the
-    /// ray count and trace time.
+    /// ray count and trace time (with GPU time as [`GpuRenderer::render`] describes).
     ///
     /// Errors: as [`GpuRenderer::render`], and [`GpuError::DeviceLimit`] for an image
     /// larger than `max_texture_dimension_2d`, which no single target can hold (use
@@ -963,18 +1030,34 @@ impl GpuRenderer {
                 progress(done, prepared.height());
             }
         };
-        let elapsed =
-            self.trace_region_chunks(device, queue, &prepared, target, &whole, &row_report)?;
+        let mut timer = TraceTimer::for_device(device);
+        let elapsed = self.trace_region_chunks(
+            device,
+            queue,
+            &prepared,
+            target,
+            &whole,
+            &row_report,
+            timer.as_mut(),
+        )?;
+        let gpu_time = match timer {
+            Some(timer) => timer.read(device, queue, self.poll_timeout)?,
+            None => None,
+        };
         Ok(RenderStats {
             rays_traced: self.read_ray_count(device, queue, &prepared)?,
             elapsed,
+            gpu_time,
         })
     }
 
     /// Traces the rows of `region` in chunks (see [`row_chunks`], split further to stay
     /// within `max_compute_workgroups_per_dimension`), one submission and
     /// wait each, calling `report(pixels)` after each chunk with the pixels it traced;
-    /// returns the time spent tracing.
+    /// returns the wall time spent tracing. With a `timer`, each chunk's first and last
+    /// trace pass write a pair of timestamps into it (read later with
+    /// [`TraceTimer::read`]).
+    #[allow(clippy::too_many_arguments)]
     fn trace_region_chunks(
         &self,
         device: &wgpu::Device,
@@ -983,6 +1066,7 @@ impl GpuRenderer {
         target: &wgpu::TextureView,
         region: &TraceRegion,
         report: &dyn Fn(u64),
+        mut timer: Option<&mut TraceTimer>,
     ) -> Result<Duration, GpuError> {
         // Compile before timing: shader and pipeline creation is not tracing.
         self.trace_pipeline(device, prepared.stack_size, &prepared.features)?;
@@ -994,7 +1078,7 @@ impl GpuRenderer {
             .max_compute_workgroups_per_dimension
             .saturating_mul(WORKGROUP_SIZE)
             .max(1);
-        let chunks = row_chunks(
+        let chunks: Vec<Range<u32>> = row_chunks(
             region_width,
             region.rows.end - region.rows.start,
             prepared.samples_per_pixel(),
@@ -1005,7 +1089,12 @@ impl GpuRenderer {
                 .clone()
                 .step_by(max_rows as usize)
                 .map(move |start| start..chunk.end.min(start.saturating_add(max_rows)))
-        });
+        })
+        .collect();
+        // Query sets are created up front, outside the chunk loop's submissions.
+        if let Some(timer) = timer.as_deref_mut() {
+            timer.reserve(device, chunks.len())?;
+        }
         for chunk in chunks {
             let rows = region.rows.start + chunk.start..region.rows.start + chunk.end;
             let pixels = u64::from(rows.end - rows.start) * u64::from(region_width);
@@ -1016,11 +1105,202 @@ impl GpuRenderer {
                 rows,
                 ..region.clone()
             };
-            self.encode_trace_region(device, &mut encoder, prepared, target, &chunk_region)?;
+            let slot = timer.as_deref().and_then(TraceTimer::next_slot);
+            let timed = slot.is_some();
+            let passes = self.encode_timed_trace_region(
+                device,
+                &mut encoder,
+                prepared,
+                target,
+                &chunk_region,
+                slot,
+            )?;
             submit_and_wait(device, queue, encoder, "trace chunk", self.poll_timeout)?;
+            if let Some(timer) = timer.as_deref_mut() {
+                timer.record(timed, passes > 0);
+            }
             report(pixels);
         }
         Ok(start.elapsed())
+    }
+}
+
+/// Where one chunk writes its two timestamps: `begin` at the start of its first trace
+/// pass, `begin + 1` at the end of its last.
+#[derive(Debug, Clone, Copy)]
+struct ChunkTimestamps<'a> {
+    query_set: &'a wgpu::QuerySet,
+    begin: u32,
+}
+
+/// One timestamp query set of a [`TraceTimer`] and how many of its queries are taken.
+#[derive(Debug)]
+struct TimerSet {
+    query_set: wgpu::QuerySet,
+    capacity: u32,
+    used: u32,
+}
+
+/// GPU timestamps around the trace passes of one render: a pair of queries per chunk,
+/// in as many query sets of up to [`wgpu::QUERY_SET_MAX_QUERIES`] as the chunks need,
+/// resolved and read back once after the last chunk ([`TraceTimer::read`]).
+#[derive(Debug)]
+struct TraceTimer {
+    sets: Vec<TimerSet>,
+    /// A chunk was traced without timestamps, so their sum would not cover the trace.
+    incomplete: bool,
+}
+
+impl TraceTimer {
+    /// A timer for `device` if it has [`wgpu::Features::TIMESTAMP_QUERY`], else `None`.
+    fn for_device(device: &wgpu::Device) -> Option<Self> {
+        device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY)
+            .then(|| Self {
+                sets: Vec::new(),
+                incomplete: false,
+            })
+    }
+
+    /// Creates query sets until `chunks` more pairs of queries are free.
+    fn reserve(&mut self, device: &wgpu::Device, chunks: usize) -> Result<(), GpuError> {
+        let free: u64 = self
+            .sets
+            .iter()
+            .map(|set| u64::from((set.capacity - set.used) / 2))
+            .sum();
+        let mut needed = (chunks as u64).saturating_sub(free);
+        while needed > 0 {
+            let capacity = needed
+                .saturating_mul(2)
+                .min(u64::from(wgpu::QUERY_SET_MAX_QUERIES)) as u32;
+            let query_set = capture(device, "timestamp query set", Caught::Resource, || {
+                device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("gpu-render trace timestamps"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: capacity,
+                })
+            })?;
+            self.sets.push(TimerSet {
+                query_set,
+                capacity,
+                used: 0,
+            });
+            needed -= u64::from(capacity / 2);
+        }
+        Ok(())
+    }
+
+    /// The set and first query of the next free pair, if any.
+    fn free_pair(&self) -> Option<(usize, u32)> {
+        self.sets
+            .iter()
+            .position(|set| set.capacity - set.used >= 2)
+            .map(|index| (index, self.sets[index].used))
+    }
+
+    /// Where the next chunk should write its timestamps (`None` if nothing was
+    /// reserved for it).
+    fn next_slot(&self) -> Option<ChunkTimestamps<'_>> {
+        self.free_pair().map(|(index, begin)| ChunkTimestamps {
+            query_set: &self.sets[index].query_set,
+            begin,
+        })
+    }
+
+    /// Records that a chunk was submitted: with its timestamps (`timed`, from
+    /// [`TraceTimer::next_slot`]) or without, and whether it `traced` any pass (a chunk
+    /// with no pass writes no timestamps and needs none).
+    fn record(&mut self, timed: bool, traced: bool) {
+        if !traced {
+            return;
+        }
+        match self.free_pair() {
+            Some((index, _)) if timed => self.sets[index].used += 2,
+            _ => self.incomplete = true,
+        }
+    }
+
+    /// Resolves and reads every recorded timestamp (one submission and one map, after
+    /// all chunks) and returns the sum over chunks of last-pass end minus first-pass
+    /// start, times the queue's timestamp period. `None` when a chunk went untimed, a
+    /// timestamp went backwards (a counter wrapped) or the period is unusable.
+    fn read(
+        self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        timeout: Duration,
+    ) -> Result<Option<Duration>, GpuError> {
+        if self.incomplete {
+            return Ok(None);
+        }
+        // Nanoseconds per timestamp tick.
+        let period_ns = f64::from(queue.get_timestamp_period());
+        if !(period_ns.is_finite() && period_ns > 0.0) {
+            return Ok(None);
+        }
+        // Each set resolves at an offset aligned as resolve_query_set requires.
+        let mut offsets = Vec::with_capacity(self.sets.len());
+        let mut size = 0;
+        for set in &self.sets {
+            offsets.push(size);
+            size = align_up(
+                size + u64::from(set.used) * u64::from(wgpu::QUERY_SIZE),
+                wgpu::QUERY_RESOLVE_BUFFER_ALIGNMENT,
+            );
+        }
+        if size == 0 {
+            return Ok(Some(Duration::ZERO));
+        }
+        let (resolve, staging) = capture(device, "timestamp buffers", Caught::Resource, || {
+            let resolve = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("gpu-render timestamp resolve"),
+                size,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let staging = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("gpu-render timestamp readback"),
+                size,
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                mapped_at_creation: false,
+            });
+            (resolve, staging)
+        })?;
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("gpu-render timestamp resolve"),
+        });
+        for (set, &offset) in self.sets.iter().zip(&offsets) {
+            if set.used > 0 {
+                encoder.resolve_query_set(&set.query_set, 0..set.used, &resolve, offset);
+            }
+        }
+        encoder.copy_buffer_to_buffer(&resolve, 0, &staging, 0, size);
+        submit_and_wait(device, queue, encoder, "timestamp resolve", timeout)?;
+        let bytes = map_read(device, &staging, size, timeout)?;
+        let tick = |index: u64| -> Option<u64> {
+            let start = usize::try_from(index * u64::from(wgpu::QUERY_SIZE)).ok()?;
+            let raw = bytes.get(start..start + 8)?;
+            Some(u64::from_ne_bytes(raw.try_into().ok()?))
+        };
+        let mut ticks = 0u128;
+        for (set, &offset) in self.sets.iter().zip(&offsets) {
+            let first = offset / u64::from(wgpu::QUERY_SIZE);
+            for pair in 0..u64::from(set.used / 2) {
+                let (Some(begin), Some(end)) = (tick(first + 2 * pair), tick(first + 2 * pair + 1))
+                else {
+                    return Err(GpuError::Readback(
+                        "timestamp readback is shorter than the queries".into(),
+                    ));
+                };
+                let Some(chunk) = end.checked_sub(begin) else {
+                    return Ok(None);
+                };
+                ticks += u128::from(chunk);
+            }
+        }
+        Ok(Duration::try_from_secs_f64(ticks as f64 * period_ns * 1e-9).ok())
     }
 }
 

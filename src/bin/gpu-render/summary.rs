@@ -30,9 +30,13 @@ impl std::fmt::Display for Summary<'_> {
         } else {
             String::new()
         };
+        // The trace time is GPU time where timestamps were taken, else wall time; the
+        // ray rate is per that time, and the line says which it is.
+        let (trace, source) = self.stats.trace_seconds();
+        let (rays_per_second, _) = self.stats.trace_rays_per_second();
         write!(
             f,
-            "rendered {passes}{}x{}, {} spp, max depth {} on {} in {:.2} s: {} rays, {:.1} Mrays/s -> {}",
+            "rendered {passes}{}x{}, {} spp, max depth {} on {} in {:.2} s: {} rays, trace {:.2} s ({source}), {:.1} Mrays/s -> {}",
             s.width,
             s.height,
             s.samples_per_pixel,
@@ -40,7 +44,8 @@ impl std::fmt::Display for Summary<'_> {
             self.backend,
             self.wall.as_secs_f64(),
             format_count(self.stats.rays_traced),
-            self.stats.rays_per_second() / 1e6,
+            trace,
+            rays_per_second / 1e6,
             self.output.display()
         )
     }
@@ -55,11 +60,13 @@ fn format_count(count: u64) -> String {
     }
 }
 
-/// Adds the statistics of two passes.
+/// Adds the statistics of two passes. The GPU time is the sum only when both passes
+/// have one; otherwise it is `None` and the summary falls back to wall time.
 pub fn add_stats(a: RenderStats, b: RenderStats) -> RenderStats {
     RenderStats {
         rays_traced: a.rays_traced + b.rays_traced,
         elapsed: a.elapsed + b.elapsed,
+        gpu_time: a.gpu_time.zip(b.gpu_time).map(|(a, b)| a + b),
     }
 }
 
@@ -94,12 +101,41 @@ mod tests {
             stats: RenderStats {
                 rays_traced: 3_000_000,
                 elapsed: Duration::from_secs(1),
+                gpu_time: None,
             },
             output: Path::new("out.png"),
         };
         assert_eq!(
             summary.to_string(),
-            "rendered 32x24, 4 spp, max depth 5 on GPU (Test) in 1.50 s: 3.00 M rays, 3.0 Mrays/s -> out.png"
+            "rendered 32x24, 4 spp, max depth 5 on GPU (Test) in 1.50 s: 3.00 M rays, trace 1.00 s (wall clock), 3.0 Mrays/s -> out.png"
         );
+        let timed = Summary {
+            stats: RenderStats {
+                gpu_time: Some(Duration::from_millis(750)),
+                ..summary.stats
+            },
+            ..summary
+        };
+        assert_eq!(
+            timed.to_string(),
+            "rendered 32x24, 4 spp, max depth 5 on GPU (Test) in 1.50 s: 3.00 M rays, trace 0.75 s (GPU timestamps), 4.0 Mrays/s -> out.png"
+        );
+    }
+
+    #[test]
+    fn gpu_time_adds_only_when_both_passes_have_it() {
+        let timed = RenderStats {
+            rays_traced: 10,
+            elapsed: Duration::from_secs(2),
+            gpu_time: Some(Duration::from_secs(1)),
+        };
+        let untimed = RenderStats {
+            gpu_time: None,
+            ..timed
+        };
+        let both = add_stats(timed, timed);
+        assert_eq!(both.gpu_time, Some(Duration::from_secs(2)));
+        assert_eq!(both.elapsed, Duration::from_secs(4));
+        assert_eq!(add_stats(timed, untimed).gpu_time, None);
     }
 }

@@ -3,6 +3,7 @@
 use std::time::Duration;
 
 use anyhow::{Context, Result};
+use gpu_render::film::TimingSource;
 use gpu_render::scene::{RenderOverrides, RenderSettings, Scene, load_scene};
 use gpu_render::tradeoff::{
     Knobs, Measurement, default_sweep, mean_flip, pareto_front, plot_png, rmse, to_csv,
@@ -63,8 +64,15 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
         }
     }
 
+    // Every render on this backend is timed the same way: GPU timestamps where the
+    // device has them (as the reference render shows), wall time otherwise.
+    let (_, source) = reference.stats.trace_time();
+    let timing = match source {
+        TimingSource::GpuTimestamps => "GPU timestamps of the trace passes",
+        TimingSource::WallClock => "wall time of the trace pass (no GPU timestamps)",
+    };
     eprintln!(
-        "{} settings at {}x{} on {}; time = wall time of the trace pass (no GPU timestamps), best of {}",
+        "{} settings at {}x{} on {}; time = {timing}, best of {}",
         sweep.len(),
         scene.render.width,
         scene.render.height,
@@ -127,7 +135,8 @@ fn with_knobs(scene: &Scene, knobs: Knobs) -> Result<Scene> {
     })
 }
 
-/// Renders `knobs` `repeats` times, keeps the fastest, and measures its error.
+/// Renders `knobs` `repeats` times, keeps the fastest trace time (GPU timestamps where
+/// measured, else wall time), and measures its error.
 fn measure(
     backend: &Backend,
     scene: &Scene,
@@ -140,7 +149,7 @@ fn measure(
     let mut frame = None;
     for _ in 0..repeats {
         let rendered = backend.render(&scene, &|_, _| {})?;
-        fastest = fastest.min(rendered.stats.elapsed);
+        fastest = fastest.min(rendered.stats.trace_time().0);
         frame = Some(rendered);
     }
     let frame = frame.context("no render was made")?;

@@ -29,7 +29,7 @@ pub const MAX_SCENE_ELEMENTS: usize = 1_000_000;
 /// Reads and validates the scene file at `path`.
 ///
 /// Fails without reading when `path` is a directory or larger than
-/// [`MAX_SCENE_FILE_BYTES`]; an OS error (missing file, no permission) is named.
+/// `MAX_SCENE_FILE_BYTES` (64 MiB); an OS error (missing file, no permission) is named.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
     let text = read_scene_file(path)?;
     parse_scene(&text, path)
