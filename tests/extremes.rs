@@ -299,10 +299,12 @@ fn huge_sphere_floor_matches_a_plane() {
             TOLERANCE,
         );
         report("huge sphere vs plane: GPU", &c);
-        // Reported, and bounded loosely: f32 cannot place a surface of radius 1e6 more
-        // finely than 0.06 units (see docs/numerics.md).
+        // f32 cannot place a surface of radius 1e6 more finely than 0.06 units (see
+        // docs/numerics.md), which moves the ball's contact shadow by a few pixels:
+        // measured 4 of 3072 pixels on lavapipe. Acne or stripes would fail whole
+        // regions of the floor.
         assert!(
-            c.outliers as f64 <= 0.25 * c.pixels as f64,
+            c.outliers as f64 <= 0.01 * c.pixels as f64,
             "huge sphere on the GPU: {} of {} pixels differ from the plane",
             c.outliers,
             c.pixels

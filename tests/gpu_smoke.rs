@@ -304,3 +304,27 @@ fn timestamp_queries_time_the_trace_passes() {
     let gpu_time = stats.gpu_time.expect("render_to_texture reports GPU time");
     assert!(gpu_time > Duration::ZERO && gpu_time <= stats.elapsed + slack);
 }
+
+/// A device that does not finish in time (a hung or lost GPU) is reported as a lost
+/// device with a clear message, not waited on forever. A 1 ns limit stands in for the
+/// hang: no real dispatch finishes that fast.
+#[test]
+fn a_stalled_device_is_an_error_not_a_hang() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let renderer = common::gpu::renderer(&gpu).with_poll_timeout(Duration::from_nanos(1));
+    let started = std::time::Instant::now();
+    match renderer.render(&gpu.device, &gpu.queue, &scene(256), None) {
+        Err(GpuError::DeviceLost(message)) => {
+            assert!(message.contains("did not finish"), "{message}");
+        }
+        Err(other) => panic!("expected a lost-device error, got {other}"),
+        Ok(_) => panic!("a 1 ns limit cannot be met by a 256-sample render"),
+    }
+    assert!(
+        started.elapsed() < Duration::from_secs(60),
+        "the error took {:?}",
+        started.elapsed()
+    );
+}
