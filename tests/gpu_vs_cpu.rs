@@ -12,6 +12,7 @@
 mod common;
 
 use common::compare::{Tolerance, assert_images_match};
+use gpu_render::film::RenderStats;
 use gpu_render::scene::{LightingSpace, RenderOverrides, Scene, load_scene};
 
 const TOLERANCE: Tolerance = Tolerance {
@@ -19,6 +20,15 @@ const TOLERANCE: Tolerance = Tolerance {
     relative: 5e-3,
     outlier_fraction: 0.005,
 };
+
+/// Both backends count the rays they trace; their counts must agree within `fraction`.
+fn assert_ray_counts_agree(label: &str, cpu: &RenderStats, gpu: &RenderStats, fraction: f64) {
+    let (c, g) = (cpu.rays_traced as f64, gpu.rays_traced as f64);
+    assert!(
+        (c - g).abs() <= fraction * c,
+        "{label}: ray counts differ: CPU {c}, GPU {g}"
+    );
+}
 
 fn reduced(scene: Scene, lighting_space: LightingSpace) -> Scene {
     let overrides = RenderOverrides {
@@ -63,16 +73,8 @@ fn gpu_matches_cpu_reference_on_every_shipped_scene() {
                 "{label}: {} of {} pixels outside tolerance, max |Δ| {:.2e}, RMSE {:.2e}",
                 comparison.outliers, comparison.pixels, comparison.max_abs_error, comparison.rmse
             );
-            // Both backends count the rays they trace; edge samples may branch
-            // differently, so allow 1%.
-            let (c, g) = (
-                cpu.stats.rays_traced as f64,
-                gpu_image.stats.rays_traced as f64,
-            );
-            assert!(
-                (c - g).abs() <= 0.01 * c,
-                "{label}: ray counts differ: CPU {c}, GPU {g}"
-            );
+            // Edge samples may branch differently in f32 and f64: allow 1%.
+            assert_ray_counts_agree(&label, &cpu.stats, &gpu_image.stats, 0.01);
         }
     }
 }
@@ -98,14 +100,7 @@ fn ray_weight_cutoff_traces_fewer_rays_alike_on_both_backends() {
         .render(&gpu.device, &gpu.queue, &cut, None)
         .unwrap_or_else(|e| panic!("GPU render failed: {e}"));
     assert_images_match("glass-cutoff", &cpu_cut.image, &gpu_cut.image, TOLERANCE);
-    let (c, g) = (
-        cpu_cut.stats.rays_traced as f64,
-        gpu_cut.stats.rays_traced as f64,
-    );
-    assert!(
-        (c - g).abs() <= 0.01 * c,
-        "ray counts differ: CPU {c}, GPU {g}"
-    );
+    assert_ray_counts_agree("glass-cutoff", &cpu_cut.stats, &gpu_cut.stats, 0.01);
 }
 
 /// Many samples of deep glass paths per pixel: lavapipe ends all loops of an
@@ -133,12 +128,5 @@ fn many_deep_samples_per_pixel_lose_no_rays() {
         .render(&gpu.device, &gpu.queue, &scene, None)
         .unwrap_or_else(|e| panic!("GPU render failed: {e}"));
     assert_images_match("showcase-64spp", &cpu.image, &gpu_image.image, TOLERANCE);
-    let (c, g) = (
-        cpu.stats.rays_traced as f64,
-        gpu_image.stats.rays_traced as f64,
-    );
-    assert!(
-        (c - g).abs() <= 1e-3 * c,
-        "ray counts differ: CPU {c}, GPU {g}"
-    );
+    assert_ray_counts_agree("showcase-64spp", &cpu.stats, &gpu_image.stats, 1e-3);
 }
