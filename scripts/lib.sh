@@ -1,6 +1,7 @@
 # Shared helpers for the scripts in this directory; source it, do not run it.
 #
 #   ensure_lavapipe   install Mesa's software Vulkan driver (lavapipe) if it is missing
+#   ensure_rust_components  rustfmt and clippy (rustup component add) if missing
 #   setup_gpu_env     XDG_RUNTIME_DIR and WGPU_BACKEND defaults for headless wgpu
 #   section TITLE     print a section header
 
@@ -44,6 +45,19 @@ ensure_lavapipe() {
         have_lavapipe || echo "warning: installed, but no lavapipe ICD found" >&2
     else
         echo "warning: could not install lavapipe; GPU tests may find no adapter" >&2
+    fi
+}
+
+# rustfmt and clippy, which a minimal rustup profile leaves out.
+ensure_rust_components() {
+    if ! cargo fmt --version >/dev/null 2>&1 || ! cargo clippy --version >/dev/null 2>&1; then
+        if command -v rustup >/dev/null 2>&1; then
+            echo "installing rustfmt and clippy"
+            rustup component add rustfmt clippy
+        else
+            echo "error: cargo fmt / cargo clippy are missing and rustup is not available" >&2
+            return 1
+        fi
     fi
 }
 

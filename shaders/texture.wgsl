@@ -45,9 +45,12 @@ fn texture_coordinates(material: Material, position: vec3<f32>, normal: vec3<f32
 //#endif
 
 //#if TEXTURES
+// i mod n for an integer-valued i of any size, wrapped in floating point (an integer
+// conversion would saturate at 2^31 far out on an infinite plane); the clamp catches
+// rounding up to n.
 fn wrap_index(i: f32, n: u32) -> u32 {
-    let m = i32(n);
-    return u32(((i32(i) % m) + m) % m);
+    let m = f32(n);
+    return min(u32(i - m * floor(i / m)), n - 1u);
 }
 //#endif
 

@@ -62,7 +62,15 @@ fn grid_angle_degrees(index: u32, size: u32) -> f64 {
 
 /// Checks a square BRDF map (at least 2×2, texel `(x, y)` = `π·f` at
 /// `θi = x/(N-1)·90°`, `θr = y/(N-1)·90°`) against the three rules.
-pub fn check_brdf_map(map: &Image) -> BrdfMapReport {
+///
+/// Errors: a message when the map is not square or smaller than 2×2.
+pub fn check_brdf_map(map: &Image) -> Result<BrdfMapReport, String> {
+    if map.width != map.height || map.width < 2 {
+        return Err(format!(
+            "a BRDF map must be square and at least 2x2 (θi across, θr down), got {}x{}",
+            map.width, map.height
+        ));
+    }
     let n = map.width;
     let mut positivity = Worst {
         value: f64::INFINITY,
@@ -136,9 +144,9 @@ pub fn check_brdf_map(map: &Image) -> BrdfMapReport {
         }
     }
     energy.holds = energy.value <= 1.0 + ENERGY_TOLERANCE;
-    BrdfMapReport {
+    Ok(BrdfMapReport {
         positivity,
         energy,
         reciprocity,
-    }
+    })
 }

@@ -349,3 +349,26 @@ fn directory_is_rejected() {
     };
     assert!(err.to_string().contains("directory"), "{err}");
 }
+
+#[test]
+fn depth_at_the_integer_limit_is_an_error_not_an_overflow() {
+    error(
+        &format!("[render]\nmax_depth = 4294967295\n{CAMERA}"),
+        &["render: max_depth must be at most"],
+    );
+}
+
+#[test]
+fn numbers_outside_32_bit_floats_are_rejected() {
+    // The GPU would see 0 (a division by zero) or infinity where the CPU sees a number.
+    error(
+        &scene("[materials.glass]\ntype = \"dielectric\"\nior = 1e-300\n"),
+        &["materials.glass", "ior", "too small for 32-bit floats"],
+    );
+    error(
+        &scene(
+            "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1e39\nmaterial = \"grey\"\n",
+        ),
+        &["objects[0]", "radius", "too large for 32-bit floats"],
+    );
+}

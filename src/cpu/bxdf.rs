@@ -408,7 +408,8 @@ impl Complex {
         if self.re >= 0.0 {
             Self::new(t1, t2)
         } else {
-            Self::new(t2.abs(), t1.copysign(self.im))
+            // sign(im) with sign(-0) = +1, as the WGSL twin's `select` computes it.
+            Self::new(t2.abs(), if self.im >= 0.0 { t1 } else { -t1 })
         }
     }
 }

@@ -57,7 +57,12 @@ pub fn sample_texture(image: &Image, u: f64, v: f64) -> DVec3 {
     let y = v * h - 0.5;
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = (x - x0, y - y0);
-    let wrap = |i: f64, n: u32| -> u32 { (i as i64).rem_euclid(i64::from(n)) as u32 };
+    // i mod n in floating point, as the WGSL twin `wrap_index` computes it (an integer
+    // conversion would saturate for huge coordinates); the clamp catches rounding up.
+    let wrap = |i: f64, n: u32| -> u32 {
+        let m = f64::from(n);
+        ((i - m * (i / m).floor()) as u32).min(n - 1)
+    };
     let (xa, xb) = (wrap(x0, image.width), wrap(x0 + 1.0, image.width));
     let (ya, yb) = (wrap(y0, image.height), wrap(y0 + 1.0, image.height));
     bilinear(image, [xa, xb], [ya, yb], fx, fy)

@@ -97,7 +97,8 @@ impl Default for RenderSettings {
 impl RenderSettings {
     /// The stack size that guarantees no branch is ever dropped for `max_depth`.
     pub fn sufficient_stack_size(max_depth: u32) -> u32 {
-        max_depth + 1
+        // Saturating: an absurd depth is reported by `check`, not by an overflow panic.
+        max_depth.saturating_add(1)
     }
 }
 

@@ -206,12 +206,18 @@ impl RenderArgs {
     /// The flag that sets the render setting a range-check message is about, with the
     /// value given, if the user gave that flag (`"--width 0"`).
     pub fn flag_for_setting_message(&self, message: &str) -> Option<String> {
+        let text = |value: Option<u32>| value.map(|v| v.to_string());
         let flags = [
-            ("width", "--width", self.width),
-            ("height", "--height", self.height),
-            ("samples_per_pixel", "--spp", self.spp),
-            ("max_depth", "--max-depth", self.max_depth),
-            ("stack_size", "--stack-size", self.stack_size),
+            ("width", "--width", text(self.width)),
+            ("height", "--height", text(self.height)),
+            ("samples_per_pixel", "--spp", text(self.spp)),
+            ("max_depth", "--max-depth", text(self.max_depth)),
+            ("stack_size", "--stack-size", text(self.stack_size)),
+            (
+                "min_ray_weight",
+                "--min-ray-weight",
+                self.min_ray_weight.map(|w| w.to_string()),
+            ),
         ];
         flags.into_iter().find_map(|(setting, flag, value)| {
             let about_it = message

@@ -103,12 +103,24 @@ impl Item<'_> {
         }
     }
 
-    /// A finite number.
+    /// A finite number that the GPU's 32-bit floats represent as a normal number (or
+    /// 0): the CPU reference works in f64, and a value that became 0 or infinity on
+    /// upload would make the two backends disagree silently.
     pub fn number(&self, field: &str, value: f64) -> Result<f64, SceneError> {
-        match non_finite(value) {
-            Some(what) => Err(self.fail(format_args!("{field} is {what}"))),
-            None => Ok(value),
+        if let Some(what) = non_finite(value) {
+            return Err(self.fail(format_args!("{field} is {what}")));
         }
+        if value.abs() > f64::from(f32::MAX) {
+            return Err(self.fail(format_args!(
+                "{field} = {value:e} is too large for 32-bit floats (|x| <= 3.4e38)"
+            )));
+        }
+        if value != 0.0 && value.abs() < f64::from(f32::MIN_POSITIVE) {
+            return Err(self.fail(format_args!(
+                "{field} = {value:e} is too small for 32-bit floats (0, or |x| >= 1.2e-38)"
+            )));
+        }
+        Ok(value)
     }
 
     /// A finite number >= 0.
