@@ -118,3 +118,14 @@ fn a_brdf_map_must_be_square() {
         "{error}"
     );
 }
+
+#[test]
+fn materials_naming_one_file_share_one_image() {
+    let text = "[camera]\neye = [0, 1, 5]\nlook_at = [0, 0, 0]\n\
+        [materials.a]\ntype = \"lambert\"\nalbedo_texture = \"textures/checker.png\"\n\
+        [materials.b]\ntype = \"oren_nayar\"\nsigma_degrees = 20\nalbedo_texture = \"textures/checker.png\"\n";
+    let scene_path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/shared-texture.toml");
+    let scene = parse_scene(text, &scene_path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.images.len(), 1);
+    assert!(scene.materials.iter().all(|m| m.albedo_texture == Some(0)));
+}

@@ -88,12 +88,35 @@ pub const CONDUCTOR_PRESETS: &[(&str, [f64; 3], [f64; 3])] = &[
     ),
 ];
 
+/// Most distinct image files one scene may load: each may be 2048x2048 RGBA `f32`
+/// (64 MiB), and the GPU holds them all as layers of one texture array.
+pub const MAX_SCENE_IMAGES: usize = 16;
+
 /// The images a scene's materials load, and where relative paths start.
 pub struct ImageTable<'a> {
     /// The directory of the scene file.
     pub base: &'a Path,
     /// Images loaded so far, indexed by `Material::albedo_texture` / `brdf_map`.
     pub images: Vec<Image>,
+}
+
+impl ImageTable<'_> {
+    /// The index of `file` (relative to the scene file) in the table, loading it on
+    /// first use: materials naming the same file share one image.
+    fn index_of(&mut self, item: &Item<'_>, field: &str, file: &str) -> Result<u32, SceneError> {
+        let path = self.base.join(file);
+        if let Some(index) = self.images.iter().position(|image| image.path == path) {
+            return Ok(index as u32);
+        }
+        if self.images.len() >= MAX_SCENE_IMAGES {
+            return Err(item.fail(format_args!(
+                "{field} `{file}`: a scene may use at most {MAX_SCENE_IMAGES} different image files"
+            )));
+        }
+        let image = load(item, field, file, self.base)?;
+        self.images.push(image);
+        Ok(self.images.len() as u32 - 1)
+    }
 }
 
 /// One material, checked and turned into the flat model record.
@@ -326,7 +349,8 @@ fn tabulated(
     images: &mut ImageTable<'_>,
 ) -> Result<Material, SceneError> {
     let file = item.require("brdf_map", raw.brdf_map.as_deref())?;
-    let image = load(item, "brdf_map", file, images.base)?;
+    let index = images.index_of(item, "brdf_map", file)?;
+    let image = &images.images[index as usize];
     if image.width != image.height || image.width < 2 {
         return Err(item.fail(format_args!(
             "brdf_map `{file}` ({}): the map must be square and at least 2x2 (θi across, \
@@ -336,8 +360,6 @@ fn tabulated(
             image.height
         )));
     }
-    let index = images.images.len() as u32;
-    images.images.push(image);
     Ok(Material {
         brdf_map: Some(index),
         emission: emission(item, raw)?,
@@ -381,9 +403,7 @@ fn texture(
         }
         material.texture_scale = scale;
     }
-    let image = load(item, "albedo_texture", file, images.base)?;
-    material.albedo_texture = Some(images.images.len() as u32);
-    images.images.push(image);
+    material.albedo_texture = Some(images.index_of(item, "albedo_texture", file)?);
     Ok(material)
 }
 
