@@ -304,3 +304,23 @@ fn regression_corpus_parses_and_renders() {
     }
     assert!(replayed > 0, "the corpus in {} is empty", dir.display());
 }
+
+/// The unmutated scenes the fuzzers start from parse and render through the same
+/// check, so that the render half of `check_scene_text` is exercised, not vacuous.
+#[test]
+fn seed_scenes_parse_and_render_through_the_check() {
+    let mut rendered = 0;
+    for text in shipped_scenes() {
+        // Scenes with image files cannot resolve them from `<fuzz>`; the rest must parse.
+        if text.contains("albedo_texture") || text.contains("brdf_map") {
+            continue;
+        }
+        assert!(
+            gpu_render::scene::parse_scene(&text, Path::new("<fuzz>")).is_ok(),
+            "a seed scene does not parse:\n{text}"
+        );
+        check_scene_text(&text);
+        rendered += 1;
+    }
+    assert!(rendered >= 3, "only {rendered} seed scenes rendered");
+}
