@@ -178,7 +178,9 @@ fn shade_hit(ray: Ray, hit: Hit, medium: MediumStack) -> ShadedHit {
 // finite_radiance is dropped: no NaN or infinity reaches the image.
 fn trace_radiance(primary: Ray) -> vec3<f32> {
     var stack: array<StackEntry, STACK_SIZE>;
-    stack[0] = StackEntry(primary, vec3<f32>(1.0), 0u, MediumStack(vec4<f32>(1.0), 0u));
+    // Camera rays start inside the dielectrics around the camera (camera_medium).
+    stack[0] = StackEntry(primary, vec3<f32>(1.0), 0u,
+                          MediumStack(frame.camera_medium_iors, frame.camera_medium_depth));
     var stack_length = 1u;
     var radiance = vec3<f32>(0.0);
     let infinity = bitcast<f32>(0x7f800000u);

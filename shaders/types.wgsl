@@ -30,7 +30,8 @@ struct FrameUniforms {
     min_ray_weight: f32,
     sample_index: u32,
     accumulation_rows: u32,
-    _pad0: u32,
+    camera_medium_depth: u32,
+    camera_medium_iors: vec4<f32>,
 }
 
 struct Sphere {

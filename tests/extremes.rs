@@ -947,3 +947,62 @@ fn progress_follows_the_row_chunks() {
         .expect("render");
     assert_eq!(calls.into_inner().unwrap(), expected);
 }
+
+/// A camera at the centre of a glass sphere (1.5) inside a water sphere (1.33): camera
+/// rays start inside both (`Scene::camera_medium`), so a radial ray crosses glass→water
+/// then water→air at normal incidence. With depth 2 the reflected branches end on a
+/// dielectric and add nothing, so every pixel is exactly the background times
+/// `(1 − R(1.5→1.33))·(1 − R(1.33→1))`, `R = ((n₁−n₂)/(n₁+n₂))²`. A camera assumed to
+/// be in air would see `1 − R(1.5→1)` at the inner interface instead (0.9407 vs 0.9765).
+#[test]
+fn camera_inside_nested_dielectrics_starts_in_the_innermost() {
+    let scene = Scene {
+        render: settings(16, 12, 2),
+        camera: Camera {
+            eye: DVec3::ZERO,
+            look_at: DVec3::new(0.2, -0.1, -1.0),
+            up: DVec3::Y,
+            fov_y_degrees: 60.0,
+        },
+        environment: Environment {
+            background: DVec3::ONE,
+            ambient: DVec3::ZERO,
+        },
+        materials: vec![dielectric(1.5), dielectric(1.33)],
+        images: Vec::new(),
+        material_names: vec!["glass".into(), "water".into()],
+        lights: Vec::new(),
+        shapes: vec![
+            Shape::Sphere {
+                center: DVec3::ZERO,
+                radius: 1.0,
+                material: 0,
+            },
+            Shape::Sphere {
+                center: DVec3::ZERO,
+                radius: 2.0,
+                material: 1,
+            },
+        ],
+    };
+    assert_eq!(scene.camera_medium(), vec![1.33, 1.5]);
+    let reflectance = |a: f64, b: f64| ((a - b) / (a + b)).powi(2);
+    let expected = ((1.0 - reflectance(1.5, 1.33)) * (1.0 - reflectance(1.33, 1.0))) as f32;
+    let check = |label: &str, image: &LinearImage, tolerance: f32| {
+        for p in &image.pixels {
+            assert!(
+                (p[0] - expected).abs() <= tolerance,
+                "{label}: {} instead of {expected}",
+                p[0]
+            );
+        }
+    };
+    check("nested (CPU)", &cpu_render("nested", &scene), 1e-6);
+    if let Some(g) = gpu() {
+        check(
+            "nested (GPU)",
+            &gpu_render_image("nested", &g, &scene),
+            1e-4,
+        );
+    }
+}

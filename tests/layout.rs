@@ -52,6 +52,8 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 min_ray_weight,
                 sample_index,
                 accumulation_rows,
+                camera_medium_depth,
+                camera_medium_iors,
             }),
         ),
         (

@@ -33,6 +33,8 @@ pub struct PreparedScene {
     pub shapes: Vec<PreparedShape>,
     /// Length scale of the self-intersection offset ([`ray_offset_scale`]).
     pub offset_scale: f64,
+    /// The dielectrics around the camera ([`Scene::camera_medium`]).
+    pub camera_medium: MediumStack,
     /// Albedo textures and BRDF maps.
     pub images: Vec<Image>,
 }
@@ -50,6 +52,7 @@ impl PreparedScene {
             lights: scene.lights.clone(),
             shapes: prepare_shapes(&scene),
             offset_scale: ray_offset_scale(&scene),
+            camera_medium: MediumStack::from_outermost_first(&scene.camera_medium()),
             images: scene.images,
         }
     }
@@ -94,6 +97,13 @@ impl MediumStack {
         iors: [1.0; MEDIUM_STACK_SIZE],
         depth: 0,
     };
+
+    /// The stack of a ray inside the dielectrics of indices `iors`, outermost first.
+    pub fn from_outermost_first(iors: &[f64]) -> Self {
+        iors.iter().fold(Self::AIR, |stack, &ior| {
+            stack.medium_after_refraction(true, ior)
+        })
+    }
 
     /// The index of refraction `level` dielectrics deep (0 = air, index 1).
     pub fn medium_ior_at(&self, level: u32) -> f64 {
@@ -208,7 +218,7 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
         ray: primary,
         weight: DVec3::ONE,
         depth: 0,
-        medium: MediumStack::AIR,
+        medium: scene.camera_medium,
     });
     let mut radiance = DVec3::ZERO;
     let mut rays = 0u64;

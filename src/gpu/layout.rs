@@ -66,8 +66,10 @@ pub struct FrameUniforms {
     pub sample_index: u32,
     /// Pixel rows the accumulation buffer holds (the dispatch's rows fit in it).
     pub accumulation_rows: u32,
-    /// Padding.
-    pub _pad0: u32,
+    /// How many dielectrics contain the camera (`Scene::camera_medium`).
+    pub camera_medium_depth: u32,
+    /// Their indices of refraction, outermost first (unused entries 1).
+    pub camera_medium_iors: [f32; 4],
 }
 
 /// A sphere (`Sphere` in WGSL).

@@ -13,6 +13,7 @@ use super::layout::{
     MATERIAL_PBR, MATERIAL_TABULATED, NO_IMAGE,
 };
 use crate::camera::CameraFrame;
+use crate::cpu::trace::MediumStack;
 use crate::scene::{
     FresnelModel, Image, Light, Material, MaterialKind, MicrofacetDistribution, PolygonPlane,
     Scene, Shape, TextureMapping, polygon_plane,
@@ -253,6 +254,8 @@ pub fn frame_uniforms(scene: &Scene, records: &SceneRecords) -> FrameUniforms {
     let settings = &scene.render;
     let camera = CameraFrame::new(&scene.camera, settings.width, settings.height);
     let count = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+    // The same stack the CPU reference starts its camera rays with.
+    let camera_medium = MediumStack::from_outermost_first(&scene.camera_medium());
     FrameUniforms {
         eye: vec3(camera.eye),
         tan_half_fov_y: camera.tan_half_fov_y as f32,
@@ -281,7 +284,8 @@ pub fn frame_uniforms(scene: &Scene, records: &SceneRecords) -> FrameUniforms {
         min_ray_weight: settings.min_ray_weight as f32,
         sample_index: 0,
         accumulation_rows: 0,
-        _pad0: 0,
+        camera_medium_depth: camera_medium.depth,
+        camera_medium_iors: camera_medium.iors.map(|ior| ior as f32),
     }
 }
 

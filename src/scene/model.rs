@@ -489,6 +489,30 @@ impl Scene {
         scene
     }
 
+    /// The indices of refraction of the dielectric spheres that contain the camera,
+    /// outermost (largest) first: the medium the camera rays start in. Other closed
+    /// dielectric shapes (polygon or triangle meshes) around the camera are not
+    /// detected; rays then start in air.
+    pub fn camera_medium(&self) -> Vec<f64> {
+        let mut around: Vec<(f64, f64)> = self
+            .shapes
+            .iter()
+            .filter_map(|shape| match shape {
+                Shape::Sphere {
+                    center,
+                    radius,
+                    material,
+                } if self.camera.eye.distance(*center) < *radius => {
+                    let material = self.materials.get(*material as usize)?;
+                    (material.kind == MaterialKind::Dielectric).then_some((*radius, material.ior))
+                }
+                _ => None,
+            })
+            .collect();
+        around.sort_by(|a, b| b.0.total_cmp(&a.0));
+        around.into_iter().map(|(_, ior)| ior).collect()
+    }
+
     /// Whether the display pass applies the sRGB curve (false in naive gamma mode,
     /// whose values are already "display" values).
     pub fn display_encodes_srgb(&self) -> bool {
