@@ -10,8 +10,11 @@
 //! - [`cpu`]: the reference tracer (f64).
 //! - [`gpu`]: the wgpu backend, built from the caller's `Device` and `Queue`.
 //! - [`output`]: writing PNG, EXR and HDR files atomically.
+//! - [`plausibility`]: the lecture's three rules checked on a tabulated BRDF map.
 //! - [`quality`]: the named presets chosen from the measured front.
 //! - [`tradeoff`]: measuring time against error for the speed/accuracy knobs.
+
+#![warn(missing_docs)]
 
 pub mod camera;
 pub mod color;
