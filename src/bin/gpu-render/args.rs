@@ -16,6 +16,9 @@ Examples:
   gpu-render scenes/showcase.toml -o showcase.png
   gpu-render scene.toml -o scene.exr --spp 64 --max-depth 8
   gpu-render scene.toml -o gamma.png --compare-gamma --backend cpu
+  gpu-render scene.toml -o draft.png --quality draft
+  gpu-render tradeoff scenes/showcase.toml --out-dir tradeoff
+  gpu-render brdf-check scenes/brdf/plausible.png
   gpu-render --adapter list";
 
 /// Renders a scene file with the GPU ray tracer (or its CPU reference).
@@ -27,7 +30,7 @@ Examples:
     long_about = "Renders a TOML scene file with a Whitted-style, physically based ray \
                   tracer that runs in WGSL compute shaders through wgpu, or with the CPU \
                   reference tracer.",
-    override_usage = "gpu-render [OPTIONS] SCENE --output <PATH>\n       gpu-render --adapter list",
+    override_usage = "gpu-render [OPTIONS] SCENE --output <PATH>\n       gpu-render tradeoff SCENE [OPTIONS]\n       gpu-render brdf-check FILE\n       gpu-render --adapter list",
     after_help = AFTER_HELP,
     args_conflicts_with_subcommands = true,
     subcommand_negates_reqs = true
