@@ -75,48 +75,44 @@ impl ShaderFeatures {
 
     /// Whether the feature called `name` in the WGSL directives is on.
     fn named(&self, name: &str) -> Option<bool> {
-        Some(match name {
-            "SPHERES" => self.spheres,
-            "PLANES" => self.planes,
-            "POLYGONS" => self.polygons,
-            "TRIANGLES" => self.triangles,
-            "REFRACTION" => self.refraction,
-            "BLINN_PHONG" => self.blinn_phong,
-            "COOK_TORRANCE" => self.cook_torrance,
-            "OREN_NAYAR" => self.oren_nayar,
-            "TABULATED" => self.tabulated,
-            "PBR" => self.pbr,
-            "TEXTURES" => self.textures,
-            _ => return None,
-        })
+        FEATURE_NAMES
+            .iter()
+            .find(|(known, _)| *known == name)
+            .map(|(_, is_on)| is_on(self))
     }
 
     /// A short label for pipeline names, listing the features that are on.
     pub fn label(&self) -> String {
-        let names = [
-            "SPHERES",
-            "PLANES",
-            "POLYGONS",
-            "TRIANGLES",
-            "REFRACTION",
-            "BLINN_PHONG",
-            "COOK_TORRANCE",
-            "OREN_NAYAR",
-            "TABULATED",
-            "PBR",
-            "TEXTURES",
-        ];
-        let on: Vec<&str> = names
-            .into_iter()
-            .filter(|name| self.named(name) == Some(true))
+        let on: Vec<String> = FEATURE_NAMES
+            .iter()
+            .filter(|(_, is_on)| is_on(self))
+            .map(|(name, _)| name.to_lowercase())
             .collect();
         if on.is_empty() {
             "none".into()
         } else {
-            on.join("+").to_lowercase()
+            on.join("+")
         }
     }
 }
+
+/// Reads one flag of a feature set.
+type FeatureFlag = fn(&ShaderFeatures) -> bool;
+
+/// The name of each feature in the WGSL directives, with the flag it reads.
+const FEATURE_NAMES: [(&str, FeatureFlag); 11] = [
+    ("SPHERES", |f| f.spheres),
+    ("PLANES", |f| f.planes),
+    ("POLYGONS", |f| f.polygons),
+    ("TRIANGLES", |f| f.triangles),
+    ("REFRACTION", |f| f.refraction),
+    ("BLINN_PHONG", |f| f.blinn_phong),
+    ("COOK_TORRANCE", |f| f.cook_torrance),
+    ("OREN_NAYAR", |f| f.oren_nayar),
+    ("TABULATED", |f| f.tabulated),
+    ("PBR", |f| f.pbr),
+    ("TEXTURES", |f| f.textures),
+];
 
 /// Keeps the lines of `source` whose enclosing `//#if` directives hold for `features`
 /// and removes the directive lines. An unknown feature name or unbalanced directives
