@@ -114,9 +114,15 @@ fn render_chunks_reads_back_and_counts_rays() {
     );
 }
 
-fn linear_target(device: &wgpu::Device) -> wgpu::Texture {
+/// An image-sized 2D texture of `format` and `usage`.
+fn image_texture(
+    device: &wgpu::Device,
+    label: &str,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
     device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("smoke linear"),
+        label: Some(label),
         size: wgpu::Extent3d {
             width: WIDTH,
             height: HEIGHT,
@@ -125,10 +131,19 @@ fn linear_target(device: &wgpu::Device) -> wgpu::Texture {
         mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba32Float,
-        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        format,
+        usage,
         view_formats: &[],
     })
+}
+
+fn linear_target(device: &wgpu::Device) -> wgpu::Texture {
+    image_texture(
+        device,
+        "smoke linear",
+        wgpu::TextureFormat::Rgba32Float,
+        wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+    )
 }
 
 #[test]
@@ -223,20 +238,12 @@ fn bad_input_is_an_error_not_a_panic() {
         renderer.encode_trace(device, &mut encoder, &prepared, &view, 0..HEIGHT + 1),
         Err(GpuError::Validation(_))
     ));
-    let wrong_format = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("wrong format"),
-        size: wgpu::Extent3d {
-            width: WIDTH,
-            height: HEIGHT,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba8Unorm,
-        usage: wgpu::TextureUsages::STORAGE_BINDING,
-        view_formats: &[],
-    });
+    let wrong_format = image_texture(
+        device,
+        "wrong format",
+        wgpu::TextureFormat::Rgba8Unorm,
+        wgpu::TextureUsages::STORAGE_BINDING,
+    );
     let result = renderer.encode_trace(
         device,
         &mut encoder,
