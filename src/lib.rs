@@ -5,6 +5,7 @@
 //! model and serves as the test oracle.
 //!
 //! - [`scene`]: the scene model and the TOML scene-file format.
+//! - [`accel`]: the primitives both tracers intersect and the BVH over them.
 //! - [`camera`], [`color`], [`film`]: the pinhole camera and sample pattern, the sRGB
 //!   curve, and the image a render produces.
 //! - [`cpu`]: the reference tracer (f64).
@@ -16,6 +17,7 @@
 
 #![warn(missing_docs)]
 
+pub mod accel;
 pub mod camera;
 pub mod color;
 pub mod cpu;

@@ -1,9 +1,13 @@
 //! Ray/primitive intersection, the CPU twin of `shaders/intersect.wgsl` (same function
-//! names, `f64`).
+//! names, `f64`): the primitive tests, the hit record of a primitive, and the
+//! self-intersection offset. The scene-level queries (`intersect_scene`, `occluded`)
+//! traverse the BVH in [`super::traverse`].
 
 use glam::DVec3;
 
-use crate::scene::{PolygonPlane, Scene, Shape, polygon_plane};
+use crate::accel::{PrimKind, PrimRef, SceneGeometry};
+use crate::scene::PolygonPlane;
+pub use crate::scene::project_to_plane;
 
 /// A ray `origin + t · direction`, `direction` of unit length.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -32,137 +36,84 @@ pub struct Hit {
     pub normal: DVec3,
     /// Material index.
     pub material: u32,
-    /// The hit point, re-projected onto the surface (see [`PreparedShape::surface_point`]).
+    /// The hit point, re-projected onto the surface (see [`hit_record`]).
     pub position: DVec3,
+    /// The primitive that was hit.
+    pub prim: PrimRef,
 }
 
-/// A shape with the per-shape constants the intersection routines need.
-#[derive(Debug, Clone, PartialEq)]
-pub enum PreparedShape {
-    /// A sphere.
-    Sphere {
-        /// Centre.
-        center: DVec3,
-        /// Radius.
-        radius: f64,
-        /// Material index.
-        material: u32,
-    },
-    /// An infinite plane.
-    Plane {
-        /// Unit normal.
-        normal: DVec3,
-        /// Offset along the normal.
-        offset: f64,
-        /// Material index.
-        material: u32,
-    },
-    /// A planar polygon.
-    Polygon {
-        /// Its plane and projection axis.
-        plane: PolygonPlane,
-        /// Its vertices.
-        vertices: Vec<DVec3>,
-        /// Material index.
-        material: u32,
-    },
-    /// A triangle.
-    Triangle {
-        /// Corners.
-        vertices: [DVec3; 3],
-        /// Material index.
-        material: u32,
-    },
+/// The ray parameter of `prim`'s nearest hit along `ray` in (0, `t_max`).
+pub fn intersect_prim(
+    geometry: &SceneGeometry,
+    prim: PrimRef,
+    ray: &Ray,
+    t_max: f64,
+) -> Option<f64> {
+    let i = prim.index();
+    match prim.kind() {
+        PrimKind::Sphere => {
+            let s = &geometry.spheres[i];
+            intersect_sphere(ray, s.center, s.radius, t_max)
+        }
+        PrimKind::Polygon => {
+            let p = &geometry.polygons[i];
+            intersect_polygon(ray, &p.plane, &p.vertices, t_max)
+        }
+        PrimKind::Triangle => intersect_triangle(ray, &geometry.triangles[i].vertices, t_max),
+        PrimKind::Plane => {
+            let p = &geometry.planes[i];
+            intersect_plane(ray, p.normal, p.offset, t_max)
+        }
+    }
 }
 
-impl PreparedShape {
-    /// Precomputes a validated shape. Degenerate polygons (rejected by the scene
-    /// loader) get a zero normal and are never hit.
-    pub fn new(shape: &Shape) -> Self {
-        match shape {
-            Shape::Sphere {
-                center,
-                radius,
-                material,
-            } => Self::Sphere {
-                center: *center,
-                radius: *radius,
-                material: *material,
-            },
-            Shape::Plane {
+/// The hit record of `prim` at parameter `t` along `ray`: its unit geometric normal as
+/// the shape defines it (outward for spheres, the plane normal, the winding normal of
+/// polygons and triangles), its material, and the hit point moved back onto the
+/// surface, as Wächter and Binder recommend before offsetting a new ray origin ("A
+/// Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing Gems, ch. 6,
+/// §6.2.1): `ray.at(t)` is off the surface by the rounding error of `t` times the ray
+/// length, which grows with the distance from the ray origin, while the re-projected
+/// point's error is relative to its own magnitude, which is what the ulp-scaled offset
+/// assumes. A sphere point becomes `c + r·normalize(p - c)`; a point of a plane,
+/// polygon or triangle is projected orthogonally onto its plane, `p - (N·p - d)·N`.
+pub fn hit_record(geometry: &SceneGeometry, prim: PrimRef, ray: &Ray, t: f64) -> Hit {
+    let point = ray.at(t);
+    let i = prim.index();
+    let (normal, position) = match prim.kind() {
+        PrimKind::Sphere => {
+            let s = &geometry.spheres[i];
+            (
+                (point - s.center).normalize(),
+                project_onto_sphere(point, s.center, s.radius),
+            )
+        }
+        PrimKind::Polygon => {
+            let plane = &geometry.polygons[i].plane;
+            (
+                plane.normal,
+                project_onto_plane(point, plane.normal, plane.offset),
+            )
+        }
+        PrimKind::Triangle => {
+            let vertices = &geometry.triangles[i].vertices;
+            let normal = triangle_normal(vertices);
+            (
                 normal,
-                offset,
-                material,
-            } => Self::Plane {
-                normal: *normal,
-                offset: *offset,
-                material: *material,
-            },
-            Shape::Polygon { vertices, material } => Self::Polygon {
-                plane: polygon_plane(vertices).unwrap_or(PolygonPlane {
-                    normal: DVec3::ZERO,
-                    offset: 0.0,
-                    dropped_axis: 2,
-                }),
-                vertices: vertices.clone(),
-                material: *material,
-            },
-            Shape::Triangle { vertices, material } => Self::Triangle {
-                vertices: *vertices,
-                material: *material,
-            },
+                project_onto_plane(point, normal, normal.dot(vertices[0])),
+            )
         }
-    }
-
-    /// The ray parameter of the nearest hit in (0, `t_max`) and the unit geometric
-    /// normal there.
-    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<(f64, DVec3)> {
-        match self {
-            Self::Sphere { center, radius, .. } => {
-                let t = intersect_sphere(ray, *center, *radius, t_max)?;
-                Some((t, (ray.at(t) - *center).normalize()))
-            }
-            Self::Plane { normal, offset, .. } => {
-                intersect_plane(ray, *normal, *offset, t_max).map(|t| (t, *normal))
-            }
-            Self::Polygon {
-                plane, vertices, ..
-            } => intersect_polygon(ray, plane, vertices, t_max).map(|t| (t, plane.normal)),
-            Self::Triangle { vertices, .. } => {
-                let t = intersect_triangle(ray, vertices, t_max)?;
-                Some((t, triangle_normal(vertices)))
-            }
+        PrimKind::Plane => {
+            let p = &geometry.planes[i];
+            (p.normal, project_onto_plane(point, p.normal, p.offset))
         }
-    }
-
-    /// The hit point `ray.at(t)` moved back onto the surface, as Wächter and Binder
-    /// recommend before offsetting a new ray origin ("A Fast and Robust Method for
-    /// Avoiding Self-Intersection", Ray Tracing Gems, ch. 6, §6.2.1): `ray.at(t)` is off
-    /// the surface by the rounding error of `t` times the ray length, which grows with
-    /// the distance from the ray origin, while the re-projected point's error is relative
-    /// to its own magnitude, which is what the ulp-scaled offset assumes. A sphere point
-    /// becomes `c + r·normalize(p - c)`; a point of a plane, polygon or triangle is
-    /// projected orthogonally onto its plane, `p - (N·p - d)·N`.
-    pub fn surface_point(&self, point: DVec3) -> DVec3 {
-        match self {
-            Self::Sphere { center, radius, .. } => project_onto_sphere(point, *center, *radius),
-            Self::Plane { normal, offset, .. } => project_onto_plane(point, *normal, *offset),
-            Self::Polygon { plane, .. } => project_onto_plane(point, plane.normal, plane.offset),
-            Self::Triangle { vertices, .. } => {
-                let normal = triangle_normal(vertices);
-                project_onto_plane(point, normal, normal.dot(vertices[0]))
-            }
-        }
-    }
-
-    /// The material index.
-    pub fn material(&self) -> u32 {
-        match self {
-            Self::Sphere { material, .. }
-            | Self::Plane { material, .. }
-            | Self::Polygon { material, .. }
-            | Self::Triangle { material, .. } => *material,
-        }
+    };
+    Hit {
+        t,
+        normal,
+        material: geometry.material(prim),
+        position,
+        prim,
     }
 }
 
@@ -251,15 +202,6 @@ pub fn intersect_polygon(
     point_in_polygon(point, vertices, plane.dropped_axis).then_some(t)
 }
 
-/// The two coordinates that remain when `dropped_axis` is removed.
-pub fn project_to_plane(point: DVec3, dropped_axis: u32) -> (f64, f64) {
-    match dropped_axis {
-        0 => (point.y, point.z),
-        1 => (point.z, point.x),
-        _ => (point.x, point.y),
-    }
-}
-
 /// Even-odd (crossing number) inside test in the projection that drops `dropped_axis`
 /// (Haines, "Point in Polygon Strategies", Graphics Gems IV): counts the polygon edges
 /// crossed by a ray from the point along +u. Works for convex and concave polygons.
@@ -340,68 +282,13 @@ pub fn intersect_triangle(ray: &Ray, vertices: &[DVec3; 3], t_max: f64) -> Optio
     (t > 0.0 && t < t_max).then_some(t)
 }
 
-/// The nearest hit along `ray` in (0, `t_max`) over all shapes, its point re-projected
-/// onto the shape ([`PreparedShape::surface_point`]).
-pub fn intersect_scene(shapes: &[PreparedShape], ray: &Ray, t_max: f64) -> Option<Hit> {
-    let mut nearest: Option<(f64, DVec3, &PreparedShape)> = None;
-    let mut limit = t_max;
-    for shape in shapes {
-        if let Some((t, normal)) = shape.intersect(ray, limit) {
-            limit = t;
-            nearest = Some((t, normal, shape));
-        }
-    }
-    nearest.map(|(t, normal, shape)| Hit {
-        t,
-        normal,
-        material: shape.material(),
-        position: shape.surface_point(ray.at(t)),
-    })
-}
-
-/// Whether anything lies along `ray` in (0, `t_max`): the shadow-ray query.
-pub fn occluded(shapes: &[PreparedShape], ray: &Ray, t_max: f64) -> bool {
-    shapes
-        .iter()
-        .any(|shape| shape.intersect(ray, t_max).is_some())
-}
-
-/// The length scale of [`offset_ray_origin`]'s near-origin branch for `scene`:
-/// the largest absolute coordinate of its geometry (sphere centres ± radii, plane
-/// offsets, vertices), capped at 1.
-///
-/// Wächter and Binder's constants (`1/32` for "near the origin", `1/65536` for the
-/// absolute offset there) assume a scene of about unit size. In a scene 10^-4 across
-/// that absolute offset would be 15% of the scene, so both constants are multiplied by
-/// this scale, which makes the offset, like every other length, scale with the scene.
-/// Larger scenes keep the published constants (scale 1): there the ulp branch covers
-/// every coordinate beyond 1/32, and a larger near-origin offset would lift rays off a
-/// small object lying near the origin of a large world.
-pub fn ray_offset_scale(scene: &Scene) -> f64 {
-    let mut extent = 0.0f64;
-    let mut include = |v: DVec3| extent = extent.max(v.abs().max_element());
-    for shape in &scene.shapes {
-        match shape {
-            Shape::Sphere { center, radius, .. } => include(center.abs() + DVec3::splat(*radius)),
-            Shape::Plane { offset, .. } => include(DVec3::splat(*offset)),
-            Shape::Polygon { vertices, .. } => vertices.iter().copied().for_each(&mut include),
-            Shape::Triangle { vertices, .. } => vertices.iter().copied().for_each(&mut include),
-        }
-    }
-    if extent > 0.0 && extent < 1.0 {
-        extent
-    } else {
-        1.0
-    }
-}
-
 /// Moves a ray origin off a surface so the new ray does not hit that surface again:
 /// the method of Wächter and Binder, "A Fast and Robust Method for Avoiding
 /// Self-Intersection" (Ray Tracing Gems, ch. 6). The point moves along `normal` (which
 /// must point to the side the new ray leaves on) by a fixed number of units in the last
 /// place of each coordinate, so the offset scales with the point's magnitude; near the
 /// origin (within `scale/32`), where ulps become tiny, a small absolute offset
-/// `scale/65536` is used instead, `scale` being [`ray_offset_scale`] (1 in scenes of
+/// `scale/65536` is used instead, `scale` being [`crate::accel::ray_offset_scale`] (1 in scenes of
 /// unit size and beyond: the published constants).
 ///
 /// The GPU applies the constants to `f32` bit patterns; here they apply to `f64` bit
@@ -426,14 +313,10 @@ pub fn offset_ray_origin(point: DVec3, normal: DVec3, scale: f64) -> DVec3 {
     )
 }
 
-/// All shapes of `scene`, prepared for intersection.
-pub fn prepare_shapes(scene: &Scene) -> Vec<PreparedShape> {
-    scene.shapes.iter().map(PreparedShape::new).collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::polygon_plane;
 
     fn ray(origin: DVec3, direction: DVec3) -> Ray {
         Ray {

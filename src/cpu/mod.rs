@@ -9,6 +9,7 @@ pub mod bxdf;
 pub mod intersect;
 pub mod texture;
 pub mod trace;
+pub mod traverse;
 
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};

@@ -5,16 +5,16 @@
 use glam::DVec3;
 
 use super::bxdf::{eval_brdf, has_base_brdf, reflect_direction, surface_response};
-use super::intersect::{
-    Hit, PreparedShape, Ray, intersect_scene, occluded, offset_ray_origin, prepare_shapes,
-    ray_offset_scale,
-};
+use super::intersect::{Hit, Ray, offset_ray_origin};
 use super::texture::shading_albedo;
+use super::traverse::{intersect_scene, occluded};
+use crate::accel::SceneGeometry;
 use crate::camera::{CameraFrame, sample_offset};
+pub use crate::scene::MediumStack;
 use crate::scene::{Image, Light, Material, RenderSettings, Scene};
 
-/// The scene in the form the tracer reads: colours in the lighting space, polygons with
-/// their planes, the camera basis.
+/// The scene in the form the tracer reads: colours in the lighting space, the geometry
+/// with its BVH, the camera basis.
 #[derive(Debug, Clone)]
 pub struct PreparedScene {
     /// Sampling and depth settings.
@@ -29,10 +29,8 @@ pub struct PreparedScene {
     pub materials: Vec<Material>,
     /// Lights.
     pub lights: Vec<Light>,
-    /// Shapes with precomputed constants.
-    pub shapes: Vec<PreparedShape>,
-    /// Length scale of the self-intersection offset ([`ray_offset_scale`]).
-    pub offset_scale: f64,
+    /// The primitives and the BVH over them (shared with the GPU backend).
+    pub geometry: SceneGeometry,
     /// The dielectrics around the camera ([`Scene::camera_medium`]).
     pub camera_medium: MediumStack,
     /// Albedo textures and BRDF maps.
@@ -40,8 +38,14 @@ pub struct PreparedScene {
 }
 
 impl PreparedScene {
-    /// Prepares a validated scene.
+    /// Prepares a validated scene, building its geometry and BVH.
     pub fn new(scene: &Scene) -> Self {
+        Self::with_geometry(scene, SceneGeometry::new(scene))
+    }
+
+    /// Prepares a validated scene with geometry already built from it (for example
+    /// the one the GPU backend uploaded, so both trace the same tree).
+    pub fn with_geometry(scene: &Scene, geometry: SceneGeometry) -> Self {
         let scene = scene.in_lighting_space();
         Self {
             settings: scene.render,
@@ -50,94 +54,18 @@ impl PreparedScene {
             ambient: scene.environment.ambient,
             materials: scene.materials.clone(),
             lights: scene.lights.clone(),
-            shapes: prepare_shapes(&scene),
-            offset_scale: ray_offset_scale(&scene),
+            geometry,
             camera_medium: MediumStack::from_outermost_first(&scene.camera_medium()),
             images: scene.images,
         }
     }
 }
 
-/// How many nested dielectrics a [`MediumStack`] remembers.
-pub const MEDIUM_STACK_SIZE: usize = 4;
-
 /// Squared distances to a point light below this (the smallest normal `f32`, 2^-126)
 /// contribute nothing: at zero or denormal distance `I / r²` is infinite or NaN in
 /// `f32`, and the light is inside the surface it would light. Both backends use the
 /// same threshold.
 pub const MIN_LIGHT_DISTANCE_SQUARED: f64 = f32::MIN_POSITIVE as f64;
-
-/// The dielectrics a ray is inside, innermost last: the per-path medium stack that
-/// lets dielectrics nest (glass in water, the camera inside glass).
-///
-/// The rule, for closed, properly nested (non-overlapping) dielectric surfaces:
-/// - every path starts in air (index 1, an empty stack);
-/// - a refracted ray that *enters* a dielectric (arrives on the side its geometric
-///   normal points to) pushes the dielectric's index; the interface is
-///   `eta_i` = the current medium's index, `eta_t` = the dielectric's;
-/// - a refracted ray that *leaves* one pops the innermost entry; the interface is
-///   `eta_i` = the dielectric's index, `eta_t` = the enclosing medium's, the entry below
-///   the innermost (air when there is none, which is also the rule when leaving a
-///   dielectric the path never entered, such as one around the camera);
-/// - reflected and shadow rays keep the stack of the ray that spawned them.
-///
-/// Only the [`MEDIUM_STACK_SIZE`] outermost indices are stored; deeper nesting keeps
-/// counting, and reads past the stored entries return the innermost one stored.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MediumStack {
-    /// Indices of refraction, outermost first; entries at `depth` and beyond are unused.
-    pub iors: [f64; MEDIUM_STACK_SIZE],
-    /// Number of dielectrics the ray is inside.
-    pub depth: u32,
-}
-
-impl MediumStack {
-    /// The stack of a camera ray: in air, inside nothing.
-    pub const AIR: Self = Self {
-        iors: [1.0; MEDIUM_STACK_SIZE],
-        depth: 0,
-    };
-
-    /// The stack of a ray inside the dielectrics of indices `iors`, outermost first.
-    pub fn from_outermost_first(iors: &[f64]) -> Self {
-        iors.iter().fold(Self::AIR, |stack, &ior| {
-            stack.medium_after_refraction(true, ior)
-        })
-    }
-
-    /// The index of refraction `level` dielectrics deep (0 = air, index 1).
-    pub fn medium_ior_at(&self, level: u32) -> f64 {
-        if level == 0 {
-            1.0
-        } else {
-            self.iors[(level as usize).min(MEDIUM_STACK_SIZE) - 1]
-        }
-    }
-
-    /// The index of the medium on the outside of a dielectric surface hit by a ray
-    /// with this stack: the current medium when `entering`, else the enclosing one.
-    pub fn medium_outside_ior(&self, entering: bool) -> f64 {
-        if entering {
-            self.medium_ior_at(self.depth)
-        } else {
-            self.medium_ior_at(self.depth.saturating_sub(1))
-        }
-    }
-
-    /// The stack of the refracted ray: `ior` pushed when `entering`, else popped.
-    pub fn medium_after_refraction(&self, entering: bool, ior: f64) -> Self {
-        let mut next = *self;
-        if entering {
-            if (next.depth as usize) < MEDIUM_STACK_SIZE {
-                next.iors[next.depth as usize] = ior;
-            }
-            next.depth = next.depth.saturating_add(1);
-        } else {
-            next.depth = next.depth.saturating_sub(1);
-        }
-        next
-    }
-}
 
 /// Whether a radiance value is finite and stays finite when rounded to `f32`: the
 /// final guard of [`trace_radiance`]. A contribution that fails it (an overflowing
@@ -224,7 +152,7 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
     let mut rays = 0u64;
     while let Some(entry) = stack.pop() {
         rays += 1;
-        let Some(hit) = intersect_scene(&scene.shapes, &entry.ray, f64::INFINITY) else {
+        let Some(hit) = intersect_scene(&scene.geometry, &entry.ray, f64::INFINITY) else {
             let contribution = entry.weight * scene.background;
             if finite_radiance(contribution) {
                 radiance += contribution;
@@ -298,7 +226,7 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumSta
     let mut shadow_rays = 0;
     if has_base_brdf(material.kind) && response.base > 0.0 {
         let mut direct = material.diffuse * scene.ambient;
-        let shadow_origin = offset_ray_origin(position, n, scene.offset_scale);
+        let shadow_origin = offset_ray_origin(position, n, scene.geometry.offset_scale);
         for light in &scene.lights {
             let (lit, traced) = direct_light(scene, light, material, shadow_origin, n, wo);
             direct += lit;
@@ -308,11 +236,11 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumSta
     }
 
     let reflected = Ray {
-        origin: offset_ray_origin(position, n, scene.offset_scale),
+        origin: offset_ray_origin(position, n, scene.geometry.offset_scale),
         direction: reflect_direction(ray.direction, n).normalize(),
     };
     let transmitted = Ray {
-        origin: offset_ray_origin(position, -n, scene.offset_scale),
+        origin: offset_ray_origin(position, -n, scene.geometry.offset_scale),
         direction: response.transmit_direction,
     };
     ShadedHit {
@@ -363,7 +291,7 @@ pub fn direct_light(
         origin,
         direction: wi,
     };
-    if occluded(&scene.shapes, &shadow, distance) {
+    if occluded(&scene.geometry, &shadow, distance) {
         return (DVec3::ZERO, 1);
     }
     (

@@ -13,10 +13,9 @@ use super::layout::{
     MATERIAL_PBR, MATERIAL_TABULATED, NO_IMAGE,
 };
 use crate::camera::CameraFrame;
-use crate::cpu::trace::MediumStack;
 use crate::scene::{
-    FresnelModel, Image, Light, Material, MaterialKind, MicrofacetDistribution, PolygonPlane,
-    Scene, Shape, TextureMapping, polygon_plane,
+    FresnelModel, Image, Light, Material, MaterialKind, MediumStack, MicrofacetDistribution,
+    PolygonPlane, Scene, Shape, TextureMapping, polygon_plane,
 };
 
 /// Every record list of a scene, ready for upload. The lists hold exactly the scene's
@@ -280,7 +279,7 @@ pub fn frame_uniforms(scene: &Scene, records: &SceneRecords) -> FrameUniforms {
         column_count: settings.width,
         target_x: 0,
         target_y: 0,
-        offset_scale: crate::cpu::intersect::ray_offset_scale(scene) as f32,
+        offset_scale: crate::accel::ray_offset_scale(&scene.shapes) as f32,
         min_ray_weight: settings.min_ray_weight as f32,
         sample_index: 0,
         accumulation_rows: 0,

@@ -4,9 +4,11 @@
 mod error;
 mod file;
 mod image;
+mod medium;
 mod model;
 
 pub use error::SceneError;
 pub use file::{CONDUCTOR_PRESETS, load_scene, parse_scene};
 pub use image::{MAX_IMAGE_SIDE, load_image};
+pub use medium::{MEDIUM_STACK_SIZE, MediumStack};
 pub use model::*;

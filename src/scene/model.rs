@@ -566,3 +566,14 @@ pub fn polygon_plane(vertices: &[DVec3]) -> Option<PolygonPlane> {
         dropped_axis,
     })
 }
+
+/// The two coordinates of `point` that remain when `dropped_axis` (0 = x, 1 = y,
+/// 2 = z) is removed: the projection of a polygon's inside test
+/// ([`PolygonPlane::dropped_axis`]).
+pub fn project_to_plane(point: DVec3, dropped_axis: u32) -> (f64, f64) {
+    match dropped_axis {
+        0 => (point.y, point.z),
+        1 => (point.z, point.x),
+        _ => (point.x, point.y),
+    }
+}

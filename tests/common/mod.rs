@@ -2,5 +2,6 @@
 #![allow(dead_code)]
 
 pub mod compare;
+pub mod geometry;
 pub mod gpu;
 pub mod scenes;

@@ -1,0 +1,556 @@
+//! The bounding volume hierarchy: `f32` node records shared by both tracers, built on
+//! the host by one of two builders.
+//!
+//! - [`BuildMethod::Sah`]: top-down binned SAH (Wald, "On fast Construction of
+//!   SAH-based Bounding Volume Hierarchies", IEEE Symposium on Interactive Ray Tracing
+//!   2007): each node bins its primitives' centroids into [`SAH_BINS`] bins along the
+//!   longest axis of their bounds and splits where `A_left·N_left + A_right·N_right` is
+//!   smallest; the two subtrees of the top levels are built on separate threads. Where
+//!   the SAH finds no split (all centroids in one bin) or the tree reaches
+//!   [`MEDIAN_SPLIT_DEPTH`], it splits at the median by count instead, so any input,
+//!   a million identical triangles included, builds in `O(n log n)` with a bounded depth.
+//! - [`BuildMethod::MedianSplit`]: the object-median split on the longest centroid axis
+//!   at every node: the simple baseline the SAH is measured against.
+//!
+//! obvhs (PLOC) was measured first and not kept: on this project's 2-core machines it
+//! built 1M spread boxes at 1.4–2.4 M/s, and 100k identical boxes took 40 s and gave a
+//! chain of depth 99,997 (`BENCHMARKS.md`).
+//!
+//! The tree is stored depth-first: node 0 is the root; an inner node's children are
+//! `first` and `first + 1`; a leaf's primitives are `prims[first .. first + count]`.
+
+use std::time::{Duration, Instant};
+
+use bytemuck::{Pod, Zeroable};
+use glam::DVec3;
+
+use super::geometry::PrimRef;
+
+/// Deepest tree either tracer traverses: the GPU's traversal stack has this many
+/// entries, and both builders stay within it (see [`MEDIAN_SPLIT_DEPTH`]).
+pub const MAX_BVH_DEPTH: u32 = 64;
+
+/// Most primitives in one leaf.
+pub const MAX_LEAF_PRIMITIVES: u32 = 4;
+
+/// One node of the tree as both tracers read it (`BvhNode` in `shaders/types.wgsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct BvhNode {
+    /// Lower corner of the node's box.
+    pub min: [f32; 3],
+    /// Inner node: index of the first child (the second is `first + 1`). Leaf: index of
+    /// its first primitive in [`Bvh::prims`].
+    pub first: u32,
+    /// Upper corner of the node's box.
+    pub max: [f32; 3],
+    /// Number of primitives of a leaf; 0 for an inner node.
+    pub count: u32,
+}
+
+impl BvhNode {
+    /// Whether the node is a leaf.
+    pub fn is_leaf(&self) -> bool {
+        self.count > 0
+    }
+}
+
+/// An axis-aligned box with `f32` corners.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aabb32 {
+    /// Lower corner.
+    pub min: [f32; 3],
+    /// Upper corner.
+    pub max: [f32; 3],
+}
+
+/// The largest `f32` not above `x` (`x` finite).
+fn f32_at_or_below(x: f64) -> f32 {
+    let f = x as f32;
+    if f64::from(f) > x { f.next_down() } else { f }
+}
+
+/// The smallest `f32` not below `x`.
+fn f32_at_or_above(x: f64) -> f32 {
+    let f = x as f32;
+    if f64::from(f) < x { f.next_up() } else { f }
+}
+
+impl Aabb32 {
+    /// The box that contains nothing.
+    pub const EMPTY: Self = Self {
+        min: [f32::INFINITY; 3],
+        max: [f32::NEG_INFINITY; 3],
+    };
+
+    /// The `f32` box around the `f64` box `lo..hi`, rounded outwards and padded on each
+    /// axis by 2^-20 of the axis's magnitude plus its extent, which covers the rounding
+    /// of the primitive to `f32` and the few ulps by which an `f32` intersection test
+    /// may report a hit just outside the exact primitive.
+    pub fn around(lo: DVec3, hi: DVec3) -> Self {
+        let pad = (lo.abs().max(hi.abs()) + (hi - lo)) * (1.0 / 1_048_576.0);
+        let lo = lo - pad;
+        let hi = hi + pad;
+        Self {
+            min: [
+                f32_at_or_below(lo.x),
+                f32_at_or_below(lo.y),
+                f32_at_or_below(lo.z),
+            ],
+            max: [
+                f32_at_or_above(hi.x),
+                f32_at_or_above(hi.y),
+                f32_at_or_above(hi.z),
+            ],
+        }
+    }
+
+    /// The box around `points` and their `f32` roundings.
+    pub fn around_points(points: &[DVec3]) -> Self {
+        let mut lo = DVec3::INFINITY;
+        let mut hi = DVec3::NEG_INFINITY;
+        for p in points {
+            let rounded = p.as_vec3().as_dvec3();
+            lo = lo.min(*p).min(rounded);
+            hi = hi.max(*p).max(rounded);
+        }
+        Self::around(lo, hi)
+    }
+
+    fn union(&self, other: &Self) -> Self {
+        let mut out = *self;
+        for axis in 0..3 {
+            out.min[axis] = out.min[axis].min(other.min[axis]);
+            out.max[axis] = out.max[axis].max(other.max[axis]);
+        }
+        out
+    }
+
+    fn centroid(&self) -> [f32; 3] {
+        [0, 1, 2].map(|a| 0.5 * self.min[a] + 0.5 * self.max[a])
+    }
+}
+
+/// Which builder makes the tree.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum BuildMethod {
+    /// Binned SAH: the default.
+    #[default]
+    Sah,
+    /// Object-median split on the longest centroid axis: the baseline.
+    MedianSplit,
+}
+
+/// Figures of one build.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct BvhStats {
+    /// The builder that made the tree.
+    pub method: BuildMethod,
+    /// Wall time of the build, flattening included.
+    pub build_time: Duration,
+    /// Depth of the tree (a lone leaf has depth 1; an empty tree 0).
+    pub depth: u32,
+    /// Number of nodes.
+    pub nodes: usize,
+    /// Number of leaves.
+    pub leaves: usize,
+    /// The tree's SAH cost relative to its root box: `Σ inner area / root area +
+    /// Σ leaf area × primitives / root area` (traversal and intersection cost 1 each).
+    pub sah_cost: f64,
+}
+
+/// The hierarchy: depth-first nodes and the primitive references of the leaves.
+#[derive(Debug, Clone, Default)]
+pub struct Bvh {
+    /// Nodes; node 0 is the root. Empty when there is no bounded primitive.
+    pub nodes: Vec<BvhNode>,
+    /// Primitive references, leaf by leaf.
+    pub prims: Vec<PrimRef>,
+    /// How it was built.
+    pub stats: BvhStats,
+}
+
+/// A node of the tree being built, before flattening.
+enum BuildNode {
+    Inner {
+        aabb: Aabb32,
+        children: [usize; 2],
+    },
+    /// Primitives `order[start .. start + count]` of the whole build order.
+    Leaf {
+        aabb: Aabb32,
+        start: usize,
+        count: usize,
+    },
+}
+
+impl Bvh {
+    /// Builds the tree over `primitives` (each with its conservative box) with
+    /// `method`; a tree deeper than [`MAX_BVH_DEPTH`] is rebuilt by median split.
+    pub fn build(primitives: &[(PrimRef, Aabb32)], method: BuildMethod) -> Self {
+        let start = Instant::now();
+        let mut bvh = build_tree(primitives, method);
+        bvh.stats.build_time = start.elapsed();
+        bvh
+    }
+
+    /// The root box, if the tree is not empty.
+    pub fn root_bounds(&self) -> Option<Aabb32> {
+        self.nodes.first().map(|n| Aabb32 {
+            min: n.min,
+            max: n.max,
+        })
+    }
+}
+
+/// Bins per axis of the SAH split search.
+pub const SAH_BINS: usize = 16;
+
+/// Depth from which [`BuildMethod::Sah`] splits at the median by count: below it every
+/// subtree of `n` primitives has depth at most `log2(n / MAX_LEAF_PRIMITIVES) + 1`, so
+/// the whole tree stays within [`MAX_BVH_DEPTH`] for up to 2^30 primitives.
+pub const MEDIAN_SPLIT_DEPTH: u32 = 30;
+
+/// Subtrees with fewer primitives than this are built on the current thread.
+const PARALLEL_THRESHOLD: usize = 50_000;
+
+/// What the builders work on: the primitives' boxes and centroids.
+struct BuildInput<'a> {
+    boxes: &'a [(PrimRef, Aabb32)],
+    centroids: Vec<[f32; 3]>,
+    method: BuildMethod,
+}
+
+fn build_tree(primitives: &[(PrimRef, Aabb32)], method: BuildMethod) -> Bvh {
+    if primitives.is_empty() {
+        return Bvh::default();
+    }
+    let input = BuildInput {
+        boxes: primitives,
+        centroids: primitives.iter().map(|(_, b)| b.centroid()).collect(),
+        method,
+    };
+    let mut order: Vec<u32> = (0..primitives.len() as u32).collect();
+    let threads = std::thread::available_parallelism().map_or(1, usize::from);
+    let mut arena = Vec::with_capacity(2 * primitives.len() / MAX_LEAF_PRIMITIVES as usize + 1);
+    build_subtree(&input, &mut order, 0, 1, threads, &mut arena);
+    let prims: Vec<PrimRef> = order.iter().map(|&i| primitives[i as usize].0).collect();
+    let mut bvh = flatten(&arena, &prims);
+    bvh.stats.method = method;
+    bvh
+}
+
+/// The box around the primitives `order` names, and the box around their centroids.
+fn bounds_of(input: &BuildInput<'_>, order: &[u32]) -> (Aabb32, Aabb32) {
+    let mut boxes = Aabb32::EMPTY;
+    let mut centroids = Aabb32::EMPTY;
+    for &i in order {
+        boxes = boxes.union(&input.boxes[i as usize].1);
+        let c = input.centroids[i as usize];
+        centroids = centroids.union(&Aabb32 { min: c, max: c });
+    }
+    (boxes, centroids)
+}
+
+/// Half the surface area of a box (0 for an empty one).
+fn half_area(b: &Aabb32) -> f32 {
+    let e = [0, 1, 2].map(|a| (b.max[a] - b.min[a]).max(0.0));
+    e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
+}
+
+/// Reorders `order` for a split and returns how many primitives go left (between 1
+/// and `order.len() - 1`).
+fn split(input: &BuildInput<'_>, order: &mut [u32], centroids: &Aabb32, depth: u32) -> usize {
+    let extent = [0, 1, 2].map(|a| centroids.max[a] - centroids.min[a]);
+    let axis = (0..3)
+        .max_by(|&a, &b| extent[a].total_cmp(&extent[b]))
+        .unwrap_or(0);
+    let median = |order: &mut [u32]| {
+        let mid = order.len() / 2;
+        // Ties (identical centroids) are split by count all the same.
+        order.select_nth_unstable_by(mid, |&x, &y| {
+            input.centroids[x as usize][axis].total_cmp(&input.centroids[y as usize][axis])
+        });
+        mid
+    };
+    if input.method == BuildMethod::MedianSplit
+        || depth >= MEDIAN_SPLIT_DEPTH
+        || extent[axis].is_nan()
+        || extent[axis] <= 0.0
+    {
+        return median(order);
+    }
+    // Bin the centroids along the axis (Wald 2007, §3).
+    let scale = SAH_BINS as f32 / extent[axis];
+    let bin_of = |i: u32| {
+        let c = input.centroids[i as usize][axis];
+        (((c - centroids.min[axis]) * scale) as usize).min(SAH_BINS - 1)
+    };
+    let mut bins = [(Aabb32::EMPTY, 0usize); SAH_BINS];
+    for &i in order.iter() {
+        let bin = &mut bins[bin_of(i)];
+        bin.0 = bin.0.union(&input.boxes[i as usize].1);
+        bin.1 += 1;
+    }
+    // The cost of every plane between bins: sweep from the right, then from the left.
+    let mut right_cost = [0.0f32; SAH_BINS];
+    let mut acc = (Aabb32::EMPTY, 0usize);
+    for b in (1..SAH_BINS).rev() {
+        acc = (acc.0.union(&bins[b].0), acc.1 + bins[b].1);
+        right_cost[b] = half_area(&acc.0) * acc.1 as f32;
+    }
+    let mut best = (f32::INFINITY, 0usize);
+    let mut acc = (Aabb32::EMPTY, 0usize);
+    for b in 0..SAH_BINS - 1 {
+        acc = (acc.0.union(&bins[b].0), acc.1 + bins[b].1);
+        if acc.1 == 0 || acc.1 == order.len() {
+            continue;
+        }
+        let cost = half_area(&acc.0) * acc.1 as f32 + right_cost[b + 1];
+        if cost < best.0 {
+            best = (cost, b);
+        }
+    }
+    if !best.0.is_finite() {
+        return median(order);
+    }
+    // Partition in place: bins 0..=best go left.
+    let mut left = 0;
+    for k in 0..order.len() {
+        if bin_of(order[k]) <= best.1 {
+            order.swap(left, k);
+            left += 1;
+        }
+    }
+    left
+}
+
+/// Builds the subtree over `order` (whose first entry is entry `offset` of the whole
+/// build order) into `arena` and returns its index there. With `threads > 1` and
+/// enough primitives, the right child is built on a second thread.
+fn build_subtree(
+    input: &BuildInput<'_>,
+    order: &mut [u32],
+    offset: usize,
+    depth: u32,
+    threads: usize,
+    arena: &mut Vec<BuildNode>,
+) -> usize {
+    let (aabb, centroids) = bounds_of(input, order);
+    let index = arena.len();
+    if order.len() <= MAX_LEAF_PRIMITIVES as usize {
+        arena.push(BuildNode::Leaf {
+            aabb,
+            start: offset,
+            count: order.len(),
+        });
+        return index;
+    }
+    let parallel = threads > 1 && order.len() >= PARALLEL_THRESHOLD;
+    let mid = split(input, order, &centroids, depth);
+    arena.push(BuildNode::Inner {
+        aabb,
+        children: [usize::MAX; 2],
+    });
+    let (left, right) = order.split_at_mut(mid);
+    let children = if parallel {
+        let mut right_arena = Vec::new();
+        let left_root = std::thread::scope(|scope| {
+            let worker = scope.spawn(|| {
+                build_subtree(
+                    input,
+                    right,
+                    offset + mid,
+                    depth + 1,
+                    threads / 2,
+                    &mut right_arena,
+                )
+            });
+            let left_root =
+                build_subtree(input, left, offset, depth + 1, threads - threads / 2, arena);
+            // A panic in the worker is a bug in this builder: raise it here.
+            if let Err(panic) = worker.join() {
+                std::panic::resume_unwind(panic);
+            }
+            left_root
+        });
+        [left_root, append_arena(arena, right_arena)]
+    } else {
+        let left_root = build_subtree(input, left, offset, depth + 1, 1, arena);
+        let right_root = build_subtree(input, right, offset + mid, depth + 1, 1, arena);
+        [left_root, right_root]
+    };
+    if let BuildNode::Inner { children: c, .. } = &mut arena[index] {
+        *c = children;
+    }
+    index
+}
+
+/// Appends a subtree built into its own arena (root at 0), shifting its child
+/// indices, and returns where its root landed.
+fn append_arena(arena: &mut Vec<BuildNode>, subtree: Vec<BuildNode>) -> usize {
+    let shift = arena.len();
+    arena.extend(subtree.into_iter().map(|node| match node {
+        BuildNode::Inner { aabb, children } => BuildNode::Inner {
+            aabb,
+            children: children.map(|c| c + shift),
+        },
+        leaf => leaf,
+    }));
+    shift
+}
+
+/// Lays a built tree out depth-first with sibling pairs adjacent, the leaves'
+/// primitives (`order`, the build order) in the same order, and measures it.
+fn flatten(tree: &[BuildNode], order: &[PrimRef]) -> Bvh {
+    let mut bvh = Bvh::default();
+    let record = |aabb: &Aabb32| BvhNode {
+        min: aabb.min,
+        first: 0,
+        max: aabb.max,
+        count: 0,
+    };
+    let area = |n: &BvhNode| {
+        let e = [0, 1, 2].map(|a| f64::from(n.max[a]) - f64::from(n.min[a]));
+        e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
+    };
+    let root_aabb = match &tree[0] {
+        BuildNode::Inner { aabb, .. } | BuildNode::Leaf { aabb, .. } => aabb,
+    };
+    bvh.nodes.push(record(root_aabb));
+    // (tree node, output slot, depth)
+    let mut pending = vec![(0usize, 0usize, 1u32)];
+    while let Some((source, slot, depth)) = pending.pop() {
+        bvh.stats.depth = bvh.stats.depth.max(depth);
+        match &tree[source] {
+            BuildNode::Leaf { start, count, .. } => {
+                bvh.nodes[slot].first = u32::try_from(bvh.prims.len()).unwrap_or(u32::MAX);
+                bvh.nodes[slot].count = *count as u32;
+                bvh.prims.extend_from_slice(&order[*start..*start + *count]);
+                bvh.stats.leaves += 1;
+            }
+            BuildNode::Inner { children, .. } => {
+                let first = bvh.nodes.len();
+                bvh.nodes[slot].first = u32::try_from(first).unwrap_or(u32::MAX);
+                for &child in children {
+                    let aabb = match &tree[child] {
+                        BuildNode::Inner { aabb, .. } | BuildNode::Leaf { aabb, .. } => aabb,
+                    };
+                    bvh.nodes.push(record(aabb));
+                }
+                pending.push((children[1], first + 1, depth + 1));
+                pending.push((children[0], first, depth + 1));
+            }
+        }
+    }
+    let root_area = area(&bvh.nodes[0]).max(f64::MIN_POSITIVE);
+    bvh.stats.sah_cost = bvh
+        .nodes
+        .iter()
+        .map(|n| area(n) / root_area * if n.is_leaf() { f64::from(n.count) } else { 1.0 })
+        .sum();
+    bvh.stats.nodes = bvh.nodes.len();
+    bvh
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::geometry::PrimKind;
+
+    fn boxes(n: usize, spread: f64) -> Vec<(PrimRef, Aabb32)> {
+        (0..n)
+            .map(|i| {
+                let x = ((i * 7919) % 1000) as f64 * spread;
+                let y = ((i * 104_729) % 997) as f64 * spread;
+                let c = DVec3::new(x, y, (i % 13) as f64);
+                (
+                    PrimRef::new(PrimKind::Triangle, i as u32),
+                    Aabb32::around(c - 0.5, c + 0.5),
+                )
+            })
+            .collect()
+    }
+
+    /// Every primitive is in exactly one leaf, every node contains its children and
+    /// its primitives, and the depth bound holds.
+    fn check_tree(bvh: &Bvh, primitives: &[(PrimRef, Aabb32)]) {
+        let mut seen = vec![0u32; primitives.len()];
+        let contains = |outer: &BvhNode, inner_min: [f32; 3], inner_max: [f32; 3]| {
+            (0..3).all(|a| outer.min[a] <= inner_min[a] && outer.max[a] >= inner_max[a])
+        };
+        for node in &bvh.nodes {
+            if node.is_leaf() {
+                assert!(node.count <= MAX_LEAF_PRIMITIVES);
+                for p in &bvh.prims[node.first as usize..(node.first + node.count) as usize] {
+                    seen[p.index()] += 1;
+                    let b = primitives[p.index()].1;
+                    assert!(contains(node, b.min, b.max));
+                }
+            } else {
+                for child in [node.first, node.first + 1] {
+                    let c = bvh.nodes[child as usize];
+                    assert!(contains(node, c.min, c.max));
+                }
+            }
+        }
+        assert!(seen.iter().all(|&s| s == 1));
+        assert!(bvh.stats.depth <= MAX_BVH_DEPTH);
+    }
+
+    #[test]
+    fn both_builders_make_valid_trees() {
+        for n in [1, 2, 5, 100, 3000] {
+            let prims = boxes(n, 0.1);
+            for method in [BuildMethod::Sah, BuildMethod::MedianSplit] {
+                let bvh = Bvh::build(&prims, method);
+                check_tree(&bvh, &prims);
+                assert_eq!(bvh.stats.nodes, bvh.nodes.len());
+            }
+        }
+        assert!(Bvh::build(&[], BuildMethod::Sah).nodes.is_empty());
+    }
+
+    #[test]
+    fn identical_primitives_build_a_shallow_tree() {
+        let one = Aabb32::around(DVec3::ZERO, DVec3::ONE);
+        let prims: Vec<_> = (0..100_000)
+            .map(|i| (PrimRef::new(PrimKind::Triangle, i), one))
+            .collect();
+        let bvh = Bvh::build(&prims, BuildMethod::Sah);
+        check_tree(&bvh, &prims);
+        assert!(bvh.stats.depth <= 20, "depth {}", bvh.stats.depth);
+    }
+
+    #[test]
+    fn sah_beats_the_median_split_on_clustered_input() {
+        // Two dense clusters far apart plus a sparse line: the SAH tree's cost is lower.
+        let mut prims = boxes(2000, 0.001);
+        prims.extend(boxes(2000, 0.001).into_iter().map(|(p, b)| {
+            let shift = |v: [f32; 3]| [v[0] + 1000.0, v[1], v[2]];
+            (
+                PrimRef::new(PrimKind::Triangle, p.index() as u32 + 2000),
+                Aabb32 {
+                    min: shift(b.min),
+                    max: shift(b.max),
+                },
+            )
+        }));
+        let sah = Bvh::build(&prims, BuildMethod::Sah);
+        let median = Bvh::build(&prims, BuildMethod::MedianSplit);
+        assert!(
+            sah.stats.sah_cost < median.stats.sah_cost,
+            "{} vs {}",
+            sah.stats.sah_cost,
+            median.stats.sah_cost
+        );
+    }
+
+    #[test]
+    fn boxes_round_outwards() {
+        let b = Aabb32::around(DVec3::splat(0.1), DVec3::splat(0.3));
+        assert!(f64::from(b.min[0]) < 0.1 && f64::from(b.max[0]) > 0.3);
+        let flat = Aabb32::around(DVec3::new(0.0, 0.0, 0.0), DVec3::new(1.0, 1.0, 0.0));
+        assert!(flat.min[2] <= 0.0 && flat.max[2] >= 0.0);
+    }
+}

@@ -1,0 +1,379 @@
+//! The primitive lists both tracers intersect, and [`SceneGeometry`], which holds them
+//! with the BVH over them.
+
+use glam::DVec3;
+
+use super::bvh::{Aabb32, BuildMethod, Bvh};
+use crate::scene::{PolygonPlane, Scene, Shape, polygon_plane, project_to_plane};
+
+/// Polygons with more vertices than this are triangulated when the geometry is built
+/// (with earcut), so that no single primitive test runs more than this many loop
+/// iterations on the GPU (see `docs/model.md`, "Bounded work").
+pub const MAX_POLYGON_VERTICES: usize = 32;
+
+/// Most infinite planes a GPU scene may have: every ray tests every plane, so their
+/// count bounds the work of one traversal step.
+pub const MAX_PLANES: usize = 1024;
+
+/// The kind of a primitive, stored in the top two bits of a [`PrimRef`]. The order
+/// (spheres, planes, polygons, triangles) decides exact ties between kinds: a polygon
+/// lying in a plane, such as the bottom of a box standing on the floor, loses to the
+/// plane, as it did before the BVH on both backends.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum PrimKind {
+    /// An entry of [`SceneGeometry::spheres`].
+    Sphere = 0,
+    /// An entry of [`SceneGeometry::planes`] (never in the BVH).
+    Plane = 1,
+    /// An entry of [`SceneGeometry::polygons`].
+    Polygon = 2,
+    /// An entry of [`SceneGeometry::triangles`].
+    Triangle = 3,
+}
+
+/// A primitive named by its kind and its index in that kind's list: `kind << 30 |
+/// index`. It is also the tie-break key: of two hits at exactly the same distance, the
+/// smaller `PrimRef` wins (on both backends).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, bytemuck::Pod, bytemuck::Zeroable,
+)]
+#[repr(transparent)]
+pub struct PrimRef(pub u32);
+
+impl PrimRef {
+    /// Bits of a [`PrimRef`] that hold the index.
+    pub const INDEX_BITS: u32 = 30;
+    /// Largest index a [`PrimRef`] can hold (one less than 2^30).
+    pub const MAX_INDEX: u32 = (1 << Self::INDEX_BITS) - 1;
+
+    /// The reference to entry `index` of `kind`'s list (`index` at most
+    /// [`PrimRef::MAX_INDEX`]).
+    pub fn new(kind: PrimKind, index: u32) -> Self {
+        debug_assert!(index <= Self::MAX_INDEX);
+        Self(((kind as u32) << Self::INDEX_BITS) | (index & Self::MAX_INDEX))
+    }
+
+    /// The primitive's kind.
+    pub fn kind(self) -> PrimKind {
+        match self.0 >> Self::INDEX_BITS {
+            0 => PrimKind::Sphere,
+            1 => PrimKind::Plane,
+            2 => PrimKind::Polygon,
+            _ => PrimKind::Triangle,
+        }
+    }
+
+    /// The index in its kind's list.
+    pub fn index(self) -> usize {
+        (self.0 & Self::MAX_INDEX) as usize
+    }
+}
+
+/// A sphere.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SphereShape {
+    /// Centre.
+    pub center: DVec3,
+    /// Radius (> 0).
+    pub radius: f64,
+    /// Material index.
+    pub material: u32,
+}
+
+/// An infinite plane `normal · p = offset`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaneShape {
+    /// Unit normal.
+    pub normal: DVec3,
+    /// Signed distance from the origin along `normal`.
+    pub offset: f64,
+    /// Material index.
+    pub material: u32,
+}
+
+/// A planar polygon of at most [`MAX_POLYGON_VERTICES`] vertices with its plane.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PolygonShape {
+    /// Its plane and projection axis, computed once ([`polygon_plane`]).
+    pub plane: PolygonPlane,
+    /// Its vertices in order.
+    pub vertices: Vec<DVec3>,
+    /// Material index.
+    pub material: u32,
+}
+
+/// A triangle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TriangleShape {
+    /// Corners; the geometric normal is `(v1-v0)×(v2-v0)`, normalized.
+    pub vertices: [DVec3; 3],
+    /// Material index.
+    pub material: u32,
+}
+
+/// A scene's primitives by kind and the BVH over the bounded ones: what both tracers
+/// intersect.
+#[derive(Debug, Clone)]
+pub struct SceneGeometry {
+    /// Spheres, in scene order.
+    pub spheres: Vec<SphereShape>,
+    /// Planes, in scene order.
+    pub planes: Vec<PlaneShape>,
+    /// Polygons of at most [`MAX_POLYGON_VERTICES`] vertices, in scene order.
+    pub polygons: Vec<PolygonShape>,
+    /// Triangles: the scene's own in scene order, then those of the polygons that had
+    /// more than [`MAX_POLYGON_VERTICES`] vertices.
+    pub triangles: Vec<TriangleShape>,
+    /// How many of the scene's polygons were triangulated.
+    pub triangulated_polygons: usize,
+    /// Length scale of the self-intersection offset's near-origin branch
+    /// ([`ray_offset_scale`]).
+    pub offset_scale: f64,
+    /// The hierarchy over spheres, polygons and triangles.
+    pub bvh: Bvh,
+}
+
+impl SceneGeometry {
+    /// The geometry of a validated `scene`, with a BVH built by [`BuildMethod::Sah`].
+    pub fn new(scene: &Scene) -> Self {
+        Self::with_method(scene, BuildMethod::Sah)
+    }
+
+    /// The geometry of `scene` with a BVH built by `method`.
+    pub fn with_method(scene: &Scene, method: BuildMethod) -> Self {
+        Self::from_shapes(&scene.shapes, method)
+    }
+
+    /// The geometry of `shapes` (validated, as in a [`Scene`]) with a BVH built by
+    /// `method`.
+    pub fn from_shapes(shapes: &[Shape], method: BuildMethod) -> Self {
+        let mut geometry = Self {
+            spheres: Vec::new(),
+            planes: Vec::new(),
+            polygons: Vec::new(),
+            triangles: Vec::new(),
+            triangulated_polygons: 0,
+            offset_scale: ray_offset_scale(shapes),
+            bvh: Bvh::default(),
+        };
+        let mut large_polygons = Vec::new();
+        for shape in shapes {
+            match shape {
+                Shape::Sphere {
+                    center,
+                    radius,
+                    material,
+                } => geometry.spheres.push(SphereShape {
+                    center: *center,
+                    radius: *radius,
+                    material: *material,
+                }),
+                Shape::Plane {
+                    normal,
+                    offset,
+                    material,
+                } => geometry.planes.push(PlaneShape {
+                    normal: *normal,
+                    offset: *offset,
+                    material: *material,
+                }),
+                Shape::Polygon { vertices, material } => {
+                    // Validation rejects degenerate polygons; one that slips through
+                    // gets a zero normal and is never hit.
+                    let plane = polygon_plane(vertices).unwrap_or(PolygonPlane {
+                        normal: DVec3::ZERO,
+                        offset: 0.0,
+                        dropped_axis: 2,
+                    });
+                    if vertices.len() > MAX_POLYGON_VERTICES {
+                        large_polygons.push((plane, vertices, *material));
+                    } else {
+                        geometry.polygons.push(PolygonShape {
+                            plane,
+                            vertices: vertices.clone(),
+                            material: *material,
+                        });
+                    }
+                }
+                Shape::Triangle { vertices, material } => geometry.triangles.push(TriangleShape {
+                    vertices: *vertices,
+                    material: *material,
+                }),
+            }
+        }
+        geometry.triangulated_polygons = large_polygons.len();
+        for (plane, vertices, material) in large_polygons {
+            triangulate_polygon(&plane, vertices, material, &mut geometry.triangles);
+        }
+        let bounds = geometry.bounded_primitives();
+        geometry.bvh = Bvh::build(&bounds, method);
+        geometry
+    }
+
+    /// Every bounded primitive with its conservative `f32` box, spheres first, then
+    /// polygons, then triangles.
+    fn bounded_primitives(&self) -> Vec<(PrimRef, Aabb32)> {
+        let index = |i: usize| u32::try_from(i).unwrap_or(PrimRef::MAX_INDEX);
+        let spheres = self.spheres.iter().enumerate().map(|(i, s)| {
+            let r = DVec3::splat(s.radius);
+            // The f32 sphere the GPU intersects, widened by both roundings.
+            let c32 = s.center.as_vec3().as_dvec3();
+            let r32 = DVec3::splat(f64::from(s.radius as f32));
+            let lo = (s.center - r).min(c32 - r32);
+            let hi = (s.center + r).max(c32 + r32);
+            (
+                PrimRef::new(PrimKind::Sphere, index(i)),
+                Aabb32::around(lo, hi),
+            )
+        });
+        let polygons = self.polygons.iter().enumerate().map(|(i, p)| {
+            (
+                PrimRef::new(PrimKind::Polygon, index(i)),
+                Aabb32::around_points(&p.vertices),
+            )
+        });
+        let triangles = self.triangles.iter().enumerate().map(|(i, t)| {
+            (
+                PrimRef::new(PrimKind::Triangle, index(i)),
+                Aabb32::around_points(&t.vertices),
+            )
+        });
+        spheres.chain(polygons).chain(triangles).collect()
+    }
+
+    /// The material of primitive `prim`.
+    pub fn material(&self, prim: PrimRef) -> u32 {
+        match prim.kind() {
+            PrimKind::Sphere => self.spheres[prim.index()].material,
+            PrimKind::Polygon => self.polygons[prim.index()].material,
+            PrimKind::Triangle => self.triangles[prim.index()].material,
+            PrimKind::Plane => self.planes[prim.index()].material,
+        }
+    }
+
+    /// The number of bounded primitives (those in the BVH).
+    pub fn bounded_count(&self) -> usize {
+        self.spheres.len() + self.polygons.len() + self.triangles.len()
+    }
+}
+
+/// The length scale of the ray offset's near-origin branch for a scene of `shapes`
+/// (`offset_ray_origin` in `src/cpu/intersect.rs` and `shaders/intersect.wgsl`): the
+/// largest absolute coordinate of its geometry (sphere centres ± radii, plane offsets,
+/// vertices), capped at 1.
+///
+/// Wächter and Binder's constants (`1/32` for "near the origin", `1/65536` for the
+/// absolute offset there) assume a scene of about unit size. In a scene 10^-4 across
+/// that absolute offset would be 15% of the scene, so both constants are multiplied by
+/// this scale, which makes the offset, like every other length, scale with the scene.
+/// Larger scenes keep the published constants (scale 1): there the ulp branch covers
+/// every coordinate beyond 1/32, and a larger near-origin offset would lift rays off a
+/// small object lying near the origin of a large world.
+pub fn ray_offset_scale(shapes: &[Shape]) -> f64 {
+    let mut extent = 0.0f64;
+    let mut include = |v: DVec3| extent = extent.max(v.abs().max_element());
+    for shape in shapes {
+        match shape {
+            Shape::Sphere { center, radius, .. } => include(center.abs() + DVec3::splat(*radius)),
+            Shape::Plane { offset, .. } => include(DVec3::splat(*offset)),
+            Shape::Polygon { vertices, .. } => vertices.iter().copied().for_each(&mut include),
+            Shape::Triangle { vertices, .. } => vertices.iter().copied().for_each(&mut include),
+        }
+    }
+    if extent > 0.0 && extent < 1.0 {
+        extent
+    } else {
+        1.0
+    }
+}
+
+/// Triangulates a planar polygon (ear clipping, mapbox's earcut, in the projection that
+/// drops the plane's dominant axis) and appends its triangles, each wound so that its
+/// normal agrees with the polygon's.
+fn triangulate_polygon(
+    plane: &PolygonPlane,
+    vertices: &[DVec3],
+    material: u32,
+    out: &mut Vec<TriangleShape>,
+) {
+    let projected: Vec<[f64; 2]> = vertices
+        .iter()
+        .map(|v| {
+            let (u, w) = project_to_plane(*v, plane.dropped_axis);
+            [u, w]
+        })
+        .collect();
+    let mut indices: Vec<u32> = Vec::new();
+    earcut::Earcut::new().earcut(projected.iter().copied(), &[] as &[u32], &mut indices);
+    for corner in indices.chunks_exact(3) {
+        let mut tri = [
+            vertices[corner[0] as usize],
+            vertices[corner[1] as usize],
+            vertices[corner[2] as usize],
+        ];
+        let normal = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+        if normal.dot(plane.normal) < 0.0 {
+            tri.swap(1, 2);
+        }
+        out.push(TriangleShape {
+            vertices: tri,
+            material,
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn prim_refs_round_trip_and_order_by_kind() {
+        for kind in [
+            PrimKind::Sphere,
+            PrimKind::Polygon,
+            PrimKind::Triangle,
+            PrimKind::Plane,
+        ] {
+            for index in [0, 1, 12345, PrimRef::MAX_INDEX] {
+                let prim = PrimRef::new(kind, index);
+                assert_eq!(prim.kind(), kind);
+                assert_eq!(prim.index(), index as usize);
+            }
+        }
+        assert!(
+            PrimRef::new(PrimKind::Sphere, PrimRef::MAX_INDEX) < PrimRef::new(PrimKind::Plane, 0)
+        );
+        assert!(
+            PrimRef::new(PrimKind::Plane, PrimRef::MAX_INDEX) < PrimRef::new(PrimKind::Polygon, 0)
+        );
+    }
+
+    #[test]
+    fn large_polygons_become_triangles_of_the_same_area_and_side() {
+        // A regular 100-gon of radius 1 in the plane y = 2, counter-clockwise seen from +y.
+        let n = 100;
+        let vertices: Vec<DVec3> = (0..n)
+            .map(|i| {
+                let a = -(i as f64) / n as f64 * std::f64::consts::TAU;
+                DVec3::new(a.cos(), 2.0, a.sin())
+            })
+            .collect();
+        let plane = polygon_plane(&vertices).expect("planar");
+        let shapes = vec![Shape::Polygon {
+            vertices,
+            material: 0,
+        }];
+        let geometry = SceneGeometry::from_shapes(&shapes, BuildMethod::Sah);
+        assert!(geometry.polygons.is_empty());
+        assert_eq!(geometry.triangulated_polygons, 1);
+        assert_eq!(geometry.triangles.len(), n - 2);
+        let mut area = 0.0;
+        for t in &geometry.triangles {
+            let cross = (t.vertices[1] - t.vertices[0]).cross(t.vertices[2] - t.vertices[0]);
+            assert!(cross.dot(plane.normal) > 0.0);
+            area += cross.length() / 2.0;
+        }
+        let expected = 0.5 * n as f64 * (std::f64::consts::TAU / n as f64).sin();
+        assert!((area - expected).abs() < 1e-9, "{area} vs {expected}");
+    }
+}

@@ -1,0 +1,27 @@
+//! Scene geometry as both tracers intersect it: the primitives in flat lists by kind,
+//! with their per-shape constants computed once, and a bounding volume hierarchy over
+//! the bounded ones.
+//!
+//! Built once per scene on the host ([`SceneGeometry::new`]) and shared by the CPU
+//! reference, which traverses it in `f64`, and the GPU backend, which uploads the same
+//! nodes and primitive lists and traverses them in WGSL. Both follow the same rules
+//! (`docs/model.md`, "Acceleration structure"):
+//!
+//! - the nearest hit wins; at exactly equal distances the smaller [`PrimRef`] wins, so
+//!   the result does not depend on the order in which the tree is visited, and a
+//!   traversal returns exactly what a brute-force loop over every primitive returns;
+//! - node boxes are `f32`, rounded outwards and padded so that they contain both the
+//!   `f64` primitive (CPU) and its `f32` rounding (GPU);
+//! - planes are unbounded and stay a short list tested before the tree.
+//!
+//! - [`geometry`]: the primitive lists and [`SceneGeometry`];
+//! - [`bvh`]: the tree, its `f32` node records and its two builders.
+
+pub mod bvh;
+pub mod geometry;
+
+pub use bvh::{BuildMethod, Bvh, BvhNode, BvhStats, MAX_BVH_DEPTH, MAX_LEAF_PRIMITIVES};
+pub use geometry::{
+    MAX_PLANES, MAX_POLYGON_VERTICES, PlaneShape, PolygonShape, PrimKind, PrimRef, SceneGeometry,
+    SphereShape, TriangleShape, ray_offset_scale,
+};
