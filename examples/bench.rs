@@ -174,13 +174,13 @@ fn compare_specialisation(
             gpu_render::gpu::ShaderFeatures::ALL
         };
         let started = Instant::now();
-        renderer.trace_pipeline(&gpu.device, scene.render.stack_size, &used)?;
+        renderer.trace_pipelines(&gpu.device, &used)?;
         let create = started.elapsed().as_secs_f64();
         let started = Instant::now();
         renderer.render(&gpu.device, &gpu.queue, &tiny, None)?;
         let first = started.elapsed().as_secs_f64();
-        let source = gpu_render::gpu::shaders::trace_shader_source(scene.render.stack_size, &used)
-            .map_err(anyhow::Error::msg)?;
+        let source =
+            gpu_render::gpu::shaders::trace_shader_source(&used).map_err(anyhow::Error::msg)?;
         println!(
             "{name}: {} lines of WGSL; create_compute_pipeline {:.1} ms; first 8x8 frame {:.1} ms",
             source.lines().count(),

@@ -7,7 +7,7 @@
 //! ```
 
 use anyhow::{Context, Result};
-use gpu_render::gpu::renderer::{DISPLAY_FORMAT, LINEAR_FORMAT};
+use gpu_render::gpu::{DISPLAY_FORMAT, LINEAR_FORMAT};
 use gpu_render::gpu::{GpuRenderer, read_texture};
 use gpu_render::scene::load_scene;
 
@@ -62,12 +62,13 @@ fn main() -> Result<()> {
     let linear_view = linear.create_view(&Default::default());
     let display_view = display.create_view(&Default::default());
 
-    // gpu-render records its passes into the application's encoder; the application
-    // decides when to submit (here: once, with everything).
+    // gpu-render traces into the application's texture, then records its display
+    // pass into the application's encoder; the application decides when to submit.
     let renderer = GpuRenderer::new(&device)?;
     let prepared = renderer.prepare(&device, &queue, &scene)?;
+    let region = gpu_render::gpu::TraceRegion::whole(width, height);
+    renderer.trace_into(&device, &queue, &prepared, &linear_view, &region, None)?;
     let mut encoder = device.create_command_encoder(&Default::default());
-    renderer.encode_trace(&device, &mut encoder, &prepared, &linear_view, 0..height)?;
     renderer.encode_display(
         &device,
         &mut encoder,
@@ -82,7 +83,7 @@ fn main() -> Result<()> {
         &queue,
         &display,
         4,
-        std::time::Duration::from_secs(120),
+        Some(std::time::Duration::from_secs(120)),
     )?;
     image::RgbaImage::from_raw(width, height, rgba8)
         .context("readback size")?

@@ -202,87 +202,87 @@ fn intersect_triangle(ray: Ray, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, t_m
 }
 //#endif
 
-// The nearest hit along `ray` in (0, t_max) over all shapes. Shapes are visited by
-// type, not in file order as on the CPU: only exact ties in t can resolve differently.
-fn intersect_scene(ray: Ray, t_max: f32) -> Hit {
-    var hit = Hit(t_max, vec3<f32>(0.0), 0u, false, vec3<f32>(0.0));
-    //#if SPHERES
-    for (var i = 0u; i < frame.sphere_count; i += 1u) {
-        let sphere = spheres[i];
-        let t = intersect_sphere(ray, sphere.center, sphere.radius, hit.t);
-        if t != NO_HIT {
-            let p = ray_at(ray, t);
-            hit = Hit(t, normalize(p - sphere.center), sphere.material, true,
-                      project_onto_sphere(p, sphere.center, sphere.radius));
-        }
-    }
-    //#endif
-    //#if PLANES
-    for (var i = 0u; i < frame.plane_count; i += 1u) {
-        let plane = planes[i];
-        let t = intersect_plane(ray, plane.normal, plane.offset, hit.t);
-        if t != NO_HIT {
-            hit = Hit(t, plane.normal, plane.material, true,
-                      project_onto_plane(ray_at(ray, t), plane.normal, plane.offset));
-        }
-    }
-    //#endif
-    //#if POLYGONS
-    for (var i = 0u; i < frame.polygon_count; i += 1u) {
-        let polygon = polygons[i];
-        let t = intersect_polygon(ray, polygon, hit.t);
-        if t != NO_HIT {
-            hit = Hit(t, polygon.normal, polygon.material, true,
-                      project_onto_plane(ray_at(ray, t), polygon.normal, polygon.offset));
-        }
-    }
-    //#endif
-    //#if TRIANGLES
-    for (var i = 0u; i < frame.triangle_count; i += 1u) {
-        let triangle = triangles[i];
-        let t = intersect_triangle(ray, triangle.v0, triangle.v1, triangle.v2, hit.t);
-        if t != NO_HIT {
-            let normal = triangle_normal(triangle.v0, triangle.v1, triangle.v2);
-            hit = Hit(t, normal, triangle.material, true,
-                      project_onto_plane(ray_at(ray, t), normal, dot(normal, triangle.v0)));
-        }
-    }
-    //#endif
-    return hit;
+fn prim_kind(prim: u32) -> u32 {
+    return prim >> PRIM_KIND_SHIFT;
 }
 
-// Whether anything lies along `ray` in (0, t_max): the shadow-ray query.
-fn occluded(ray: Ray, t_max: f32) -> bool {
-    //#if SPHERES
-    for (var i = 0u; i < frame.sphere_count; i += 1u) {
-        if intersect_sphere(ray, spheres[i].center, spheres[i].radius, t_max) != NO_HIT {
-            return true;
+fn prim_index(prim: u32) -> u32 {
+    return prim & PRIM_INDEX_MASK;
+}
+
+// The ray parameter of primitive `prim`'s nearest hit in (0, t_max), or NO_HIT.
+fn intersect_prim(prim: u32, ray: Ray, t_max: f32) -> f32 {
+    let i = prim_index(prim);
+    switch prim_kind(prim) {
+        //#if SPHERES
+        case PRIM_SPHERE: {
+            let sphere = spheres[i];
+            return intersect_sphere(ray, sphere.center, sphere.radius, t_max);
+        }
+        //#endif
+        //#if PLANES
+        case PRIM_PLANE: {
+            let plane = planes[i];
+            return intersect_plane(ray, plane.normal, plane.offset, t_max);
+        }
+        //#endif
+        //#if POLYGONS
+        case PRIM_POLYGON: {
+            return intersect_polygon(ray, polygons[i], t_max);
+        }
+        //#endif
+        //#if TRIANGLES
+        case PRIM_TRIANGLE: {
+            let triangle = triangles[i];
+            return intersect_triangle(ray, triangle.v0, triangle.v1, triangle.v2, t_max);
+        }
+        //#endif
+        default: {
+            return NO_HIT;
         }
     }
-    //#endif
-    //#if PLANES
-    for (var i = 0u; i < frame.plane_count; i += 1u) {
-        if intersect_plane(ray, planes[i].normal, planes[i].offset, t_max) != NO_HIT {
-            return true;
+}
+
+// The hit record of `prim` at parameter `t` along `ray`: the shape's unit geometric
+// normal, its material, and the hit point re-projected onto the surface (Wächter and
+// Binder, Ray Tracing Gems, ch. 6, §6.2.1).
+fn hit_record(prim: u32, ray: Ray, t: f32) -> Hit {
+    let i = prim_index(prim);
+    let p = ray_at(ray, t);
+    switch prim_kind(prim) {
+        //#if SPHERES
+        case PRIM_SPHERE: {
+            let sphere = spheres[i];
+            return Hit(t, normalize(p - sphere.center), sphere.material, true,
+                       project_onto_sphere(p, sphere.center, sphere.radius));
+        }
+        //#endif
+        //#if PLANES
+        case PRIM_PLANE: {
+            let plane = planes[i];
+            return Hit(t, plane.normal, plane.material, true,
+                       project_onto_plane(p, plane.normal, plane.offset));
+        }
+        //#endif
+        //#if POLYGONS
+        case PRIM_POLYGON: {
+            let polygon = polygons[i];
+            return Hit(t, polygon.normal, polygon.material, true,
+                       project_onto_plane(p, polygon.normal, polygon.offset));
+        }
+        //#endif
+        //#if TRIANGLES
+        case PRIM_TRIANGLE: {
+            let triangle = triangles[i];
+            let normal = triangle_normal(triangle.v0, triangle.v1, triangle.v2);
+            return Hit(t, normal, triangle.material, true,
+                       project_onto_plane(p, normal, dot(normal, triangle.v0)));
+        }
+        //#endif
+        default: {
+            return Hit(t, vec3<f32>(0.0), 0u, false, p);
         }
     }
-    //#endif
-    //#if POLYGONS
-    for (var i = 0u; i < frame.polygon_count; i += 1u) {
-        if intersect_polygon(ray, polygons[i], t_max) != NO_HIT {
-            return true;
-        }
-    }
-    //#endif
-    //#if TRIANGLES
-    for (var i = 0u; i < frame.triangle_count; i += 1u) {
-        let triangle = triangles[i];
-        if intersect_triangle(ray, triangle.v0, triangle.v1, triangle.v2, t_max) != NO_HIT {
-            return true;
-        }
-    }
-    //#endif
-    return false;
 }
 
 // Moves a ray origin off a surface: Wächter and Binder, "A Fast and Robust Method for

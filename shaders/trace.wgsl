@@ -1,6 +1,23 @@
-// The Whitted tracer: one invocation per pixel, each sample traced iteratively with an
-// explicit bounce stack (WGSL has no recursion). CPU twin: src/cpu/trace.rs.
-// STACK_SIZE is prepended by the host (src/gpu/shaders.rs) when it composes the module.
+// The Whitted tracer as a wavefront of path states: each slot of `paths` owns one
+// pixel at a time and walks its samples' ray trees with the CPU reference's stack
+// discipline (src/cpu/trace.rs: same bounce stack, same order of every sum), but one
+// ray at a time, in two small kernels that the host dispatches in turns (Laine,
+// Karras and Aila, "Megakernels Considered Harmful: Wavefront Path Tracing on GPUs",
+// HPG 2013):
+//
+// - `shade_paths` consumes the slot's finished trace (shades a hit, pushes the
+//   reflected and refracted rays, adds a light's contribution) and advances the path
+//   to its next ray: the next light's shadow ray, the next ray on the bounce stack,
+//   the next sample's camera ray, or the next pixel, which it takes from a shared
+//   counter;
+// - `trace_rays` runs that ray's BVH traversal (shaders/traverse.wgsl).
+//
+// No invocation's work grows with the scene's depth, lights, samples or size: each
+// runs one traversal or one shading step and its cheap bookkeeping, within
+// frame.iteration_budget loop iterations, and resumes in the next dispatch where it
+// stopped. A slot's pixel gets every sample and every ray from that slot alone, so
+// its sums happen in one fixed order: the image does not depend on how many slots,
+// dispatches or budgets it took.
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
 @group(0) @binding(1) var<storage, read> spheres: array<Sphere>;
@@ -11,21 +28,26 @@
 @group(0) @binding(6) var<storage, read> materials: array<Material>;
 @group(0) @binding(7) var<storage, read> lights: array<Light>;
 @group(0) @binding(8) var linear_output: texture_storage_2d<rgba32float, write>;
-// One counter per image row: the rays each pixel of the row traced.
-@group(0) @binding(9) var<storage, read_write> ray_counts: array<atomic<u32>>;
-// Running radiance sums of the dispatched rows (row - row_offset, column), carried
-// from one sample's dispatch to the next.
+@group(0) @binding(9) var<storage, read_write> counters: Counters;
+// Each finished pixel's sample sum (when frame.flags has FLAG_STORE_SUM), and the sum
+// a pixel starts from when frame.first_sample > 0: progressive rendering.
 @group(0) @binding(10) var<storage, read_write> accumulation: array<vec4<f32>>;
-
-// Rays traced by this invocation (camera, shadow and secondary).
-var<private> rays_traced: u32;
+// binding 11: `images` (shaders/texture.wgsl).
+@group(0) @binding(12) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(13) var<storage, read> bvh_prims: array<u32>;
+@group(0) @binding(14) var<storage, read_write> paths: array<PathState>;
+// Each slot's bounce stack of frame.stack_size entries (interleaved across slots).
+@group(0) @binding(15) var<storage, read_write> ray_stack: array<StackEntry>;
+@group(0) @binding(16) var<storage, read_write> traces: array<TraceRay>;
+// Each slot's traversal stack of MAX_BVH_DEPTH entries (interleaved across slots).
+@group(0) @binding(17) var<storage, read_write> traversal_stack: array<u32>;
 
 // Squared point-light distances below the smallest normal f32 (2^-126) contribute
 // nothing: I / r² would be infinite or NaN. Twin of MIN_LIGHT_DISTANCE_SQUARED.
 const MIN_LIGHT_DISTANCE_SQUARED: f32 = 1.17549435e-38;
 
 // The dielectrics a ray is inside, outermost first (the per-path medium stack; the
-// rule is documented on the CPU twin, MediumStack in src/cpu/trace.rs): a refracted
+// rule is documented on the CPU twin, MediumStack in src/scene/medium.rs): a refracted
 // ray entering a dielectric pushes its index, one leaving pops; reflected rays keep
 // the stack. Entries past `depth` are unused; deeper nesting than 4 keeps counting.
 struct MediumStack {
@@ -71,76 +93,97 @@ fn medium_after_refraction(medium: MediumStack, entering: bool, ior: f32) -> Med
 //#endif
 
 // Whether every component is finite, read from the exponent bits so that no
-// fast-math assumption of the shader compiler can fold the test away. The final guard
-// of trace_radiance; twin of finite_radiance.
+// fast-math assumption of the shader compiler can fold the test away. The guard on
+// every contribution; twin of finite_radiance.
 fn finite_radiance(c: vec3<f32>) -> bool {
     let exponent = bitcast<vec3<u32>>(c) & vec3<u32>(0x7f800000u);
     return all(exponent != vec3<u32>(0x7f800000u));
 }
 
-struct StackEntry {
-    ray: Ray,
-    // Product of the weights of the bounces that led here.
-    weight: vec3<f32>,
-    // Bounces since the primary ray.
-    depth: u32,
-    // The dielectrics the ray travels inside.
-    medium: MediumStack,
+fn max_component(c: vec3<f32>) -> f32 {
+    return max(c.x, max(c.y, c.z));
 }
 
-struct ShadedHit {
-    // Emitted plus directly lit (and ambient) radiance towards the eye.
-    radiance: vec3<f32>,
-    reflect_weight: vec3<f32>,
-    reflected: Ray,
-    transmit_weight: vec3<f32>,
-    transmitted: Ray,
-    transmitted_medium: MediumStack,
+// Adds `weight × radiance` to the sample's radiance if it is finite.
+fn add_contribution(path: ptr<function, PathState>, contribution: vec3<f32>) {
+    if finite_radiance(contribution) {
+        (*path).radiance += contribution;
+    }
 }
 
-// Reflected radiance due to one light, f(wi, wo)·E·cos θi, if the shadow ray from
-// `origin` to the light is unblocked. Counts the shadow ray it traces.
-fn direct_light(light: Light, material: Material, origin: vec3<f32>, n: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
-    var wi: vec3<f32>;
-    var distance: f32;
-    var irradiance: vec3<f32>;
+// Where entry `level` of slot `slot`'s bounce stack lives (interleaved across slots).
+fn ray_stack_index(slot: u32, level: u32) -> u32 {
+    return level * frame.slot_count + slot;
+}
+
+// Pushes a branch if it carries more than the weight cutoff and the stack has room;
+// otherwise the branch is dropped (both backends alike).
+fn push_branch(slot: u32, path: ptr<function, PathState>, entry: StackEntry) {
+    if max_component(entry.weight) > frame.min_ray_weight && (*path).stack_len < frame.stack_size {
+        ray_stack[ray_stack_index(slot, (*path).stack_len)] = entry;
+        (*path).stack_len += 1u;
+    }
+}
+
+// Sets up the traversal of a ray: the nearest hit in (0, t_max), or with `any_hit`
+// whether anything lies there.
+fn start_trace(trace: ptr<function, TraceRay>, origin: vec3<f32>, direction: vec3<f32>, t_max: f32, any_hit: bool) {
+    *trace = TraceRay(origin, t_max, direction, TRACE_PENDING, t_max, NO_PRIM, 0u, NO_NODE,
+                      0u, 0u, u32(any_hit), 0u);
+}
+
+// What a light does at a shading point: the direction to it, its distance, the
+// irradiance it delivers on a surface facing it, and cos θi; `lit` is false when it
+// contributes nothing and casts no shadow ray (behind the surface, or a point light
+// at zero distance). Twin of the geometry part of direct_light.
+struct LightSample {
+    wi: vec3<f32>,
+    distance: f32,
+    irradiance: vec3<f32>,
+    cos_i: f32,
+    lit: bool,
+}
+
+fn sample_light(light: Light, origin: vec3<f32>, n: vec3<f32>) -> LightSample {
+    var sample = LightSample(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, false);
     if light.kind == LIGHT_POINT {
         let to_light = light.position_or_direction - origin;
         let distance_squared = dot(to_light, to_light);
         if !(distance_squared >= MIN_LIGHT_DISTANCE_SQUARED) {
-            return vec3<f32>(0.0);
+            return sample;
         }
-        distance = sqrt(distance_squared);
-        wi = to_light / distance;
+        sample.distance = sqrt(distance_squared);
+        sample.wi = to_light / sample.distance;
         // Inverse-square law: E = I / r² on a surface facing the light.
-        irradiance = light.power / distance_squared;
+        sample.irradiance = light.power / distance_squared;
     } else {
-        wi = -light.position_or_direction;
-        distance = bitcast<f32>(0x7f800000u); // +infinity
-        irradiance = light.power;
+        sample.wi = -light.position_or_direction;
+        sample.distance = bitcast<f32>(0x7f800000u); // +infinity
+        sample.irradiance = light.power;
     }
-    let cos_i = clamp(dot(n, wi), -1.0, 1.0);
-    if cos_i <= 0.0 {
-        return vec3<f32>(0.0);
-    }
-    rays_traced += 1u;
-    if occluded(Ray(origin, wi), distance) {
-        return vec3<f32>(0.0);
-    }
-    return eval_brdf(material, n, wi, wo) * irradiance * cos_i;
+    sample.cos_i = clamp(dot(n, sample.wi), -1.0, 1.0);
+    sample.lit = sample.cos_i > 0.0;
+    return sample;
 }
 
-// Shades a hit: emission, ambient and direct light with one shadow ray per light, and
-// the reflected and refracted rays with their weights, for a ray inside `medium`. New
-// rays start at the re-projected hit point moved off the surface (offset_ray_origin).
-fn shade_hit(ray: Ray, hit: Hit, medium: MediumStack) -> ShadedHit {
-    let position = hit.position;
+// Shades the hit (or miss) of the path's current ray, as shade_hit and trace_radiance
+// do on the CPU: a miss adds the background; a hit pushes the refracted, then the
+// reflected branch, and either adds its emission at once or, for a surface with a base
+// BRDF, starts gathering its lights (PHASE_NEXT_LIGHT), the ambient term first.
+fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) {
+    let ray = Ray((*path).origin, (*path).direction);
+    if trace.best_prim == NO_PRIM {
+        add_contribution(path, (*path).weight * frame.background);
+        (*path).phase = PHASE_POP;
+        return;
+    }
+    let hit = hit_record(trace.best_prim, ray, trace.best_t);
     var material = materials[hit.material];
-    material.diffuse = shading_albedo(material, position, hit.normal);
+    material.diffuse = shading_albedo(material, hit.position, hit.normal);
     let entering = dot(ray.direction, hit.normal) < 0.0;
     // Shading happens on the side the ray came from.
     let n = select(-hit.normal, hit.normal, entering);
-    let wo = -ray.direction;
+    let medium = MediumStack((*path).medium_iors, (*path).medium_depth);
     //#if REFRACTION
     let outside_ior = medium_outside_ior(medium, entering);
     //#else
@@ -148,115 +191,240 @@ fn shade_hit(ray: Ray, hit: Hit, medium: MediumStack) -> ShadedHit {
     let outside_ior = 1.0;
     //#endif
     let response = surface_response(material, ray.direction, n, entering, outside_ior);
-
-    var radiance = material.emission;
-    if has_base_brdf(material.kind) && response.base > 0.0 {
-        var direct = material.diffuse * frame.ambient;
-        let shadow_origin = offset_ray_origin(position, n, frame.offset_scale);
-        for (var i = 0u; i < frame.light_count; i += 1u) {
-            direct += direct_light(lights[i], material, shadow_origin, n, wo);
-        }
-        radiance += direct * response.base;
-    }
-    let reflected = Ray(offset_ray_origin(position, n, frame.offset_scale), normalize(reflect_direction(ray.direction, n)));
-    //#if REFRACTION
-    let transmitted = Ray(offset_ray_origin(position, -n, frame.offset_scale), response.transmit_direction);
-    let transmitted_medium = medium_after_refraction(medium, entering, material.ior);
-    //#else
-    // No dielectric, no refracted ray (its weight is zero).
-    let transmitted = reflected;
-    let transmitted_medium = medium;
-    //#endif
-    return ShadedHit(radiance, response.reflect, reflected, response.transmit, transmitted,
-                     transmitted_medium);
-}
-
-// Radiance arriving along `primary`: every reflected or refracted ray is pushed on a
-// stack of STACK_SIZE entries and popped until none is left. Refraction is pushed
-// first so reflection is traced first; a branch that finds the stack full, or whose
-// weight is not above frame.min_ray_weight, is dropped. A contribution that is not
-// finite_radiance is dropped: no NaN or infinity reaches the image.
-fn trace_radiance(primary: Ray) -> vec3<f32> {
-    var stack: array<StackEntry, STACK_SIZE>;
-    // Camera rays start inside the dielectrics around the camera (camera_medium).
-    stack[0] = StackEntry(primary, vec3<f32>(1.0), 0u,
-                          MediumStack(frame.camera_medium_iors, frame.camera_medium_depth));
-    var stack_length = 1u;
-    var radiance = vec3<f32>(0.0);
-    let infinity = bitcast<f32>(0x7f800000u);
-    while stack_length > 0u {
-        stack_length -= 1u;
-        let entry = stack[stack_length];
-        rays_traced += 1u;
-        let hit = intersect_scene(entry.ray, infinity);
-        if !hit.found {
-            let contribution = entry.weight * frame.background;
-            if finite_radiance(contribution) {
-                radiance += contribution;
-            }
-            continue;
-        }
-        let shaded = shade_hit(entry.ray, hit, entry.medium);
-        let contribution = entry.weight * shaded.radiance;
-        if finite_radiance(contribution) {
-            radiance += contribution;
-        }
-        if entry.depth >= frame.max_depth {
-            continue;
-        }
+    if (*path).depth < frame.max_depth {
+        // Refraction is pushed first so that reflection is traced first.
         //#if REFRACTION
-        let transmit_weight = entry.weight * shaded.transmit_weight;
-        if max(transmit_weight.x, max(transmit_weight.y, transmit_weight.z)) > frame.min_ray_weight && stack_length < STACK_SIZE {
-            stack[stack_length] = StackEntry(shaded.transmitted, transmit_weight, entry.depth + 1u,
-                                             shaded.transmitted_medium);
-            stack_length += 1u;
-        }
+        let inside = medium_after_refraction(medium, entering, material.ior);
+        push_branch(slot, path, StackEntry(
+            offset_ray_origin(hit.position, -n, frame.offset_scale), (*path).depth + 1u,
+            response.transmit_direction, inside.depth,
+            (*path).weight * response.transmit, 0u, inside.iors));
         //#endif
-        let reflect_weight = entry.weight * shaded.reflect_weight;
-        if max(reflect_weight.x, max(reflect_weight.y, reflect_weight.z)) > frame.min_ray_weight && stack_length < STACK_SIZE {
-            stack[stack_length] = StackEntry(shaded.reflected, reflect_weight, entry.depth + 1u,
-                                             entry.medium);
-            stack_length += 1u;
-        }
+        push_branch(slot, path, StackEntry(
+            offset_ray_origin(hit.position, n, frame.offset_scale), (*path).depth + 1u,
+            normalize(reflect_direction(ray.direction, n)), medium.depth,
+            (*path).weight * response.reflect, 0u, medium.iors));
     }
-    return radiance;
+    if has_base_brdf(material.kind) && response.base > 0.0 {
+        (*path).direct = material.diffuse * frame.ambient;
+        (*path).albedo = material.diffuse;
+        (*path).material = hit.material;
+        (*path).normal = n;
+        (*path).base = response.base;
+        (*path).shadow_origin = offset_ray_origin(hit.position, n, frame.offset_scale);
+        (*path).light = 0u;
+        (*path).phase = PHASE_NEXT_LIGHT;
+    } else {
+        add_contribution(path, (*path).weight * material.emission);
+        (*path).phase = PHASE_POP;
+    }
 }
 
-// One invocation per pixel of the dispatched region (rows row_offset.., columns
-// column_offset..), tracing sample frame.sample_index. Samples are summed in the
-// accumulation buffer in index order, as the CPU sums them; the dispatch of the last
-// sample writes the mean (box filter) into the linear output at the pixel's position
-// relative to the target's origin (target_x, target_y), which is (0, 0) unless the
-// image is traced in tiles.
-//
-// One sample per dispatch, not a loop over samples: Mesa's llvmpipe/lavapipe ends
-// every loop of an invocation once all loops together have run 65535 iterations
-// (LP_MAX_TGSI_LOOP_ITERATIONS in gallivm), which a pixel with many samples of deep
-// glass paths exceeds, silently losing rays.
-@compute @workgroup_size(8, 8, 1)
-fn trace_pixels(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= frame.column_count || id.y >= frame.row_count {
+// Adds the current light's f(wi, wo)·E·cos θi if its shadow ray was unblocked, and
+// moves on to the next light.
+fn consume_shadow_ray(path: ptr<function, PathState>, trace: TraceRay) {
+    if trace.best_prim == NO_PRIM {
+        let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal);
+        var material = materials[(*path).material];
+        material.diffuse = (*path).albedo;
+        (*path).direct += eval_brdf(material, (*path).normal, sample.wi, -(*path).direction)
+            * sample.irradiance * sample.cos_i;
+    }
+    (*path).light += 1u;
+    (*path).phase = PHASE_NEXT_LIGHT;
+}
+
+// Starts the shadow ray of the next light that faces the shading point and returns
+// true; after the last light, adds the hit's emission plus its direct light times the
+// base weight and moves on to the bounce stack (false).
+fn next_light(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) -> bool {
+    if (*path).light >= frame.light_count {
+        let emission = materials[(*path).material].emission;
+        add_contribution(path, (*path).weight * (emission + (*path).direct * (*path).base));
+        (*path).phase = PHASE_POP;
+        return false;
+    }
+    let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal);
+    if !sample.lit {
+        (*path).light += 1u;
+        return false;
+    }
+    (*path).rays += 1u;
+    start_trace(trace, (*path).shadow_origin, sample.wi, sample.distance, true);
+    (*path).phase = PHASE_SHADOW;
+    return true;
+}
+
+// Pops the next ray of the bounce stack and starts its traversal (true), or ends the
+// sample when the stack is empty (false).
+fn pop_ray(slot: u32, path: ptr<function, PathState>, trace: ptr<function, TraceRay>) -> bool {
+    if (*path).stack_len == 0u {
+        (*path).phase = PHASE_END_SAMPLE;
+        return false;
+    }
+    (*path).stack_len -= 1u;
+    let entry = ray_stack[ray_stack_index(slot, (*path).stack_len)];
+    (*path).origin = entry.origin;
+    (*path).direction = entry.direction;
+    (*path).weight = entry.weight;
+    (*path).depth = entry.depth;
+    (*path).medium_depth = entry.medium_depth;
+    (*path).medium_iors = entry.medium_iors;
+    (*path).rays += 1u;
+    start_trace(trace, entry.origin, entry.direction, bitcast<f32>(0x7f800000u), false);
+    (*path).phase = PHASE_CLOSEST;
+    return true;
+}
+
+// The image pixel of region pixel `pixel`.
+fn pixel_position(pixel: u32) -> vec2<u32> {
+    return vec2<u32>(frame.region_x + pixel % frame.region_width,
+                     frame.region_y + pixel / frame.region_width);
+}
+
+// Starts the camera ray of the path's current sample (jittered stratified, box
+// filter), inside the dielectrics around the camera.
+fn start_sample(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) {
+    let xy = pixel_position((*path).pixel);
+    let offset = sample_offset(xy.x, xy.y, (*path).sample);
+    let direction = camera_ray_direction(f32(xy.x) + offset.x, f32(xy.y) + offset.y);
+    (*path).radiance = vec3<f32>(0.0);
+    (*path).origin = frame.eye;
+    (*path).direction = direction;
+    (*path).weight = vec3<f32>(1.0);
+    (*path).depth = 0u;
+    (*path).medium_depth = frame.camera_medium_depth;
+    (*path).medium_iors = frame.camera_medium_iors;
+    (*path).stack_len = 0u;
+    (*path).rays += 1u;
+    start_trace(trace, frame.eye, direction, bitcast<f32>(0x7f800000u), false);
+    (*path).phase = PHASE_CLOSEST;
+}
+
+// Adds the finished sample to the pixel's sum; after the last sample of the range,
+// writes the pixel (the mean over frame.end_sample samples, black if not finite),
+// counts its rays and moves on to the next pixel.
+fn end_sample(path: ptr<function, PathState>) {
+    (*path).pixel_sum += (*path).radiance;
+    (*path).sample += 1u;
+    if (*path).sample < frame.end_sample {
+        (*path).phase = PHASE_START_SAMPLE;
         return;
     }
-    let x = frame.column_offset + id.x;
-    let y = frame.row_offset + id.y;
-    let slot = id.y * frame.width + x;
-    rays_traced = 0u;
-    let offset = sample_offset(x, y, frame.sample_index);
-    let direction = camera_ray_direction(f32(x) + offset.x, f32(y) + offset.y);
-    var sum = trace_radiance(Ray(frame.eye, direction));
-    if frame.sample_index > 0u {
-        sum = accumulation[slot].xyz + sum;
+    var mean = (*path).pixel_sum / f32(frame.end_sample);
+    // The sum of finite contributions may still overflow: the pixel is then black.
+    if !finite_radiance(mean) {
+        mean = vec3<f32>(0.0);
     }
-    if frame.sample_index + 1u < frame.samples_per_pixel {
-        accumulation[slot] = vec4<f32>(sum, 0.0);
-    } else {
-        var radiance = sum / f32(frame.samples_per_pixel);
-        // The sum of finite contributions may still overflow: the pixel is then black.
-        if !finite_radiance(radiance) {
-            radiance = vec3<f32>(0.0);
+    if (frame.flags & FLAG_STORE_SUM) != 0u {
+        accumulation[(*path).pixel] = vec4<f32>((*path).pixel_sum, 0.0);
+    }
+    let xy = pixel_position((*path).pixel);
+    textureStore(linear_output, vec2<u32>(xy.x - frame.target_x, xy.y - frame.target_y),
+                 vec4<f32>(mean, 1.0));
+    // 64-bit ray count as two words: carry when the low word wraps.
+    let low = atomicAdd(&counters.rays_low, (*path).rays);
+    if low + (*path).rays < low {
+        atomicAdd(&counters.rays_high, 1u);
+    }
+    atomicAdd(&counters.pixels_done, 1u);
+    (*path).phase = PHASE_FETCH_PIXEL;
+}
+
+// Takes the next pixel of the region from the shared counter, or goes idle.
+fn fetch_pixel(path: ptr<function, PathState>) {
+    let pixel = atomicAdd(&counters.next_pixel, 1u);
+    if pixel >= frame.region_width * frame.region_height {
+        (*path).phase = PHASE_IDLE;
+        return;
+    }
+    (*path).pixel = pixel;
+    (*path).sample = frame.first_sample;
+    (*path).rays = 0u;
+    (*path).pixel_sum = vec3<f32>(0.0);
+    if frame.first_sample > 0u {
+        (*path).pixel_sum = accumulation[pixel].xyz;
+    }
+    (*path).phase = PHASE_START_SAMPLE;
+}
+
+@compute @workgroup_size(64, 1, 1)
+fn shade_paths(@builtin(global_invocation_id) id: vec3<u32>) {
+    let slot = id.x;
+    if slot >= frame.slot_count {
+        return;
+    }
+    var path = paths[slot];
+    if path.phase == PHASE_IDLE {
+        return;
+    }
+    var trace = traces[slot];
+    if trace.status == TRACE_PENDING || trace.status == TRACE_RUNNING {
+        return;
+    }
+    iterations = 0u;
+    if trace.status == TRACE_DONE {
+        trace.status = TRACE_IDLE;
+        if path.phase == PHASE_CLOSEST {
+            consume_closest_hit(slot, &path, trace);
+        } else if path.phase == PHASE_SHADOW {
+            consume_shadow_ray(&path, trace);
         }
-        textureStore(linear_output, vec2<u32>(x - frame.target_x, y - frame.target_y), vec4<f32>(radiance, 1.0));
     }
-    atomicAdd(&ray_counts[y], rays_traced);
+    // Bookkeeping until the next traversal starts, the slot runs out of pixels, or
+    // the budget is spent (then the next dispatch continues here).
+    var exited = false;
+    loop {
+        if iterations >= frame.iteration_budget || path.phase == PHASE_IDLE {
+            exited = true;
+            break;
+        }
+        iterations += 1u;
+        var started = false;
+        switch path.phase {
+            case PHASE_NEXT_LIGHT: {
+                started = next_light(&path, &trace);
+            }
+            case PHASE_POP: {
+                started = pop_ray(slot, &path, &trace);
+            }
+            case PHASE_END_SAMPLE: {
+                end_sample(&path);
+            }
+            case PHASE_START_SAMPLE: {
+                start_sample(&path, &trace);
+                started = true;
+            }
+            case PHASE_FETCH_PIXEL: {
+                fetch_pixel(&path);
+            }
+            default: {}
+        }
+        if started {
+            exited = true;
+            break;
+        }
+    }
+    if !exited {
+        atomicOr(&counters.errors, ERROR_LOOP_CUT);
+    }
+    paths[slot] = path;
+    traces[slot] = trace;
+}
+
+@compute @workgroup_size(64, 1, 1)
+fn trace_rays(@builtin(global_invocation_id) id: vec3<u32>) {
+    let slot = id.x;
+    if slot >= frame.slot_count {
+        return;
+    }
+    var trace = traces[slot];
+    if trace.status != TRACE_PENDING && trace.status != TRACE_RUNNING {
+        return;
+    }
+    iterations = 0u;
+    if advance_traversal(slot, &trace) {
+        trace.status = TRACE_DONE;
+    }
+    traces[slot] = trace;
 }

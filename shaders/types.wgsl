@@ -15,24 +15,31 @@ struct FrameUniforms {
     samples_per_pixel: u32,
     ambient: vec3<f32>,
     max_depth: u32,
-    sphere_count: u32,
+    camera_medium_iors: vec4<f32>,
+    camera_medium_depth: u32,
     plane_count: u32,
-    polygon_count: u32,
-    triangle_count: u32,
+    node_count: u32,
     light_count: u32,
-    row_offset: u32,
-    row_count: u32,
-    column_offset: u32,
-    column_count: u32,
+    region_x: u32,
+    region_y: u32,
+    region_width: u32,
+    region_height: u32,
     target_x: u32,
     target_y: u32,
+    first_sample: u32,
+    end_sample: u32,
+    slot_count: u32,
+    stack_size: u32,
+    iteration_budget: u32,
+    flags: u32,
     offset_scale: f32,
     min_ray_weight: f32,
-    sample_index: u32,
-    accumulation_rows: u32,
-    camera_medium_depth: u32,
-    camera_medium_iors: vec4<f32>,
+    _pad0: u32,
+    _pad1: u32,
 }
+
+// FrameUniforms.flags: also store each finished pixel's sample sum in `accumulation`.
+const FLAG_STORE_SUM: u32 = 1u;
 
 struct Sphere {
     center: vec3<f32>,
@@ -124,6 +131,119 @@ struct Light {
     kind: u32,
     power: vec3<f32>,
     _pad: u32,
+}
+
+// One node of the BVH (twin of `accel::BvhNode`): an inner node's children are
+// `first` and `first + 1`; a leaf (count > 0) holds bvh_prims[first .. first + count].
+struct BvhNode {
+    min: vec3<f32>,
+    first: u32,
+    max: vec3<f32>,
+    count: u32,
+}
+
+// A primitive reference (twin of `accel::PrimRef`): kind << 30 | index in its list;
+// also the tie-break key (the smaller wins at equal distance).
+const PRIM_KIND_SHIFT: u32 = 30u;
+const PRIM_INDEX_MASK: u32 = 0x3fffffffu;
+const PRIM_SPHERE: u32 = 0u;
+const PRIM_PLANE: u32 = 1u;
+const PRIM_POLYGON: u32 = 2u;
+const PRIM_TRIANGLE: u32 = 3u;
+const NO_PRIM: u32 = 0xffffffffu;
+const NO_NODE: u32 = 0xffffffffu;
+
+// TraceRay.status
+const TRACE_IDLE: u32 = 0u;
+const TRACE_PENDING: u32 = 1u;
+const TRACE_RUNNING: u32 = 2u;
+const TRACE_DONE: u32 = 3u;
+
+// One traversal of one ray through the scene, resumable: the ray, its distance
+// limit, the best hit so far and where the traversal stands (the current node, the
+// next primitive of the current leaf, and the depth of the slot's traversal stack).
+struct TraceRay {
+    origin: vec3<f32>,
+    t_max: f32,
+    direction: vec3<f32>,
+    status: u32,
+    best_t: f32,
+    best_prim: u32,
+    stack_len: u32,
+    node: u32,
+    cursor: u32,
+    leaf_end: u32,
+    any_hit: u32,
+    _pad: u32,
+}
+
+// PathState.phase: what a path does next (see shaders/trace.wgsl).
+const PHASE_FETCH_PIXEL: u32 = 0u;
+const PHASE_CLOSEST: u32 = 1u;
+const PHASE_SHADOW: u32 = 2u;
+const PHASE_NEXT_LIGHT: u32 = 3u;
+const PHASE_POP: u32 = 4u;
+const PHASE_END_SAMPLE: u32 = 5u;
+const PHASE_START_SAMPLE: u32 = 6u;
+const PHASE_IDLE: u32 = 7u;
+
+// The state of one slot's path tree between dispatches: its pixel and sample, the
+// sums, the ray being shaded (origin, direction, weight, depth, medium) and, while its
+// lights are being gathered, the shading point's lighting state.
+struct PathState {
+    pixel: u32,
+    sample: u32,
+    phase: u32,
+    stack_len: u32,
+    pixel_sum: vec3<f32>,
+    rays: u32,
+    radiance: vec3<f32>,
+    light: u32,
+    origin: vec3<f32>,
+    depth: u32,
+    direction: vec3<f32>,
+    medium_depth: u32,
+    weight: vec3<f32>,
+    material: u32,
+    medium_iors: vec4<f32>,
+    shadow_origin: vec3<f32>,
+    base: f32,
+    normal: vec3<f32>,
+    _pad0: u32,
+    albedo: vec3<f32>,
+    _pad1: u32,
+    direct: vec3<f32>,
+    _pad2: u32,
+}
+
+// One pending reflected or refracted ray on a slot's bounce stack.
+struct StackEntry {
+    origin: vec3<f32>,
+    depth: u32,
+    direction: vec3<f32>,
+    medium_depth: u32,
+    weight: vec3<f32>,
+    _pad: u32,
+    medium_iors: vec4<f32>,
+}
+
+// Counters.errors bits.
+// A loop ended without reaching its exit: the driver cut it (llvmpipe's loop limit).
+const ERROR_LOOP_CUT: u32 = 1u;
+// A traversal needed more than MAX_BVH_DEPTH stack entries.
+const ERROR_TRAVERSAL_STACK: u32 = 2u;
+
+// Shared counters of one trace: pixels handed out and finished, rays traced (64 bits
+// as two words) and error bits.
+struct Counters {
+    next_pixel: atomic<u32>,
+    pixels_done: atomic<u32>,
+    rays_low: atomic<u32>,
+    rays_high: atomic<u32>,
+    errors: atomic<u32>,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 struct DisplayUniforms {

@@ -120,7 +120,7 @@ fn run_display_pass(encode_srgb: bool) -> Option<(LinearImage, Vec<u8>)> {
         )
         .expect("display pass records");
     queue.submit([encoder.finish()]);
-    let bytes = read_texture(device, queue, &display, 4, Duration::from_secs(60))
+    let bytes = read_texture(device, queue, &display, 4, Some(Duration::from_secs(60)))
         .expect("display texture reads back");
     Some((image, bytes))
 }

@@ -924,30 +924,6 @@ fn oversized_scene_buffers_give_a_clear_error() {
     );
 }
 
-/// Long renders are split into row chunks, each submitted on its own; the progress
-/// callback is called once per chunk with the rows finished so far.
-#[test]
-fn progress_follows_the_row_chunks() {
-    let Some(g) = gpu() else { return };
-    // An empty scene (every ray escapes): cheap, yet more than one chunk of samples.
-    let mut scene = mesh_scene(&[], DVec3::splat(3.0), DVec3::ZERO, 12.0);
-    // 512 × 64 samples = 2^15 per row: 64 rows per chunk of 2^21 samples.
-    scene.render.width = 512;
-    scene.render.height = 150;
-    scene.render.samples_per_pixel = 64;
-    let expected: Vec<(u32, u32)> = gpu_render::gpu::renderer::row_chunks(512, 150, 64)
-        .iter()
-        .map(|c| (c.end, 150))
-        .collect();
-    assert_eq!(expected, vec![(64, 150), (128, 150), (150, 150)]);
-    let calls = Mutex::new(Vec::new());
-    let progress = |done: u32, total: u32| calls.lock().unwrap().push((done, total));
-    g.renderer
-        .render(&g.gpu.device, &g.gpu.queue, &scene, Some(&progress))
-        .expect("render");
-    assert_eq!(calls.into_inner().unwrap(), expected);
-}
-
 /// A camera at the centre of a glass sphere (1.5) inside a water sphere (1.33): camera
 /// rays start inside both (`Scene::camera_medium`), so a radial ray crosses glass→water
 /// then water→air at normal incidence. With depth 2 the reflected branches end on a

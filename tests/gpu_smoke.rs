@@ -1,6 +1,7 @@
 //! End-to-end plumbing of the GPU backend, independent of what the trace shader
-//! computes: chunked dispatch, readback of a width whose rows need padding, the ray
-//! counters, the low-level API and its error paths.
+//! computes: submissions of rounds, readback of a width whose rows need padding, the
+//! ray counters, the low-level API and its error paths, and the independence of the
+//! image from slots, budgets and regions.
 
 mod common;
 
@@ -8,14 +9,13 @@ use std::sync::Mutex;
 use std::time::Duration;
 
 use glam::DVec3;
-use gpu_render::gpu::renderer::{MAX_CHUNK_SAMPLES, row_chunks};
-use gpu_render::gpu::{GpuError, read_texture};
+use gpu_render::gpu::{GpuError, TraceRegion, read_texture};
 use gpu_render::scene::{
     Camera, Environment, Light, LightingSpace, Material, RenderSettings, Scene, Shape,
 };
 
 // 37 columns: 37 * 16 and 37 * 4 bytes are not multiples of 256, so both readbacks
-// strip row padding. 37 * 61 * 1024 samples are more than one chunk.
+// strip row padding. 37 * 61 * 1024 samples take many rounds and submissions.
 const WIDTH: u32 = 37;
 const HEIGHT: u32 = 61;
 const SPP: u32 = 1024;
@@ -64,15 +64,12 @@ fn scene(samples_per_pixel: u32) -> Scene {
 }
 
 #[test]
-fn render_chunks_reads_back_and_counts_rays() {
+fn render_reads_back_counts_rays_and_reports_progress() {
     let Some(gpu) = common::gpu::headless_gpu() else {
         return;
     };
     let renderer = common::gpu::renderer(&gpu);
     let scene = scene(SPP);
-    let chunks = row_chunks(WIDTH, HEIGHT, SPP);
-    assert!(chunks.len() > 1, "the scene must need several chunks");
-    assert!(u64::from(WIDTH * HEIGHT * SPP) > MAX_CHUNK_SAMPLES);
 
     let reported = Mutex::new(Vec::new());
     let progress = |done: u32, total: u32| reported.lock().unwrap().push((done, total));
@@ -81,8 +78,15 @@ fn render_chunks_reads_back_and_counts_rays() {
         .expect("render succeeds");
 
     let reported = reported.into_inner().unwrap();
-    let expected: Vec<(u32, u32)> = chunks.iter().map(|c| (c.end, HEIGHT)).collect();
-    assert_eq!(reported, expected, "one progress call per chunk");
+    assert!(
+        reported.len() > 1,
+        "progress after each submission: {reported:?}"
+    );
+    assert!(
+        reported.windows(2).all(|w| w[0].0 <= w[1].0),
+        "{reported:?}"
+    );
+    assert_eq!(reported.last(), Some(&(HEIGHT, HEIGHT)));
 
     assert_eq!((out.image.width, out.image.height), (WIDTH, HEIGHT));
     assert_eq!(out.image.pixels.len(), (WIDTH * HEIGHT) as usize);
@@ -96,18 +100,17 @@ fn render_chunks_reads_back_and_counts_rays() {
     for (g, c) in out.display_rgba8.iter().zip(&cpu_display) {
         assert!(g.abs_diff(*c) <= 1);
     }
+    // Camera rays plus at least one shadow ray for every pixel sample that sees the
+    // lit sphere or floor; the CPU reference counts exactly the same rays.
+    let cpu = gpu_render::cpu::render(&scene, None);
+    assert_eq!(out.stats.rays_traced, cpu.stats.rays_traced);
     let primary = u64::from(WIDTH) * u64::from(HEIGHT) * u64::from(SPP);
-    assert!(
-        out.stats.rays_traced >= primary,
-        "{} rays traced, at least {primary} primary rays expected",
-        out.stats.rays_traced
-    );
+    assert!(out.stats.rays_traced > primary);
     assert!(out.stats.elapsed > Duration::ZERO);
     eprintln!(
-        "{}x{} at {SPP} spp in {} chunks: {} rays in {:?} ({:.1} Mrays/s)",
+        "{}x{} at {SPP} spp: {} rays in {:?} ({:.1} Mrays/s)",
         WIDTH,
         HEIGHT,
-        chunks.len(),
         out.stats.rays_traced,
         out.stats.elapsed,
         out.stats.rays_per_second() / 1e6
@@ -146,14 +149,18 @@ fn linear_target(device: &wgpu::Device) -> wgpu::Texture {
     )
 }
 
+/// The image is the same bit for bit whether it is traced whole or as three
+/// regions into one target, with one slot or many, and with an iteration budget so
+/// small that every traversal is suspended and resumed many times.
 #[test]
-fn chunks_recorded_into_one_encoder_match_render_to_texture() {
+fn regions_slots_and_budgets_do_not_change_the_image() {
     let Some(gpu) = common::gpu::headless_gpu() else {
         return;
     };
     let (device, queue) = (&gpu.device, &gpu.queue);
     let renderer = common::gpu::renderer(&gpu);
     let scene = scene(4);
+    let timeout = Some(Duration::from_secs(60));
 
     // Reference: the high-level call into a caller-owned texture.
     let reference = linear_target(device);
@@ -166,37 +173,46 @@ fn chunks_recorded_into_one_encoder_match_render_to_texture() {
             None,
         )
         .expect("render_to_texture succeeds");
-    let reference = read_texture(device, queue, &reference, 16, Duration::from_secs(60))
-        .expect("reference reads back");
+    let reference =
+        read_texture(device, queue, &reference, 16, timeout).expect("reference reads back");
 
-    // Low level: three uneven chunks in a single encoder and submission; each chunk
-    // must get its own row offset.
+    // Three uneven bands of rows, each traced into its place in one target.
     let prepared = renderer.prepare(device, queue, &scene).expect("prepare");
     let target = linear_target(device);
     let view = target.create_view(&Default::default());
-    let mut encoder = device.create_command_encoder(&Default::default());
+    let mut rays = 0;
     for rows in [0..5, 5..40, 40..HEIGHT] {
-        renderer
-            .encode_trace(device, &mut encoder, &prepared, &view, rows)
-            .expect("encode_trace");
+        let region = TraceRegion {
+            columns: 0..WIDTH,
+            rows,
+            target_origin: (0, 0),
+        };
+        rays += renderer
+            .trace_into(device, queue, &prepared, &view, &region, None)
+            .expect("trace_into")
+            .rays_traced;
     }
-    queue.submit([encoder.finish()]);
-    let chunked = read_texture(device, queue, &target, 16, Duration::from_secs(60))
-        .expect("chunked image reads back");
-    assert_eq!(chunked, reference, "chunking must not change the image");
-    let rays = renderer
-        .read_ray_count(device, queue, &prepared)
-        .expect("ray count");
+    let banded = read_texture(device, queue, &target, 16, timeout).expect("reads back");
+    assert_eq!(banded, reference, "regions must not change the image");
     assert_eq!(rays, stats.rays_traced, "same rays either way");
 
-    // Clearing the counters resets them.
-    let mut encoder = device.create_command_encoder(&Default::default());
-    renderer.encode_clear_ray_counts(&mut encoder, &prepared);
-    queue.submit([encoder.finish()]);
-    assert_eq!(
-        renderer.read_ray_count(device, queue, &prepared).unwrap(),
-        0
-    );
+    // One slot, and a budget of 3 iterations per dispatch.
+    for (label, variant) in [
+        ("one slot", common::gpu::renderer(&gpu).with_slot_count(1)),
+        (
+            "budget 3",
+            common::gpu::renderer(&gpu).with_iteration_budget(3),
+        ),
+    ] {
+        let target = linear_target(device);
+        let view = target.create_view(&Default::default());
+        let traced = variant
+            .render_to_texture(device, queue, &scene, &view, None)
+            .expect("render_to_texture");
+        let image = read_texture(device, queue, &target, 16, timeout).expect("reads back");
+        assert_eq!(image, reference, "{label} must not change the image");
+        assert_eq!(traced.rays_traced, stats.rays_traced, "{label}: same rays");
+    }
 }
 
 #[test]
@@ -233,9 +249,13 @@ fn bad_input_is_an_error_not_a_panic() {
     let prepared = renderer.prepare(device, queue, &scene(1)).expect("prepare");
     let target = linear_target(device);
     let view = target.create_view(&Default::default());
-    let mut encoder = device.create_command_encoder(&Default::default());
+    let outside = TraceRegion {
+        columns: 0..WIDTH,
+        rows: 0..HEIGHT + 1,
+        target_origin: (0, 0),
+    };
     assert!(matches!(
-        renderer.encode_trace(device, &mut encoder, &prepared, &view, 0..HEIGHT + 1),
+        renderer.trace_into(device, queue, &prepared, &view, &outside, None),
         Err(GpuError::Validation(_))
     ));
     let wrong_format = image_texture(
@@ -244,12 +264,13 @@ fn bad_input_is_an_error_not_a_panic() {
         wgpu::TextureFormat::Rgba8Unorm,
         wgpu::TextureUsages::STORAGE_BINDING,
     );
-    let result = renderer.encode_trace(
+    let result = renderer.trace_into(
         device,
-        &mut encoder,
+        queue,
         &prepared,
         &wrong_format.create_view(&Default::default()),
-        0..HEIGHT,
+        &TraceRegion::whole(WIDTH, HEIGHT),
+        None,
     );
     assert!(matches!(result, Err(GpuError::Validation(_))), "{result:?}");
 }
@@ -278,8 +299,6 @@ fn timestamp_queries_time_the_trace_passes() {
         return;
     }
     let renderer = common::gpu::renderer(&gpu);
-    // Several chunks, so the per-chunk times are summed.
-    assert!(row_chunks(WIDTH, HEIGHT, SPP).len() > 1);
     let out = renderer
         .render(&gpu.device, &gpu.queue, &scene(SPP), None)
         .expect("render succeeds");
@@ -302,7 +321,7 @@ fn timestamp_queries_time_the_trace_passes() {
         info.name, out.stats.elapsed
     );
 
-    // render_to_texture times its chunks the same way.
+    // render_to_texture times its submissions the same way.
     let target = linear_target(&gpu.device);
     let view = target.create_view(&Default::default());
     let stats = renderer

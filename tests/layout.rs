@@ -5,6 +5,7 @@
 use std::collections::BTreeMap;
 use std::mem::{offset_of, size_of};
 
+use gpu_render::accel::{BvhNode, PrimKind, PrimRef};
 use gpu_render::gpu::ShaderFeatures;
 use gpu_render::gpu::layout::*;
 use gpu_render::gpu::shaders::{
@@ -37,23 +38,27 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 samples_per_pixel,
                 ambient,
                 max_depth,
-                sphere_count,
+                camera_medium_iors,
+                camera_medium_depth,
                 plane_count,
-                polygon_count,
-                triangle_count,
+                node_count,
                 light_count,
-                row_offset,
-                row_count,
-                column_offset,
-                column_count,
+                region_x,
+                region_y,
+                region_width,
+                region_height,
                 target_x,
                 target_y,
+                first_sample,
+                end_sample,
+                slot_count,
+                stack_size,
+                iteration_budget,
+                flags,
                 offset_scale,
                 min_ray_weight,
-                sample_index,
-                accumulation_rows,
-                camera_medium_depth,
-                camera_medium_iors,
+                _pad0,
+                _pad1,
             }),
         ),
         (
@@ -140,6 +145,83 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
             "DisplayUniforms",
             twin!(DisplayUniforms { encode_srgb, _pad }),
         ),
+        (
+            "BvhNode",
+            twin!(BvhNode {
+                min,
+                first,
+                max,
+                count
+            }),
+        ),
+        (
+            "TraceRay",
+            twin!(GpuTraceRay {
+                origin,
+                t_max,
+                direction,
+                status,
+                best_t,
+                best_prim,
+                stack_len,
+                node,
+                cursor,
+                leaf_end,
+                any_hit,
+                _pad
+            }),
+        ),
+        (
+            "PathState",
+            twin!(GpuPathState {
+                pixel,
+                sample,
+                phase,
+                stack_len,
+                pixel_sum,
+                rays,
+                radiance,
+                light,
+                origin,
+                depth,
+                direction,
+                medium_depth,
+                weight,
+                material,
+                medium_iors,
+                shadow_origin,
+                base,
+                normal,
+                _pad0,
+                albedo,
+                _pad1,
+                direct,
+                _pad2
+            }),
+        ),
+        (
+            "StackEntry",
+            twin!(GpuStackEntry {
+                origin,
+                depth,
+                direction,
+                medium_depth,
+                weight,
+                _pad,
+                medium_iors
+            }),
+        ),
+        (
+            "Counters",
+            twin!(GpuCounters {
+                next_pixel,
+                pixels_done,
+                rays_low,
+                rays_high,
+                errors,
+                _pad
+            }),
+        ),
     ])
 }
 
@@ -221,6 +303,15 @@ fn constants_match() {
         ("NO_IMAGE", NO_IMAGE),
         ("LIGHT_POINT", LIGHT_POINT),
         ("LIGHT_DIRECTIONAL", LIGHT_DIRECTIONAL),
+        ("FLAG_STORE_SUM", FLAG_STORE_SUM),
+        ("ERROR_LOOP_CUT", ERROR_LOOP_CUT),
+        ("ERROR_TRAVERSAL_STACK", ERROR_TRAVERSAL_STACK),
+        ("PRIM_KIND_SHIFT", PrimRef::INDEX_BITS),
+        ("PRIM_INDEX_MASK", PrimRef::MAX_INDEX),
+        ("PRIM_SPHERE", PrimKind::Sphere as u32),
+        ("PRIM_PLANE", PrimKind::Plane as u32),
+        ("PRIM_POLYGON", PrimKind::Polygon as u32),
+        ("PRIM_TRIANGLE", PrimKind::Triangle as u32),
     ]);
     let mut found = 0;
     for (_, constant) in module.constants.iter() {
@@ -254,17 +345,20 @@ fn validate(name: &str, source: &str) {
 
 #[test]
 fn composed_trace_shader_validates() {
-    for stack_size in [1, 9] {
-        let source = trace_shader_source(stack_size, &ShaderFeatures::ALL).expect("directives");
-        validate(&format!("trace shader (stack size {stack_size})"), &source);
-        let module = naga::front::wgsl::parse_str(&source).expect("parsed above");
+    let source = trace_shader_source(&ShaderFeatures::ALL).expect("directives");
+    validate("trace shader", &source);
+    let module = naga::front::wgsl::parse_str(&source).expect("parsed above");
+    for name in ["shade_paths", "trace_rays"] {
         let entry = module
             .entry_points
             .iter()
-            .find(|e| e.name == "trace_pixels")
-            .expect("entry point trace_pixels");
+            .find(|e| e.name == name)
+            .unwrap_or_else(|| panic!("entry point {name}"));
         assert_eq!(entry.stage, naga::ShaderStage::Compute);
-        assert_eq!(entry.workgroup_size, [8, 8, 1]);
+        assert_eq!(
+            entry.workgroup_size,
+            [gpu_render::gpu::shaders::SLOT_WORKGROUP_SIZE, 1, 1]
+        );
     }
 }
 

@@ -13,7 +13,7 @@ use common::scenes::shipped as scene;
 
 /// The names of the functions in the naga module built for `features`.
 fn function_names(features: &ShaderFeatures) -> BTreeSet<String> {
-    let source = trace_shader_source(5, features).expect("well-formed directives");
+    let source = trace_shader_source(features).expect("well-formed directives");
     let module = naga::front::wgsl::parse_str(&source)
         .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
     naga::valid::Validator::new(
@@ -108,7 +108,7 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         toggle(&mut without, false);
         function_names(&without);
         let source_length = |f: &ShaderFeatures| {
-            trace_shader_source(5, f)
+            trace_shader_source(f)
                 .expect("well-formed directives")
                 .len()
         };
@@ -163,7 +163,7 @@ fn specialised_and_general_modules_render_the_same_pixels() {
 }
 
 #[test]
-fn pipelines_are_cached_by_stack_size_and_feature_set() {
+fn pipelines_are_cached_by_feature_set() {
     let Some(gpu) = common::gpu::headless_gpu() else {
         return;
     };

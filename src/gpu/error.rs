@@ -37,6 +37,10 @@ pub enum GpuError {
     /// The device was lost (driver reset, watchdog, hang past the poll timeout).
     #[error("GPU device lost: {0}")]
     DeviceLost(String),
+    /// The trace kernels reported work they could not finish (a loop cut short by the
+    /// driver): the image would be wrong, so none is returned.
+    #[error("the GPU trace did not complete: {0}")]
+    TraceIncomplete(String),
     /// Reading results back from the GPU failed.
     #[error("reading back from the GPU failed: {0}")]
     Readback(String),

@@ -9,6 +9,7 @@
 //! to remove it. Dropping the text means a module for a scene without glass really
 //! has no refraction code, which `tests/specialisation.rs` checks on the naga module.
 
+use crate::accel::MAX_POLYGON_VERTICES;
 use crate::scene::{MaterialKind, Scene, Shape};
 
 /// Which optional parts of the trace shader a module contains.
@@ -61,8 +62,15 @@ impl ShaderFeatures {
         Self {
             spheres: has_shape(|s| matches!(s, Shape::Sphere { .. })),
             planes: has_shape(|s| matches!(s, Shape::Plane { .. })),
-            polygons: has_shape(|s| matches!(s, Shape::Polygon { .. })),
-            triangles: has_shape(|s| matches!(s, Shape::Triangle { .. })),
+            // Polygons of many vertices are traced as their triangles (see
+            // `crate::accel::MAX_POLYGON_VERTICES`).
+            polygons: has_shape(
+                |s| matches!(s, Shape::Polygon { vertices, .. } if vertices.len() <= MAX_POLYGON_VERTICES),
+            ),
+            triangles: has_shape(|s| {
+                matches!(s, Shape::Triangle { .. })
+                    || matches!(s, Shape::Polygon { vertices, .. } if vertices.len() > MAX_POLYGON_VERTICES)
+            }),
             refraction: has_kind(MaterialKind::Dielectric),
             blinn_phong: has_kind(MaterialKind::BlinnPhong),
             cook_torrance: has_kind(MaterialKind::CookTorrance),

@@ -5,7 +5,9 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// Per-frame constants (`FrameUniforms` in WGSL), bound as a uniform buffer.
+/// The constants of one trace (`FrameUniforms` in WGSL), bound as a uniform buffer:
+/// the camera and scene settings, and which region of the image, which sample range
+/// and how many slots the trace covers.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct FrameUniforms {
@@ -27,50 +29,197 @@ pub struct FrameUniforms {
     pub height: u32,
     /// Radiance of rays that escape.
     pub background: [f32; 3],
-    /// Samples per pixel.
+    /// Samples per pixel of the whole render.
     pub samples_per_pixel: u32,
     /// Whitted ambient radiance.
     pub ambient: [f32; 3],
     /// Largest bounce depth after the primary ray.
     pub max_depth: u32,
-    /// Number of spheres in the sphere buffer (the buffer may hold a padding record).
-    pub sphere_count: u32,
-    /// Number of planes.
+    /// Indices of refraction of the dielectrics around the camera, outermost first
+    /// (unused entries 1).
+    pub camera_medium_iors: [f32; 4],
+    /// How many dielectrics contain the camera (`Scene::camera_medium`).
+    pub camera_medium_depth: u32,
+    /// Number of infinite planes.
     pub plane_count: u32,
-    /// Number of polygons.
-    pub polygon_count: u32,
-    /// Number of triangles.
-    pub triangle_count: u32,
+    /// Number of BVH nodes (0: no bounded primitive).
+    pub node_count: u32,
     /// Number of lights.
     pub light_count: u32,
-    /// First image row this dispatch traces (dispatches are split into row chunks).
-    pub row_offset: u32,
-    /// Number of rows this dispatch traces.
-    pub row_count: u32,
-    /// First image column this dispatch traces (images wider than the device's
-    /// texture limit are traced in tiles).
-    pub column_offset: u32,
-    /// Number of columns this dispatch traces.
-    pub column_count: u32,
-    /// Image column stored at texel x = 0 of the target texture (the tile's left edge).
+    /// First image column of the traced region.
+    pub region_x: u32,
+    /// First image row of the traced region.
+    pub region_y: u32,
+    /// Columns of the traced region.
+    pub region_width: u32,
+    /// Rows of the traced region.
+    pub region_height: u32,
+    /// Image column stored at texel x = 0 of the target texture.
     pub target_x: u32,
-    /// Image row stored at texel y = 0 of the target texture (the tile's top edge).
+    /// Image row stored at texel y = 0 of the target texture.
     pub target_y: u32,
+    /// First sample index this trace adds to each pixel.
+    pub first_sample: u32,
+    /// One past the last sample index this trace adds; the written mean divides by it.
+    pub end_sample: u32,
+    /// Number of path slots (invocations per dispatch).
+    pub slot_count: u32,
+    /// Entries of each slot's bounce stack (the scene's `stack_size`).
+    pub stack_size: u32,
+    /// Most loop iterations one invocation runs per dispatch (see `docs/model.md`,
+    /// "Bounded work").
+    pub iteration_budget: u32,
+    /// `FLAG_*` bits.
+    pub flags: u32,
     /// Length scale of the self-intersection offset's near-origin branch (see
-    /// `crate::cpu::intersect::ray_offset_scale`).
+    /// [`crate::accel::ray_offset_scale`]).
     pub offset_scale: f32,
     /// Branches whose weight is not above this are not traced.
     pub min_ray_weight: f32,
-    /// The sample this dispatch traces in every pixel: one dispatch per sample index
-    /// (see `docs/model.md`, "One sample per dispatch").
-    pub sample_index: u32,
-    /// Pixel rows the accumulation buffer holds (the dispatch's rows fit in it).
-    pub accumulation_rows: u32,
-    /// How many dielectrics contain the camera (`Scene::camera_medium`).
-    pub camera_medium_depth: u32,
-    /// Their indices of refraction, outermost first (unused entries 1).
-    pub camera_medium_iors: [f32; 4],
+    /// Padding.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
 }
+
+/// `FrameUniforms.flags`: store each finished pixel's sample sum in the accumulation
+/// buffer.
+pub const FLAG_STORE_SUM: u32 = 1;
+
+/// One traversal of one ray, resumable (`TraceRay` in WGSL). Only the shaders read and
+/// write it; the host zeroes it (`TRACE_IDLE`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuTraceRay {
+    /// Ray origin.
+    pub origin: [f32; 3],
+    /// Exclusive distance limit.
+    pub t_max: f32,
+    /// Unit direction.
+    pub direction: [f32; 3],
+    /// `TRACE_*` state.
+    pub status: u32,
+    /// Distance of the best hit so far (`t_max` without one).
+    pub best_t: f32,
+    /// The best hit's primitive reference, or `u32::MAX`.
+    pub best_prim: u32,
+    /// Entries on the slot's traversal stack.
+    pub stack_len: u32,
+    /// Node to visit next, or `u32::MAX`.
+    pub node: u32,
+    /// Next primitive of the current leaf.
+    pub cursor: u32,
+    /// One past the current leaf's last primitive.
+    pub leaf_end: u32,
+    /// 1 for a shadow ray (the first hit ends it).
+    pub any_hit: u32,
+    /// Padding.
+    pub _pad: u32,
+}
+
+/// The state of one slot's path tree between dispatches (`PathState` in WGSL). Only
+/// the shaders read and write it; the host zeroes it (`PHASE_FETCH_PIXEL`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuPathState {
+    /// Region pixel the slot works on.
+    pub pixel: u32,
+    /// Current sample index.
+    pub sample: u32,
+    /// `PHASE_*` of the path.
+    pub phase: u32,
+    /// Entries on the slot's bounce stack.
+    pub stack_len: u32,
+    /// Sum of the pixel's finished samples.
+    pub pixel_sum: [f32; 3],
+    /// Rays traced for the pixel so far.
+    pub rays: u32,
+    /// Radiance of the current sample so far.
+    pub radiance: [f32; 3],
+    /// Index of the light being gathered.
+    pub light: u32,
+    /// Origin of the ray being shaded.
+    pub origin: [f32; 3],
+    /// Its bounce depth.
+    pub depth: u32,
+    /// Its direction.
+    pub direction: [f32; 3],
+    /// How many dielectrics it is inside.
+    pub medium_depth: u32,
+    /// Its path weight.
+    pub weight: [f32; 3],
+    /// Material of the hit being lit.
+    pub material: u32,
+    /// Indices of refraction of the dielectrics it is inside.
+    pub medium_iors: [f32; 4],
+    /// Origin of the hit's shadow rays.
+    pub shadow_origin: [f32; 3],
+    /// Weight of the hit's base BRDF (1 - coat reflectance).
+    pub base: f32,
+    /// Shading normal (facing the incoming ray).
+    pub normal: [f32; 3],
+    /// Padding.
+    pub _pad0: u32,
+    /// Albedo at the hit (texture applied).
+    pub albedo: [f32; 3],
+    /// Padding.
+    pub _pad1: u32,
+    /// Direct light gathered so far (ambient included).
+    pub direct: [f32; 3],
+    /// Padding.
+    pub _pad2: u32,
+}
+
+/// One pending ray on a slot's bounce stack (`StackEntry` in WGSL).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuStackEntry {
+    /// Ray origin.
+    pub origin: [f32; 3],
+    /// Bounce depth.
+    pub depth: u32,
+    /// Ray direction.
+    pub direction: [f32; 3],
+    /// How many dielectrics the ray is inside.
+    pub medium_depth: u32,
+    /// Path weight.
+    pub weight: [f32; 3],
+    /// Padding.
+    pub _pad: u32,
+    /// Indices of refraction of the dielectrics it is inside.
+    pub medium_iors: [f32; 4],
+}
+
+/// The shared counters of one trace (`Counters` in WGSL), read back after each
+/// submission.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Pod, Zeroable)]
+pub struct GpuCounters {
+    /// Region pixels handed out to slots (may pass the region's size).
+    pub next_pixel: u32,
+    /// Region pixels finished.
+    pub pixels_done: u32,
+    /// Rays traced, low word.
+    pub rays_low: u32,
+    /// Rays traced, high word.
+    pub rays_high: u32,
+    /// `ERROR_*` bits.
+    pub errors: u32,
+    /// Padding.
+    pub _pad: [u32; 3],
+}
+
+impl GpuCounters {
+    /// Rays traced, as one number.
+    pub fn rays(&self) -> u64 {
+        (u64::from(self.rays_high) << 32) | u64::from(self.rays_low)
+    }
+}
+
+/// `Counters.errors` bit: a loop ended without reaching its exit (the driver cut it).
+pub const ERROR_LOOP_CUT: u32 = 1;
+/// `Counters.errors` bit: a traversal needed more stack than `MAX_BVH_DEPTH`.
+pub const ERROR_TRAVERSAL_STACK: u32 = 2;
 
 /// A sphere (`Sphere` in WGSL).
 #[repr(C)]

@@ -3,8 +3,11 @@
 //! - [`context`]: a headless instance/adapter/device/queue ([`HeadlessGpu`]) for apps
 //!   and tests that do not bring their own device.
 //! - [`renderer`]: [`GpuRenderer`], built from the caller's `Device`; a high-level
-//!   [`GpuRenderer::render`] and low-level `prepare`/`encode_trace`/`encode_display`
-//!   for apps that own their frame.
+//!   [`GpuRenderer::render`] and `prepare`/`trace_into`/`encode_display` for apps that
+//!   own their textures and frame.
+//! - `scene_buffers`: a scene uploaded to the device ([`PreparedScene`]).
+//! - `wavefront`: the path slots and the schedule of the two trace kernels.
+//! - `pipelines`, `display`: the pipelines and the display pass.
 //! - [`upload`]: pure conversion of a [`crate::scene::Scene`] into the GPU records.
 //! - [`shaders`]: composition of the WGSL sources, specialised by [`features`].
 //! - [`layout`]: the `#[repr(C)]` records shared with `shaders/types.wgsl`.
@@ -21,16 +24,25 @@
 //! ```
 
 pub mod context;
+mod display;
 mod error;
 pub mod features;
 pub mod layout;
+mod pipelines;
 mod readback;
 pub mod renderer;
+mod scene_buffers;
 pub mod shaders;
 pub mod upload;
+mod wavefront;
 
 pub use context::{AdapterChoice, HeadlessGpu, list_adapters};
 pub use error::GpuError;
 pub use features::ShaderFeatures;
+pub use pipelines::{DISPLAY_FORMAT, LINEAR_FORMAT, TRACE_STORAGE_BUFFERS, TracePipelines};
 pub use readback::read_texture;
-pub use renderer::{GpuRendered, GpuRenderer, PreparedScene, TraceRegion, image_tiles};
+pub use renderer::{GpuRendered, GpuRenderer, TraceRegion, image_tiles};
+pub use scene_buffers::PreparedScene;
+pub use wavefront::{
+    LLVMPIPE_LOOP_LIMIT, TARGET_SUBMISSION, default_slot_count, iteration_budget_for,
+};

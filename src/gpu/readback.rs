@@ -48,7 +48,8 @@ pub(crate) fn capture<T>(
     Ok(value)
 }
 
-/// Blocks until `submission` has finished, for at most `timeout`.
+/// Blocks until `submission` has finished, for at most `timeout` (`None`: as long as
+/// it takes).
 ///
 /// A timeout is reported as [`GpuError::DeviceLost`]: a dispatch that runs that long
 /// has hung or been killed by a watchdog, and waiting forever is worse. wgpu panics
@@ -58,18 +59,19 @@ pub(crate) fn capture<T>(
 pub(crate) fn wait(
     device: &wgpu::Device,
     submission: wgpu::SubmissionIndex,
-    timeout: Duration,
+    timeout: Option<Duration>,
 ) -> Result<(), GpuError> {
     let poll = catch_unwind(AssertUnwindSafe(|| {
         device.poll(wgpu::PollType::Wait {
             submission_index: Some(submission),
-            timeout: Some(timeout),
+            timeout,
         })
     }));
     match poll {
         Ok(Ok(_)) => Ok(()),
         Ok(Err(wgpu::PollError::Timeout)) => Err(GpuError::DeviceLost(format!(
-            "the GPU did not finish within {timeout:?}"
+            "the GPU did not finish within {:?} (the renderer's poll timeout)",
+            timeout.unwrap_or_default()
         ))),
         Ok(Err(e)) => Err(GpuError::DeviceLost(e.to_string())),
         Err(panic) => {
@@ -89,7 +91,7 @@ pub(crate) fn submit_and_wait(
     queue: &wgpu::Queue,
     encoder: wgpu::CommandEncoder,
     what: &str,
-    timeout: Duration,
+    timeout: Option<Duration>,
 ) -> Result<(), GpuError> {
     let submission = capture(device, what, Caught::Resource, || {
         queue.submit([encoder.finish()])
@@ -102,7 +104,7 @@ pub(crate) fn map_read(
     device: &wgpu::Device,
     buffer: &wgpu::Buffer,
     size: u64,
-    timeout: Duration,
+    timeout: Option<Duration>,
 ) -> Result<Vec<u8>, GpuError> {
     let (sender, receiver) = mpsc::channel();
     buffer.map_async(wgpu::MapMode::Read, 0..size, move |result| {
@@ -113,7 +115,7 @@ pub(crate) fn map_read(
     let poll = catch_unwind(AssertUnwindSafe(|| {
         device.poll(wgpu::PollType::Wait {
             submission_index: None,
-            timeout: Some(timeout),
+            timeout,
         })
     }));
     match poll {
@@ -156,7 +158,7 @@ const READBACK_BAND_BYTES: u64 = 64 << 20;
 /// # fn demo(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture)
 /// # -> Result<(), gpu_render::gpu::GpuError> {
 /// let rgba8 = gpu_render::gpu::read_texture(
-///     device, queue, texture, 4, std::time::Duration::from_secs(10))?;
+///     device, queue, texture, 4, Some(std::time::Duration::from_secs(10)))?;
 /// assert_eq!(rgba8.len(), (texture.width() * texture.height() * 4) as usize);
 /// # Ok(())
 /// # }
@@ -166,7 +168,7 @@ pub fn read_texture(
     queue: &wgpu::Queue,
     texture: &wgpu::Texture,
     bytes_per_texel: u32,
-    timeout: Duration,
+    timeout: Option<Duration>,
 ) -> Result<Vec<u8>, GpuError> {
     let (width, height) = (texture.width(), texture.height());
     let row_bytes = u64::from(width) * u64::from(bytes_per_texel);
@@ -221,31 +223,6 @@ pub fn read_texture(
         row += rows;
     }
     Ok(out)
-}
-
-/// Copies the first `size` bytes of `source` (COPY_SRC) into a staging buffer and
-/// reads them.
-pub(crate) fn read_buffer(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    source: &wgpu::Buffer,
-    size: u64,
-    timeout: Duration,
-) -> Result<Vec<u8>, GpuError> {
-    let staging = capture(device, "readback buffer", Caught::Resource, || {
-        device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("gpu-render buffer readback"),
-            size,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        })
-    })?;
-    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-        label: Some("gpu-render buffer readback copy"),
-    });
-    encoder.copy_buffer_to_buffer(source, 0, &staging, 0, size);
-    submit_and_wait(device, queue, encoder, "buffer readback copy", timeout)?;
-    map_read(device, &staging, size, timeout)
 }
 
 #[cfg(test)]

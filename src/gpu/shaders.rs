@@ -23,42 +23,50 @@ pub const BXDF_WGSL: &str = include_str!("../../shaders/bxdf.wgsl");
 pub const BXDF_EVAL_WGSL: &str = include_str!("../../shaders/bxdf_eval.wgsl");
 /// Entry point of the BRDF test kernel.
 pub const BXDF_EVAL_ENTRY_POINT: &str = "eval_brdfs";
-/// The tracing kernel (`trace_pixels`).
+/// The resumable BVH traversal, twin of [`crate::cpu::traverse`].
+pub const TRAVERSE_WGSL: &str = include_str!("../../shaders/traverse.wgsl");
+/// The wavefront kernels (`shade_paths`, `trace_rays`) and their bindings.
 pub const TRACE_WGSL: &str = include_str!("../../shaders/trace.wgsl");
 
-/// Entry point of the trace module.
-pub const TRACE_ENTRY_POINT: &str = "trace_pixels";
+/// Entry point of the shading kernel of the trace module.
+pub const SHADE_ENTRY_POINT: &str = "shade_paths";
+/// Entry point of the traversal kernel of the trace module.
+pub const TRACE_ENTRY_POINT: &str = "trace_rays";
+/// Invocations per workgroup of the two trace kernels, `@workgroup_size(64, 1, 1)`.
+pub const SLOT_WORKGROUP_SIZE: u32 = 64;
 /// Entry point of the display module.
 pub const DISPLAY_ENTRY_POINT: &str = "encode_display";
-/// Workgroup size (x and y) of both compute entry points, `@workgroup_size(8, 8, 1)`.
+/// Workgroup size (x and y) of the display pass, `@workgroup_size(8, 8, 1)`.
 pub const WORKGROUP_SIZE: u32 = 8;
 
-/// The complete trace module for a bounce stack of `stack_size` entries, specialised
-/// to `features` (see [`super::features`]): the `STACK_SIZE` constant, then types,
-/// sampling, intersect, texture, bxdf and trace.
-///
-/// The stack size is a `const` rather than a pipeline-overridable constant because
-/// WGSL array sizes in function address space must be creation-time constants; each
-/// stack size and feature set therefore gets its own pipeline (cached by the renderer).
+/// The complete trace module specialised to `features` (see [`super::features`]): the
+/// constants shared with the Rust side (`MAX_BVH_DEPTH`, `MAX_POLYGON_VERTICES`), then
+/// types, sampling, intersect, texture, bxdf, traverse and trace.
 ///
 /// Errors: a message if the sources' feature directives are malformed.
 ///
 /// ```
 /// use gpu_render::gpu::ShaderFeatures;
-/// let src = gpu_render::gpu::shaders::trace_shader_source(9, &ShaderFeatures::ALL).unwrap();
-/// assert!(src.starts_with("const STACK_SIZE: u32 = 9u;\n"));
+/// let src = gpu_render::gpu::shaders::trace_shader_source(&ShaderFeatures::ALL).unwrap();
+/// assert!(src.starts_with("const MAX_BVH_DEPTH: u32 = 64u;\n"));
 /// assert!(src.contains("fn refract_direction"));
+/// assert!(src.contains("fn shade_paths") && src.contains("fn trace_rays"));
 /// ```
-pub fn trace_shader_source(stack_size: u32, features: &ShaderFeatures) -> Result<String, String> {
+pub fn trace_shader_source(features: &ShaderFeatures) -> Result<String, String> {
     let parts = [
         TYPES_WGSL,
         SAMPLING_WGSL,
         INTERSECT_WGSL,
         TEXTURE_WGSL,
         BXDF_WGSL,
+        TRAVERSE_WGSL,
         TRACE_WGSL,
     ];
-    let mut source = format!("const STACK_SIZE: u32 = {stack_size}u;\n");
+    let mut source = format!(
+        "const MAX_BVH_DEPTH: u32 = {}u;\nconst MAX_POLYGON_VERTICES: u32 = {}u;\n",
+        crate::accel::MAX_BVH_DEPTH,
+        crate::accel::MAX_POLYGON_VERTICES
+    );
     for part in parts {
         source.push_str(&specialise(part, features)?);
     }

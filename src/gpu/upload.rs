@@ -12,78 +12,88 @@ use super::layout::{
     MATERIAL_DIELECTRIC, MATERIAL_EMISSIVE, MATERIAL_LAMBERT, MATERIAL_MIRROR, MATERIAL_OREN_NAYAR,
     MATERIAL_PBR, MATERIAL_TABULATED, NO_IMAGE,
 };
+use crate::accel::{BvhNode, PolygonShape, SceneGeometry};
 use crate::camera::CameraFrame;
 use crate::scene::{
-    FresnelModel, Image, Light, Material, MaterialKind, MediumStack, MicrofacetDistribution,
-    PolygonPlane, Scene, Shape, TextureMapping, polygon_plane,
+    FresnelModel, Image, Light, Material, MaterialKind, MediumStack, MicrofacetDistribution, Scene,
+    TextureMapping,
 };
 
 /// Every record list of a scene, ready for upload. The lists hold exactly the scene's
 /// items (possibly none); [`SceneRecords::padded`] adds the padding record WGSL needs.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SceneRecords {
-    /// Spheres, in scene order.
+    /// Spheres, in [`SceneGeometry::spheres`] order.
     pub spheres: Vec<GpuSphere>,
-    /// Planes, in scene order.
+    /// Planes, in [`SceneGeometry::planes`] order.
     pub planes: Vec<GpuPlane>,
-    /// Polygons, in scene order; their vertices are in `polygon_vertices`.
+    /// Polygons, in [`SceneGeometry::polygons`] order; their vertices are in
+    /// `polygon_vertices`.
     pub polygons: Vec<GpuPolygon>,
     /// The vertices of all polygons, concatenated, as `vec4` with `w = 0`.
     pub polygon_vertices: Vec<[f32; 4]>,
-    /// Triangles, in scene order.
+    /// Triangles, in [`SceneGeometry::triangles`] order.
     pub triangles: Vec<GpuTriangle>,
     /// Materials, indexed by the shapes' `material`.
     pub materials: Vec<GpuMaterial>,
     /// Lights, in scene order.
     pub lights: Vec<GpuLight>,
+    /// The BVH nodes, as both tracers read them.
+    pub bvh_nodes: Vec<BvhNode>,
+    /// The BVH's primitive references (`PrimRef` values), leaf by leaf.
+    pub bvh_prims: Vec<u32>,
 }
 
 impl SceneRecords {
-    /// Converts every shape, material and light of `scene` (already in lighting space).
-    pub fn from_scene(scene: &Scene) -> Self {
-        let mut records = Self::default();
-        for shape in &scene.shapes {
-            match shape {
-                Shape::Sphere {
-                    center,
-                    radius,
-                    material,
-                } => records.spheres.push(GpuSphere {
-                    center: vec3(*center),
-                    radius: *radius as f32,
-                    material: *material,
+    /// Converts the materials and lights of `scene` (already in lighting space) and
+    /// the primitives and BVH of its `geometry`.
+    pub fn new(scene: &Scene, geometry: &SceneGeometry) -> Self {
+        let mut records = Self {
+            spheres: geometry
+                .spheres
+                .iter()
+                .map(|s| GpuSphere {
+                    center: vec3(s.center),
+                    radius: s.radius as f32,
+                    material: s.material,
                     _pad: [0; 3],
-                }),
-                Shape::Plane {
-                    normal,
-                    offset,
-                    material,
-                } => records.planes.push(GpuPlane {
-                    normal: vec3(*normal),
-                    offset: *offset as f32,
-                    material: *material,
+                })
+                .collect(),
+            planes: geometry
+                .planes
+                .iter()
+                .map(|p| GpuPlane {
+                    normal: vec3(p.normal),
+                    offset: p.offset as f32,
+                    material: p.material,
                     _pad: [0; 3],
-                }),
-                Shape::Polygon { vertices, material } => {
-                    let first_vertex = records.polygon_vertices.len();
-                    records.polygon_vertices.extend(
-                        vertices
-                            .iter()
-                            .map(|v| [v.x as f32, v.y as f32, v.z as f32, 0.0]),
-                    );
-                    records
-                        .polygons
-                        .push(polygon_record(vertices, first_vertex, *material));
-                }
-                Shape::Triangle { vertices, material } => records.triangles.push(GpuTriangle {
-                    v0: vec3(vertices[0]),
-                    material: *material,
-                    v1: vec3(vertices[1]),
+                })
+                .collect(),
+            triangles: geometry
+                .triangles
+                .iter()
+                .map(|t| GpuTriangle {
+                    v0: vec3(t.vertices[0]),
+                    material: t.material,
+                    v1: vec3(t.vertices[1]),
                     _pad1: 0,
-                    v2: vec3(vertices[2]),
+                    v2: vec3(t.vertices[2]),
                     _pad2: 0,
-                }),
-            }
+                })
+                .collect(),
+            bvh_nodes: geometry.bvh.nodes.clone(),
+            bvh_prims: geometry.bvh.prims.iter().map(|p| p.0).collect(),
+            ..Self::default()
+        };
+        for polygon in &geometry.polygons {
+            let first_vertex = records.polygon_vertices.len();
+            records.polygon_vertices.extend(
+                polygon
+                    .vertices
+                    .iter()
+                    .map(|v| [v.x as f32, v.y as f32, v.z as f32, 0.0]),
+            );
+            records.polygons.push(polygon_record(polygon, first_vertex));
         }
         records.materials = scene
             .materials
@@ -95,7 +105,8 @@ impl SceneRecords {
     }
 
     /// The same lists with one zeroed record in place of each empty list: WGSL has no
-    /// zero-sized storage buffers, and the real counts travel in [`FrameUniforms`].
+    /// zero-sized storage buffers, and the real counts travel in [`FrameUniforms`]
+    /// (or, for the BVH, in an empty tree's node count of 0).
     pub fn padded(&self) -> Self {
         Self {
             spheres: pad(&self.spheres),
@@ -105,6 +116,8 @@ impl SceneRecords {
             triangles: pad(&self.triangles),
             materials: pad(&self.materials),
             lights: pad(&self.lights),
+            bvh_nodes: pad(&self.bvh_nodes),
+            bvh_prims: pad(&self.bvh_prims),
         }
     }
 }
@@ -122,23 +135,16 @@ fn vec3(v: DVec3) -> [f32; 3] {
     [v.x as f32, v.y as f32, v.z as f32]
 }
 
-/// The record of one polygon whose vertices start at `first_vertex` in the vertex list.
-/// The plane comes from [`polygon_plane`], as on the CPU. A degenerate (zero-area)
-/// polygon gets a zero normal, which no ray can hit; scene validation rejects those
-/// anyway.
-pub fn polygon_record(vertices: &[DVec3], first_vertex: usize, material: u32) -> GpuPolygon {
-    let plane = polygon_plane(vertices).unwrap_or(PolygonPlane {
-        normal: DVec3::ZERO,
-        offset: 0.0,
-        dropped_axis: 2,
-    });
+/// The record of one polygon whose vertices start at `first_vertex` in the vertex list,
+/// with the plane computed once for both tracers ([`PolygonShape::plane`]).
+pub fn polygon_record(polygon: &PolygonShape, first_vertex: usize) -> GpuPolygon {
     GpuPolygon {
-        normal: vec3(plane.normal),
-        offset: plane.offset as f32,
+        normal: vec3(polygon.plane.normal),
+        offset: polygon.plane.offset as f32,
         first_vertex: u32::try_from(first_vertex).unwrap_or(u32::MAX),
-        vertex_count: u32::try_from(vertices.len()).unwrap_or(u32::MAX),
-        dropped_axis: plane.dropped_axis,
-        material,
+        vertex_count: u32::try_from(polygon.vertices.len()).unwrap_or(u32::MAX),
+        dropped_axis: polygon.plane.dropped_axis,
+        material: polygon.material,
     }
 }
 
@@ -246,10 +252,10 @@ pub fn light_record(light: &Light) -> GpuLight {
     }
 }
 
-/// The frame constants for `scene` (in lighting space) and its `records`, covering the
-/// whole image (`row_offset` 0, `row_count` = height, all columns, target origin 0);
-/// chunked and tiled dispatches override the row, column and target fields.
-pub fn frame_uniforms(scene: &Scene, records: &SceneRecords) -> FrameUniforms {
+/// The constants of a trace of `scene` (in lighting space) with `geometry`, covering
+/// the whole image and all its samples with no slots yet: the scheduler fills in the
+/// region, sample range, slot count and budget of each trace.
+pub fn frame_uniforms(scene: &Scene, geometry: &SceneGeometry) -> FrameUniforms {
     let settings = &scene.render;
     let camera = CameraFrame::new(&scene.camera, settings.width, settings.height);
     let count = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
@@ -268,23 +274,27 @@ pub fn frame_uniforms(scene: &Scene, records: &SceneRecords) -> FrameUniforms {
         samples_per_pixel: settings.samples_per_pixel,
         ambient: vec3(scene.environment.ambient),
         max_depth: settings.max_depth,
-        sphere_count: count(records.spheres.len()),
-        plane_count: count(records.planes.len()),
-        polygon_count: count(records.polygons.len()),
-        triangle_count: count(records.triangles.len()),
-        light_count: count(records.lights.len()),
-        row_offset: 0,
-        row_count: settings.height,
-        column_offset: 0,
-        column_count: settings.width,
+        camera_medium_iors: camera_medium.iors.map(|ior| ior as f32),
+        camera_medium_depth: camera_medium.depth,
+        plane_count: count(geometry.planes.len()),
+        node_count: count(geometry.bvh.nodes.len()),
+        light_count: count(scene.lights.len()),
+        region_x: 0,
+        region_y: 0,
+        region_width: settings.width,
+        region_height: settings.height,
         target_x: 0,
         target_y: 0,
-        offset_scale: crate::accel::ray_offset_scale(&scene.shapes) as f32,
+        first_sample: 0,
+        end_sample: settings.samples_per_pixel,
+        slot_count: 0,
+        stack_size: settings.stack_size,
+        iteration_budget: u32::MAX,
+        flags: 0,
+        offset_scale: geometry.offset_scale as f32,
         min_ray_weight: settings.min_ray_weight as f32,
-        sample_index: 0,
-        accumulation_rows: 0,
-        camera_medium_depth: camera_medium.depth,
-        camera_medium_iors: camera_medium.iors.map(|ior| ior as f32),
+        _pad0: 0,
+        _pad1: 0,
     }
 }
 
@@ -293,7 +303,7 @@ mod tests {
     use bytemuck::Zeroable;
 
     use super::*;
-    use crate::scene::{Camera, Environment, LightingSpace, RenderSettings};
+    use crate::scene::{Camera, Environment, LightingSpace, RenderSettings, Shape};
 
     fn scene(shapes: Vec<Shape>, lights: Vec<Light>) -> Scene {
         Scene {
@@ -324,6 +334,18 @@ mod tests {
         }
     }
 
+    fn polygon(vertices: &[DVec3], material: u32) -> PolygonShape {
+        PolygonShape {
+            plane: crate::scene::polygon_plane(vertices).unwrap_or(crate::scene::PolygonPlane {
+                normal: DVec3::ZERO,
+                offset: 0.0,
+                dropped_axis: 2,
+            }),
+            vertices: vertices.to_vec(),
+            material,
+        }
+    }
+
     #[test]
     fn polygon_in_xz_plane_drops_y() {
         // Counter-clockwise seen from +y: normal +y.
@@ -333,7 +355,7 @@ mod tests {
             DVec3::new(1.0, 2.0, 1.0),
             DVec3::new(1.0, 2.0, 0.0),
         ];
-        let rec = polygon_record(&square, 7, 3);
+        let rec = polygon_record(&polygon(&square, 3), 7);
         assert_eq!(rec.normal, [0.0, 1.0, 0.0]);
         assert_eq!(rec.offset, 2.0);
         assert_eq!(rec.dropped_axis, 1);
@@ -358,7 +380,7 @@ mod tests {
             .iter()
             .map(|&(y, z)| DVec3::new(0.1 * z + 1.0, y, z))
             .collect();
-        let rec = polygon_record(&l, 0, 0);
+        let rec = polygon_record(&polygon(&l, 0), 0);
         let n = DVec3::new(
             f64::from(rec.normal[0]),
             f64::from(rec.normal[1]),
@@ -380,20 +402,21 @@ mod tests {
             DVec3::new(1.0, 0.3, 1.0),
             DVec3::new(0.0, 0.2, 1.0),
         ];
-        let record = polygon_record(&tilted, 4, 2);
+        let record = polygon_record(&polygon(&tilted, 2), 4);
         assert_eq!(record.dropped_axis, 1);
         assert_eq!(
             (record.first_vertex, record.vertex_count, record.material),
             (4, 4, 2)
         );
         let degenerate = [DVec3::ZERO, DVec3::X, DVec3::X * 2.0];
-        assert_eq!(polygon_record(&degenerate, 0, 0).normal, [0.0; 3]);
+        assert_eq!(polygon_record(&polygon(&degenerate, 0), 0).normal, [0.0; 3]);
     }
 
     #[test]
     fn empty_lists_get_one_padding_record_and_counts_stay_zero() {
         let s = scene(vec![], vec![]);
-        let records = SceneRecords::from_scene(&s);
+        let geometry = SceneGeometry::new(&s);
+        let records = SceneRecords::new(&s, &geometry);
         assert!(records.spheres.is_empty() && records.lights.is_empty());
         let padded = records.padded();
         assert_eq!(padded.spheres, vec![GpuSphere::zeroed()]);
@@ -402,17 +425,13 @@ mod tests {
         assert_eq!(padded.polygon_vertices, vec![[0.0; 4]]);
         assert_eq!(padded.triangles.len(), 1);
         assert_eq!(padded.lights.len(), 1);
+        assert_eq!(padded.bvh_nodes.len(), 1);
+        assert_eq!(padded.bvh_prims.len(), 1);
         assert_eq!(padded.materials.len(), 1, "the scene's one material");
-        let frame = frame_uniforms(&s, &records);
+        let frame = frame_uniforms(&s, &geometry);
         assert_eq!(
-            (
-                frame.sphere_count,
-                frame.plane_count,
-                frame.polygon_count,
-                frame.triangle_count,
-                frame.light_count
-            ),
-            (0, 0, 0, 0, 0)
+            (frame.plane_count, frame.node_count, frame.light_count),
+            (0, 0, 0)
         );
     }
 
@@ -461,7 +480,8 @@ mod tests {
                 },
             ],
         );
-        let r = SceneRecords::from_scene(&s);
+        let geometry = SceneGeometry::new(&s);
+        let r = SceneRecords::new(&s, &geometry);
         assert_eq!(r.spheres[0].center, [1.0, 2.0, 3.0]);
         assert_eq!(r.spheres[0].radius, 0.5);
         assert_eq!(r.planes[0].offset, -1.0);
@@ -478,14 +498,19 @@ mod tests {
         assert_eq!(r.lights[1].kind, LIGHT_DIRECTIONAL);
         assert_eq!(r.lights[1].position_or_direction, [0.0, -1.0, 0.0]);
         assert_eq!(r.materials[0].kind, MATERIAL_LAMBERT);
-        let f = frame_uniforms(&s, &r);
+        // Four bounded primitives: the tree's leaves reference each once.
+        let mut referenced = r.bvh_prims.clone();
+        referenced.sort_unstable();
+        assert_eq!(referenced.len(), 4);
+        assert_eq!(r.bvh_nodes.len(), geometry.bvh.nodes.len());
+        let f = frame_uniforms(&s, &geometry);
         assert_eq!(
             (f.width, f.height, f.samples_per_pixel, f.max_depth),
             (40, 20, 4, 3)
         );
-        assert_eq!((f.sphere_count, f.plane_count, f.polygon_count), (1, 1, 2));
-        assert_eq!((f.triangle_count, f.light_count), (1, 2));
-        assert_eq!((f.row_offset, f.row_count), (0, 20));
+        assert_eq!((f.plane_count, f.light_count), (1, 2));
+        assert_eq!(f.node_count as usize, geometry.bvh.nodes.len());
+        assert_eq!((f.region_width, f.region_height, f.end_sample), (40, 20, 4));
         assert_eq!(f.aspect, 2.0);
         assert_eq!(f.forward, [0.0, 0.0, -1.0]);
         assert_eq!(f.background, [0.1, 0.2, 0.3]);

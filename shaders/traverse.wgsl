@@ -1,0 +1,196 @@
+// BVH traversal, resumable and bounded. CPU twin: src/cpu/traverse.rs (same nodes,
+// same rules: planes first, then the tree nearest child first; at equal distance the
+// smaller primitive reference wins, so the result does not depend on the visit order).
+//
+// MAX_BVH_DEPTH and MAX_POLYGON_VERTICES are prepended by the host from the Rust
+// constants (src/gpu/shaders.rs).
+//
+// Bounded work: every loop iteration of an invocation is charged to `iterations`,
+// and a traversal that would pass frame.iteration_budget stops between two steps with
+// its state (current node, leaf cursor, best hit, stack depth) saved in its TraceRay
+// and its stack in `traversal_stack`; the next dispatch resumes it. llvmpipe ends
+// every loop of an invocation once the vector of invocations it runs together has
+// made 65,535 iterations in all (LP_MAX_TGSI_LOOP_ITERATIONS in Mesa's gallivm). One
+// flat loop keeps that count equal to the largest lane's; the inner loop of a polygon
+// test is charged at its worst case (MAX_POLYGON_VERTICES) on every step, so no lane's
+// charge can undercount the vector's. A loop that ends without reaching one of its
+// exits was cut by the driver: that sets ERROR_LOOP_CUT for the host, which then
+// refuses the image.
+
+// Direction components smaller than this are replaced by it (with their sign; -0
+// counts as positive) before the slab test divides by them: a ray parallel to a slab
+// gets huge but finite distances, never the NaN of 0·∞.
+const MIN_DIRECTION_COMPONENT: f32 = 1e-20;
+
+// 1 + 2γ₃ for f32 (γₙ = nε/(1 - nε), ε = 2^-24), which rounds to 1 + 3·2^-23: the far
+// slab distance is enlarged by it so that rounding never loses a box the ray enters
+// (Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013).
+const FAR_SLAB_SCALE: f32 = 1.0000003576;
+
+// The charge of one step of the traversal loop.
+//#if POLYGONS
+const ITERATION_COST: u32 = 1u + MAX_POLYGON_VERTICES;
+//#else
+const ITERATION_COST: u32 = 1u;
+//#endif
+
+// Loop iterations this invocation has run (see above).
+var<private> iterations: u32;
+
+fn inverse_direction(d: vec3<f32>) -> vec3<f32> {
+    let tiny = select(vec3<f32>(MIN_DIRECTION_COMPONENT), vec3<f32>(-MIN_DIRECTION_COMPONENT),
+                      d < vec3<f32>(0.0));
+    return 1.0 / select(d, tiny, abs(d) < vec3<f32>(MIN_DIRECTION_COMPONENT));
+}
+
+// The distance at which the ray enters node `index`'s box, if it does so in
+// [0, t_max], else NO_HIT (the slab test of Kay and Kajiya, with Ize's far distance).
+fn slab_enter(index: u32, origin: vec3<f32>, inverse: vec3<f32>, t_max: f32) -> f32 {
+    let node = bvh_nodes[index];
+    let lo = (node.min - origin) * inverse;
+    let hi = (node.max - origin) * inverse;
+    let near_axes = min(lo, hi);
+    let far_axes = max(lo, hi);
+    let near = max(max(max(near_axes.x, near_axes.y), near_axes.z), 0.0);
+    let far = min(min(min(far_axes.x, far_axes.y), far_axes.z), t_max) * FAR_SLAB_SCALE;
+    return select(NO_HIT, near, near <= far);
+}
+
+// The exclusive distance limit for testing `prim` against the best hit so far: the
+// best distance, or just beyond it for a smaller reference, which wins exact ties.
+fn tie_limit(prim: u32, best_t: f32, best_prim: u32) -> f32 {
+    if best_prim != NO_PRIM && prim < best_prim && best_t < bitcast<f32>(0x7f800000u) {
+        // The next f32 up: best_t is positive and finite.
+        return bitcast<f32>(bitcast<u32>(best_t) + 1u);
+    }
+    return best_t;
+}
+
+// Where level `level` of slot `slot`'s traversal stack lives: levels are interleaved
+// across slots, so the lanes of one vector touch neighbouring words.
+fn traversal_stack_index(slot: u32, level: u32) -> u32 {
+    return level * frame.slot_count + slot;
+}
+
+// Runs `trace`'s traversal until it finishes (true) or the iteration budget is spent
+// (false: the state is saved in `trace` and the slot's traversal stack). For an
+// any-hit trace (a shadow ray) the first hit ends it; best_prim != NO_PRIM then means
+// occluded.
+fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
+    let ray = Ray((*trace).origin, (*trace).direction);
+    let inverse = inverse_direction(ray.direction);
+    let any_hit = (*trace).any_hit != 0u;
+    var best_t = (*trace).best_t;
+    var best_prim = (*trace).best_prim;
+    var node = (*trace).node;
+    var cursor = (*trace).cursor;
+    var leaf_end = (*trace).leaf_end;
+    var stack_len = (*trace).stack_len;
+    if (*trace).status == TRACE_PENDING {
+        //#if PLANES
+        // Planes are unbounded: every ray tests every plane, before the tree.
+        var i = 0u;
+        loop {
+            if i >= frame.plane_count {
+                break;
+            }
+            iterations += 1u;
+            let prim = (PRIM_PLANE << PRIM_KIND_SHIFT) | i;
+            let t = intersect_prim(prim, ray, tie_limit(prim, best_t, best_prim));
+            if t != NO_HIT {
+                best_t = t;
+                best_prim = prim;
+            }
+            i += 1u;
+        }
+        if i < frame.plane_count {
+            atomicOr(&counters.errors, ERROR_LOOP_CUT);
+        }
+        //#endif
+        node = NO_NODE;
+        cursor = 0u;
+        leaf_end = 0u;
+        stack_len = 0u;
+        if frame.node_count > 0u && slab_enter(0u, ray.origin, inverse, best_t) != NO_HIT {
+            node = 0u;
+        }
+        (*trace).status = TRACE_RUNNING;
+    }
+    var finished = false;
+    var exited = false;
+    loop {
+        if (any_hit && best_prim != NO_PRIM) || (cursor >= leaf_end && node == NO_NODE && stack_len == 0u) {
+            finished = true;
+            exited = true;
+            break;
+        }
+        if iterations + ITERATION_COST > frame.iteration_budget {
+            exited = true;
+            break;
+        }
+        iterations += ITERATION_COST;
+        if cursor < leaf_end {
+            // The next primitive of the current leaf.
+            let prim = bvh_prims[cursor];
+            cursor += 1u;
+            let t = intersect_prim(prim, ray, tie_limit(prim, best_t, best_prim));
+            if t != NO_HIT {
+                best_t = t;
+                best_prim = prim;
+            }
+            continue;
+        }
+        if node == NO_NODE {
+            // Pop; a node pushed earlier may lie beyond a hit found since.
+            stack_len -= 1u;
+            let candidate = traversal_stack[traversal_stack_index(slot, stack_len)];
+            if slab_enter(candidate, ray.origin, inverse, best_t) != NO_HIT {
+                node = candidate;
+            }
+            continue;
+        }
+        let current = bvh_nodes[node];
+        if current.count > 0u {
+            cursor = current.first;
+            leaf_end = current.first + current.count;
+            node = NO_NODE;
+            continue;
+        }
+        let a = current.first;
+        let b = current.first + 1u;
+        let enter_a = slab_enter(a, ray.origin, inverse, best_t);
+        let enter_b = slab_enter(b, ray.origin, inverse, best_t);
+        if enter_a != NO_HIT && enter_b != NO_HIT {
+            // Nearest child first; the other waits on the stack.
+            var near = a;
+            var far = b;
+            if enter_b < enter_a {
+                near = b;
+                far = a;
+            }
+            if stack_len < MAX_BVH_DEPTH {
+                traversal_stack[traversal_stack_index(slot, stack_len)] = far;
+                stack_len += 1u;
+            } else {
+                atomicOr(&counters.errors, ERROR_TRAVERSAL_STACK);
+            }
+            node = near;
+        } else if enter_a != NO_HIT {
+            node = a;
+        } else if enter_b != NO_HIT {
+            node = b;
+        } else {
+            node = NO_NODE;
+        }
+    }
+    if !exited {
+        atomicOr(&counters.errors, ERROR_LOOP_CUT);
+    }
+    (*trace).best_t = best_t;
+    (*trace).best_prim = best_prim;
+    (*trace).node = node;
+    (*trace).cursor = cursor;
+    (*trace).leaf_end = leaf_end;
+    (*trace).stack_len = stack_len;
+    return finished;
+}

@@ -1,0 +1,261 @@
+//! Bind group layouts and compute pipelines: the trace kernels, specialised to each
+//! scene's features and cached, and the display pass.
+
+use std::collections::HashMap;
+use std::sync::{Mutex, PoisonError};
+
+use super::GpuError;
+use super::features::ShaderFeatures;
+use super::readback::{Caught, capture};
+use super::shaders::{
+    DISPLAY_ENTRY_POINT, SHADE_ENTRY_POINT, TRACE_ENTRY_POINT, display_shader_source,
+    trace_shader_source,
+};
+
+/// Format of the linear radiance texture the trace writes.
+pub const LINEAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// Format of the display texture (sRGB encoding is done in the shader because
+/// `Rgba8UnormSrgb` cannot be a storage texture).
+pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+/// Bindings of the trace module (`shaders/trace.wgsl`): 0 uniforms; 1–7 spheres,
+/// planes, polygons, polygon vertices, triangles, materials, lights; 8 the linear
+/// output; 9 counters; 10 accumulation; 11 images; 12–13 BVH nodes and primitives;
+/// 14–17 path states, bounce stacks, traces, traversal stacks.
+pub(crate) mod binding {
+    pub const FRAME: u32 = 0;
+    pub const SPHERES: u32 = 1;
+    pub const PLANES: u32 = 2;
+    pub const POLYGONS: u32 = 3;
+    pub const POLYGON_VERTICES: u32 = 4;
+    pub const TRIANGLES: u32 = 5;
+    pub const MATERIALS: u32 = 6;
+    pub const LIGHTS: u32 = 7;
+    pub const LINEAR_OUTPUT: u32 = 8;
+    pub const COUNTERS: u32 = 9;
+    pub const ACCUMULATION: u32 = 10;
+    pub const IMAGES: u32 = 11;
+    pub const BVH_NODES: u32 = 12;
+    pub const BVH_PRIMS: u32 = 13;
+    pub const PATHS: u32 = 14;
+    pub const RAY_STACK: u32 = 15;
+    pub const TRACES: u32 = 16;
+    pub const TRAVERSAL_STACK: u32 = 17;
+}
+
+/// Storage buffers the trace kernels bind in one stage.
+pub const TRACE_STORAGE_BUFFERS: u32 = 15;
+
+/// The two kernels of one trace module.
+#[derive(Debug, Clone)]
+pub struct TracePipelines {
+    /// `shade_paths`.
+    pub shade: wgpu::ComputePipeline,
+    /// `trace_rays`.
+    pub trace: wgpu::ComputePipeline,
+}
+
+/// Every layout and pipeline the renderer uses on one device.
+#[derive(Debug)]
+pub(crate) struct Pipelines {
+    pub trace_bind_group_layout: wgpu::BindGroupLayout,
+    trace_pipeline_layout: wgpu::PipelineLayout,
+    pub display_bind_group_layout: wgpu::BindGroupLayout,
+    pub display: wgpu::ComputePipeline,
+    /// Trace pipelines by feature set, built on first use.
+    trace: Mutex<HashMap<ShaderFeatures, TracePipelines>>,
+}
+
+fn compute_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty,
+        count: None,
+    }
+}
+
+fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    compute_entry(
+        binding,
+        wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+    )
+}
+
+fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    compute_entry(
+        binding,
+        wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+    )
+}
+
+fn storage_texture_entry(binding: u32, format: wgpu::TextureFormat) -> wgpu::BindGroupLayoutEntry {
+    compute_entry(
+        binding,
+        wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+    )
+}
+
+fn float_texture_entry(
+    binding: u32,
+    dimension: wgpu::TextureViewDimension,
+) -> wgpu::BindGroupLayoutEntry {
+    compute_entry(
+        binding,
+        wgpu::BindingType::Texture {
+            // Rgba32Float is not filterable without an extra feature; the shaders
+            // only use textureLoad.
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: dimension,
+            multisampled: false,
+        },
+    )
+}
+
+impl Pipelines {
+    /// Builds the layouts and the display pipeline (trace pipelines come on demand).
+    pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
+        use binding::*;
+        // Explicit layouts: an automatic layout would drop bindings a shader leaves
+        // unused, and the bind groups would no longer match it.
+        let trace_bind_group_layout =
+            capture(device, "trace bind group layout", Caught::Resource, || {
+                device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some("gpu-render trace bindings"),
+                    entries: &[
+                        uniform_entry(FRAME),
+                        storage_entry(SPHERES, true),
+                        storage_entry(PLANES, true),
+                        storage_entry(POLYGONS, true),
+                        storage_entry(POLYGON_VERTICES, true),
+                        storage_entry(TRIANGLES, true),
+                        storage_entry(MATERIALS, true),
+                        storage_entry(LIGHTS, true),
+                        storage_texture_entry(LINEAR_OUTPUT, LINEAR_FORMAT),
+                        storage_entry(COUNTERS, false),
+                        storage_entry(ACCUMULATION, false),
+                        float_texture_entry(IMAGES, wgpu::TextureViewDimension::D2Array),
+                        storage_entry(BVH_NODES, true),
+                        storage_entry(BVH_PRIMS, true),
+                        storage_entry(PATHS, false),
+                        storage_entry(RAY_STACK, false),
+                        storage_entry(TRACES, false),
+                        storage_entry(TRAVERSAL_STACK, false),
+                    ],
+                })
+            })?;
+        let trace_pipeline_layout =
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("gpu-render trace layout"),
+                bind_group_layouts: &[Some(&trace_bind_group_layout)],
+                immediate_size: 0,
+            });
+        let display_bind_group_layout =
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("gpu-render display bindings"),
+                entries: &[
+                    uniform_entry(0),
+                    float_texture_entry(1, wgpu::TextureViewDimension::D2),
+                    storage_texture_entry(2, DISPLAY_FORMAT),
+                ],
+            });
+        let display_pipeline_layout =
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("gpu-render display layout"),
+                bind_group_layouts: &[Some(&display_bind_group_layout)],
+                immediate_size: 0,
+            });
+        let display = build_pipelines(
+            device,
+            "display",
+            display_shader_source(),
+            &display_pipeline_layout,
+            &[DISPLAY_ENTRY_POINT],
+        )?
+        .remove(0);
+        Ok(Self {
+            trace_bind_group_layout,
+            trace_pipeline_layout,
+            display_bind_group_layout,
+            display,
+            trace: Mutex::new(HashMap::new()),
+        })
+    }
+
+    /// The trace pipelines for `features`, built and cached on first use.
+    pub fn trace(
+        &self,
+        device: &wgpu::Device,
+        features: &ShaderFeatures,
+    ) -> Result<TracePipelines, GpuError> {
+        let mut cache = self.trace.lock().unwrap_or_else(PoisonError::into_inner);
+        if let Some(pipelines) = cache.get(features) {
+            return Ok(pipelines.clone());
+        }
+        let source = trace_shader_source(features).map_err(GpuError::Shader)?;
+        let mut built = build_pipelines(
+            device,
+            &format!("trace ({})", features.label()),
+            source,
+            &self.trace_pipeline_layout,
+            &[SHADE_ENTRY_POINT, TRACE_ENTRY_POINT],
+        )?;
+        let pipelines = TracePipelines {
+            trace: built.remove(1),
+            shade: built.remove(0),
+        };
+        cache.insert(*features, pipelines.clone());
+        Ok(pipelines)
+    }
+
+    /// How many trace modules have been built so far.
+    pub fn cached_trace_count(&self) -> usize {
+        self.trace
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .len()
+    }
+}
+
+/// Creates one shader module and a compute pipeline per entry point inside error
+/// scopes, so that WGSL or pipeline errors come back as [`GpuError::Shader`] instead of
+/// panicking.
+fn build_pipelines(
+    device: &wgpu::Device,
+    name: &str,
+    source: String,
+    layout: &wgpu::PipelineLayout,
+    entry_points: &[&str],
+) -> Result<Vec<wgpu::ComputePipeline>, GpuError> {
+    capture(device, &format!("{name} shader"), Caught::Shader, || {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(name),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        entry_points
+            .iter()
+            .map(|entry_point| {
+                device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(&format!("{name}: {entry_point}")),
+                    layout: Some(layout),
+                    module: &module,
+                    entry_point: Some(entry_point),
+                    compilation_options: wgpu::PipelineCompilationOptions::default(),
+                    cache: None,
+                })
+            })
+            .collect()
+    })
+}

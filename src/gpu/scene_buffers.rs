@@ -1,0 +1,218 @@
+//! A scene uploaded to one device: its storage buffers (primitives, BVH, materials,
+//! lights), its image array and its trace constants.
+
+use super::GpuError;
+use super::features::ShaderFeatures;
+use super::layout::FrameUniforms;
+use super::readback::{Caught, capture};
+use super::upload::{SceneRecords, frame_uniforms, image_layers};
+use crate::accel::{BvhStats, MAX_PLANES, SceneGeometry};
+use crate::scene::Scene;
+
+/// The storage buffers of an uploaded scene.
+#[derive(Debug)]
+pub(crate) struct SceneBuffers {
+    pub spheres: wgpu::Buffer,
+    pub planes: wgpu::Buffer,
+    pub polygons: wgpu::Buffer,
+    pub polygon_vertices: wgpu::Buffer,
+    pub triangles: wgpu::Buffer,
+    pub materials: wgpu::Buffer,
+    pub lights: wgpu::Buffer,
+    pub bvh_nodes: wgpu::Buffer,
+    pub bvh_prims: wgpu::Buffer,
+}
+
+/// A scene uploaded to one device, ready to trace with
+/// [`super::GpuRenderer::render_prepared`].
+#[derive(Debug)]
+pub struct PreparedScene {
+    pub(crate) frame: FrameUniforms,
+    pub(crate) stack_size: u32,
+    pub(crate) features: ShaderFeatures,
+    pub(crate) encode_srgb: bool,
+    pub(crate) buffers: SceneBuffers,
+    /// Albedo textures and BRDF maps, one layer each (see [`image_layers`]).
+    pub(crate) images: wgpu::TextureView,
+    bvh: BvhStats,
+    scene_bytes: u64,
+}
+
+impl PreparedScene {
+    /// Image width in pixels.
+    pub fn width(&self) -> u32 {
+        self.frame.width
+    }
+
+    /// Image height in pixels.
+    pub fn height(&self) -> u32 {
+        self.frame.height
+    }
+
+    /// Samples per pixel.
+    pub fn samples_per_pixel(&self) -> u32 {
+        self.frame.samples_per_pixel
+    }
+
+    /// Capacity of each path's bounce stack.
+    pub fn stack_size(&self) -> u32 {
+        self.stack_size
+    }
+
+    /// The shader features the trace pipelines for this scene contain.
+    pub fn features(&self) -> ShaderFeatures {
+        self.features
+    }
+
+    /// Whether the display pass should apply the sRGB curve for this scene (false in
+    /// naive gamma mode).
+    pub fn display_encodes_srgb(&self) -> bool {
+        self.encode_srgb
+    }
+
+    /// The trace constants for the whole image (the scheduler sets region, samples,
+    /// slots and budget per trace).
+    pub fn frame_uniforms(&self) -> &FrameUniforms {
+        &self.frame
+    }
+
+    /// How the scene's BVH was built.
+    pub fn bvh_stats(&self) -> &BvhStats {
+        &self.bvh
+    }
+
+    /// Bytes of the scene's storage buffers on the device (primitives, BVH,
+    /// materials, lights; not the images or the per-trace slots).
+    pub fn scene_bytes(&self) -> u64 {
+        self.scene_bytes
+    }
+}
+
+/// Uploads `scene` (as loaded: it is converted to its lighting space here) with its
+/// `geometry` (built from the lighting-space-independent shapes).
+pub(crate) fn upload_scene(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    scene: &Scene,
+    geometry: &SceneGeometry,
+    specialise: bool,
+) -> Result<PreparedScene, GpuError> {
+    scene.render.check().map_err(GpuError::Validation)?;
+    if geometry.planes.len() > MAX_PLANES {
+        return Err(GpuError::DeviceLimit {
+            what: "infinite planes (every ray tests every plane; use polygons)".into(),
+            value: geometry.planes.len() as u64,
+            limit: MAX_PLANES as u64,
+        });
+    }
+    let shaded = scene.in_lighting_space();
+    let records = SceneRecords::new(&shaded, geometry);
+    let frame = frame_uniforms(&shaded, geometry);
+    let limits = device.limits();
+    let max_binding = limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size);
+    let padded = records.padded();
+    let mut scene_bytes = 0;
+    let mut upload = |what: &str, bytes: &[u8]| -> Result<wgpu::Buffer, GpuError> {
+        let size = bytes.len() as u64;
+        if size > max_binding {
+            return Err(GpuError::DeviceLimit {
+                what: format!("{what} buffer bytes"),
+                value: size,
+                limit: max_binding,
+            });
+        }
+        scene_bytes += size;
+        let buffer = capture(device, what, Caught::Resource, || {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(what),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        })?;
+        // write_buffer stages through the queue: no mapped_at_creation, whose mapping
+        // would panic if the allocation had failed.
+        queue.write_buffer(&buffer, 0, bytes);
+        Ok(buffer)
+    };
+    let buffers = SceneBuffers {
+        spheres: upload("sphere", bytemuck::cast_slice(&padded.spheres))?,
+        planes: upload("plane", bytemuck::cast_slice(&padded.planes))?,
+        polygons: upload("polygon", bytemuck::cast_slice(&padded.polygons))?,
+        polygon_vertices: upload(
+            "polygon vertex",
+            bytemuck::cast_slice(&padded.polygon_vertices),
+        )?,
+        triangles: upload("triangle", bytemuck::cast_slice(&padded.triangles))?,
+        materials: upload("material", bytemuck::cast_slice(&padded.materials))?,
+        lights: upload("light", bytemuck::cast_slice(&padded.lights))?,
+        bvh_nodes: upload("BVH node", bytemuck::cast_slice(&padded.bvh_nodes))?,
+        bvh_prims: upload("BVH primitive", bytemuck::cast_slice(&padded.bvh_prims))?,
+    };
+    let images = upload_images(device, queue, &shaded, &limits)?;
+    Ok(PreparedScene {
+        frame,
+        stack_size: scene.render.stack_size,
+        features: if specialise {
+            ShaderFeatures::for_scene(scene)
+        } else {
+            ShaderFeatures::ALL
+        },
+        encode_srgb: scene.display_encodes_srgb(),
+        buffers,
+        images,
+        bvh: geometry.bvh.stats,
+        scene_bytes,
+    })
+}
+
+/// Uploads the scene's images as one `Rgba32Float` 2D array texture (one layer per
+/// image, see [`image_layers`]) and returns its view.
+fn upload_images(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    scene: &Scene,
+    limits: &wgpu::Limits,
+) -> Result<wgpu::TextureView, GpuError> {
+    let (width, height, layers, texels) = image_layers(&scene.images);
+    if layers > limits.max_texture_array_layers {
+        return Err(GpuError::DeviceLimit {
+            what: "images (texture array layers)".to_string(),
+            value: u64::from(layers),
+            limit: u64::from(limits.max_texture_array_layers),
+        });
+    }
+    let size = wgpu::Extent3d {
+        width,
+        height,
+        depth_or_array_layers: layers,
+    };
+    let texture = capture(device, "image array", Caught::Resource, || {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("gpu-render images"),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        })
+    })?;
+    queue.write_texture(
+        texture.as_image_copy(),
+        bytemuck::cast_slice(&texels),
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(width * 16),
+            rows_per_image: Some(height),
+        },
+        size,
+    );
+    Ok(texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    }))
+}

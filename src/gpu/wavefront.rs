@@ -1,0 +1,357 @@
+//! The wavefront schedule: path slots in storage buffers, and the host loop that
+//! dispatches the two trace kernels in turns until every pixel of a region is done.
+//!
+//! A trace of one region runs in submissions of `rounds` rounds, each round one
+//! dispatch of `shade_paths` and one of `trace_rays` over every slot. After each
+//! submission the host reads the shared counters (pixels finished, rays, error bits)
+//! and, where the device has timestamp queries, the GPU time of the submission; the
+//! number of rounds per submission adapts so that each takes about
+//! [`TARGET_SUBMISSION`]. Every buffer is created once per trace, whatever the number
+//! of samples, rounds or submissions.
+
+use std::time::{Duration, Instant};
+
+use super::GpuError;
+use super::layout::{
+    ERROR_LOOP_CUT, ERROR_TRAVERSAL_STACK, FrameUniforms, GpuCounters, GpuPathState, GpuStackEntry,
+    GpuTraceRay,
+};
+use super::pipelines::{TracePipelines, binding};
+use super::readback::{Caught, capture, map_read, submit_and_wait};
+use super::scene_buffers::PreparedScene;
+use super::shaders::SLOT_WORKGROUP_SIZE;
+use crate::accel::MAX_BVH_DEPTH;
+
+/// llvmpipe's (and so lavapipe's) limit on the loop iterations of one shader
+/// invocation: `LP_MAX_TGSI_LOOP_ITERATIONS` in Mesa's gallivm. Past it every loop of
+/// the invocation ends silently.
+pub const LLVMPIPE_LOOP_LIMIT: u32 = 65_535;
+
+/// The iteration budget of one invocation per dispatch on `adapter`: on llvmpipe its
+/// loop limit less a margin of 4096 for the few iterations the kernels do not charge
+/// (a loop's last test, the bookkeeping loop's exits); elsewhere 2^20, which no driver
+/// is known to cut and which keeps one dispatch short.
+pub fn iteration_budget_for(adapter: &wgpu::AdapterInfo) -> u32 {
+    let llvmpipe = |s: &str| s.to_lowercase().contains("llvmpipe");
+    if llvmpipe(&adapter.name) || llvmpipe(&adapter.driver) || llvmpipe(&adapter.driver_info) {
+        LLVMPIPE_LOOP_LIMIT - 4096
+    } else {
+        1 << 20
+    }
+}
+
+/// The number of path slots a trace uses on `adapter` when the caller does not choose:
+/// 16,384 on CPU devices (enough for every SIMD lane of every core, small enough for
+/// the slots' state to stay in cache) and 131,072 elsewhere.
+pub fn default_slot_count(adapter: &wgpu::AdapterInfo) -> u32 {
+    if adapter.device_type == wgpu::DeviceType::Cpu {
+        1 << 14
+    } else {
+        1 << 17
+    }
+}
+
+/// How long one submission of rounds should take.
+pub const TARGET_SUBMISSION: Duration = Duration::from_millis(100);
+
+/// Most rounds in one submission.
+const MAX_ROUNDS: u32 = 4096;
+
+/// Bytes of the readback buffer: the counters at 0, the two timestamps at 256.
+const READBACK_SIZE: u64 = 256 + 16;
+
+/// The buffers of a trace's path slots.
+#[derive(Debug)]
+pub(crate) struct SlotBuffers {
+    uniforms: wgpu::Buffer,
+    paths: wgpu::Buffer,
+    traces: wgpu::Buffer,
+    ray_stack: wgpu::Buffer,
+    traversal_stack: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    accumulation: wgpu::Buffer,
+    readback: wgpu::Buffer,
+    timestamps: Option<(wgpu::QuerySet, wgpu::Buffer)>,
+}
+
+impl SlotBuffers {
+    /// The slot count for a region of `pixels` pixels: `requested` (or the adapter's
+    /// default), at most one slot per pixel, and few enough that the largest slot
+    /// buffer fits one storage binding.
+    pub fn slot_count(
+        device: &wgpu::Device,
+        requested: Option<u32>,
+        pixels: u64,
+        stack_size: u32,
+    ) -> u32 {
+        let limits = device.limits();
+        let binding = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
+        let largest_per_slot = (u64::from(stack_size.max(1)) * size_of::<GpuStackEntry>() as u64)
+            .max(size_of::<GpuPathState>() as u64)
+            .max(u64::from(MAX_BVH_DEPTH) * 4);
+        let fits = binding / largest_per_slot;
+        let workgroups =
+            u64::from(limits.max_compute_workgroups_per_dimension) * u64::from(SLOT_WORKGROUP_SIZE);
+        let wanted =
+            u64::from(requested.unwrap_or_else(|| default_slot_count(&device.adapter_info())));
+        wanted.min(pixels).min(fits).min(workgroups).max(1) as u32
+    }
+
+    /// Creates the buffers for `slot_count` slots with bounce stacks of `stack_size`.
+    pub fn new(device: &wgpu::Device, slot_count: u32, stack_size: u32) -> Result<Self, GpuError> {
+        let storage = |label: &str, bytes: u64, extra: wgpu::BufferUsages| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(16),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | extra,
+                mapped_at_creation: false,
+            })
+        };
+        let slots = u64::from(slot_count);
+        let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        capture(device, "path slot buffers", Caught::Resource, || Self {
+            uniforms: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("gpu-render trace uniforms"),
+                size: size_of::<FrameUniforms>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            paths: storage(
+                "gpu-render path states",
+                slots * size_of::<GpuPathState>() as u64,
+                wgpu::BufferUsages::empty(),
+            ),
+            traces: storage(
+                "gpu-render traces",
+                slots * size_of::<GpuTraceRay>() as u64,
+                wgpu::BufferUsages::empty(),
+            ),
+            ray_stack: storage(
+                "gpu-render bounce stacks",
+                slots * u64::from(stack_size) * size_of::<GpuStackEntry>() as u64,
+                wgpu::BufferUsages::empty(),
+            ),
+            traversal_stack: storage(
+                "gpu-render traversal stacks",
+                slots * u64::from(MAX_BVH_DEPTH) * 4,
+                wgpu::BufferUsages::empty(),
+            ),
+            counters: storage(
+                "gpu-render counters",
+                size_of::<GpuCounters>() as u64,
+                wgpu::BufferUsages::COPY_SRC,
+            ),
+            // Progressive sums are not used by whole renders: one record.
+            accumulation: storage("gpu-render accumulation", 16, wgpu::BufferUsages::empty()),
+            readback: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("gpu-render counter readback"),
+                size: READBACK_SIZE,
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                mapped_at_creation: false,
+            }),
+            timestamps: timestamps.then(|| {
+                (
+                    device.create_query_set(&wgpu::QuerySetDescriptor {
+                        label: Some("gpu-render trace timestamps"),
+                        ty: wgpu::QueryType::Timestamp,
+                        count: 2,
+                    }),
+                    device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("gpu-render timestamp resolve"),
+                        size: 16,
+                        usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                        mapped_at_creation: false,
+                    }),
+                )
+            }),
+        })
+    }
+
+    /// The bind group of the trace kernels for `scene`, writing into `target`.
+    pub fn bind_group(
+        &self,
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        scene: &PreparedScene,
+        target: &wgpu::TextureView,
+    ) -> Result<wgpu::BindGroup, GpuError> {
+        fn buffer(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            }
+        }
+        let s = &scene.buffers;
+        capture(device, "trace bind group", Caught::Resource, || {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("gpu-render trace bind group"),
+                layout,
+                entries: &[
+                    buffer(binding::FRAME, &self.uniforms),
+                    buffer(binding::SPHERES, &s.spheres),
+                    buffer(binding::PLANES, &s.planes),
+                    buffer(binding::POLYGONS, &s.polygons),
+                    buffer(binding::POLYGON_VERTICES, &s.polygon_vertices),
+                    buffer(binding::TRIANGLES, &s.triangles),
+                    buffer(binding::MATERIALS, &s.materials),
+                    buffer(binding::LIGHTS, &s.lights),
+                    wgpu::BindGroupEntry {
+                        binding: binding::LINEAR_OUTPUT,
+                        resource: wgpu::BindingResource::TextureView(target),
+                    },
+                    buffer(binding::COUNTERS, &self.counters),
+                    buffer(binding::ACCUMULATION, &self.accumulation),
+                    wgpu::BindGroupEntry {
+                        binding: binding::IMAGES,
+                        resource: wgpu::BindingResource::TextureView(&scene.images),
+                    },
+                    buffer(binding::BVH_NODES, &s.bvh_nodes),
+                    buffer(binding::BVH_PRIMS, &s.bvh_prims),
+                    buffer(binding::PATHS, &self.paths),
+                    buffer(binding::RAY_STACK, &self.ray_stack),
+                    buffer(binding::TRACES, &self.traces),
+                    buffer(binding::TRAVERSAL_STACK, &self.traversal_stack),
+                ],
+            })
+        })
+    }
+}
+
+/// What one region's trace measured.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct TraceOutcome {
+    /// Rays traced.
+    pub rays: u64,
+    /// Wall time of the submissions.
+    pub elapsed: Duration,
+    /// GPU time of the trace passes, where the device has timestamp queries.
+    pub gpu_time: Option<Duration>,
+    /// Submissions and rounds it took.
+    pub submissions: u32,
+    /// Rounds (one dispatch of each kernel) it took.
+    pub rounds: u64,
+}
+
+/// Traces every pixel of the region `frame` names (its region, target origin, sample
+/// range, slot count and budget filled in) into `target`, blocking until done;
+/// `report(pixels)` is told the newly finished pixels after each submission.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn trace_region(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    pipelines: &TracePipelines,
+    slots: &SlotBuffers,
+    bind_group: &wgpu::BindGroup,
+    frame: &FrameUniforms,
+    timeout: Option<Duration>,
+    report: &dyn Fn(u64),
+) -> Result<TraceOutcome, GpuError> {
+    let pixels = u64::from(frame.region_width) * u64::from(frame.region_height);
+    let mut outcome = TraceOutcome::default();
+    if pixels == 0 {
+        return Ok(outcome);
+    }
+    queue.write_buffer(&slots.uniforms, 0, bytemuck::bytes_of(frame));
+    let groups = frame.slot_count.div_ceil(SLOT_WORKGROUP_SIZE);
+    let period_ns = f64::from(queue.get_timestamp_period());
+    let mut rounds = 4u32;
+    let mut done = 0u64;
+    let mut gpu_ns = 0.0f64;
+    let mut first = true;
+    let start = Instant::now();
+    while done < pixels {
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("gpu-render trace rounds"),
+        });
+        if first {
+            // Zeroed slots start at PHASE_FETCH_PIXEL with no trace pending.
+            encoder.clear_buffer(&slots.paths, 0, None);
+            encoder.clear_buffer(&slots.traces, 0, None);
+            encoder.clear_buffer(&slots.counters, 0, None);
+            first = false;
+        }
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("gpu-render trace"),
+                timestamp_writes: slots.timestamps.as_ref().map(|(set, _)| {
+                    wgpu::ComputePassTimestampWrites {
+                        query_set: set,
+                        beginning_of_pass_write_index: Some(0),
+                        end_of_pass_write_index: Some(1),
+                    }
+                }),
+            });
+            pass.set_bind_group(0, bind_group, &[]);
+            for _ in 0..rounds {
+                pass.set_pipeline(&pipelines.shade);
+                pass.dispatch_workgroups(groups, 1, 1);
+                pass.set_pipeline(&pipelines.trace);
+                pass.dispatch_workgroups(groups, 1, 1);
+            }
+        }
+        encoder.copy_buffer_to_buffer(
+            &slots.counters,
+            0,
+            &slots.readback,
+            0,
+            size_of::<GpuCounters>() as u64,
+        );
+        if let Some((set, resolve)) = &slots.timestamps {
+            encoder.resolve_query_set(set, 0..2, resolve, 0);
+            encoder.copy_buffer_to_buffer(resolve, 0, &slots.readback, 256, 16);
+        }
+        let submitted = Instant::now();
+        submit_and_wait(device, queue, encoder, "trace rounds", timeout)?;
+        let took = submitted.elapsed();
+        let bytes = map_read(device, &slots.readback, READBACK_SIZE, timeout)?;
+        let counters: GpuCounters =
+            bytemuck::pod_read_unaligned(&bytes[..size_of::<GpuCounters>()]);
+        outcome.submissions += 1;
+        outcome.rounds += u64::from(rounds);
+        if slots.timestamps.is_some() {
+            let tick =
+                |at: usize| u64::from_ne_bytes(bytes[at..at + 8].try_into().unwrap_or([0; 8]));
+            let (begin, end) = (tick(256), tick(264));
+            gpu_ns += end.saturating_sub(begin) as f64 * period_ns;
+        }
+        check_errors(counters.errors)?;
+        let finished = u64::from(counters.pixels_done).min(pixels);
+        if finished > done {
+            report(finished - done);
+            done = finished;
+        }
+        outcome.rays = counters.rays();
+        // Aim at TARGET_SUBMISSION per submission, growing at most 4x at a time.
+        let ratio = TARGET_SUBMISSION.as_secs_f64() / took.as_secs_f64().max(1e-6);
+        let next = (f64::from(rounds) * ratio.clamp(0.25, 4.0)).round();
+        rounds = (next as u32).clamp(1, MAX_ROUNDS);
+    }
+    outcome.elapsed = start.elapsed();
+    outcome.gpu_time = (slots.timestamps.is_some() && period_ns.is_finite() && period_ns > 0.0)
+        .then(|| Duration::from_secs_f64(gpu_ns * 1e-9));
+    Ok(outcome)
+}
+
+/// Turns the kernels' error bits into an error: an image with a cut loop or an
+/// overflowing traversal stack would be silently wrong, so none is returned.
+fn check_errors(errors: u32) -> Result<(), GpuError> {
+    if errors & ERROR_LOOP_CUT != 0 {
+        return Err(GpuError::TraceIncomplete(
+            "a shader loop was cut short by the driver before it finished (llvmpipe ends \
+             every loop of an invocation after 65,535 iterations); the image would miss \
+             rays, so none is returned. Lower the iteration budget \
+             (GpuRenderer::with_iteration_budget, or the CLI's --iteration-budget) or \
+             render with the CPU backend"
+                .into(),
+        ));
+    }
+    if errors & ERROR_TRAVERSAL_STACK != 0 {
+        return Err(GpuError::TraceIncomplete(format!(
+            "a BVH traversal needed more than {MAX_BVH_DEPTH} stack entries; the image would \
+             miss hits, so none is returned (a bug: the builders bound the depth)"
+        )));
+    }
+    Ok(())
+}
