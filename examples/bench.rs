@@ -25,7 +25,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use gpu_render::gpu::{AdapterChoice, GpuRenderer, HeadlessGpu};
+use gpu_render::gpu::{AdapterChoice, GpuRenderer, HeadlessGpu, Schedule};
 use gpu_render::scene::{RenderOverrides, load_scene};
 
 #[derive(Parser)]
@@ -50,6 +50,12 @@ struct Args {
     /// Compare the specialised trace pipeline with the general one.
     #[arg(long)]
     specialisation: bool,
+    /// Compare the fused and the wavefront schedule of the GPU kernels.
+    #[arg(long)]
+    schedules: bool,
+    /// The GPU schedule: `fused` or `wavefront` (default: the adapter's).
+    #[arg(long)]
+    schedule: Option<String>,
 }
 
 fn median(mut values: Vec<f64>) -> f64 {
@@ -70,7 +76,13 @@ fn main() -> Result<()> {
         })
         .map_err(anyhow::Error::msg)?;
     let gpu = HeadlessGpu::new(&AdapterChoice::Default).context("no GPU adapter")?;
-    let renderer = GpuRenderer::new(&gpu.device)?;
+    let mut renderer = GpuRenderer::new(&gpu.device)?;
+    match args.schedule.as_deref() {
+        None => {}
+        Some("fused") => renderer = renderer.with_schedule(Schedule::Fused),
+        Some("wavefront") => renderer = renderer.with_schedule(Schedule::Wavefront),
+        Some(other) => anyhow::bail!("--schedule must be fused or wavefront, not {other}"),
+    }
     let info = gpu.adapter_info();
     println!(
         "scene {} at {}x{}, {} spp, max depth {}; adapter: {} ({:?}); CPU threads: {}",
@@ -85,6 +97,9 @@ fn main() -> Result<()> {
     );
     if args.specialisation {
         return compare_specialisation(&gpu, &scene, args.runs);
+    }
+    if args.schedules {
+        return compare_schedules(&gpu, &scene, args.runs);
     }
     // Warm-up: the first dispatch compiles the pipeline (lavapipe runs LLVM then).
     renderer.render(&gpu.device, &gpu.queue, &scene, None)?;
@@ -203,6 +218,46 @@ fn compare_specialisation(
         specialised,
         general,
         specialised / general
+    );
+    Ok(())
+}
+
+/// Times the fused and the wavefront schedule on `scene`, alternating, and checks that
+/// they trace the same rays.
+fn compare_schedules(
+    gpu: &HeadlessGpu,
+    scene: &gpu_render::scene::Scene,
+    runs: usize,
+) -> Result<()> {
+    let schedules = [Schedule::Fused, Schedule::Wavefront];
+    let renderers: Vec<GpuRenderer> = schedules
+        .iter()
+        .map(|&s| Ok(GpuRenderer::new(&gpu.device)?.with_schedule(s)))
+        .collect::<Result<_>>()?;
+    for renderer in &renderers {
+        renderer.render(&gpu.device, &gpu.queue, scene, None)?;
+    }
+    let mut times = [Vec::new(), Vec::new()];
+    let mut rays = [0, 0];
+    for _ in 0..runs {
+        for (index, renderer) in renderers.iter().enumerate() {
+            let rendered = renderer.render(&gpu.device, &gpu.queue, scene, None)?;
+            let (time, _) = rendered.stats.trace_time();
+            times[index].push(time.as_secs_f64());
+            rays[index] = rendered.stats.rays_traced;
+        }
+    }
+    anyhow::ensure!(
+        rays[0] == rays[1],
+        "the schedules traced different rays: {rays:?}"
+    );
+    let (fused, wavefront) = (median(times[0].clone()), median(times[1].clone()));
+    println!(
+        "trace time, median of {runs} alternating runs: fused {fused:.3} s ({:.1} Mrays/s), \
+         wavefront {wavefront:.3} s ({:.1} Mrays/s), wavefront/fused {:.2}",
+        rays[0] as f64 / fused / 1e6,
+        rays[1] as f64 / wavefront / 1e6,
+        wavefront / fused
     );
     Ok(())
 }

@@ -116,6 +116,8 @@ fn project_to_plane(p: vec3<f32>, dropped_axis: u32) -> vec2<f32> {
 // Even-odd (crossing number) inside test in the projection that drops the polygon's
 // dominant axis (Haines, "Point in Polygon Strategies", Graphics Gems IV).
 fn point_in_polygon(p: vec3<f32>, polygon: Polygon) -> bool {
+    // Its loop's iterations count against the invocation's budget (traverse.wgsl).
+    iterations += polygon.vertex_count;
     let point = project_to_plane(p, polygon.dropped_axis);
     var inside = false;
     let last = polygon.first_vertex + polygon.vertex_count - 1u;

@@ -348,7 +348,56 @@ fn fetch_pixel(path: ptr<function, PathState>) {
     (*path).phase = PHASE_START_SAMPLE;
 }
 
-@compute @workgroup_size(64, 1, 1)
+// One shading step of a slot: consumes its finished traversal (if any), then moves
+// the path on through the cheap phases in their natural order (the lights that cast
+// no ray, the end of the hit, the bounce stack, the end of the sample or pixel, the
+// next pixel, the next camera ray) until a new traversal starts, the slot runs out of
+// pixels, or the budget is spent (the path then stays in its phase and the next step
+// continues there). Straight-line code, so that each phase's code runs once per step
+// on SIMD devices that execute every branch (llvmpipe).
+fn shade_step(slot: u32, path: ptr<function, PathState>, trace: ptr<function, TraceRay>) {
+    if (*trace).status == TRACE_DONE {
+        (*trace).status = TRACE_IDLE;
+        if (*path).phase == PHASE_CLOSEST {
+            consume_closest_hit(slot, path, *trace);
+        } else if (*path).phase == PHASE_SHADOW {
+            consume_shadow_ray(path, *trace);
+        }
+    }
+    if (*path).phase == PHASE_NEXT_LIGHT {
+        // Lights behind the surface cast no ray: skip them here.
+        var exited = false;
+        loop {
+            if iterations >= frame.iteration_budget || (*path).phase != PHASE_NEXT_LIGHT {
+                exited = true;
+                break;
+            }
+            iterations += 1u;
+            if next_light(path, trace) {
+                exited = true;
+                break;
+            }
+        }
+        if !exited {
+            atomicOr(&counters.errors, ERROR_LOOP_CUT);
+        }
+    }
+    if (*path).phase == PHASE_POP {
+        _ = pop_ray(slot, path, trace);
+    }
+    if (*path).phase == PHASE_END_SAMPLE {
+        end_sample(path);
+    }
+    if (*path).phase == PHASE_FETCH_PIXEL {
+        fetch_pixel(path);
+    }
+    if (*path).phase == PHASE_START_SAMPLE {
+        start_sample(path, trace);
+    }
+}
+
+// The wavefront schedule's shading kernel: one shading step per slot.
+@compute @workgroup_size(256, 1, 1)
 fn shade_paths(@builtin(global_invocation_id) id: vec3<u32>) {
     let slot = id.x;
     if slot >= frame.slot_count {
@@ -363,56 +412,14 @@ fn shade_paths(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     iterations = 0u;
-    if trace.status == TRACE_DONE {
-        trace.status = TRACE_IDLE;
-        if path.phase == PHASE_CLOSEST {
-            consume_closest_hit(slot, &path, trace);
-        } else if path.phase == PHASE_SHADOW {
-            consume_shadow_ray(&path, trace);
-        }
-    }
-    // Bookkeeping until the next traversal starts, the slot runs out of pixels, or
-    // the budget is spent (then the next dispatch continues here).
-    var exited = false;
-    loop {
-        if iterations >= frame.iteration_budget || path.phase == PHASE_IDLE {
-            exited = true;
-            break;
-        }
-        iterations += 1u;
-        var started = false;
-        switch path.phase {
-            case PHASE_NEXT_LIGHT: {
-                started = next_light(&path, &trace);
-            }
-            case PHASE_POP: {
-                started = pop_ray(slot, &path, &trace);
-            }
-            case PHASE_END_SAMPLE: {
-                end_sample(&path);
-            }
-            case PHASE_START_SAMPLE: {
-                start_sample(&path, &trace);
-                started = true;
-            }
-            case PHASE_FETCH_PIXEL: {
-                fetch_pixel(&path);
-            }
-            default: {}
-        }
-        if started {
-            exited = true;
-            break;
-        }
-    }
-    if !exited {
-        atomicOr(&counters.errors, ERROR_LOOP_CUT);
-    }
+    shade_step(slot, &path, &trace);
     paths[slot] = path;
     traces[slot] = trace;
 }
 
-@compute @workgroup_size(64, 1, 1)
+// The wavefront schedule's traversal kernel: one traversal (or its part within the
+// budget) per slot.
+@compute @workgroup_size(256, 1, 1)
 fn trace_rays(@builtin(global_invocation_id) id: vec3<u32>) {
     let slot = id.x;
     if slot >= frame.slot_count {
@@ -426,5 +433,44 @@ fn trace_rays(@builtin(global_invocation_id) id: vec3<u32>) {
     if advance_traversal(slot, &trace) {
         trace.status = TRACE_DONE;
     }
+    traces[slot] = trace;
+}
+
+// The fused schedule's only kernel: each slot alternates traversals and shading steps
+// until its budget is spent or it runs out of pixels, keeping its state in registers
+// between rays. The same functions in the same order as the wavefront schedule, so
+// the image is the same.
+@compute @workgroup_size(256, 1, 1)
+fn trace_paths(@builtin(global_invocation_id) id: vec3<u32>) {
+    let slot = id.x;
+    if slot >= frame.slot_count {
+        return;
+    }
+    var path = paths[slot];
+    if path.phase == PHASE_IDLE {
+        return;
+    }
+    var trace = traces[slot];
+    iterations = 0u;
+    var exited = false;
+    loop {
+        if trace.status == TRACE_PENDING || trace.status == TRACE_RUNNING {
+            if !advance_traversal(slot, &trace) {
+                exited = true;
+                break;
+            }
+            trace.status = TRACE_DONE;
+        }
+        if path.phase == PHASE_IDLE || iterations >= frame.iteration_budget {
+            exited = true;
+            break;
+        }
+        iterations += 1u;
+        shade_step(slot, &path, &trace);
+    }
+    if !exited {
+        atomicOr(&counters.errors, ERROR_LOOP_CUT);
+    }
+    paths[slot] = path;
     traces[slot] = trace;
 }

@@ -5,17 +5,17 @@
 // MAX_BVH_DEPTH and MAX_POLYGON_VERTICES are prepended by the host from the Rust
 // constants (src/gpu/shaders.rs).
 //
-// Bounded work: every loop iteration of an invocation is charged to `iterations`,
-// and a traversal that would pass frame.iteration_budget stops between two steps with
-// its state (current node, leaf cursor, best hit, stack depth) saved in its TraceRay
-// and its stack in `traversal_stack`; the next dispatch resumes it. llvmpipe ends
-// every loop of an invocation once the vector of invocations it runs together has
-// made 65,535 iterations in all (LP_MAX_TGSI_LOOP_ITERATIONS in Mesa's gallivm). One
-// flat loop keeps that count equal to the largest lane's; the inner loop of a polygon
-// test is charged at its worst case (MAX_POLYGON_VERTICES) on every step, so no lane's
-// charge can undercount the vector's. A loop that ends without reaching one of its
-// exits was cut by the driver: that sets ERROR_LOOP_CUT for the host, which then
-// refuses the image.
+// Bounded work: every loop iteration of an invocation is charged to `iterations`
+// (a polygon test by its vertex count), and a traversal that would pass
+// frame.iteration_budget stops between two steps with its state (current node, leaf
+// cursor, best hit, stack depth) saved in its TraceRay and its stack in
+// `traversal_stack`; the next dispatch resumes it. llvmpipe ends every loop of an
+// invocation once the vector of invocations it runs together has made 65,535 loop
+// iterations in all (LP_MAX_TGSI_LOOP_ITERATIONS in Mesa's gallivm). A vector iterates
+// only while one of its lanes does, so its count is at most the sum of its lanes'
+// counts: the host gives each lane the limit divided by the lanes per vector. A loop
+// that ends without reaching one of its exits was cut by the driver all the same: that
+// sets ERROR_LOOP_CUT for the host, which then refuses the image.
 
 // Direction components smaller than this are replaced by it (with their sign; -0
 // counts as positive) before the slab test divides by them: a ray parallel to a slab
@@ -27,11 +27,12 @@ const MIN_DIRECTION_COMPONENT: f32 = 1e-20;
 // (Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013).
 const FAR_SLAB_SCALE: f32 = 1.0000003576;
 
-// The charge of one step of the traversal loop.
+// The largest charge of one step of the traversal loop (a polygon test charges its
+// vertices besides the step).
 //#if POLYGONS
-const ITERATION_COST: u32 = 1u + MAX_POLYGON_VERTICES;
+const MAX_STEP_COST: u32 = 1u + MAX_POLYGON_VERTICES;
 //#else
-const ITERATION_COST: u32 = 1u;
+const MAX_STEP_COST: u32 = 1u;
 //#endif
 
 // Loop iterations this invocation has run (see above).
@@ -118,17 +119,20 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
     }
     var finished = false;
     var exited = false;
+    // At least one step per call, so that any budget makes progress.
+    var steps = 0u;
     loop {
         if (any_hit && best_prim != NO_PRIM) || (cursor >= leaf_end && node == NO_NODE && stack_len == 0u) {
             finished = true;
             exited = true;
             break;
         }
-        if iterations + ITERATION_COST > frame.iteration_budget {
+        if steps > 0u && iterations + MAX_STEP_COST > frame.iteration_budget {
             exited = true;
             break;
         }
-        iterations += ITERATION_COST;
+        steps += 1u;
+        iterations += 1u;
         if cursor < leaf_end {
             // The next primitive of the current leaf.
             let prim = bvh_prims[cursor];

@@ -9,7 +9,7 @@ use std::sync::Mutex;
 use std::time::Duration;
 
 use glam::DVec3;
-use gpu_render::gpu::{GpuError, TraceRegion, read_texture};
+use gpu_render::gpu::{GpuError, Schedule, TraceRegion, read_texture};
 use gpu_render::scene::{
     Camera, Environment, Light, LightingSpace, Material, RenderSettings, Scene, Shape,
 };
@@ -68,7 +68,8 @@ fn render_reads_back_counts_rays_and_reports_progress() {
     let Some(gpu) = common::gpu::headless_gpu() else {
         return;
     };
-    let renderer = common::gpu::renderer(&gpu);
+    // A small budget, so that the render takes several submissions.
+    let renderer = common::gpu::renderer(&gpu).with_iteration_budget(64);
     let scene = scene(SPP);
 
     let reported = Mutex::new(Vec::new());
@@ -150,8 +151,8 @@ fn linear_target(device: &wgpu::Device) -> wgpu::Texture {
 }
 
 /// The image is the same bit for bit whether it is traced whole or as three
-/// regions into one target, with one slot or many, and with an iteration budget so
-/// small that every traversal is suspended and resumed many times.
+/// regions into one target, with one slot or many, with either schedule, and with an
+/// iteration budget so small that every traversal is suspended and resumed many times.
 #[test]
 fn regions_slots_and_budgets_do_not_change_the_image() {
     let Some(gpu) = common::gpu::headless_gpu() else {
@@ -202,6 +203,16 @@ fn regions_slots_and_budgets_do_not_change_the_image() {
         (
             "budget 3",
             common::gpu::renderer(&gpu).with_iteration_budget(3),
+        ),
+        (
+            "wavefront schedule",
+            common::gpu::renderer(&gpu).with_schedule(Schedule::Wavefront),
+        ),
+        (
+            "fused schedule, budget 3",
+            common::gpu::renderer(&gpu)
+                .with_schedule(Schedule::Fused)
+                .with_iteration_budget(3),
         ),
     ] {
         let target = linear_target(device);

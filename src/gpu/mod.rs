@@ -44,5 +44,6 @@ pub use readback::read_texture;
 pub use renderer::{GpuRendered, GpuRenderer, TraceRegion, image_tiles};
 pub use scene_buffers::PreparedScene;
 pub use wavefront::{
-    LLVMPIPE_LOOP_LIMIT, TARGET_SUBMISSION, default_slot_count, iteration_budget_for,
+    LLVMPIPE_LOOP_LIMIT, Schedule, TARGET_SUBMISSION, default_schedule, default_slot_count,
+    iteration_budget_for,
 };

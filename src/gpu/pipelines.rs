@@ -8,8 +8,8 @@ use super::GpuError;
 use super::features::ShaderFeatures;
 use super::readback::{Caught, capture};
 use super::shaders::{
-    DISPLAY_ENTRY_POINT, SHADE_ENTRY_POINT, TRACE_ENTRY_POINT, display_shader_source,
-    trace_shader_source,
+    DISPLAY_ENTRY_POINT, FUSED_ENTRY_POINT, SHADE_ENTRY_POINT, TRACE_ENTRY_POINT,
+    display_shader_source, trace_shader_source,
 };
 
 /// Format of the linear radiance texture the trace writes.
@@ -46,13 +46,15 @@ pub(crate) mod binding {
 /// Storage buffers the trace kernels bind in one stage.
 pub const TRACE_STORAGE_BUFFERS: u32 = 15;
 
-/// The two kernels of one trace module.
+/// The kernels of one trace module.
 #[derive(Debug, Clone)]
 pub struct TracePipelines {
-    /// `shade_paths`.
+    /// `shade_paths` (wavefront schedule).
     pub shade: wgpu::ComputePipeline,
-    /// `trace_rays`.
+    /// `trace_rays` (wavefront schedule).
     pub trace: wgpu::ComputePipeline,
+    /// `trace_paths` (fused schedule).
+    pub fused: wgpu::ComputePipeline,
 }
 
 /// Every layout and pipeline the renderer uses on one device.
@@ -210,9 +212,10 @@ impl Pipelines {
             &format!("trace ({})", features.label()),
             source,
             &self.trace_pipeline_layout,
-            &[SHADE_ENTRY_POINT, TRACE_ENTRY_POINT],
+            &[SHADE_ENTRY_POINT, TRACE_ENTRY_POINT, FUSED_ENTRY_POINT],
         )?;
         let pipelines = TracePipelines {
+            fused: built.remove(2),
             trace: built.remove(1),
             shade: built.remove(0),
         };
@@ -240,10 +243,11 @@ fn build_pipelines(
     entry_points: &[&str],
 ) -> Result<Vec<wgpu::ComputePipeline>, GpuError> {
     capture(device, &format!("{name} shader"), Caught::Shader, || {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        let desc = wgpu::ShaderModuleDescriptor {
             label: Some(name),
             source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
+        };
+        let module = device.create_shader_module(desc);
         entry_points
             .iter()
             .map(|entry_point| {

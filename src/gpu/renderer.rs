@@ -24,7 +24,9 @@ use super::pipelines::{
 use super::readback::{Caught, capture, read_texture, submit_and_wait};
 use super::scene_buffers::{PreparedScene, upload_scene};
 use super::shaders::WORKGROUP_SIZE;
-use super::wavefront::{SlotBuffers, iteration_budget_for, trace_region};
+use super::wavefront::{
+    Schedule, SlotBuffers, default_schedule, iteration_budget_for, trace_region,
+};
 use crate::accel::SceneGeometry;
 use crate::film::{LinearImage, ProgressFn, RenderStats};
 use crate::scene::Scene;
@@ -49,6 +51,7 @@ pub struct GpuRenderer {
     specialise: bool,
     iteration_budget: Option<u32>,
     slot_count: Option<u32>,
+    schedule: Option<Schedule>,
 }
 
 /// The result of [`GpuRenderer::render`].
@@ -144,6 +147,7 @@ impl GpuRenderer {
             specialise: true,
             iteration_budget: None,
             slot_count: None,
+            schedule: None,
         })
     }
 
@@ -191,6 +195,19 @@ impl GpuRenderer {
     pub fn with_slot_count(mut self, slots: u32) -> Self {
         self.slot_count = Some(slots.max(1));
         self
+    }
+
+    /// Sets how the trace kernels are dispatched instead of the adapter's default
+    /// ([`super::default_schedule`]). The image does not depend on it.
+    pub fn with_schedule(mut self, schedule: Schedule) -> Self {
+        self.schedule = Some(schedule);
+        self
+    }
+
+    /// The schedule this renderer uses on `device`.
+    pub fn schedule(&self, device: &wgpu::Device) -> Schedule {
+        self.schedule
+            .unwrap_or_else(|| default_schedule(&device.adapter_info()))
     }
 
     /// The iteration budget this renderer uses on `device`.
@@ -327,6 +344,7 @@ impl GpuRenderer {
             device,
             queue,
             &pipelines,
+            self.schedule(device),
             &slots,
             &bind_group,
             &frame,

@@ -32,8 +32,11 @@ pub const TRACE_WGSL: &str = include_str!("../../shaders/trace.wgsl");
 pub const SHADE_ENTRY_POINT: &str = "shade_paths";
 /// Entry point of the traversal kernel of the trace module.
 pub const TRACE_ENTRY_POINT: &str = "trace_rays";
-/// Invocations per workgroup of the two trace kernels, `@workgroup_size(64, 1, 1)`.
-pub const SLOT_WORKGROUP_SIZE: u32 = 64;
+/// Entry point of the fused kernel of the trace module (shading and traversal in one
+/// loop).
+pub const FUSED_ENTRY_POINT: &str = "trace_paths";
+/// Invocations per workgroup of the trace kernels, `@workgroup_size(256, 1, 1)`.
+pub const SLOT_WORKGROUP_SIZE: u32 = 256;
 /// Entry point of the display module.
 pub const DISPLAY_ENTRY_POINT: &str = "encode_display";
 /// Workgroup size (x and y) of the display pass, `@workgroup_size(8, 8, 1)`.

@@ -27,14 +27,29 @@ use crate::accel::MAX_BVH_DEPTH;
 /// the invocation ends silently.
 pub const LLVMPIPE_LOOP_LIMIT: u32 = 65_535;
 
-/// The iteration budget of one invocation per dispatch on `adapter`: on llvmpipe its
-/// loop limit less a margin of 4096 for the few iterations the kernels do not charge
-/// (a loop's last test, the bookkeeping loop's exits); elsewhere 2^20, which no driver
-/// is known to cut and which keeps one dispatch short.
+/// Lanes of one SIMD vector of llvmpipe: the vector width its name states
+/// ("llvmpipe (LLVM 15.0.6, 256 bits)": 8 lanes of 32 bits), else 16 (AVX-512's).
+fn llvmpipe_lanes(adapter: &wgpu::AdapterInfo) -> u32 {
+    let name = &adapter.name;
+    let bits = name.find(" bits").and_then(|end| {
+        let start = name[..end].rfind(|c: char| !c.is_ascii_digit())? + 1;
+        name[start..end].parse::<u32>().ok()
+    });
+    bits.map_or(16, |bits| (bits / 32).max(1))
+}
+
+/// The iteration budget of one invocation per dispatch on `adapter`.
+///
+/// On llvmpipe a vector of lanes shares the loop limit ([`LLVMPIPE_LOOP_LIMIT`]) and
+/// iterates only while one of its lanes does, so its count is at most the sum of its
+/// lanes': each lane gets the limit divided by the lanes per vector, less 2048 for
+/// what a lane may run past its budget (the planes of a traversal's start, at most
+/// [`crate::accel::MAX_PLANES`], and its one guaranteed step). Elsewhere 2^20, which
+/// no driver is known to cut and which keeps one dispatch short.
 pub fn iteration_budget_for(adapter: &wgpu::AdapterInfo) -> u32 {
     let llvmpipe = |s: &str| s.to_lowercase().contains("llvmpipe");
     if llvmpipe(&adapter.name) || llvmpipe(&adapter.driver) || llvmpipe(&adapter.driver_info) {
-        LLVMPIPE_LOOP_LIMIT - 4096
+        LLVMPIPE_LOOP_LIMIT / llvmpipe_lanes(adapter) - 2048
     } else {
         1 << 20
     }
@@ -48,6 +63,33 @@ pub fn default_slot_count(adapter: &wgpu::AdapterInfo) -> u32 {
         1 << 14
     } else {
         1 << 17
+    }
+}
+
+/// How the trace kernels are dispatched (`docs/model.md`, "Bounded work"). Both run the
+/// same functions in the same order for every slot, so the image does not depend on
+/// the choice; only the speed does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Schedule {
+    /// Rounds of two kernels: `shade_paths` (one shading step per slot), then
+    /// `trace_rays` (one traversal per slot); the path state goes through memory
+    /// between them. Small, coherent kernels: the layout GPUs are built for (Laine,
+    /// Karras and Aila 2013).
+    Wavefront,
+    /// One kernel, `trace_paths`, in which each slot alternates traversals and shading
+    /// steps until its budget is spent, its state in registers between rays. Faster on
+    /// llvmpipe, where every dispatch and every load and store of a lane's state costs
+    /// more than the arithmetic (`BENCHMARKS.md`).
+    Fused,
+}
+
+/// The schedule a trace uses on `adapter` when the caller does not choose: fused on
+/// CPU devices (measured faster on lavapipe), the wavefront elsewhere.
+pub fn default_schedule(adapter: &wgpu::AdapterInfo) -> Schedule {
+    if adapter.device_type == wgpu::DeviceType::Cpu {
+        Schedule::Fused
+    } else {
+        Schedule::Wavefront
     }
 }
 
@@ -242,6 +284,7 @@ pub(crate) fn trace_region(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     pipelines: &TracePipelines,
+    schedule: Schedule,
     slots: &SlotBuffers,
     bind_group: &wgpu::BindGroup,
     frame: &FrameUniforms,
@@ -285,10 +328,18 @@ pub(crate) fn trace_region(
             });
             pass.set_bind_group(0, bind_group, &[]);
             for _ in 0..rounds {
-                pass.set_pipeline(&pipelines.shade);
-                pass.dispatch_workgroups(groups, 1, 1);
-                pass.set_pipeline(&pipelines.trace);
-                pass.dispatch_workgroups(groups, 1, 1);
+                match schedule {
+                    Schedule::Wavefront => {
+                        pass.set_pipeline(&pipelines.shade);
+                        pass.dispatch_workgroups(groups, 1, 1);
+                        pass.set_pipeline(&pipelines.trace);
+                        pass.dispatch_workgroups(groups, 1, 1);
+                    }
+                    Schedule::Fused => {
+                        pass.set_pipeline(&pipelines.fused);
+                        pass.dispatch_workgroups(groups, 1, 1);
+                    }
+                }
             }
         }
         encoder.copy_buffer_to_buffer(
