@@ -1,5 +1,6 @@
 // The pinhole camera and the pixel sample pattern.
-// CPU twin: src/camera.rs (pcg_hash, unit_from_hash, strata_grid, sample_offset,
+// CPU twin: src/camera.rs (pcg_hash, unit_from_hash, strata_grid, greatest_common_divisor,
+// lattice_generator, sample_offset,
 // CameraFrame::ray_direction -> camera_ray_direction).
 
 // PCG hash of one 32-bit word (Jarzynski and Olano, "Hash Functions for GPU Rendering",
@@ -15,18 +16,46 @@ fn unit_from_hash(hash: u32) -> f32 {
     return f32(hash >> 8u) * (1.0 / 16777216.0);
 }
 
-// ceil(sqrt(n)) columns and as many rows as needed for n samples.
+// n columns and n rows of elementary strata for n samples; sample_offset puts exactly
+// one sample in every column and every row.
 fn strata_grid(samples_per_pixel: u32) -> vec2<u32> {
-    var columns = u32(sqrt(f32(samples_per_pixel)));
-    if columns * columns < samples_per_pixel {
-        columns += 1u;
+    let n = max(samples_per_pixel, 1u);
+    return vec2<u32>(n, n);
+}
+
+// Euclid's algorithm.
+fn greatest_common_divisor(a: u32, b: u32) -> u32 {
+    var x = a;
+    var y = b;
+    loop {
+        if y == 0u {
+            break;
+        }
+        let t = x % y;
+        x = y;
+        y = t;
     }
-    let rows = (samples_per_pixel + columns - 1u) / columns;
-    return vec2<u32>(columns, rows);
+    return x;
+}
+
+// The generator of the rank-1 (Fibonacci) lattice of n points: the integer nearest n/phi
+// (40503 = round(2^16/phi), exact in u32 for n <= 65536) that is coprime with n. At most
+// 13 candidates for any n <= 65536.
+fn lattice_generator(n: u32) -> u32 {
+    var g = (n * 40503u + 32768u) >> 16u;
+    loop {
+        if greatest_common_divisor(g, n) == 1u {
+            break;
+        }
+        g += 1u;
+    }
+    return g;
 }
 
 // Offset in [0, 1)^2 of sample `index` inside pixel (px, py): the pixel centre for one
-// sample, otherwise jittered stratified with a hash of pixel and sample index.
+// sample; otherwise column `index` and row (index * g + shift) mod n of the n x n strata
+// (one sample per column and per row, on a Fibonacci lattice shifted by a hash of the
+// pixel), jittered inside the cell by a hash of pixel and sample index.
 fn sample_offset(px: u32, py: u32, index: u32) -> vec2<f32> {
     let spp = frame.samples_per_pixel;
     if spp <= 1u {
@@ -34,9 +63,13 @@ fn sample_offset(px: u32, py: u32, index: u32) -> vec2<f32> {
     }
     let grid = strata_grid(spp);
     let pixel_index = py * frame.width + px;
+    let shift = pcg_hash(pixel_index) % grid.y;
+    let column = index % grid.x;
+    // column * g + shift < 65535 * 65535 + 65536 < 2^32: no overflow for n <= 65536.
+    let row = (column * lattice_generator(spp) + shift) % grid.y;
     let seed = pcg_hash(pixel_index * spp + index);
     let jitter = vec2<f32>(unit_from_hash(seed), unit_from_hash(pcg_hash(seed)));
-    let cell = vec2<f32>(f32(index % grid.x), f32(index / grid.x));
+    let cell = vec2<f32>(f32(column), f32(row));
     return (cell + jitter) / vec2<f32>(grid);
 }
 
