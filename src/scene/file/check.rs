@@ -12,7 +12,7 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::raw::{RawColor, RawVec3};
-use crate::scene::SceneError;
+use crate::scene::{SceneError, SceneWarning};
 
 /// The scene text and its path, for building located errors.
 pub struct Source<'a> {
@@ -87,6 +87,16 @@ impl Item<'_> {
         let location = self.offset.map(|offset| self.source.location(offset));
         self.source
             .error(location, format!("{}: {message}", self.name))
+    }
+
+    /// The warning `"{item}: {message}"` at the item's place.
+    pub fn warning(&self, message: impl Display) -> SceneWarning {
+        let location = self.offset.map(|offset| self.source.location(offset));
+        SceneWarning {
+            path: self.source.path.to_path_buf(),
+            location,
+            message: format!("{}: {message}", self.name),
+        }
     }
 
     /// The value of a required field, or an error naming it.
