@@ -1,5 +1,5 @@
 // The pinhole camera and the pixel sample pattern.
-// CPU twin: src/camera.rs (pcg_hash, unit_from_hash, strata_grid, greatest_common_divisor,
+// CPU twin: src/camera.rs (pcg_hash, unit_from_hash, strata_grid, largest_partial_quotient,
 // lattice_generator, sample_offset,
 // CameraFrame::ray_direction -> camera_ray_direction).
 
@@ -23,33 +23,51 @@ fn strata_grid(samples_per_pixel: u32) -> vec2<u32> {
     return vec2<u32>(n, n);
 }
 
-// Euclid's algorithm.
-fn greatest_common_divisor(a: u32, b: u32) -> u32 {
-    var x = a;
-    var y = b;
+// The largest partial quotient of the continued fraction of n/g (Euclid's algorithm),
+// or 0xffffffff when n and g are not coprime.
+fn largest_partial_quotient(n: u32, g: u32) -> u32 {
+    var a = n;
+    var b = g;
+    var largest = 0u;
     loop {
-        if y == 0u {
+        if b == 0u {
             break;
         }
-        let t = x % y;
-        x = y;
-        y = t;
+        largest = max(largest, a / b);
+        let t = a % b;
+        a = b;
+        b = t;
     }
-    return x;
+    if a == 1u {
+        return largest;
+    }
+    return 0xffffffffu;
 }
 
-// The generator of the rank-1 (Fibonacci) lattice of n points: the integer nearest n/phi
-// (40503 = round(2^16/phi), exact in u32 for n <= 65536) that is coprime with n. At most
-// 13 candidates for any n <= 65536.
+// The generator of the rank-1 (Fibonacci) lattice of n points: of the 17 integers
+// nearest n/phi (40503 = round(2^16/phi), exact in u32 for n <= 65536), the one coprime
+// with n whose continued fraction n/g has the smallest largest partial quotient, the
+// nearest on a tie.
 fn lattice_generator(n: u32) -> u32 {
-    var g = (n * 40503u + 32768u) >> 16u;
-    loop {
-        if greatest_common_divisor(g, n) == 1u {
-            break;
+    let nearest = (n * 40503u + 32768u) >> 16u;
+    var best_quality = 0xffffffffu;
+    var best = 1u;
+    for (var k = 0u; k < 17u; k += 1u) {
+        let step = (k + 1u) / 2u;
+        var g = nearest - step;
+        if k % 2u == 1u {
+            g = nearest + step;
         }
-        g += 1u;
+        if g == 0u || g >= n {
+            continue;
+        }
+        let quality = largest_partial_quotient(n, g);
+        if quality < best_quality {
+            best_quality = quality;
+            best = g;
+        }
     }
-    return g;
+    return best;
 }
 
 // Offset in [0, 1)^2 of sample `index` inside pixel (px, py): the pixel centre for one

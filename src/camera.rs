@@ -72,28 +72,52 @@ pub fn strata_grid(samples_per_pixel: u32) -> (u32, u32) {
     (n, n)
 }
 
-/// The generator `g` of the rank-1 lattice of `n` points `(i/n, (i·g mod n)/n)`: the
-/// integer nearest `n/φ` (golden ratio φ, a Fibonacci lattice) that is coprime with
-/// `n`, so that `i ↦ i·g mod n` is a permutation of the rows. Integer arithmetic only
-/// (`40503 = round(2^16/φ)`; exact for `n <= 65536`), so both backends agree bit for
-/// bit; at most 13 candidates are tried for any `n <= 65536`.
+/// Candidates [`lattice_generator`] weighs: the integer nearest `n/φ` and the 8 on
+/// each side of it.
+pub const LATTICE_CANDIDATES: u32 = 17;
+
+/// The generator `g` of the rank-1 lattice of `n` points `(i/n, (i·g mod n)/n)`: of the
+/// integers near `n/φ` (golden ratio φ: a Fibonacci lattice) that are coprime with `n`,
+/// so that `i ↦ i·g mod n` is a permutation of the rows, the one whose continued
+/// fraction `n/g` has the smallest largest partial quotient (Zaremba's figure of merit:
+/// small quotients mean no two points close together), the nearest to `n/φ` on a tie.
+/// Integer arithmetic only (`40503 = round(2^16/φ)`; exact for `n <= 65536`), so both
+/// backends agree bit for bit.
 ///
 /// Rank-1 lattices for pixel sampling: Dammertz and Keller, "Image Synthesis by Rank-1
-/// Lattices", Monte Carlo and Quasi-Monte Carlo Methods 2006 (Springer, 2008).
+/// Lattices", Monte Carlo and Quasi-Monte Carlo Methods 2006 (Springer, 2008); the
+/// figure of merit: Niederreiter, "Random Number Generation and Quasi-Monte Carlo
+/// Methods" (SIAM, 1992), §5.
 pub fn lattice_generator(n: u32) -> u32 {
-    let mut g = (n.wrapping_mul(40_503).wrapping_add(32_768)) >> 16;
-    while greatest_common_divisor(g, n) != 1 {
-        g += 1;
+    let nearest = (n.wrapping_mul(40_503).wrapping_add(32_768)) >> 16;
+    let mut best = (u32::MAX, 1);
+    for k in 0..LATTICE_CANDIDATES {
+        let step = k.div_ceil(2);
+        let g = if k % 2 == 1 {
+            nearest.wrapping_add(step)
+        } else {
+            nearest.wrapping_sub(step)
+        };
+        if g == 0 || g >= n {
+            continue;
+        }
+        let quality = largest_partial_quotient(n, g);
+        if quality < best.0 {
+            best = (quality, g);
+        }
     }
-    g
+    best.1
 }
 
-/// Euclid's algorithm.
-fn greatest_common_divisor(mut a: u32, mut b: u32) -> u32 {
+/// The largest partial quotient of the continued fraction of `n/g` (Euclid's
+/// algorithm), or `u32::MAX` when `n` and `g` are not coprime.
+fn largest_partial_quotient(n: u32, g: u32) -> u32 {
+    let (mut a, mut b, mut largest) = (n, g, 0);
     while b != 0 {
+        largest = largest.max(a / b);
         (a, b) = (b, a % b);
     }
-    a
+    if a == 1 { largest } else { u32::MAX }
 }
 
 /// The offset inside pixel (`px`, `py`) of sample `index`, in [0, 1)². One sample goes
@@ -185,10 +209,22 @@ mod tests {
         for n in 2..=65_536u32 {
             let g = lattice_generator(n);
             assert!(g >= 1 && g < n, "n={n} g={g}");
-            assert_eq!(greatest_common_divisor(g, n), 1, "n={n} g={g}");
+            assert_ne!(
+                largest_partial_quotient(n, g),
+                u32::MAX,
+                "n={n} g={g}: not coprime"
+            );
+            // Some candidate is coprime: never the diagonal fallback g = 1.
+            assert!(n <= 3 || g > 1, "n={n}");
         }
         // Fibonacci numbers get the Fibonacci lattice: 89 points, generator 55.
         assert_eq!(lattice_generator(89), 55);
+        // 32 points: 21 is nearest 32/φ, but 32/21 = [1; 1, 1, 10]; 25 gives [1; 3, 1, 1, 3].
+        assert_eq!(lattice_generator(32), 25);
+        for n in 2..=300 {
+            let quality = largest_partial_quotient(n, lattice_generator(n));
+            assert!(quality <= 8, "n={n}: largest partial quotient {quality}");
+        }
     }
 
     #[test]
