@@ -339,3 +339,152 @@ fn brdf_check_reports_every_violated_rule() {
     let missing = gpu_render(&["brdf-check", "/nonexistent/map.png"]);
     assert_fails_with(&missing, &["/nonexistent/map.png", "cannot read"]);
 }
+
+// ------------------------------------------------------------------ signals
+
+use std::time::{Duration, Instant};
+
+/// Waits for `child` for at most `limit`; kills it (a failure) if it is still running.
+fn wait_at_most(
+    child: &mut std::process::Child,
+    limit: Duration,
+) -> Option<std::process::ExitStatus> {
+    let started = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().expect("wait") {
+            return Some(status);
+        }
+        if started.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+#[cfg(unix)]
+fn send_signal(child: &std::process::Child, signal: &str) {
+    let sent = Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status()
+        .expect("run kill");
+    assert!(sent.success(), "kill {signal} failed");
+}
+
+/// Temporary files of gpu-render in `dir`, with their sizes.
+fn temporaries(dir: &Path) -> Vec<(String, u64)> {
+    std::fs::read_dir(dir)
+        .expect("list")
+        .filter_map(|e| {
+            let e = e.ok()?;
+            let name = e.file_name().to_string_lossy().into_owned();
+            let size = e.metadata().ok()?.len();
+            (name.starts_with(".gpu-render-") && name.ends_with(".tmp")).then_some((name, size))
+        })
+        .collect()
+}
+
+/// Renders an empty 4096x4096 scene to `out.exr` (256 MiB) and sends `signal` once
+/// the temporary file has data in it: the write is in progress.
+#[cfg(unix)]
+fn interrupt_a_write(signal: &str) {
+    let ws = Workspace::new(
+        "[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\n[environment]\nbackground = 0.5\n",
+    );
+    std::fs::write(ws.path("out.exr"), OLD_OUTPUT).expect("old exr");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gpu-render"))
+        .args([
+            &ws.arg("scene.toml"),
+            "-o",
+            &ws.arg("out.exr"),
+            "--backend",
+            "cpu",
+            "--width",
+            "4096",
+            "--height",
+            "4096",
+            "-q",
+        ])
+        .spawn()
+        .expect("spawn");
+    let started = Instant::now();
+    let mut sent = false;
+    while started.elapsed() < Duration::from_secs(120) {
+        if child.try_wait().expect("wait").is_some() {
+            break;
+        }
+        if temporaries(ws.dir.path()).iter().any(|&(_, size)| size > 0) {
+            send_signal(&child, signal);
+            sent = true;
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let status = wait_at_most(&mut child, Duration::from_secs(60));
+    assert!(sent, "the write finished before the signal could be sent");
+    assert_eq!(
+        status.and_then(|s| s.code()),
+        Some(130),
+        "{signal}: {status:?}"
+    );
+    assert!(
+        temporaries(ws.dir.path()).is_empty(),
+        "{signal} left {:?}",
+        temporaries(ws.dir.path())
+    );
+    assert_eq!(std::fs::read(ws.path("out.exr")).expect("read"), OLD_OUTPUT);
+}
+
+#[cfg(unix)]
+#[test]
+fn sigint_during_a_write_leaves_no_temporary_file_and_exits_130() {
+    interrupt_a_write("-INT");
+}
+
+#[cfg(unix)]
+#[test]
+fn sigterm_during_a_write_leaves_no_temporary_file_and_exits_130() {
+    interrupt_a_write("-TERM");
+}
+
+#[cfg(unix)]
+#[test]
+fn sigint_during_a_render_stops_it_and_keeps_the_old_output() {
+    let ws = Workspace::new(TINY_SCENE);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gpu-render"))
+        .args([
+            &ws.arg("scene.toml"),
+            "-o",
+            &ws.arg("out.png"),
+            "--backend",
+            "cpu",
+            "--width",
+            "2048",
+            "--height",
+            "2048",
+            "--spp",
+            "256",
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    // The render takes minutes; the handler is installed within milliseconds of the
+    // start, and by a second the render is well under way.
+    std::thread::sleep(Duration::from_secs(1));
+    let started = Instant::now();
+    send_signal(&child, "-INT");
+    let status = wait_at_most(&mut child, Duration::from_secs(30));
+    assert_eq!(status.and_then(|s| s.code()), Some(130), "{status:?}");
+    assert!(started.elapsed() < Duration::from_secs(30));
+    let mut rest = String::new();
+    use std::io::Read;
+    child
+        .stderr
+        .take()
+        .expect("stderr")
+        .read_to_string(&mut rest)
+        .expect("read");
+    assert!(rest.contains("interrupted"), "{rest}");
+    ws.assert_old_output_kept();
+}

@@ -3,12 +3,14 @@
 //! Cheap checks (output format and directory, command-line settings, the scene file)
 //! all happen before a device is opened or a ray traced. Errors are printed as
 //! `error: ...` with their causes and exit with status 1; usage errors are clap's
-//! (status 2).
+//! (status 2). Ctrl-C, SIGTERM and SIGHUP stop it cleanly with status 130 (see
+//! `signals.rs`).
 
 mod args;
 mod backend;
 mod compare;
 mod progress;
+mod signals;
 mod summary;
 mod tradeoff;
 
@@ -29,6 +31,10 @@ use crate::summary::Summary;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Err(error) = signals::install() {
+        eprintln!("error: {error:#}");
+        return ExitCode::FAILURE;
+    }
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
