@@ -340,6 +340,54 @@ fn brdf_check_reports_every_violated_rule() {
     assert_fails_with(&missing, &["/nonexistent/map.png", "cannot read"]);
 }
 
+// ------------------------------------------------------------- flag values
+
+#[test]
+fn a_negative_width_says_it_must_be_positive() {
+    let run = gpu_render(&["scene.toml", "-o", "x.png", "--width", "-1"]);
+    assert_eq!(run.status, Some(2), "stderr:\n{}", run.stderr);
+    assert!(
+        run.stderr.contains("--width") && run.stderr.contains("positive integer"),
+        "{}",
+        run.stderr
+    );
+    let run = gpu_render(&["scene.toml", "-o", "x.png", "--min-ray-weight", "-0.5"]);
+    assert!(
+        !run.stderr.contains("unexpected argument"),
+        "{}",
+        run.stderr
+    );
+}
+
+#[test]
+fn tradeoff_refuses_bad_counts_before_creating_its_folder() {
+    let ws = Workspace::new(TINY_SCENE);
+    let out_dir = ws.path("sweep");
+    for (flag, value) in [
+        ("--reference-spp", "0"),
+        ("--repeats", "0"),
+        ("--width", "-5"),
+    ] {
+        let run = gpu_render(&[
+            "tradeoff",
+            &ws.arg("scene.toml"),
+            "--out-dir",
+            &out_dir.to_string_lossy(),
+            "--backend",
+            "cpu",
+            flag,
+            value,
+        ]);
+        assert_eq!(run.status, Some(2), "{flag} {value}: {}", run.stderr);
+        assert!(run.stderr.contains(flag), "{flag}: {}", run.stderr);
+        assert!(
+            !out_dir.exists(),
+            "{flag} {value} created the output folder"
+        );
+    }
+    ws.assert_old_output_kept();
+}
+
 // ------------------------------------------------------------------ signals
 
 use std::time::{Duration, Instant};
