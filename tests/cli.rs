@@ -340,6 +340,178 @@ fn brdf_check_reports_every_violated_rule() {
     assert_fails_with(&missing, &["/nonexistent/map.png", "cannot read"]);
 }
 
+// ------------------------------------------------- inputs, outputs and limits
+
+#[test]
+fn the_scene_file_is_never_the_output() {
+    // A scene file with an image extension, rendered onto itself.
+    let ws = Workspace::new(TINY_SCENE);
+    let scene = ws.path("scene.png");
+    std::fs::write(&scene, TINY_SCENE).expect("write scene.png");
+    let run = gpu_render(&[
+        &ws.arg("scene.png"),
+        "-o",
+        &ws.arg("scene.png"),
+        "--backend",
+        "cpu",
+    ]);
+    assert_fails_with(&run, &["scene.png", "same file as the scene file"]);
+    assert_eq!(std::fs::read_to_string(&scene).expect("read"), TINY_SCENE);
+    // Through a symbolic link too.
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(ws.path("scene.toml"), ws.path("link.png")).expect("symlink");
+        let run = gpu_render(&[
+            &ws.arg("scene.toml"),
+            "-o",
+            &ws.arg("link.png"),
+            "--backend",
+            "cpu",
+        ]);
+        assert_fails_with(&run, &["link.png", "scene.toml"]);
+        assert_eq!(
+            std::fs::read_to_string(ws.path("scene.toml")).expect("read"),
+            TINY_SCENE
+        );
+    }
+}
+
+#[test]
+fn a_texture_is_never_the_output() {
+    let ws = Workspace::new(&TINY_SCENE.replace("albedo = 0.7", "albedo_texture = \"wood.png\""));
+    image::RgbImage::from_pixel(2, 2, image::Rgb([200, 100, 50]))
+        .save(ws.path("wood.png"))
+        .expect("write the texture");
+    let before = std::fs::read(ws.path("wood.png")).expect("read");
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("wood.png"),
+        "--backend",
+        "cpu",
+    ]);
+    assert_fails_with(&run, &["wood.png", "same file as the image"]);
+    assert_eq!(std::fs::read(ws.path("wood.png")).expect("read"), before);
+}
+
+#[test]
+fn an_output_path_naming_a_directory_is_refused_before_rendering() {
+    let ws = Workspace::new(TINY_SCENE);
+    let target = format!("{}/", ws.arg("dir.png"));
+    // 4096x4096 at 64 spp would take minutes: the refusal must come first.
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &target,
+        "--backend",
+        "cpu",
+        "--width",
+        "4096",
+        "--height",
+        "4096",
+        "--spp",
+        "64",
+    ]);
+    assert_fails_with(&run, &["dir.png/", "is a directory"]);
+    ws.assert_old_output_kept();
+}
+
+#[test]
+fn hdr_output_clamps_radiance_it_cannot_hold_and_says_so() {
+    let scene = TINY_SCENE.replace(
+        "type = \"lambert\"\nalbedo = 0.7",
+        "type = \"emissive\"\nradiance = 3e38",
+    );
+    let ws = Workspace::new(&scene);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.hdr"),
+        "--backend",
+        "cpu",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(
+        run.stderr.contains("warning:") && run.stderr.contains("clamped"),
+        "{}",
+        run.stderr
+    );
+    let image = image::open(ws.path("out.hdr"))
+        .expect("open hdr")
+        .to_rgb32f();
+    let centre = image.get_pixel(16, 12).0;
+    assert_eq!(centre[0], gpu_render::output::HDR_MAX, "{centre:?}");
+}
+
+#[test]
+fn albedo_textures_above_one_are_clamped_with_a_warning_unless_quiet() {
+    let ws = Workspace::new(&TINY_SCENE.replace("albedo = 0.7", "albedo_texture = \"hot.exr\""));
+    image::Rgba32FImage::from_pixel(2, 2, image::Rgba([4.0, 0.5, 0.5, 1.0]))
+        .save(ws.path("hot.exr"))
+        .expect("write the texture");
+    let args = [
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+    ];
+    let run = gpu_render(&args);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(
+        run.stderr.contains("warning: ") && run.stderr.contains("clamped to 1"),
+        "{}",
+        run.stderr
+    );
+    let quiet = gpu_render(&[args.as_slice(), &["-q"]].concat());
+    assert_eq!(quiet.status, Some(0));
+    assert!(quiet.stderr.is_empty(), "{}", quiet.stderr);
+}
+
+#[test]
+fn the_sandbox_refuses_textures_outside_the_scene_folder() {
+    let ws =
+        Workspace::new(&TINY_SCENE.replace("albedo = 0.7", "albedo_texture = \"../wood.png\""));
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+        "--sandbox",
+    ]);
+    assert_fails_with(&run, &["scene.toml:", "albedo_texture", "`..`"]);
+    ws.assert_old_output_kept();
+}
+
+#[cfg(unix)]
+#[test]
+fn a_fifo_as_scene_is_refused_at_once() {
+    let ws = Workspace::new(TINY_SCENE);
+    let fifo = ws.path("pipe.toml");
+    let made = Command::new("mkfifo").arg(&fifo).status().expect("mkfifo");
+    assert!(made.success());
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gpu-render"))
+        .args([
+            &ws.arg("pipe.toml"),
+            "-o",
+            &ws.arg("out.png"),
+            "--backend",
+            "cpu",
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    let status = wait_at_most(&mut child, Duration::from_secs(30));
+    let mut stderr = String::new();
+    if let Some(mut pipe) = child.stderr.take() {
+        use std::io::Read;
+        pipe.read_to_string(&mut stderr).expect("read stderr");
+    }
+    assert_eq!(status.and_then(|s| s.code()), Some(1), "{stderr}");
+    assert!(stderr.contains("a FIFO, not a regular file"), "{stderr}");
+}
+
 // ------------------------------------------------------------- flag values
 
 #[test]

@@ -8,7 +8,6 @@ use gpu_render::scene::{
     LightingSpace, MAX_DEPTH_LIMIT, MAX_IMAGE_DIMENSION, MAX_SAMPLES_PER_PIXEL, RenderOverrides,
 };
 
-
 const AFTER_HELP: &str = "\
 Output formats (chosen by the extension of --output):
   .png   8-bit sRGB display image
@@ -125,6 +124,9 @@ pub struct TradeoffArgs {
     #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
     pub backend: BackendArg,
 
+    /// Confine the files the scene names to its folder (see the render options).
+    #[arg(long)]
+    pub sandbox: bool,
 }
 
 /// The arguments of a render.
@@ -240,7 +242,13 @@ pub struct RenderArgs {
     #[arg(long, value_name = "list|INDEX|NAME", value_parser = parse_adapter, help_heading = "Device")]
     pub adapter: Option<AdapterArg>,
 
-    /// Print nothing but errors: no progress, notes or summary.
+    /// Confine the files the scene names (textures, BRDF maps) to the scene file's
+    /// folder: refuse absolute paths, `..` and links out of it. Without it a scene
+    /// file is trusted like a program: it may name any file you can read.
+    #[arg(long)]
+    pub sandbox: bool,
+
+    /// Print nothing but errors: no progress, warnings, notes or summary.
     #[arg(short, long)]
     pub quiet: bool,
 }

@@ -21,8 +21,8 @@ use std::time::Instant;
 
 use anyhow::{Result, anyhow, bail};
 use clap::{CommandFactory, Parser, error::ErrorKind};
-use gpu_render::output::{self, OutputFormat};
-use gpu_render::scene::{self, LightingSpace, RenderSettings, Scene};
+use gpu_render::output::{self, HDR_MAX, OutputFormat, Written};
+use gpu_render::scene::{self, LightingSpace, LoadOptions, RenderSettings, Scene, SceneWarning};
 
 use crate::args::{AdapterArg, BackendArg, Cli, RenderArgs};
 use crate::backend::{Backend, Frame};
@@ -127,9 +127,11 @@ fn render(args: &RenderArgs, scene_path: &Path, output_path: &Path) -> Result<()
     }
     // Values out of range whatever the scene says (`--width 0`) fail before loading it.
     apply_overrides(args, minimal_settings(), None)?;
+    output::check_not_an_input(output_path, [(scene_path, "scene file")])?;
 
-    let mut scene = scene::load_scene(scene_path)?;
+    let mut scene = load(scene_path, args.sandbox, args.quiet)?;
     scene.render = apply_overrides(args, scene.render, Some(scene_path))?;
+    check_inputs_survive(output_path, scene_path, &scene)?;
 
     let backend = Backend::open(args.backend, args.adapter.as_ref(), args.quiet)?;
     let started = Instant::now();
@@ -147,9 +149,10 @@ fn render(args: &RenderArgs, scene_path: &Path, output_path: &Path) -> Result<()
     };
     let wall = started.elapsed();
 
-    output::write_image(output_path, &frame.image, &frame.display_rgba8)?;
+    let written = output::write_image(output_path, &frame.image, &frame.display_rgba8)?;
 
     if !args.quiet {
+        warn_clamped(output_path, written);
         let summary = Summary {
             settings: &scene.render,
             passes: if args.compare_gamma { 2 } else { 1 },
@@ -161,6 +164,46 @@ fn render(args: &RenderArgs, scene_path: &Path, output_path: &Path) -> Result<()
         eprintln!("{summary}");
     }
     Ok(())
+}
+
+/// Loads the scene file, with progress after a second and warnings on stderr (unless
+/// `quiet`), confined to its folder with `sandbox`.
+pub fn load(scene_path: &Path, sandbox: bool, quiet: bool) -> Result<Scene> {
+    let warn = |warning: &SceneWarning| eprintln!("warning: {warning}");
+    let label = scene_path.display().to_string();
+    let scene = progress::while_loading(&label, !quiet, |progress| {
+        let options = LoadOptions {
+            sandbox,
+            progress: Some(progress),
+            warning: (!quiet).then_some(&warn as &(dyn Fn(&SceneWarning) + Sync)),
+        };
+        scene::load_scene_with(scene_path, &options)
+    })?;
+    Ok(scene)
+}
+
+/// Refuses an output that is the scene file or one of its images.
+fn check_inputs_survive(output_path: &Path, scene_path: &Path, scene: &Scene) -> Result<()> {
+    let inputs = std::iter::once((scene_path, "scene file")).chain(
+        scene
+            .images
+            .iter()
+            .map(|image| (image.path.as_path(), "image")),
+    );
+    output::check_not_an_input(output_path, inputs)?;
+    Ok(())
+}
+
+/// Warns when the format could not hold every pixel and clamped some.
+fn warn_clamped(output_path: &Path, written: Written) {
+    if written.clamped_pixels > 0 {
+        eprintln!(
+            "warning: {}: {} pixels had radiance above {HDR_MAX:e}, the largest a Radiance \
+             HDR file holds, and were clamped to it; write .exr to keep them",
+            output_path.display(),
+            written.clamped_pixels
+        );
+    }
 }
 
 /// Renders `scene`, in `lighting` space if given, with progress on stderr.

@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use anyhow::{Context, Result};
 use gpu_render::film::TimingSource;
-use gpu_render::scene::{RenderOverrides, RenderSettings, Scene, load_scene};
+use gpu_render::scene::{RenderOverrides, RenderSettings, Scene};
 use gpu_render::tradeoff::{
     Knobs, Measurement, default_sweep, mean_flip, pareto_front, plot_png, rmse, to_csv,
 };
@@ -27,7 +27,7 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
             args.out_dir.display()
         );
     }
-    let scene = load_scene(&args.scene)?;
+    let scene = crate::load(&args.scene, args.sandbox, false)?;
     let height = (u64::from(scene.render.height) * u64::from(args.width)
         / u64::from(scene.render.width))
     .max(1) as u32;
@@ -49,6 +49,12 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
         min_ray_weight: 0.0,
     };
     let reference_scene = with_knobs(&scene, reference_knobs)?;
+    for name in OUTPUT_FILES {
+        let path = args.out_dir.join(name);
+        let inputs = std::iter::once((args.scene.as_path(), "scene file"))
+            .chain(scene.images.iter().map(|i| (i.path.as_path(), "image")));
+        gpu_render::output::check_not_an_input(&path, inputs)?;
+    }
     std::fs::create_dir_all(&args.out_dir)
         .with_context(|| format!("cannot create {}", args.out_dir.display()))?;
     for name in OUTPUT_FILES {
