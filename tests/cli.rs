@@ -417,6 +417,44 @@ fn an_output_path_naming_a_directory_is_refused_before_rendering() {
 }
 
 #[test]
+fn a_render_beyond_the_memory_cap_is_refused_up_front_with_the_estimate() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+        "--compare-gamma",
+        "--width",
+        "16384",
+        "--height",
+        "8192",
+    ]);
+    assert_fails_with(
+        &run,
+        &[
+            "16384x8192",
+            "GiB",
+            "more than the 4 GiB allowed",
+            "--max-memory",
+        ],
+    );
+    ws.assert_old_output_kept();
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+        "--max-memory",
+        "0.01",
+    ]);
+    assert_fails_with(&run, &["more than the 0.01 GiB allowed"]);
+    ws.assert_old_output_kept();
+}
+
+#[test]
 fn hdr_output_clamps_radiance_it_cannot_hold_and_says_so() {
     let scene = TINY_SCENE.replace(
         "type = \"lambert\"\nalbedo = 0.7",

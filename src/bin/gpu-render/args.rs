@@ -8,6 +8,8 @@ use gpu_render::scene::{
     LightingSpace, MAX_DEPTH_LIMIT, MAX_IMAGE_DIMENSION, MAX_SAMPLES_PER_PIXEL, RenderOverrides,
 };
 
+use crate::memory::DEFAULT_MAX_MEMORY_GIB;
+
 const AFTER_HELP: &str = "\
 Output formats (chosen by the extension of --output):
   .png   8-bit sRGB display image
@@ -248,6 +250,16 @@ pub struct RenderArgs {
     #[arg(long)]
     pub sandbox: bool,
 
+    /// Refuse, before rendering, a render whose estimated peak memory is above this
+    /// many GiB (see docs/reliability.md for the estimate per backend and format).
+    #[arg(
+        long,
+        value_name = "GIB",
+        default_value_t = DEFAULT_MAX_MEMORY_GIB,
+        value_parser = parse_gib
+    )]
+    pub max_memory: f64,
+
     /// Print nothing but errors: no progress, warnings, notes or summary.
     #[arg(short, long)]
     pub quiet: bool,
@@ -396,6 +408,16 @@ fn parse_in_range<const LOW: u32, const HIGH: u32>(text: &str) -> Result<u32, St
     Ok(value)
 }
 
+/// A memory size in GiB, more than 0.
+fn parse_gib(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(gib) if gib.is_finite() && gib > 0.0 => Ok(gib),
+        _ => Err(format!(
+            "must be a number of GiB above 0 (e.g. 4 or 0.5), got `{text}`"
+        )),
+    }
+}
+
 fn parse_adapter(text: &str) -> Result<AdapterArg, String> {
     let text = text.trim();
     if text.is_empty() {
@@ -464,6 +486,8 @@ mod tests {
         );
         assert_eq!(parse_in_range::<1, 10>("10"), Ok(10));
         assert!(parse_in_range::<1, 10>("0").is_err());
+        assert!(parse_gib("0").is_err() && parse_gib("nan").is_err());
+        assert_eq!(parse_gib("0.5"), Ok(0.5));
     }
 
     #[test]

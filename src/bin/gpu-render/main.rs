@@ -9,6 +9,7 @@
 mod args;
 mod backend;
 mod compare;
+mod memory;
 mod progress;
 mod signals;
 mod summary;
@@ -26,6 +27,7 @@ use gpu_render::scene::{self, LightingSpace, LoadOptions, RenderSettings, Scene,
 
 use crate::args::{AdapterArg, BackendArg, Cli, RenderArgs};
 use crate::backend::{Backend, Frame};
+use crate::memory::{BackendKind, Estimate};
 use crate::progress::Progress;
 use crate::summary::Summary;
 
@@ -134,6 +136,13 @@ fn render(args: &RenderArgs, scene_path: &Path, output_path: &Path) -> Result<()
     check_inputs_survive(output_path, scene_path, &scene)?;
 
     let backend = Backend::open(args.backend, args.adapter.as_ref(), args.quiet)?;
+    check_memory(
+        &scene,
+        &backend,
+        format,
+        args.compare_gamma,
+        args.max_memory,
+    )?;
     let started = Instant::now();
     let frame = if args.compare_gamma {
         let linear = render_pass(&backend, &scene, Some(LightingSpace::Linear), args.quiet)?;
@@ -191,6 +200,39 @@ fn check_inputs_survive(output_path: &Path, scene_path: &Path, scene: &Scene) ->
             .map(|image| (image.path.as_path(), "image")),
     );
     output::check_not_an_input(output_path, inputs)?;
+    Ok(())
+}
+
+/// Refuses, before rendering, a render whose estimated peak memory is above the cap.
+fn check_memory(
+    scene: &Scene,
+    backend: &Backend,
+    format: OutputFormat,
+    compare_gamma: bool,
+    max_memory_gib: f64,
+) -> Result<()> {
+    let kind = match backend {
+        Backend::Gpu { .. } => BackendKind::Gpu,
+        Backend::Cpu => BackendKind::Cpu,
+    };
+    let estimate = Estimate::new(scene, kind, format, compare_gamma);
+    let cap = max_memory_gib * f64::from(1u32 << 30);
+    if estimate.total as f64 > cap {
+        let s = &scene.render;
+        bail!(
+            "rendering {}x{}{} to {format} on the {} would need about {estimate}, more than \
+             the {max_memory_gib} GiB allowed; render smaller, or raise --max-memory if the \
+             machine has the memory",
+            s.width,
+            s.height,
+            if compare_gamma {
+                " twice (--compare-gamma)"
+            } else {
+                ""
+            },
+            backend.describe()
+        );
+    }
     Ok(())
 }
 
