@@ -30,10 +30,11 @@ pub const MAX_SCENE_FILE_BYTES: u64 = 64 * 1024 * 1024;
 /// Largest accepted number of objects plus polygon and triangle vertices.
 pub const MAX_SCENE_ELEMENTS: usize = 1_000_000;
 /// Largest accepted number of TOML values (tables, arrays, numbers, strings), counted
-/// before parsing. The parser needs about 375 bytes per value at its peak (measured:
-/// 742k spheres, 6.7M values, 2.5 GB), so this bounds it at about 3 GB; the largest
-/// legitimate files (64 MiB of spheres, or the 1,000,000-element limit in triangles)
-/// have fewer, while 64 MiB of `[],` has 22 million.
+/// before parsing as the `=`, `,`, `[` and `{` outside strings and comments (an upper
+/// bound). Loading needs about 375 bytes per counted value at its peak (measured:
+/// 742k spheres, 6.7M counted, 2.5 GB), so this bounds it at about 3 GB; the largest
+/// legitimate files (64 MiB of spheres, or the 1,000,000-element limit in triangles,
+/// 4.2M counted) are below it, while 64 MiB of `[],` counts 44.7 million.
 pub const MAX_SCENE_VALUES: u64 = 8_000_000;
 
 /// How a scene file is loaded: whether the files it names are confined to its folder,
@@ -133,9 +134,9 @@ pub fn parse_scene_with(
             format!(
                 "the scene file holds up to {} values (every `=`, `,`, `[` and `{{` outside \
                  strings and comments starts one), more than the {MAX_SCENE_VALUES} accepted: \
-                 parsing it would need about {} GB of memory",
-                structure.values,
-                structure.values * 375 / 1_000_000_000
+                 the TOML parser keeps every value in memory (200 to 400 bytes each, so \
+                 several GB for this file)",
+                structure.values
             ),
         ));
     }
