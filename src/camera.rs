@@ -63,21 +63,71 @@ pub fn unit_from_hash(hash: u32) -> f64 {
     f64::from(hash >> 8) * (1.0 / 16_777_216.0)
 }
 
-/// Number of stratum columns and rows for `samples_per_pixel` samples: a grid of
-/// `ceil(sqrt(n))` columns and as many rows as needed.
+/// The stratum grid of `samples_per_pixel` samples: `n` columns and `n` rows of
+/// elementary strata, each `1/n` of the pixel wide and high. [`sample_offset`] puts
+/// exactly one sample in every column and exactly one in every row (a Latin square),
+/// so the grid is always covered uniformly, whatever `n` is. One sample is `(1, 1)`.
 pub fn strata_grid(samples_per_pixel: u32) -> (u32, u32) {
-    let mut columns = (f64::from(samples_per_pixel)).sqrt() as u32;
-    if columns * columns < samples_per_pixel {
-        columns += 1;
+    let n = samples_per_pixel.max(1);
+    (n, n)
+}
+
+/// Candidates [`lattice_generator`] weighs: the integer nearest `n/φ` and the 8 on
+/// each side of it.
+pub const LATTICE_CANDIDATES: u32 = 17;
+
+/// The generator `g` of the rank-1 lattice of `n` points `(i/n, (i·g mod n)/n)`: of the
+/// integers near `n/φ` (golden ratio φ: a Fibonacci lattice) that are coprime with `n`,
+/// so that `i ↦ i·g mod n` is a permutation of the rows, the one whose continued
+/// fraction `n/g` has the smallest largest partial quotient (Zaremba's figure of merit:
+/// small quotients mean no two points close together), the nearest to `n/φ` on a tie.
+/// Integer arithmetic only (`40503 = round(2^16/φ)`; exact for `n <= 65536`), so both
+/// backends agree bit for bit.
+///
+/// Rank-1 lattices for pixel sampling: Dammertz and Keller, "Image Synthesis by Rank-1
+/// Lattices", Monte Carlo and Quasi-Monte Carlo Methods 2006 (Springer, 2008); the
+/// figure of merit: Niederreiter, "Random Number Generation and Quasi-Monte Carlo
+/// Methods" (SIAM, 1992), §5.
+pub fn lattice_generator(n: u32) -> u32 {
+    let nearest = (n.wrapping_mul(40_503).wrapping_add(32_768)) >> 16;
+    let mut best = (u32::MAX, 1);
+    for k in 0..LATTICE_CANDIDATES {
+        let step = k.div_ceil(2);
+        let g = if k % 2 == 1 {
+            nearest.wrapping_add(step)
+        } else {
+            nearest.wrapping_sub(step)
+        };
+        if g == 0 || g >= n {
+            continue;
+        }
+        let quality = largest_partial_quotient(n, g);
+        if quality < best.0 {
+            best = (quality, g);
+        }
     }
-    let rows = samples_per_pixel.div_ceil(columns);
-    (columns, rows)
+    best.1
+}
+
+/// The largest partial quotient of the continued fraction of `n/g` (Euclid's
+/// algorithm), or `u32::MAX` when `n` and `g` are not coprime.
+fn largest_partial_quotient(n: u32, g: u32) -> u32 {
+    let (mut a, mut b, mut largest) = (n, g, 0);
+    while b != 0 {
+        largest = largest.max(a / b);
+        (a, b) = (b, a % b);
+    }
+    if a == 1 { largest } else { u32::MAX }
 }
 
 /// The offset inside pixel (`px`, `py`) of sample `index`, in [0, 1)². One sample goes
-/// through the pixel centre (as in the lecture); more are jittered stratified: sample
-/// `i` lies in cell (`i mod columns`, `i div columns`) of the [`strata_grid`], jittered
-/// by a hash of the pixel and sample index, so both backends pick identical positions.
+/// through the pixel centre (as in the lecture). With `n > 1` samples, sample `i` lies
+/// in column `i` and row `(i·g + s) mod n` of the `n × n` [`strata_grid`], where `g` is
+/// the [`lattice_generator`] of `n` and `s` a hash of the pixel: every column and every
+/// row holds exactly one sample (so the mean offset is within `1/(2n)` of the pixel
+/// centre in each axis, for every `n`), and the points lie on a Fibonacci lattice, so
+/// they are spread in 2D too. Each sample is jittered inside its cell by a hash of the
+/// pixel and sample index, so both backends pick identical positions.
 pub fn sample_offset(px: u32, py: u32, index: u32, settings: &RenderSettings) -> (f64, f64) {
     let spp = settings.samples_per_pixel;
     if spp <= 1 {
@@ -85,12 +135,17 @@ pub fn sample_offset(px: u32, py: u32, index: u32, settings: &RenderSettings) ->
     }
     let (columns, rows) = strata_grid(spp);
     let pixel_index = py.wrapping_mul(settings.width).wrapping_add(px);
+    let shift = pcg_hash(pixel_index) % rows;
+    let column = index % columns;
+    // In u64 for safety; the WGSL twin's u32 cannot overflow either for n <= 65536.
+    let row = ((u64::from(column) * u64::from(lattice_generator(spp)) + u64::from(shift))
+        % u64::from(rows)) as u32;
     let seed = pcg_hash(pixel_index.wrapping_mul(spp).wrapping_add(index));
     let jitter_x = unit_from_hash(seed);
     let jitter_y = unit_from_hash(pcg_hash(seed));
     (
-        (f64::from(index % columns) + jitter_x) / f64::from(columns),
-        (f64::from(index / columns) + jitter_y) / f64::from(rows),
+        (f64::from(column) + jitter_x) / f64::from(columns),
+        (f64::from(row) + jitter_y) / f64::from(rows),
     )
 }
 
@@ -98,12 +153,90 @@ pub fn sample_offset(px: u32, py: u32, index: u32, settings: &RenderSettings) ->
 mod tests {
     use super::*;
 
-    #[test]
-    fn strata_cover_every_sample() {
-        for n in 1..200 {
-            let (c, r) = strata_grid(n);
-            assert!(c * r >= n && c * (r - 1) < n, "n={n} c={c} r={r}");
+    fn settings(width: u32, samples_per_pixel: u32) -> RenderSettings {
+        RenderSettings {
+            width,
+            samples_per_pixel,
+            ..RenderSettings::default()
         }
+    }
+
+    #[test]
+    fn every_column_and_row_holds_exactly_one_sample() {
+        for n in 1..=300 {
+            let (columns, rows) = strata_grid(n);
+            assert_eq!((columns, rows), (n, n));
+            for (px, py) in [(0, 0), (7, 3), (639, 479)] {
+                let mut column_hits = vec![0u32; columns as usize];
+                let mut row_hits = vec![0u32; rows as usize];
+                for index in 0..n {
+                    let (x, y) = sample_offset(px, py, index, &settings(640, n));
+                    assert!((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y));
+                    column_hits[(x * f64::from(columns)) as usize] += 1;
+                    row_hits[(y * f64::from(rows)) as usize] += 1;
+                }
+                assert!(
+                    column_hits.iter().all(|&h| h == 1),
+                    "n={n}: {column_hits:?}"
+                );
+                assert!(row_hits.iter().all(|&h| h == 1), "n={n}: {row_hits:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn mean_offset_is_the_pixel_centre_for_every_sample_count() {
+        // One sample per column and per row, each jittered inside a cell 1/n wide: the
+        // mean lies within 1/(2n) of 0.5. The old ceil(sqrt(n)) grid left cells of its
+        // last row empty (32 samples: 4 of 36), a bias of 0.05 in y.
+        for n in 1..=300 {
+            let bound = 0.5 / f64::from(n);
+            for (px, py) in [(0, 0), (5, 2), (31, 23), (1000, 1000)] {
+                let (sum_x, sum_y) = (0..n)
+                    .map(|i| sample_offset(px, py, i, &settings(1920, n)))
+                    .fold((0.0, 0.0), |(sx, sy), (x, y)| (sx + x, sy + y));
+                let mean = (sum_x / f64::from(n), sum_y / f64::from(n));
+                assert!(
+                    (mean.0 - 0.5).abs() <= bound && (mean.1 - 0.5).abs() <= bound,
+                    "n={n} pixel ({px}, {py}): mean offset {mean:?}, bound {bound}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn lattice_generator_permutes_the_rows() {
+        for n in 2..=65_536u32 {
+            let g = lattice_generator(n);
+            assert!(g >= 1 && g < n, "n={n} g={g}");
+            assert_ne!(
+                largest_partial_quotient(n, g),
+                u32::MAX,
+                "n={n} g={g}: not coprime"
+            );
+            // Some candidate is coprime: never the diagonal fallback g = 1.
+            assert!(n <= 3 || g > 1, "n={n}");
+        }
+        // Fibonacci numbers get the Fibonacci lattice: 89 points, generator 55.
+        assert_eq!(lattice_generator(89), 55);
+        // 32 points: 21 is nearest 32/φ, but 32/21 = [1; 1, 1, 10]; 25 gives [1; 3, 1, 1, 3].
+        assert_eq!(lattice_generator(32), 25);
+        for n in 2..=300 {
+            let quality = largest_partial_quotient(n, lattice_generator(n));
+            assert!(quality <= 8, "n={n}: largest partial quotient {quality}");
+        }
+    }
+
+    #[test]
+    fn pixels_get_different_patterns() {
+        let a: Vec<_> = (0..16)
+            .map(|i| sample_offset(0, 0, i, &settings(64, 16)))
+            .collect();
+        let b: Vec<_> = (0..16)
+            .map(|i| sample_offset(1, 0, i, &settings(64, 16)))
+            .collect();
+        assert_ne!(a, b);
+        assert_eq!(sample_offset(3, 4, 0, &settings(64, 1)), (0.5, 0.5));
     }
 
     #[test]

@@ -5,14 +5,29 @@
 //! RGBE. Every file is first written to a temporary file beside the target, flushed and
 //! synced, then renamed over the target, so a failed write never leaves a truncated or
 //! half-written file where the old one was, and no temporary file stays behind.
+//!
+//! A program that handles signals calls [`cancel_pending_writes`] from its handler
+//! before it exits: that removes the temporary files of the writes in progress and
+//! makes them fail instead of completing (see `docs/reliability.md`).
+//!
+//! Radiance HDR cannot hold every `f32`: a channel above [`HDR_MAX`] is clamped to it
+//! (and counted in [`Written::clamped_pixels`]) rather than written as black.
 
 use std::fmt;
-use std::io::{self, BufWriter, Write};
+use std::io::{self, BufWriter, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard};
 
-use image::{DynamicImage, ImageFormat, Rgb32FImage, Rgba32FImage, RgbaImage};
+use image::codecs::hdr::HdrEncoder;
+use image::codecs::openexr::OpenExrEncoder;
+use image::codecs::png::PngEncoder;
+use image::{ExtendedColorType, ImageEncoder, Rgb};
 
 use crate::film::LinearImage;
+
+/// The largest value a Radiance HDR (RGBE) file holds: mantissa 255, exponent 2^127
+/// (`255 · 2^119 ≈ 1.69e38`). Larger channels are clamped to it.
+pub const HDR_MAX: f32 = 255.0 * (1u128 << 119) as f32;
 
 /// An image file format the renderer writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -59,14 +74,6 @@ impl OutputFormat {
     pub fn is_linear(self) -> bool {
         !matches!(self, OutputFormat::Png)
     }
-
-    fn image_format(self) -> ImageFormat {
-        match self {
-            OutputFormat::Png => ImageFormat::Png,
-            OutputFormat::Exr => ImageFormat::OpenExr,
-            OutputFormat::Hdr => ImageFormat::Hdr,
-        }
-    }
 }
 
 impl fmt::Display for OutputFormat {
@@ -81,6 +88,7 @@ impl fmt::Display for OutputFormat {
 
 /// A failure to write an output image. Every message starts with the output path.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum OutputError {
     /// The extension names no supported format.
     #[error(
@@ -102,11 +110,33 @@ pub enum OutputError {
         /// Its parent directory.
         dir: PathBuf,
     },
-    /// The output path names an existing directory.
+    /// The output path names an existing directory, or ends with a path separator.
     #[error("{}: is a directory; give a file name ending in .png, .exr or .hdr", .path.display())]
     IsDirectory {
         /// The output path.
         path: PathBuf,
+    },
+    /// The output path exists and is not a regular file (a FIFO, a device, a socket).
+    #[error("{}: exists and is not a regular file ({kind}); give the path of a file", .path.display())]
+    NotARegularFile {
+        /// The output path.
+        path: PathBuf,
+        /// What it is instead.
+        kind: &'static str,
+    },
+    /// The output is one of the render's inputs (the scene file or a texture).
+    #[error(
+        "{}: is the same file as the {what} {}; writing it would destroy the input",
+        .path.display(),
+        .input.display()
+    )]
+    OverwritesInput {
+        /// The output path.
+        path: PathBuf,
+        /// The input it would replace.
+        input: PathBuf,
+        /// What the input is ("scene file", "texture").
+        what: String,
     },
     /// The image and the buffers handed to the writer disagree in size.
     #[error("{}: cannot write the image: {message}", .path.display())]
@@ -116,26 +146,41 @@ pub enum OutputError {
         /// Which buffer has the wrong size.
         message: String,
     },
-    /// Encoding the image failed.
-    #[error("{}: cannot encode the image as {format}: {source}", .path.display())]
+    /// The encoder failed for a reason other than writing (which is [`OutputError::Io`]).
+    #[error("{}: cannot encode the image as {format}: {error}", .path.display())]
     Encode {
         /// The output file.
         path: PathBuf,
         /// The format being written.
         format: OutputFormat,
-        /// The encoder's error.
-        source: image::ImageError,
+        /// The encoder's error (in the message; not repeated as a source).
+        error: image::ImageError,
     },
     /// Creating, writing, syncing or renaming the file failed.
-    #[error("{}: cannot {action}: {source}", .path.display())]
+    #[error("{}: cannot {action}: {error}", .path.display())]
     Io {
         /// The output file.
         path: PathBuf,
         /// What was being done ("create a temporary file in /dir", ...).
         action: String,
-        /// The operating system's error.
-        source: io::Error,
+        /// The operating system's error (in the message; not repeated as a source).
+        error: io::Error,
     },
+    /// [`cancel_pending_writes`] was called (a signal arrived): nothing was written.
+    #[error("{}: not written: the program was interrupted", .path.display())]
+    Cancelled {
+        /// The output file.
+        path: PathBuf,
+    },
+}
+
+/// What a successful write did besides writing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Written {
+    /// Pixels with a channel above what the format holds, clamped to its largest value
+    /// ([`HDR_MAX`] for `.hdr`; always 0 for `.png`, which clamps to [0, 1] by design,
+    /// and `.exr`, which holds every `f32`).
+    pub clamped_pixels: u64,
 }
 
 fn describe_extension(extension: &Option<String>) -> String {
@@ -153,12 +198,23 @@ fn parent_dir(path: &Path) -> &Path {
     }
 }
 
-/// Checks, before any rendering, that `path` can take an image: its extension names a
-/// supported format and its directory exists. Returns the format.
+/// Checks, before any rendering, that `path` can take an image: it does not name a
+/// directory (nor end with a path separator), it is not an existing FIFO, device or
+/// other non-regular file, its extension names a supported format, and its directory
+/// exists and takes a new file (a temporary file is created there and removed).
+/// Returns the format.
 pub fn check_output_path(path: &Path) -> Result<OutputFormat, OutputError> {
-    if path.is_dir() {
+    if path.is_dir() || ends_with_separator(path) {
         return Err(OutputError::IsDirectory {
             path: path.to_path_buf(),
+        });
+    }
+    if let Ok(metadata) = std::fs::metadata(path)
+        && !metadata.is_file()
+    {
+        return Err(OutputError::NotARegularFile {
+            path: path.to_path_buf(),
+            kind: file_kind(&metadata),
         });
     }
     let format = OutputFormat::from_path(path)?;
@@ -169,32 +225,155 @@ pub fn check_output_path(path: &Path) -> Result<OutputFormat, OutputError> {
             dir: dir.to_path_buf(),
         });
     }
+    // The probe proves the directory takes new files.
+    discard(create_temporary(path, dir)?);
     Ok(format)
+}
+
+/// Whether `path` is spelled with a trailing separator (`out.png/`), which names a
+/// directory even though `Path` ignores it.
+fn ends_with_separator(path: &Path) -> bool {
+    let text = path.as_os_str().as_encoded_bytes();
+    text.last()
+        .is_some_and(|&last| std::path::is_separator(char::from(last)))
+}
+
+/// A short name of what a non-regular file is.
+fn file_kind(metadata: &std::fs::Metadata) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let kind = metadata.file_type();
+        if kind.is_fifo() {
+            return "a FIFO";
+        }
+        if kind.is_char_device() || kind.is_block_device() {
+            return "a device";
+        }
+        if kind.is_socket() {
+            return "a socket";
+        }
+    }
+    if metadata.is_dir() {
+        "a directory"
+    } else {
+        "not a regular file"
+    }
+}
+
+/// Refuses an output path that is the same file as one of `inputs` (compared by device
+/// and inode, so symbolic and hard links to an input count): rendering a scene file
+/// `scene.png` to `-o scene.png`, or over one of its textures, would destroy the input.
+/// `inputs` pairs each path with what it is ("scene file", "texture"). An output that
+/// does not exist yet is no input.
+pub fn check_not_an_input<'a>(
+    path: &Path,
+    inputs: impl IntoIterator<Item = (&'a Path, &'a str)>,
+) -> Result<(), OutputError> {
+    let Ok(output) = std::fs::metadata(path) else {
+        return Ok(());
+    };
+    for (input, what) in inputs {
+        let Ok(metadata) = std::fs::metadata(input) else {
+            continue;
+        };
+        if same_file(&output, &metadata, path, input) {
+            return Err(OutputError::OverwritesInput {
+                path: path.to_path_buf(),
+                input: input.to_path_buf(),
+                what: what.to_owned(),
+            });
+        }
+    }
+    Ok(())
+}
+
+#[cfg(unix)]
+fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata, _: &Path, _: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    (a.dev(), a.ino()) == (b.dev(), b.ino())
+}
+
+#[cfg(not(unix))]
+fn same_file(_: &std::fs::Metadata, _: &std::fs::Metadata, a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
 }
 
 /// Writes `image` to `path`, choosing the format from the extension: `.png` gets the
 /// 8-bit display image `display_rgba8` (`width * height * 4` bytes, top row first),
-/// `.exr` and `.hdr` the linear float image.
+/// `.exr` and `.hdr` the linear float image. A `.hdr` channel above [`HDR_MAX`] is
+/// clamped to it; the returned [`Written`] counts those pixels, so a program can warn.
 ///
 /// The write is atomic: the file is written to a temporary file in the same directory
 /// and renamed over `path` only once it is complete and synced. On any error an
 /// existing file at `path` is left untouched and the temporary file is removed.
+/// The buffers are encoded in place (only `.hdr` makes a copy, of RGB without alpha).
 pub fn write_image(
     path: &Path,
     image: &LinearImage,
     display_rgba8: &[u8],
-) -> Result<(), OutputError> {
+) -> Result<Written, OutputError> {
     let format = OutputFormat::from_path(path)?;
-    let encoded = to_dynamic_image(path, format, image, display_rgba8)?;
+    check_buffers(path, format, image, display_rgba8)?;
+    let mut clamped_pixels = 0;
     write_atomically(path, |writer| {
-        encoded
-            .write_to(writer, format.image_format())
-            .map_err(|source| OutputError::Encode {
-                path: path.to_path_buf(),
-                format,
-                source,
-            })
-    })
+        clamped_pixels = encode_image(writer, format, image, display_rgba8)?;
+        Ok(())
+    })?;
+    Ok(Written { clamped_pixels })
+}
+
+/// Encodes the buffers `format` needs (checked by [`check_buffers`]) into `writer`;
+/// returns the number of pixels clamped to the format's range.
+fn encode_image(
+    writer: &mut EncodeWriter<'_>,
+    format: OutputFormat,
+    image: &LinearImage,
+    display_rgba8: &[u8],
+) -> Result<u64, EncodeFailure> {
+    let (width, height) = (image.width, image.height);
+    let mut clamped_pixels = 0;
+    let encoded = match format {
+        OutputFormat::Png => PngEncoder::new(writer).write_image(
+            display_rgba8,
+            width,
+            height,
+            ExtendedColorType::Rgba8,
+        ),
+        OutputFormat::Exr => OpenExrEncoder::new(writer).write_image(
+            bytemuck::cast_slice(&image.pixels),
+            width,
+            height,
+            ExtendedColorType::Rgba32F,
+        ),
+        OutputFormat::Hdr => {
+            let (rgb, clamped) = hdr_pixels(image);
+            clamped_pixels = clamped;
+            HdrEncoder::new(writer).encode(&rgb, width as usize, height as usize)
+        }
+    };
+    encoded.map_err(|error| EncodeFailure::Image(format, error))?;
+    Ok(clamped_pixels)
+}
+
+/// The RGB of `image` with every channel clamped to [`HDR_MAX`], and how many pixels
+/// had a channel clamped.
+fn hdr_pixels(image: &LinearImage) -> (Vec<Rgb<f32>>, u64) {
+    let mut clamped = 0;
+    let rgb = image
+        .pixels
+        .iter()
+        .map(|p| {
+            if p[..3].iter().any(|&c| c > HDR_MAX) {
+                clamped += 1;
+            }
+            Rgb([p[0].min(HDR_MAX), p[1].min(HDR_MAX), p[2].min(HDR_MAX)])
+        })
+        .collect();
+    (rgb, clamped)
 }
 
 /// Writes an 8-bit RGBA image (a plot, say) to the PNG file `path`, atomically.
@@ -204,41 +383,34 @@ pub fn write_png_rgba8(
     height: u32,
     rgba8: Vec<u8>,
 ) -> Result<(), OutputError> {
-    let image = RgbaImage::from_raw(width, height, rgba8).ok_or_else(|| OutputError::BadImage {
-        path: path.to_path_buf(),
-        message: format!("the buffer does not hold a {width}x{height} RGBA8 image"),
-    })?;
+    let expected = width as usize * height as usize * 4;
+    if width == 0 || height == 0 || rgba8.len() != expected {
+        return Err(OutputError::BadImage {
+            path: path.to_path_buf(),
+            message: format!("the buffer does not hold a {width}x{height} RGBA8 image"),
+        });
+    }
     write_atomically(path, |writer| {
-        image
-            .write_to(writer, ImageFormat::Png)
-            .map_err(|source| OutputError::Encode {
-                path: path.to_path_buf(),
-                format: OutputFormat::Png,
-                source,
-            })
+        PngEncoder::new(writer)
+            .write_image(&rgba8, width, height, ExtendedColorType::Rgba8)
+            .map_err(|error| EncodeFailure::Image(OutputFormat::Png, error))
     })
 }
 
 /// Writes `text` to `path` atomically (a CSV table, say).
 pub fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
     write_atomically(path, |writer| {
-        writer
-            .write_all(text.as_bytes())
-            .map_err(|source| OutputError::Io {
-                path: path.to_path_buf(),
-                action: "write the file".to_owned(),
-                source,
-            })
+        writer.write_all(text.as_bytes()).map_err(EncodeFailure::Io)
     })
 }
 
-/// Converts the render to the pixel layout `format` stores, checking buffer sizes.
-fn to_dynamic_image(
+/// Checks that the buffers the format needs have the image's size.
+fn check_buffers(
     path: &Path,
     format: OutputFormat,
     image: &LinearImage,
     display_rgba8: &[u8],
-) -> Result<DynamicImage, OutputError> {
+) -> Result<(), OutputError> {
     let bad = |message: String| OutputError::BadImage {
         path: path.to_path_buf(),
         message,
@@ -249,53 +421,191 @@ fn to_dynamic_image(
         return Err(bad(format!("the image is empty ({width}x{height})")));
     }
     match format {
-        OutputFormat::Png => {
-            let expected = pixels * 4;
-            if display_rgba8.len() != expected {
-                return Err(bad(format!(
-                    "the display buffer has {} bytes, but a {width}x{height} RGBA8 image needs {expected}",
-                    display_rgba8.len()
-                )));
-            }
-            RgbaImage::from_raw(width, height, display_rgba8.to_vec())
-                .map(DynamicImage::ImageRgba8)
-                .ok_or_else(|| bad("the display buffer does not fit the image size".into()))
+        OutputFormat::Png if display_rgba8.len() != pixels * 4 => Err(bad(format!(
+            "the display buffer has {} bytes, but a {width}x{height} RGBA8 image needs {}",
+            display_rgba8.len(),
+            pixels * 4
+        ))),
+        OutputFormat::Exr | OutputFormat::Hdr if image.pixels.len() != pixels => Err(bad(format!(
+            "the linear image has {} pixels, but {width}x{height} needs {pixels}",
+            image.pixels.len()
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// The temporary files of the writes in progress, and whether they were cancelled.
+struct Pending {
+    paths: Vec<PathBuf>,
+    cancelled: bool,
+}
+
+static PENDING: Mutex<Pending> = Mutex::new(Pending {
+    paths: Vec::new(),
+    cancelled: false,
+});
+
+fn pending() -> MutexGuard<'static, Pending> {
+    PENDING
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// Removes the temporary file of every write in progress and makes those writes, and
+/// every later one, fail with [`OutputError::Cancelled`] instead of renaming anything
+/// into place. Meant for a signal handler that then exits: afterwards no output of
+/// this process is replaced, and none of its temporary files remains. A write whose
+/// rename already started completes first (this waits for it). Returns how many
+/// temporary files were removed.
+pub fn cancel_pending_writes() -> usize {
+    let mut pending = pending();
+    pending.cancelled = true;
+    pending
+        .paths
+        .drain(..)
+        .filter(|path| std::fs::remove_file(path).is_ok())
+        .count()
+}
+
+/// Creates a temporary file for `path` in `dir`, registered so that
+/// [`cancel_pending_writes`] can remove it. Removed when dropped.
+fn create_temporary(path: &Path, dir: &Path) -> Result<tempfile::NamedTempFile, OutputError> {
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".gpu-render-").suffix(".tmp");
+    #[cfg(unix)]
+    {
+        // Like an ordinary new file: rw for everyone, narrowed by the umask.
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    // Created and registered under the lock, so a cancellation sees it or prevents it.
+    let mut pending = pending();
+    if pending.cancelled {
+        return Err(OutputError::Cancelled {
+            path: path.to_path_buf(),
+        });
+    }
+    let temp = builder.tempfile_in(dir).map_err(|error| OutputError::Io {
+        path: path.to_path_buf(),
+        action: format!("create a temporary file in {}", dir.display()),
+        error,
+    })?;
+    pending.paths.push(temp.path().to_path_buf());
+    Ok(temp)
+}
+
+/// Forgets a temporary file (it was renamed or is about to be deleted).
+fn unregister(pending: &mut Pending, temp: &Path) {
+    pending.paths.retain(|p| p != temp);
+}
+
+/// Deletes a temporary file and forgets it, under the lock, so that no signal can
+/// arrive between the two and leave it behind.
+fn discard(temp: tempfile::NamedTempFile) {
+    let mut pending = pending();
+    unregister(&mut pending, temp.path());
+    // Best effort: a file that cannot be deleted cannot be helped here.
+    let _ = temp.close();
+}
+
+/// Why an encoder stopped.
+enum EncodeFailure {
+    /// The image encoder's error, while writing this format.
+    Image(OutputFormat, image::ImageError),
+    /// A plain write failed.
+    Io(io::Error),
+}
+
+/// A writer that keeps the first I/O error it returned, so that a failed encode is
+/// reported as the write error it was (disk full), not as whatever the encoder calls
+/// it (the OpenEXR encoder calls every error a decoding error).
+struct RecordingWriter<W> {
+    inner: W,
+    error: Option<io::Error>,
+}
+
+impl<W> RecordingWriter<W> {
+    fn record<T>(&mut self, result: io::Result<T>) -> io::Result<T> {
+        if let Err(e) = &result
+            && self.error.is_none()
+        {
+            self.error = Some(match e.raw_os_error() {
+                Some(code) => io::Error::from_raw_os_error(code),
+                None => io::Error::new(e.kind(), e.to_string()),
+            });
         }
-        OutputFormat::Exr | OutputFormat::Hdr => {
-            if image.pixels.len() != pixels {
-                return Err(bad(format!(
-                    "the linear image has {} pixels, but {width}x{height} needs {pixels}",
-                    image.pixels.len()
-                )));
-            }
-            let converted = if format == OutputFormat::Exr {
-                let data = image.pixels.iter().flatten().copied().collect();
-                Rgba32FImage::from_raw(width, height, data).map(DynamicImage::ImageRgba32F)
-            } else {
-                let data = image
-                    .pixels
-                    .iter()
-                    .flat_map(|p| [p[0], p[1], p[2]])
-                    .collect();
-                Rgb32FImage::from_raw(width, height, data).map(DynamicImage::ImageRgb32F)
-            };
-            converted.ok_or_else(|| bad("the linear image does not fit the image size".into()))
-        }
+        result
+    }
+}
+
+impl<W: Write> Write for RecordingWriter<W> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        let result = self.inner.write(buf);
+        self.record(result)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        let result = self.inner.flush();
+        self.record(result)
+    }
+}
+
+impl<W: Seek> Seek for RecordingWriter<W> {
+    fn seek(&mut self, pos: SeekFrom) -> io::Result<u64> {
+        let result = self.inner.seek(pos);
+        self.record(result)
+    }
+}
+
+/// What an encoder writes into: a file, or in tests anything seekable.
+trait WriteSeek: Write + Seek {}
+
+impl<T: Write + Seek> WriteSeek for T {}
+
+/// The writer an encoder gets: buffered, over the temporary file, recording errors.
+type EncodeWriter<'a> = BufWriter<RecordingWriter<&'a mut dyn WriteSeek>>;
+
+/// Runs `encode` into `inner` and flushes it. An I/O error of `inner` is reported as
+/// what it is ([`OutputError::Io`], "cannot write the file: No space left on device")
+/// whatever the encoder turned it into.
+fn encode_to(
+    path: &Path,
+    inner: &mut dyn WriteSeek,
+    encode: impl FnOnce(&mut EncodeWriter<'_>) -> Result<(), EncodeFailure>,
+) -> Result<(), OutputError> {
+    let write_error = |error| OutputError::Io {
+        path: path.to_path_buf(),
+        action: "write the file".to_owned(),
+        error,
+    };
+    let mut writer = BufWriter::new(RecordingWriter { inner, error: None });
+    let encoded = encode(&mut writer);
+    let flushed = writer.flush();
+    match (encoded, writer.get_mut().error.take()) {
+        (_, Some(error)) | (Err(EncodeFailure::Io(error)), None) => Err(write_error(error)),
+        (Err(EncodeFailure::Image(format, error)), None) => Err(OutputError::Encode {
+            path: path.to_path_buf(),
+            format,
+            error,
+        }),
+        (Ok(()), None) => flushed.map_err(write_error),
     }
 }
 
 /// Runs `encode` on a temporary file beside `path`, syncs it and renames it over `path`.
-/// The temporary file is deleted on every error path (by `NamedTempFile`'s drop).
+/// The temporary file is deleted on every error path, and is known to
+/// [`cancel_pending_writes`] while it exists.
 fn write_atomically(
     path: &Path,
-    encode: impl FnOnce(&mut BufWriter<&mut std::fs::File>) -> Result<(), OutputError>,
+    encode: impl FnOnce(&mut EncodeWriter<'_>) -> Result<(), EncodeFailure>,
 ) -> Result<(), OutputError> {
-    let io_error = |action: String| {
+    let io_error = |action: &str| {
         let path = path.to_path_buf();
-        move |source: io::Error| OutputError::Io {
+        let action = action.to_owned();
+        move |error: io::Error| OutputError::Io {
             path,
             action,
-            source,
+            error,
         }
     };
     let dir = parent_dir(path);
@@ -305,31 +615,34 @@ fn write_atomically(
             dir: dir.to_path_buf(),
         });
     }
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".gpu-render-").suffix(".tmp");
-    #[cfg(unix)]
-    {
-        // Like an ordinary new file: rw for everyone, narrowed by the umask.
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    let mut temp = create_temporary(path, dir)?;
+    let result = encode_to(path, temp.as_file_mut(), encode).and_then(|()| {
+        temp.as_file()
+            .sync_all()
+            .map_err(io_error("sync the file to disk"))
+    });
+    if let Err(error) = result {
+        discard(temp);
+        return Err(error);
     }
-    let mut temp = builder.tempfile_in(dir).map_err(io_error(format!(
-        "create a temporary file in {}",
-        dir.display()
-    )))?;
-    {
-        let mut writer = BufWriter::new(temp.as_file_mut());
-        encode(&mut writer)?;
-        writer
-            .flush()
-            .map_err(io_error("write the file".to_owned()))?;
+    let mut pending = pending();
+    if pending.cancelled {
+        drop(pending);
+        discard(temp);
+        return Err(OutputError::Cancelled {
+            path: path.to_path_buf(),
+        });
     }
-    temp.as_file()
-        .sync_all()
-        .map_err(io_error("sync the file to disk".to_owned()))?;
-    temp.persist(path)
-        .map_err(|e| io_error("move the finished file into place".to_owned())(e.error))?;
-    Ok(())
+    // Renamed under the lock: a cancellation waits for it rather than racing it.
+    unregister(&mut pending, temp.path());
+    match temp.persist(path) {
+        Ok(_) => Ok(()),
+        Err(e) => {
+            // Still under the lock: deleted before a cancellation could miss it.
+            let _ = e.file.close();
+            Err(io_error("move the finished file into place")(e.error))
+        }
+    }
 }
 
 #[cfg(test)]
@@ -518,5 +831,185 @@ mod tests {
         write_image(&path, &image, &display).expect("overwrite");
         let read = image::open(&path).expect("open").to_rgba8();
         assert_eq!(read.into_raw(), display);
+    }
+
+    #[test]
+    fn hdr_clamps_radiance_above_its_largest_value_instead_of_writing_black() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("bright.hdr");
+        let mut image = LinearImage::new(4, 1);
+        image.pixels = vec![
+            [1.0, 2.0, 3.0, 1.0],
+            [2e38, 0.0, 0.0, 1.0],
+            [f32::MAX, 1e38, 0.5, 1.0],
+            [HDR_MAX, HDR_MAX, 0.0, 1.0],
+        ];
+        let written = write_image(&path, &image, &[]).expect("write hdr");
+        assert_eq!(written.clamped_pixels, 2);
+        let read = image::open(&path).expect("open hdr").to_rgb32f();
+        let pixels: Vec<[f32; 3]> = read.pixels().map(|p| p.0).collect();
+        assert_eq!(pixels[1][0], HDR_MAX, "{pixels:?}");
+        assert_eq!(pixels[2][0], HDR_MAX, "{pixels:?}");
+        assert!((pixels[2][1] - 1e38).abs() <= HDR_MAX / 128.0, "{pixels:?}");
+        assert_eq!(pixels[3][..2], [HDR_MAX, HDR_MAX]);
+        // A value past HDR_MAX is not representable: RGBE's largest exponent is 2^127.
+        assert!(f64::from(HDR_MAX) < 2f64.powi(127));
+    }
+
+    #[test]
+    fn exr_and_png_report_no_clamping() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let mut image = gradient(2, 2);
+        image.pixels[0] = [3e38, 1.0, 1.0, 1.0];
+        let display = image.to_display_rgba8(true);
+        for name in ["a.exr", "a.png"] {
+            let written = write_image(&dir.path().join(name), &image, &display).expect(name);
+            assert_eq!(written.clamped_pixels, 0, "{name}");
+        }
+        let read = image::open(dir.path().join("a.exr"))
+            .expect("exr")
+            .to_rgba32f();
+        assert_eq!(read.get_pixel(0, 0).0[0], 3e38);
+    }
+
+    /// A seekable writer that fails like a full disk after `room` bytes.
+    struct DiskFull {
+        room: usize,
+        written: std::io::Cursor<Vec<u8>>,
+    }
+
+    impl Write for DiskFull {
+        fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+            if self.written.get_ref().len() + buf.len() > self.room {
+                return Err(io::Error::from_raw_os_error(28)); // ENOSPC
+            }
+            self.written.write(buf)
+        }
+        fn flush(&mut self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+
+    impl Seek for DiskFull {
+        fn seek(&mut self, pos: SeekFrom) -> io::Result<u64> {
+            self.written.seek(pos)
+        }
+    }
+
+    #[test]
+    fn a_full_disk_is_a_write_error_in_every_format() {
+        let image = gradient(64, 64);
+        let display = image.to_display_rgba8(true);
+        for format in OutputFormat::ALL {
+            let path = PathBuf::from(format!("full.{}", format.extension()));
+            let mut disk = DiskFull {
+                room: 1000,
+                written: std::io::Cursor::new(Vec::new()),
+            };
+            let err = encode_to(&path, &mut disk, |writer| {
+                encode_image(writer, format, &image, &display).map(|_| ())
+            })
+            .expect_err("the disk is full");
+            let message = err.to_string();
+            assert!(matches!(err, OutputError::Io { .. }), "{format}: {message}");
+            assert!(
+                message.starts_with(path.to_str().unwrap_or("")),
+                "{message}"
+            );
+            assert!(message.contains("cannot write the file"), "{message}");
+            assert!(!message.to_lowercase().contains("decod"), "{message}");
+            let os = io::Error::from_raw_os_error(28).to_string();
+            assert_eq!(message.matches(&os).count(), 1, "{message}");
+        }
+    }
+
+    #[test]
+    fn io_errors_do_not_repeat_themselves_in_the_cause_chain() {
+        let err = OutputError::Io {
+            path: PathBuf::from("x.png"),
+            action: "write the file".into(),
+            error: io::Error::from_raw_os_error(13),
+        };
+        assert!(std::error::Error::source(&err).is_none());
+        let shown = format!("{:#}", anyhow::Error::new(err));
+        assert_eq!(shown.matches("ermission denied").count(), 1, "{shown}");
+    }
+
+    #[test]
+    fn check_output_path_refuses_a_trailing_separator() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = PathBuf::from(format!("{}/dir.png/", dir.path().display()));
+        let err = check_output_path(&path).expect_err("names a directory");
+        assert!(matches!(err, OutputError::IsDirectory { .. }), "{err}");
+        assert!(entries(dir.path()).is_empty());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn check_output_path_refuses_a_fifo_and_leaves_no_probe() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let fifo = dir.path().join("pipe.png");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .expect("run mkfifo");
+        assert!(made.success());
+        let err = check_output_path(&fifo).expect_err("a FIFO");
+        assert!(err.to_string().contains("a FIFO"), "{err}");
+        let ok = dir.path().join("fine.png");
+        assert_eq!(check_output_path(&ok).ok(), Some(OutputFormat::Png));
+        assert_eq!(entries(dir.path()), vec![fifo]);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn check_output_path_refuses_a_directory_that_takes_no_files() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().expect("tempdir");
+        let locked = dir.path().join("locked");
+        std::fs::create_dir(&locked).expect("mkdir");
+        std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o555)).expect("chmod");
+        // Root writes anywhere; the check is only meaningful for other users.
+        let writable = tempfile::tempfile_in(&locked).is_ok();
+        let result = check_output_path(&locked.join("out.png"));
+        std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o755)).expect("chmod");
+        if writable {
+            assert!(result.is_ok());
+        } else {
+            let err = result.expect_err("read-only directory");
+            let message = err.to_string();
+            assert!(message.contains("create a temporary file"), "{message}");
+            assert_eq!(message.matches("ermission denied").count(), 1, "{message}");
+        }
+    }
+
+    #[test]
+    fn an_output_that_is_an_input_is_refused() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let scene = dir.path().join("scene.png");
+        let texture = dir.path().join("wood.png");
+        std::fs::write(&scene, b"[camera]").expect("scene");
+        std::fs::write(&texture, b"texels").expect("texture");
+        let inputs = [
+            (scene.as_path(), "scene file"),
+            (texture.as_path(), "texture"),
+        ];
+        let err = check_not_an_input(&scene, inputs).expect_err("the scene itself");
+        assert!(err.to_string().contains("scene file"), "{err}");
+        assert!(check_not_an_input(&texture, inputs).is_err());
+        assert!(check_not_an_input(&dir.path().join("new.png"), inputs).is_ok());
+        let other = dir.path().join("other.png");
+        std::fs::write(&other, b"x").expect("other");
+        assert!(check_not_an_input(&other, inputs).is_ok());
+        let hard = dir.path().join("hard.png");
+        std::fs::hard_link(&texture, &hard).expect("hard link");
+        assert!(check_not_an_input(&hard, inputs).is_err());
+        #[cfg(unix)]
+        {
+            let link = dir.path().join("link.png");
+            std::os::unix::fs::symlink(&scene, &link).expect("symlink");
+            let err = check_not_an_input(&link, inputs).expect_err("a link to the scene");
+            assert!(err.to_string().contains("scene.png"), "{err}");
+        }
     }
 }

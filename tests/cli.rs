@@ -339,3 +339,410 @@ fn brdf_check_reports_every_violated_rule() {
     let missing = gpu_render(&["brdf-check", "/nonexistent/map.png"]);
     assert_fails_with(&missing, &["/nonexistent/map.png", "cannot read"]);
 }
+
+// ------------------------------------------------- inputs, outputs and limits
+
+#[test]
+fn the_scene_file_is_never_the_output() {
+    // A scene file with an image extension, rendered onto itself.
+    let ws = Workspace::new(TINY_SCENE);
+    let scene = ws.path("scene.png");
+    std::fs::write(&scene, TINY_SCENE).expect("write scene.png");
+    let run = gpu_render(&[
+        &ws.arg("scene.png"),
+        "-o",
+        &ws.arg("scene.png"),
+        "--backend",
+        "cpu",
+    ]);
+    assert_fails_with(&run, &["scene.png", "same file as the scene file"]);
+    assert_eq!(std::fs::read_to_string(&scene).expect("read"), TINY_SCENE);
+    // Through a symbolic link too.
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(ws.path("scene.toml"), ws.path("link.png")).expect("symlink");
+        let run = gpu_render(&[
+            &ws.arg("scene.toml"),
+            "-o",
+            &ws.arg("link.png"),
+            "--backend",
+            "cpu",
+        ]);
+        assert_fails_with(&run, &["link.png", "scene.toml"]);
+        assert_eq!(
+            std::fs::read_to_string(ws.path("scene.toml")).expect("read"),
+            TINY_SCENE
+        );
+    }
+}
+
+#[test]
+fn a_texture_is_never_the_output() {
+    let ws = Workspace::new(&TINY_SCENE.replace("albedo = 0.7", "albedo_texture = \"wood.png\""));
+    image::RgbImage::from_pixel(2, 2, image::Rgb([200, 100, 50]))
+        .save(ws.path("wood.png"))
+        .expect("write the texture");
+    let before = std::fs::read(ws.path("wood.png")).expect("read");
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("wood.png"),
+        "--backend",
+        "cpu",
+    ]);
+    assert_fails_with(&run, &["wood.png", "same file as the image"]);
+    assert_eq!(std::fs::read(ws.path("wood.png")).expect("read"), before);
+}
+
+#[test]
+fn an_output_path_naming_a_directory_is_refused_before_rendering() {
+    let ws = Workspace::new(TINY_SCENE);
+    let target = format!("{}/", ws.arg("dir.png"));
+    // 4096x4096 at 64 spp would take minutes: the refusal must come first.
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &target,
+        "--backend",
+        "cpu",
+        "--width",
+        "4096",
+        "--height",
+        "4096",
+        "--spp",
+        "64",
+    ]);
+    assert_fails_with(&run, &["dir.png/", "is a directory"]);
+    ws.assert_old_output_kept();
+}
+
+#[test]
+fn a_render_beyond_the_memory_cap_is_refused_up_front_with_the_estimate() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+        "--compare-gamma",
+        "--width",
+        "16384",
+        "--height",
+        "8192",
+    ]);
+    assert_fails_with(
+        &run,
+        &[
+            "16384x8192",
+            "GiB",
+            "more than the 4 GiB allowed",
+            "--max-memory",
+        ],
+    );
+    ws.assert_old_output_kept();
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+        "--max-memory",
+        "0.01",
+    ]);
+    assert_fails_with(&run, &["more than the 0.01 GiB allowed"]);
+    ws.assert_old_output_kept();
+}
+
+#[test]
+fn hdr_output_clamps_radiance_it_cannot_hold_and_says_so() {
+    let scene = TINY_SCENE.replace(
+        "type = \"lambert\"\nalbedo = 0.7",
+        "type = \"emissive\"\nradiance = 3e38",
+    );
+    let ws = Workspace::new(&scene);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.hdr"),
+        "--backend",
+        "cpu",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(
+        run.stderr.contains("warning:") && run.stderr.contains("clamped"),
+        "{}",
+        run.stderr
+    );
+    let image = image::open(ws.path("out.hdr"))
+        .expect("open hdr")
+        .to_rgb32f();
+    let centre = image.get_pixel(16, 12).0;
+    assert_eq!(centre[0], gpu_render::output::HDR_MAX, "{centre:?}");
+}
+
+#[test]
+fn albedo_textures_above_one_are_clamped_with_a_warning_unless_quiet() {
+    let ws = Workspace::new(&TINY_SCENE.replace("albedo = 0.7", "albedo_texture = \"hot.exr\""));
+    image::Rgba32FImage::from_pixel(2, 2, image::Rgba([4.0, 0.5, 0.5, 1.0]))
+        .save(ws.path("hot.exr"))
+        .expect("write the texture");
+    let args = [
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+    ];
+    let run = gpu_render(&args);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(
+        run.stderr.contains("warning: ") && run.stderr.contains("clamped to 1"),
+        "{}",
+        run.stderr
+    );
+    let quiet = gpu_render(&[args.as_slice(), &["-q"]].concat());
+    assert_eq!(quiet.status, Some(0));
+    assert!(quiet.stderr.is_empty(), "{}", quiet.stderr);
+}
+
+#[test]
+fn the_sandbox_refuses_textures_outside_the_scene_folder() {
+    let ws =
+        Workspace::new(&TINY_SCENE.replace("albedo = 0.7", "albedo_texture = \"../wood.png\""));
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+        "--sandbox",
+    ]);
+    assert_fails_with(&run, &["scene.toml:", "albedo_texture", "`..`"]);
+    ws.assert_old_output_kept();
+}
+
+#[cfg(unix)]
+#[test]
+fn a_fifo_as_scene_is_refused_at_once() {
+    let ws = Workspace::new(TINY_SCENE);
+    let fifo = ws.path("pipe.toml");
+    let made = Command::new("mkfifo").arg(&fifo).status().expect("mkfifo");
+    assert!(made.success());
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gpu-render"))
+        .args([
+            &ws.arg("pipe.toml"),
+            "-o",
+            &ws.arg("out.png"),
+            "--backend",
+            "cpu",
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    let status = wait_at_most(&mut child, Duration::from_secs(30));
+    let mut stderr = String::new();
+    if let Some(mut pipe) = child.stderr.take() {
+        use std::io::Read;
+        pipe.read_to_string(&mut stderr).expect("read stderr");
+    }
+    assert_eq!(status.and_then(|s| s.code()), Some(1), "{stderr}");
+    assert!(stderr.contains("a FIFO, not a regular file"), "{stderr}");
+}
+
+// ------------------------------------------------------------- flag values
+
+#[test]
+fn a_negative_width_says_it_must_be_positive() {
+    let run = gpu_render(&["scene.toml", "-o", "x.png", "--width", "-1"]);
+    assert_eq!(run.status, Some(2), "stderr:\n{}", run.stderr);
+    assert!(
+        run.stderr.contains("--width") && run.stderr.contains("positive integer"),
+        "{}",
+        run.stderr
+    );
+    let run = gpu_render(&["scene.toml", "-o", "x.png", "--min-ray-weight", "-0.5"]);
+    assert!(
+        !run.stderr.contains("unexpected argument"),
+        "{}",
+        run.stderr
+    );
+}
+
+#[test]
+fn tradeoff_refuses_bad_counts_before_creating_its_folder() {
+    let ws = Workspace::new(TINY_SCENE);
+    let out_dir = ws.path("sweep");
+    for (flag, value) in [
+        ("--reference-spp", "0"),
+        ("--repeats", "0"),
+        ("--width", "-5"),
+    ] {
+        let run = gpu_render(&[
+            "tradeoff",
+            &ws.arg("scene.toml"),
+            "--out-dir",
+            &out_dir.to_string_lossy(),
+            "--backend",
+            "cpu",
+            flag,
+            value,
+        ]);
+        assert_eq!(run.status, Some(2), "{flag} {value}: {}", run.stderr);
+        assert!(run.stderr.contains(flag), "{flag}: {}", run.stderr);
+        assert!(
+            !out_dir.exists(),
+            "{flag} {value} created the output folder"
+        );
+    }
+    ws.assert_old_output_kept();
+}
+
+// ------------------------------------------------------------------ signals
+
+use std::time::{Duration, Instant};
+
+/// Waits for `child` for at most `limit`; kills it (a failure) if it is still running.
+fn wait_at_most(
+    child: &mut std::process::Child,
+    limit: Duration,
+) -> Option<std::process::ExitStatus> {
+    let started = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().expect("wait") {
+            return Some(status);
+        }
+        if started.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+#[cfg(unix)]
+fn send_signal(child: &std::process::Child, signal: &str) {
+    let sent = Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status()
+        .expect("run kill");
+    assert!(sent.success(), "kill {signal} failed");
+}
+
+/// Temporary files of gpu-render in `dir`, with their sizes.
+fn temporaries(dir: &Path) -> Vec<(String, u64)> {
+    std::fs::read_dir(dir)
+        .expect("list")
+        .filter_map(|e| {
+            let e = e.ok()?;
+            let name = e.file_name().to_string_lossy().into_owned();
+            let size = e.metadata().ok()?.len();
+            (name.starts_with(".gpu-render-") && name.ends_with(".tmp")).then_some((name, size))
+        })
+        .collect()
+}
+
+/// Renders an empty 4096x4096 scene to `out.exr` (256 MiB) and sends `signal` once
+/// the temporary file has data in it: the write is in progress.
+#[cfg(unix)]
+fn interrupt_a_write(signal: &str) {
+    let ws = Workspace::new(
+        "[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\n[environment]\nbackground = 0.5\n",
+    );
+    std::fs::write(ws.path("out.exr"), OLD_OUTPUT).expect("old exr");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gpu-render"))
+        .args([
+            &ws.arg("scene.toml"),
+            "-o",
+            &ws.arg("out.exr"),
+            "--backend",
+            "cpu",
+            "--width",
+            "4096",
+            "--height",
+            "4096",
+            "-q",
+        ])
+        .spawn()
+        .expect("spawn");
+    let started = Instant::now();
+    let mut sent = false;
+    while started.elapsed() < Duration::from_secs(120) {
+        if child.try_wait().expect("wait").is_some() {
+            break;
+        }
+        if temporaries(ws.dir.path()).iter().any(|&(_, size)| size > 0) {
+            send_signal(&child, signal);
+            sent = true;
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let status = wait_at_most(&mut child, Duration::from_secs(60));
+    assert!(sent, "the write finished before the signal could be sent");
+    assert_eq!(
+        status.and_then(|s| s.code()),
+        Some(130),
+        "{signal}: {status:?}"
+    );
+    assert!(
+        temporaries(ws.dir.path()).is_empty(),
+        "{signal} left {:?}",
+        temporaries(ws.dir.path())
+    );
+    assert_eq!(std::fs::read(ws.path("out.exr")).expect("read"), OLD_OUTPUT);
+}
+
+#[cfg(unix)]
+#[test]
+fn sigint_during_a_write_leaves_no_temporary_file_and_exits_130() {
+    interrupt_a_write("-INT");
+}
+
+#[cfg(unix)]
+#[test]
+fn sigterm_during_a_write_leaves_no_temporary_file_and_exits_130() {
+    interrupt_a_write("-TERM");
+}
+
+#[cfg(unix)]
+#[test]
+fn sigint_during_a_render_stops_it_and_keeps_the_old_output() {
+    let ws = Workspace::new(TINY_SCENE);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gpu-render"))
+        .args([
+            &ws.arg("scene.toml"),
+            "-o",
+            &ws.arg("out.png"),
+            "--backend",
+            "cpu",
+            "--width",
+            "2048",
+            "--height",
+            "2048",
+            "--spp",
+            "256",
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    // The render takes minutes; the handler is installed within milliseconds of the
+    // start, and by a second the render is well under way.
+    std::thread::sleep(Duration::from_secs(1));
+    let started = Instant::now();
+    send_signal(&child, "-INT");
+    let status = wait_at_most(&mut child, Duration::from_secs(30));
+    assert_eq!(status.and_then(|s| s.code()), Some(130), "{status:?}");
+    assert!(started.elapsed() < Duration::from_secs(30));
+    let mut rest = String::new();
+    use std::io::Read;
+    child
+        .stderr
+        .take()
+        .expect("stderr")
+        .read_to_string(&mut rest)
+        .expect("read");
+    assert!(rest.contains("interrupted"), "{rest}");
+    ws.assert_old_output_kept();
+}

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use gpu_render::scene::parse_scene;
+use gpu_render::scene::{LoadOptions, SceneWarning, parse_scene, parse_scene_with};
 
 /// Parses a scene in `scenes/` (so image paths resolve there) with one material.
 fn error_for(material: &str) -> String {
@@ -128,4 +128,176 @@ fn materials_naming_one_file_share_one_image() {
     let scene = parse_scene(text, &scene_path).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(scene.images.len(), 1);
     assert!(scene.materials.iter().all(|m| m.albedo_texture == Some(0)));
+}
+
+/// A directory with `scene.toml` (one material `m` of `material`) and an EXR image
+/// `name` whose texels are `texels` (a 2x2 image).
+fn scene_with_exr(
+    material: &str,
+    name: &str,
+    texels: [[f32; 4]; 4],
+) -> (tempfile::TempDir, String) {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let data: Vec<f32> = texels.iter().flatten().copied().collect();
+    image::Rgba32FImage::from_raw(2, 2, data)
+        .expect("2x2")
+        .save(dir.path().join(name))
+        .expect("writes the EXR");
+    let text =
+        format!("[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\n\n[materials.m]\n{material}\n");
+    (dir, text)
+}
+
+const GREY: [f32; 4] = [0.5, 0.5, 0.5, 1.0];
+
+#[test]
+fn negative_texels_are_refused_naming_the_file_and_the_texel() {
+    for material in [
+        "type = \"lambert\"\nalbedo_texture = \"bad.exr\"",
+        "type = \"tabulated\"\nbrdf_map = \"bad.exr\"",
+    ] {
+        let (dir, text) = scene_with_exr(
+            material,
+            "bad.exr",
+            [GREY, GREY, [0.5, -0.99, 0.5, 1.0], GREY],
+        );
+        let error = parse_scene(&text, &dir.path().join("scene.toml"))
+            .expect_err("a negative texel is refused")
+            .to_string();
+        for needle in [
+            "scene.toml:5:1: materials.m",
+            "`bad.exr`",
+            "texel (0, 1)",
+            "g = -0.99",
+            ">= 0",
+        ] {
+            assert!(error.contains(needle), "{error} lacks {needle}");
+        }
+    }
+}
+
+#[test]
+fn albedo_texels_above_one_are_clamped_with_a_warning() {
+    let material = "type = \"lambert\"\nalbedo_texture = \"bright.exr\"";
+    let (dir, text) = scene_with_exr(
+        material,
+        "bright.exr",
+        [GREY, [3.0, 0.5, 1.5, 1.0], GREY, [1.25, 1.0, 0.0, 1.0]],
+    );
+    let warnings = std::sync::Mutex::new(Vec::new());
+    let warn = |w: &SceneWarning| warnings.lock().expect("lock").push(w.to_string());
+    let options = LoadOptions {
+        warning: Some(&warn),
+        ..LoadOptions::default()
+    };
+    let scene = parse_scene_with(&text, &dir.path().join("scene.toml"), &options)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let texels = &scene.images[0].texels;
+    assert_eq!(texels[1], [1.0, 0.5, 1.0, 1.0]);
+    assert_eq!(texels[3], [1.0, 1.0, 0.0, 1.0]);
+    assert_eq!(texels[0], GREY);
+    let warnings = warnings.into_inner().expect("lock");
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    for needle in [
+        "scene.toml:5:1: materials.m",
+        "bright.exr",
+        "2 texels",
+        "largest 3 at (1, 0)",
+        "clamped to 1",
+    ] {
+        assert!(
+            warnings[0].contains(needle),
+            "{} lacks {needle}",
+            warnings[0]
+        );
+    }
+    // Without a hook the scene loads the same, silently.
+    let quiet =
+        parse_scene(&text, &dir.path().join("scene.toml")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(quiet.images, scene.images);
+}
+
+#[test]
+fn a_brdf_map_above_one_is_kept_and_a_file_used_both_ways_is_loaded_twice() {
+    let (dir, mut text) = scene_with_exr(
+        "type = \"tabulated\"\nbrdf_map = \"map.exr\"",
+        "map.exr",
+        [[2.0, 2.0, 2.0, 1.0], GREY, GREY, GREY],
+    );
+    text.push_str("[materials.n]\ntype = \"lambert\"\nalbedo_texture = \"map.exr\"\n");
+    let scene =
+        parse_scene(&text, &dir.path().join("scene.toml")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.images.len(), 2);
+    let map = scene.materials[0].brdf_map.expect("a map") as usize;
+    let albedo = scene.materials[1].albedo_texture.expect("a texture") as usize;
+    assert_eq!(scene.images[map].texels[0][0], 2.0);
+    assert_eq!(scene.images[albedo].texels[0][0], 1.0);
+}
+
+#[cfg(unix)]
+#[test]
+fn a_fifo_as_texture_is_refused_without_blocking() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let fifo = dir.path().join("pipe.png");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo");
+    assert!(made.success());
+    let text = "[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\n\n[materials.m]\n\
+                type = \"lambert\"\nalbedo_texture = \"pipe.png\"\n";
+    let scene_path = dir.path().join("scene.toml");
+    // Opening a FIFO for reading blocks until a writer comes: a hang, not a failure,
+    // would be the bug, so the parse runs on a thread that is given 30 s.
+    let (send, receive) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = send.send(
+            parse_scene(text, &scene_path)
+                .map(|_| ())
+                .map_err(|e| e.to_string()),
+        );
+    });
+    let result = receive
+        .recv_timeout(std::time::Duration::from_secs(30))
+        .expect("parse_scene blocked on a FIFO");
+    let error = result.expect_err("a FIFO is refused");
+    assert!(
+        error.contains("`pipe.png`") && error.contains("a FIFO, not a regular file"),
+        "{error}"
+    );
+}
+
+#[test]
+fn the_sandbox_keeps_textures_inside_the_scene_folder() {
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let sandboxed = LoadOptions {
+        sandbox: true,
+        ..LoadOptions::default()
+    };
+    let texture = |file: &str| {
+        format!(
+            "[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\n\n[materials.m]\n\
+             type = \"lambert\"\nalbedo_texture = \"{file}\"\n"
+        )
+    };
+    let inside = texture("textures/checker.png");
+    assert!(parse_scene_with(&inside, &scenes.join("s.toml"), &sandboxed).is_ok());
+    let absolute = scenes.join("textures/checker.png");
+    let outside = [
+        (texture(&absolute.to_string_lossy()), "absolute path"),
+        (texture("../scenes/textures/checker.png"), "`..`"),
+    ];
+    for (text, why) in outside {
+        // Trusted without the sandbox, refused with it.
+        assert!(parse_scene(&text, &scenes.join("s.toml")).is_ok());
+        let error = parse_scene_with(&text, &scenes.join("s.toml"), &sandboxed)
+            .expect_err("escapes the folder")
+            .to_string();
+        assert!(
+            error.contains("s.toml:5:1: materials.m")
+                && error.contains("albedo_texture")
+                && error.contains(why),
+            "{error}"
+        );
+    }
 }

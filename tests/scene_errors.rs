@@ -3,7 +3,9 @@
 
 use std::path::Path;
 
-use gpu_render::scene::{SceneError, load_scene, parse_scene};
+use gpu_render::scene::{
+    LoadOptions, LoadProgress, SceneError, load_scene, load_scene_with, parse_scene,
+};
 
 const FILE: &str = "bad.toml";
 const CAMERA: &str = "[camera]\neye = [0, 1, 5]\nlook_at = [0, 0.5, 0]\n";
@@ -370,5 +372,114 @@ fn numbers_outside_32_bit_floats_are_rejected() {
             "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1e39\nmaterial = \"grey\"\n",
         ),
         &["objects[0]", "radius", "too large for 32-bit floats"],
+    );
+}
+
+#[test]
+fn duplicate_key_names_the_key() {
+    let err = error(
+        "[camera]\neye = [0, 1, 5]\neye = [1, 2, 3]\nlook_at = [0, 0.5, 0]\n",
+        &["duplicate key `eye`"],
+    );
+    assert_eq!(err.location, Some((3, 1)));
+    let err = error(
+        &format!("{CAMERA}{LAMBERT}[materials.grey]\ntype = \"mirror\"\n"),
+        &["duplicate table `[materials.grey]`"],
+    );
+    assert_eq!(err.location.map(|l| l.0), Some(7));
+}
+
+#[test]
+fn recursion_limit_has_a_location() {
+    // The TOML parser refuses a dotted key of more than 80 parts, without a place.
+    let key = vec!["a"; 81].join(".");
+    let err = error(
+        &format!("{CAMERA}\n  {key} = 1\n"),
+        &["recursion limit", "81 parts", "`a.a.a"],
+    );
+    assert_eq!(err.location, Some((5, 3)));
+    // Nesting too deep is located by the parser itself.
+    let nested = format!("{CAMERA}x = {}{}\n", "[".repeat(100), "]".repeat(100));
+    let err = error(&nested, &["recursion"]);
+    assert_eq!(err.location.map(|l| l.0), Some(4));
+}
+
+#[test]
+fn a_file_of_tiny_values_is_refused_before_parsing() {
+    // 64 MiB of `[],` made the parser peak at 4.4 GB; it is refused by counting.
+    let text = "[],".repeat(64 * 1024 * 1024 / 3 - 1);
+    let err = error(
+        &text,
+        &[
+            "44739240 values",
+            "more than the 8000000 accepted",
+            "in memory",
+        ],
+    );
+    assert_eq!(err.location, None);
+    // Below the count a file of values is parsed (and fails for what it is).
+    let small = format!("x = [{}]\n{CAMERA}", "[],".repeat(1000));
+    error(&small, &["unknown field `x`"]);
+}
+
+#[cfg(unix)]
+#[test]
+fn a_fifo_as_scene_is_refused_without_blocking() {
+    let dir = match tempfile::tempdir() {
+        Ok(dir) => dir,
+        Err(e) => panic!("{e}"),
+    };
+    let fifo = dir.path().join("scene.toml");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    assert!(made.is_ok_and(|s| s.success()), "mkfifo failed");
+    // A hang would be the bug: the load runs on a thread that is given 30 s.
+    let (send, receive) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = send.send(load_scene(&fifo).map(|_| ()).map_err(|e| e.to_string()));
+    });
+    let result = receive.recv_timeout(std::time::Duration::from_secs(30));
+    let Ok(Err(shown)) = result else {
+        panic!("load_scene did not refuse the FIFO in time: {result:?}");
+    };
+    assert!(
+        shown.contains("scene.toml") && shown.contains("a FIFO, not a regular file"),
+        "{shown}"
+    );
+}
+
+#[test]
+fn progress_is_reported_through_the_hook() {
+    let dir = match tempfile::tempdir() {
+        Ok(dir) => dir,
+        Err(e) => panic!("{e}"),
+    };
+    let path = dir.path().join("scene.toml");
+    let sphere =
+        "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"grey\"\n";
+    let text = scene(&sphere.repeat(10));
+    if let Err(e) = std::fs::write(&path, &text) {
+        panic!("{e}");
+    }
+    let seen = std::sync::Mutex::new(Vec::new());
+    let record = |p: LoadProgress| seen.lock().unwrap_or_else(|e| e.into_inner()).push(p);
+    let options = LoadOptions {
+        progress: Some(&record),
+        ..LoadOptions::default()
+    };
+    if let Err(e) = load_scene_with(&path, &options) {
+        panic!("{e}");
+    }
+    let seen = seen.into_inner().unwrap_or_else(|e| e.into_inner());
+    let bytes = text.len() as u64;
+    assert_eq!(seen[0], LoadProgress::Reading { bytes });
+    assert_eq!(seen[1], LoadProgress::Parsing { bytes });
+    // One material and ten objects.
+    assert_eq!(seen.len(), 2 + 11);
+    assert_eq!(
+        seen.last(),
+        Some(&LoadProgress::Checking {
+            done: 11,
+            total: 11
+        })
     );
 }

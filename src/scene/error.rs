@@ -29,3 +29,31 @@ impl fmt::Display for SceneError {
         }
     }
 }
+
+/// Something suspicious in a scene file that was accepted anyway (and how), for example
+/// an albedo texel above 1 that was clamped. Located like a [`SceneError`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneWarning {
+    /// The scene file.
+    pub path: PathBuf,
+    /// 1-based line and column of the item concerned, where known.
+    pub location: Option<(usize, usize)>,
+    /// What was found and what was done about it.
+    pub message: String,
+}
+
+impl fmt::Display for SceneWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.location {
+            Some((line, column)) => write!(
+                f,
+                "{}:{}:{}: {}",
+                self.path.display(),
+                line,
+                column,
+                self.message
+            ),
+            None => write!(f, "{}: {}", self.path.display(), self.message),
+        }
+    }
+}

@@ -16,9 +16,16 @@ pub const MAX_IMAGE_SIDE: u32 = 2048;
 /// taken as sRGB-encoded and linearised with the exact sRGB curve (IEC 61966-2-1);
 /// 32-bit float files (OpenEXR, Radiance HDR) are taken as linear. Fails with a
 /// message (without the path, which the caller names) when the file is missing,
-/// unreadable, not an image, empty or larger than [`MAX_IMAGE_SIDE`], or holds a
-/// non-finite value.
+/// unreadable, not a regular file (a FIFO or a device would block or never end), not
+/// an image, empty or larger than [`MAX_IMAGE_SIDE`], or holds a non-finite value.
+/// Texels outside [0, 1] are kept as they are: a scene's materials check their range.
 pub fn load_image(path: &Path) -> Result<Image, String> {
+    let metadata = std::fs::metadata(path).map_err(|e| format!("cannot read the file: {e}"))?;
+    if let Some(kind) = not_a_regular_file(&metadata) {
+        return Err(format!(
+            "cannot read the file: it is {kind}, not a regular file"
+        ));
+    }
     let reader = ImageReader::open(path)
         .map_err(|e| format!("cannot read the file: {e}"))?
         .with_guessed_format()
@@ -72,6 +79,33 @@ pub fn load_image(path: &Path) -> Result<Image, String> {
         height,
         texels,
     })
+}
+
+/// What a file that is not a regular file is ("a directory", "a FIFO", "a device",
+/// "a socket"), or `None` for a regular file. Symbolic links are followed by the
+/// caller's `metadata`.
+pub(crate) fn not_a_regular_file(metadata: &std::fs::Metadata) -> Option<&'static str> {
+    if metadata.is_file() {
+        return None;
+    }
+    if metadata.is_dir() {
+        return Some("a directory");
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let kind = metadata.file_type();
+        if kind.is_fifo() {
+            return Some("a FIFO");
+        }
+        if kind.is_char_device() || kind.is_block_device() {
+            return Some("a device");
+        }
+        if kind.is_socket() {
+            return Some("a socket");
+        }
+    }
+    Some("a special file")
 }
 
 fn check_dimensions((width, height): (u32, u32)) -> Result<(), String> {

@@ -7,8 +7,11 @@ mod image;
 mod medium;
 mod model;
 
-pub use error::SceneError;
-pub use file::{CONDUCTOR_PRESETS, load_scene, parse_scene};
+pub use error::{SceneError, SceneWarning};
+pub use file::{
+    CONDUCTOR_PRESETS, LoadOptions, LoadProgress, MAX_SCENE_FILE_BYTES, confined_path, load_scene,
+    load_scene_with, parse_scene, parse_scene_with,
+};
 pub use image::{MAX_IMAGE_SIDE, load_image};
 pub use medium::{MEDIUM_STACK_SIZE, MediumStack};
 pub use model::*;

@@ -4,7 +4,11 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use gpu_render::quality::QualityPreset;
-use gpu_render::scene::{LightingSpace, RenderOverrides};
+use gpu_render::scene::{
+    LightingSpace, MAX_DEPTH_LIMIT, MAX_IMAGE_DIMENSION, MAX_SAMPLES_PER_PIXEL, RenderOverrides,
+};
+
+use crate::memory::DEFAULT_MAX_MEMORY_GIB;
 
 const AFTER_HELP: &str = "\
 Output formats (chosen by the extension of --output):
@@ -79,24 +83,52 @@ pub struct TradeoffArgs {
     pub out_dir: PathBuf,
 
     /// Width of every render in pixels; the height keeps the scene's aspect ratio.
-    #[arg(long, value_name = "N", default_value_t = 320)]
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 320,
+        allow_negative_numbers = true,
+        value_parser = parse_in_range::<1, MAX_IMAGE_DIMENSION>
+    )]
     pub width: u32,
 
     /// Samples per pixel of the converged reference.
-    #[arg(long, value_name = "N", default_value_t = 256)]
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 256,
+        allow_negative_numbers = true,
+        value_parser = parse_in_range::<1, MAX_SAMPLES_PER_PIXEL>
+    )]
     pub reference_spp: u32,
 
     /// Maximum depth of the converged reference.
-    #[arg(long, value_name = "N", default_value_t = 16)]
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 16,
+        allow_negative_numbers = true,
+        value_parser = parse_in_range::<0, MAX_DEPTH_LIMIT>
+    )]
     pub reference_depth: u32,
 
     /// Timed runs per setting; the fastest counts.
-    #[arg(long, value_name = "N", default_value_t = 2)]
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 2,
+        allow_negative_numbers = true,
+        value_parser = parse_in_range::<1, 1000>
+    )]
     pub repeats: u32,
 
     /// Where to trace (see the render options).
     #[arg(long, value_enum, default_value_t = BackendArg::Auto)]
     pub backend: BackendArg,
+
+    /// Confine the files the scene names to its folder (see the render options).
+    #[arg(long)]
+    pub sandbox: bool,
 }
 
 /// The arguments of a render.
@@ -111,25 +143,55 @@ pub struct RenderArgs {
     pub output: Option<PathBuf>,
 
     /// Image width in pixels [default: the scene's].
-    #[arg(long, value_name = "N", help_heading = "Render settings")]
+    #[arg(
+        long,
+        value_name = "N",
+        help_heading = "Render settings",
+        allow_negative_numbers = true,
+        value_parser = parse_positive
+    )]
     pub width: Option<u32>,
 
     /// Image height in pixels [default: the scene's].
-    #[arg(long, value_name = "N", help_heading = "Render settings")]
+    #[arg(
+        long,
+        value_name = "N",
+        help_heading = "Render settings",
+        allow_negative_numbers = true,
+        value_parser = parse_positive
+    )]
     pub height: Option<u32>,
 
     /// Samples per pixel [default: the scene's].
-    #[arg(long, value_name = "N", help_heading = "Render settings")]
+    #[arg(
+        long,
+        value_name = "N",
+        help_heading = "Render settings",
+        allow_negative_numbers = true,
+        value_parser = parse_positive
+    )]
     pub spp: Option<u32>,
 
     /// Maximum reflection/refraction bounces; the bounce stack grows to fit unless
     /// --stack-size is given [default: the scene's].
-    #[arg(long, value_name = "N", help_heading = "Render settings")]
+    #[arg(
+        long,
+        value_name = "N",
+        help_heading = "Render settings",
+        allow_negative_numbers = true,
+        value_parser = parse_whole
+    )]
     pub max_depth: Option<u32>,
 
     /// Bounce-stack capacity; smaller than max depth + 1 drops deep branches
     /// [default: the scene's].
-    #[arg(long, value_name = "N", help_heading = "Render settings")]
+    #[arg(
+        long,
+        value_name = "N",
+        help_heading = "Render settings",
+        allow_negative_numbers = true,
+        value_parser = parse_positive
+    )]
     pub stack_size: Option<u32>,
 
     /// A measured speed/accuracy preset (samples, depth, cutoff); explicit --spp,
@@ -144,7 +206,12 @@ pub struct RenderArgs {
 
     /// Do not trace reflected/refracted branches whose weight is at most this, in
     /// [0, 1]: faster, slightly darker glass and mirrors [default: the scene's, or 0].
-    #[arg(long, value_name = "W", help_heading = "Render settings")]
+    #[arg(
+        long,
+        value_name = "W",
+        help_heading = "Render settings",
+        allow_negative_numbers = true
+    )]
     pub min_ray_weight: Option<f64>,
 
     /// Shade in linear space (correct) or naively on gamma-encoded colours
@@ -177,7 +244,23 @@ pub struct RenderArgs {
     #[arg(long, value_name = "list|INDEX|NAME", value_parser = parse_adapter, help_heading = "Device")]
     pub adapter: Option<AdapterArg>,
 
-    /// Print nothing but errors: no progress, notes or summary.
+    /// Confine the files the scene names (textures, BRDF maps) to the scene file's
+    /// folder: refuse absolute paths, `..` and links out of it. Without it a scene
+    /// file is trusted like a program: it may name any file you can read.
+    #[arg(long)]
+    pub sandbox: bool,
+
+    /// Refuse, before rendering, a render whose estimated peak memory is above this
+    /// many GiB (see docs/reliability.md for the estimate per backend and format).
+    #[arg(
+        long,
+        value_name = "GIB",
+        default_value_t = DEFAULT_MAX_MEMORY_GIB,
+        value_parser = parse_gib
+    )]
+    pub max_memory: f64,
+
+    /// Print nothing but errors: no progress, warnings, notes or summary.
     #[arg(short, long)]
     pub quiet: bool,
 }
@@ -295,6 +378,46 @@ pub enum AdapterArg {
     Name(String),
 }
 
+/// A count that must be at least 1: the range is checked later, against the scene's
+/// other settings, but a negative or non-numeric value is refused here.
+fn parse_positive(text: &str) -> Result<u32, String> {
+    parse_count(text, "a positive integer (1 or more)")
+}
+
+/// A count that may be 0.
+fn parse_whole(text: &str) -> Result<u32, String> {
+    parse_count(text, "a whole number (0 or more)")
+}
+
+fn parse_count(text: &str, what: &str) -> Result<u32, String> {
+    let digits = text.trim();
+    if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return Err(format!("must be {what}, got `{text}`"));
+    }
+    digits
+        .parse()
+        .map_err(|_| format!("must be {what} no larger than {}, got {text}", u32::MAX))
+}
+
+/// A count within `LOW..=HIGH`.
+fn parse_in_range<const LOW: u32, const HIGH: u32>(text: &str) -> Result<u32, String> {
+    let value = parse_count(text, "a whole number")?;
+    if !(LOW..=HIGH).contains(&value) {
+        return Err(format!("must be between {LOW} and {HIGH}, got {value}"));
+    }
+    Ok(value)
+}
+
+/// A memory size in GiB, more than 0.
+fn parse_gib(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(gib) if gib.is_finite() && gib > 0.0 => Ok(gib),
+        _ => Err(format!(
+            "must be a number of GiB above 0 (e.g. 4 or 0.5), got `{text}`"
+        )),
+    }
+}
+
 fn parse_adapter(text: &str) -> Result<AdapterArg, String> {
     let text = text.trim();
     if text.is_empty() {
@@ -343,6 +466,42 @@ mod tests {
             Some("--spp 0")
         );
         assert_eq!(cli.render.flag_for_setting_message("width must be"), None);
+    }
+
+    #[test]
+    fn counts_say_what_they_must_be() {
+        assert_eq!(parse_positive("12"), Ok(12));
+        assert_eq!(parse_positive("0"), Ok(0));
+        let negative = parse_positive("-1").expect_err("negative");
+        assert!(
+            negative.contains("positive integer") && negative.contains("-1"),
+            "{negative}"
+        );
+        assert!(parse_positive("1.5").is_err());
+        assert!(parse_positive("99999999999").is_err());
+        assert!(
+            parse_whole("-3")
+                .expect_err("negative")
+                .contains("whole number")
+        );
+        assert_eq!(parse_in_range::<1, 10>("10"), Ok(10));
+        assert!(parse_in_range::<1, 10>("0").is_err());
+        assert!(parse_gib("0").is_err() && parse_gib("nan").is_err());
+        assert_eq!(parse_gib("0.5"), Ok(0.5));
+    }
+
+    #[test]
+    fn a_negative_width_reaches_the_value_parser() {
+        let err = Cli::try_parse_from(["gpu-render", "s.toml", "-o", "o.png", "--width", "-1"])
+            .expect_err("refused");
+        let shown = err.to_string();
+        assert!(
+            shown.contains("--width") && shown.contains("positive integer"),
+            "{shown}"
+        );
+        let err = Cli::try_parse_from(["gpu-render", "tradeoff", "s.toml", "--repeats", "0"])
+            .expect_err("refused");
+        assert!(err.to_string().contains("--repeats"), "{err}");
     }
 
     #[test]

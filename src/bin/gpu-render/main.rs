@@ -3,12 +3,15 @@
 //! Cheap checks (output format and directory, command-line settings, the scene file)
 //! all happen before a device is opened or a ray traced. Errors are printed as
 //! `error: ...` with their causes and exit with status 1; usage errors are clap's
-//! (status 2).
+//! (status 2). Ctrl-C, SIGTERM and SIGHUP stop it cleanly with status 130 (see
+//! `signals.rs`).
 
 mod args;
 mod backend;
 mod compare;
+mod memory;
 mod progress;
+mod signals;
 mod summary;
 mod tradeoff;
 
@@ -19,16 +22,21 @@ use std::time::Instant;
 
 use anyhow::{Result, anyhow, bail};
 use clap::{CommandFactory, Parser, error::ErrorKind};
-use gpu_render::output::{self, OutputFormat};
-use gpu_render::scene::{self, LightingSpace, RenderSettings, Scene};
+use gpu_render::output::{self, HDR_MAX, OutputFormat, Written};
+use gpu_render::scene::{self, LightingSpace, LoadOptions, RenderSettings, Scene, SceneWarning};
 
 use crate::args::{AdapterArg, BackendArg, Cli, RenderArgs};
 use crate::backend::{Backend, Frame};
+use crate::memory::{BackendKind, Estimate};
 use crate::progress::Progress;
 use crate::summary::Summary;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Err(error) = signals::install() {
+        eprintln!("error: {error:#}");
+        return ExitCode::FAILURE;
+    }
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
@@ -121,11 +129,20 @@ fn render(args: &RenderArgs, scene_path: &Path, output_path: &Path) -> Result<()
     }
     // Values out of range whatever the scene says (`--width 0`) fail before loading it.
     apply_overrides(args, minimal_settings(), None)?;
+    output::check_not_an_input(output_path, [(scene_path, "scene file")])?;
 
-    let mut scene = scene::load_scene(scene_path)?;
+    let mut scene = load(scene_path, args.sandbox, args.quiet)?;
     scene.render = apply_overrides(args, scene.render, Some(scene_path))?;
+    check_inputs_survive(output_path, scene_path, &scene)?;
 
     let backend = Backend::open(args.backend, args.adapter.as_ref(), args.quiet)?;
+    check_memory(
+        &scene,
+        &backend,
+        format,
+        args.compare_gamma,
+        args.max_memory,
+    )?;
     let started = Instant::now();
     let frame = if args.compare_gamma {
         let linear = render_pass(&backend, &scene, Some(LightingSpace::Linear), args.quiet)?;
@@ -141,9 +158,10 @@ fn render(args: &RenderArgs, scene_path: &Path, output_path: &Path) -> Result<()
     };
     let wall = started.elapsed();
 
-    output::write_image(output_path, &frame.image, &frame.display_rgba8)?;
+    let written = output::write_image(output_path, &frame.image, &frame.display_rgba8)?;
 
     if !args.quiet {
+        warn_clamped(output_path, written);
         let summary = Summary {
             settings: &scene.render,
             passes: if args.compare_gamma { 2 } else { 1 },
@@ -155,6 +173,79 @@ fn render(args: &RenderArgs, scene_path: &Path, output_path: &Path) -> Result<()
         eprintln!("{summary}");
     }
     Ok(())
+}
+
+/// Loads the scene file, with progress after a second and warnings on stderr (unless
+/// `quiet`), confined to its folder with `sandbox`.
+pub fn load(scene_path: &Path, sandbox: bool, quiet: bool) -> Result<Scene> {
+    let warn = |warning: &SceneWarning| eprintln!("warning: {warning}");
+    let label = scene_path.display().to_string();
+    let scene = progress::while_loading(&label, !quiet, |progress| {
+        let options = LoadOptions {
+            sandbox,
+            progress: Some(progress),
+            warning: (!quiet).then_some(&warn as &(dyn Fn(&SceneWarning) + Sync)),
+        };
+        scene::load_scene_with(scene_path, &options)
+    })?;
+    Ok(scene)
+}
+
+/// Refuses an output that is the scene file or one of its images.
+fn check_inputs_survive(output_path: &Path, scene_path: &Path, scene: &Scene) -> Result<()> {
+    let inputs = std::iter::once((scene_path, "scene file")).chain(
+        scene
+            .images
+            .iter()
+            .map(|image| (image.path.as_path(), "image")),
+    );
+    output::check_not_an_input(output_path, inputs)?;
+    Ok(())
+}
+
+/// Refuses, before rendering, a render whose estimated peak memory is above the cap.
+fn check_memory(
+    scene: &Scene,
+    backend: &Backend,
+    format: OutputFormat,
+    compare_gamma: bool,
+    max_memory_gib: f64,
+) -> Result<()> {
+    let kind = match backend {
+        Backend::Gpu { .. } => BackendKind::Gpu,
+        Backend::Cpu => BackendKind::Cpu,
+    };
+    let estimate = Estimate::new(scene, kind, format, compare_gamma);
+    let cap = max_memory_gib * f64::from(1u32 << 30);
+    if estimate.total as f64 > cap {
+        let s = &scene.render;
+        bail!(
+            "rendering {}x{}{} to {format} on the {} would need about {estimate}, more than \
+             the {max_memory_gib} GiB allowed; render smaller, or raise --max-memory if the \
+             machine has the memory",
+            s.width,
+            s.height,
+            if compare_gamma {
+                " twice (--compare-gamma)"
+            } else {
+                ""
+            },
+            backend.describe()
+        );
+    }
+    Ok(())
+}
+
+/// Warns when the format could not hold every pixel and clamped some.
+fn warn_clamped(output_path: &Path, written: Written) {
+    if written.clamped_pixels > 0 {
+        eprintln!(
+            "warning: {}: {} pixels had radiance above {HDR_MAX:e}, the largest a Radiance \
+             HDR file holds, and were clamped to it; write .exr to keep them",
+            output_path.display(),
+            written.clamped_pixels
+        );
+    }
 }
 
 /// Renders `scene`, in `lighting` space if given, with progress on stderr.

@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use anyhow::{Context, Result};
 use gpu_render::film::TimingSource;
-use gpu_render::scene::{RenderOverrides, RenderSettings, Scene, load_scene};
+use gpu_render::scene::{RenderOverrides, RenderSettings, Scene};
 use gpu_render::tradeoff::{
     Knobs, Measurement, default_sweep, mean_flip, pareto_front, plot_png, rmse, to_csv,
 };
@@ -13,9 +13,21 @@ use crate::args::TradeoffArgs;
 use crate::backend::{Backend, Frame};
 use crate::progress::Progress;
 
+/// The files written into `--out-dir`.
+const OUTPUT_FILES: [&str; 3] = ["reference.png", "tradeoff.csv", "tradeoff.png"];
+
 /// Renders the reference, sweeps the knobs and writes the table, CSV and plot.
+///
+/// Everything that can be checked (the flags, by clap; the scene; the settings; the
+/// output folder) is checked before the folder is created or a ray is traced.
 pub fn run(args: &TradeoffArgs) -> Result<()> {
-    let scene = load_scene(&args.scene)?;
+    if args.out_dir.exists() && !args.out_dir.is_dir() {
+        anyhow::bail!(
+            "{}: --out-dir must be a directory, and this is a file",
+            args.out_dir.display()
+        );
+    }
+    let scene = crate::load(&args.scene, args.sandbox, false)?;
     let height = (u64::from(scene.render.height) * u64::from(args.width)
         / u64::from(scene.render.width))
     .max(1) as u32;
@@ -31,16 +43,25 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
         render: base,
         ..scene
     };
-    std::fs::create_dir_all(&args.out_dir)
-        .with_context(|| format!("cannot create {}", args.out_dir.display()))?;
-    let backend = Backend::open(args.backend, None, false)?;
-
     let reference_knobs = Knobs {
         samples_per_pixel: args.reference_spp,
         max_depth: args.reference_depth,
         min_ray_weight: 0.0,
     };
     let reference_scene = with_knobs(&scene, reference_knobs)?;
+    for name in OUTPUT_FILES {
+        let path = args.out_dir.join(name);
+        let inputs = std::iter::once((args.scene.as_path(), "scene file"))
+            .chain(scene.images.iter().map(|i| (i.path.as_path(), "image")));
+        gpu_render::output::check_not_an_input(&path, inputs)?;
+    }
+    std::fs::create_dir_all(&args.out_dir)
+        .with_context(|| format!("cannot create {}", args.out_dir.display()))?;
+    for name in OUTPUT_FILES {
+        gpu_render::output::check_output_path(&args.out_dir.join(name))?;
+    }
+    let backend = Backend::open(args.backend, None, false)?;
+
     let progress = Progress::new("rendering the reference", true);
     let reference = backend.render(&reference_scene, &|done, total| {
         progress.update(done, total)
@@ -77,7 +98,7 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
         scene.render.width,
         scene.render.height,
         backend.describe(),
-        args.repeats.max(1)
+        args.repeats
     );
     println!(
         "{:>4} {:>5} {:>6} {:>10} {:>10} {:>11} {:>9}",
@@ -85,7 +106,7 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
     );
     let mut measurements = Vec::with_capacity(sweep.len());
     for knobs in sweep {
-        let measurement = measure(&backend, &scene, knobs, &reference, args.repeats.max(1))?;
+        let measurement = measure(&backend, &scene, knobs, &reference, args.repeats)?;
         print_row(&measurement, "");
         measurements.push(measurement);
     }

@@ -1,5 +1,9 @@
 //! Building blocks of validation: turning byte offsets into line:column, and checking
 //! single fields (finite numbers, vectors, colours) of a named item.
+//!
+//! An item keeps only the byte offset where it begins; its line and column are worked
+//! out when an error is reported, so loading stays linear in the size of the file
+//! however many items it has.
 
 use std::fmt::Display;
 use std::ops::Range;
@@ -8,7 +12,7 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::raw::{RawColor, RawVec3};
-use crate::scene::SceneError;
+use crate::scene::{SceneError, SceneWarning};
 
 /// The scene text and its path, for building located errors.
 pub struct Source<'a> {
@@ -19,7 +23,8 @@ pub struct Source<'a> {
 }
 
 impl<'a> Source<'a> {
-    /// 1-based line and column (in characters) of byte `offset`.
+    /// 1-based line and column (in characters) of byte `offset`. Linear in `offset`:
+    /// call it for an error being reported, not for every item.
     pub fn location(&self, offset: usize) -> (usize, usize) {
         let offset = offset.min(self.text.len());
         let before = &self.text.as_bytes()[..offset];
@@ -53,7 +58,7 @@ impl<'a> Source<'a> {
         Item {
             source: self,
             name,
-            location: span.map(|s| self.location(s.start)),
+            offset: span.map(|s| s.start),
         }
     }
 }
@@ -72,14 +77,26 @@ pub enum ColourRange {
 pub struct Item<'a> {
     source: &'a Source<'a>,
     name: String,
-    location: Option<(usize, usize)>,
+    /// Byte offset where the item begins in the file, if it has a place there.
+    offset: Option<usize>,
 }
 
 impl Item<'_> {
     /// The error `"{item}: {message}"` at the item's place.
     pub fn fail(&self, message: impl Display) -> SceneError {
+        let location = self.offset.map(|offset| self.source.location(offset));
         self.source
-            .error(self.location, format!("{}: {message}", self.name))
+            .error(location, format!("{}: {message}", self.name))
+    }
+
+    /// The warning `"{item}: {message}"` at the item's place.
+    pub fn warning(&self, message: impl Display) -> SceneWarning {
+        let location = self.offset.map(|offset| self.source.location(offset));
+        SceneWarning {
+            path: self.source.path.to_path_buf(),
+            location,
+            message: format!("{}: {message}", self.name),
+        }
     }
 
     /// The value of a required field, or an error naming it.

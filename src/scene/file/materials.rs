@@ -5,7 +5,9 @@ use std::path::Path;
 use glam::DVec3;
 use toml::Spanned;
 
+use super::LoadOptions;
 use super::check::{ColourRange, Item, Source};
+use super::paths::confined_path;
 use super::raw::RawMaterial;
 use crate::scene::{
     FresnelModel, Image, Material, MaterialKind, MicrofacetDistribution, SceneError,
@@ -92,20 +94,61 @@ pub const CONDUCTOR_PRESETS: &[(&str, [f64; 3], [f64; 3])] = &[
 /// (64 MiB), and the GPU holds them all as layers of one texture array.
 pub const MAX_SCENE_IMAGES: usize = 16;
 
+/// What a material uses an image for; the same file used both ways is loaded twice,
+/// because only an albedo texture is clamped to [0, 1].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum ImageRole {
+    /// `albedo_texture`: a reflectance in [0, 1] (larger texels are clamped).
+    Albedo,
+    /// `brdf_map`: π·f, any value >= 0.
+    BrdfMap,
+}
+
 /// The images a scene's materials load, and where relative paths start.
 pub struct ImageTable<'a> {
     /// The directory of the scene file.
-    pub base: &'a Path,
-    /// Images loaded so far, indexed by `Material::albedo_texture` / `brdf_map`.
-    pub images: Vec<Image>,
+    base: &'a Path,
+    /// Confinement, and who hears about clamped texels.
+    options: &'a LoadOptions<'a>,
+    /// Images loaded so far, indexed by `Material::albedo_texture` / `brdf_map`, with
+    /// what each is used for.
+    images: Vec<(Image, ImageRole)>,
 }
 
-impl ImageTable<'_> {
+impl<'a> ImageTable<'a> {
+    /// An empty table for a scene file in directory `base`.
+    pub fn new(base: &'a Path, options: &'a LoadOptions<'a>) -> Self {
+        Self {
+            base,
+            options,
+            images: Vec::new(),
+        }
+    }
+
+    /// The images, in index order.
+    pub fn into_images(self) -> Vec<Image> {
+        self.images.into_iter().map(|(image, _)| image).collect()
+    }
+
     /// The index of `file` (relative to the scene file) in the table, loading it on
-    /// first use: materials naming the same file share one image.
-    fn index_of(&mut self, item: &Item<'_>, field: &str, file: &str) -> Result<u32, SceneError> {
-        let path = self.base.join(file);
-        if let Some(index) = self.images.iter().position(|image| image.path == path) {
+    /// first use: materials naming the same file for the same role share one image.
+    fn index_of(
+        &mut self,
+        item: &Item<'_>,
+        field: &str,
+        file: &str,
+        role: ImageRole,
+    ) -> Result<u32, SceneError> {
+        let path = if self.options.sandbox {
+            confined_path(self.base, file).map_err(|e| item.fail(format_args!("{field} {e}")))?
+        } else {
+            self.base.join(file)
+        };
+        if let Some(index) = self
+            .images
+            .iter()
+            .position(|(image, r)| image.path == path && *r == role)
+        {
             return Ok(index as u32);
         }
         if self.images.len() >= MAX_SCENE_IMAGES {
@@ -113,10 +156,89 @@ impl ImageTable<'_> {
                 "{field} `{file}`: a scene may use at most {MAX_SCENE_IMAGES} different image files"
             )));
         }
-        let image = load(item, field, file, self.base)?;
-        self.images.push(image);
+        let fail = |message: String| {
+            item.fail(format_args!(
+                "{field} `{file}` ({}): {message}",
+                path.display()
+            ))
+        };
+        let mut image = load_image(&path).map_err(fail)?;
+        if let Some(((x, y), channel, value)) = negative_texel(&image) {
+            let why = match role {
+                ImageRole::Albedo => "a reflectance cannot be negative",
+                ImageRole::BrdfMap => "a BRDF (π·f) cannot be negative",
+            };
+            return Err(fail(format!(
+                "texel ({x}, {y}) has {channel} = {value}; texels must be >= 0 ({why})"
+            )));
+        }
+        if role == ImageRole::Albedo
+            && let Some(clamped) = clamp_albedo(&mut image)
+            && let Some(warn) = self.options.warning
+        {
+            warn(&item.warning(format_args!(
+                "{field} `{file}` ({}): {} texels have a channel above 1 (largest {} at \
+                 ({}, {})); clamped to 1, as a surface reflects at most the light it receives",
+                path.display(),
+                clamped.count,
+                clamped.largest,
+                clamped.at.0,
+                clamped.at.1
+            )));
+        }
+        self.images.push((image, role));
         Ok(self.images.len() as u32 - 1)
     }
+}
+
+/// The first texel with a negative colour channel: its position, channel and value.
+/// Alpha is not used by any material and is not checked.
+fn negative_texel(image: &Image) -> Option<((u32, u32), &'static str, f32)> {
+    image.texels.iter().enumerate().find_map(|(i, texel)| {
+        let (channel, value) = ["r", "g", "b"]
+            .into_iter()
+            .zip(texel.iter().copied())
+            .find(|&(_, v)| v < 0.0)?;
+        let i = i as u32;
+        Some(((i % image.width, i / image.width), channel, value))
+    })
+}
+
+/// What [`clamp_albedo`] changed.
+struct Clamped {
+    /// Texels with a channel above 1.
+    count: usize,
+    /// The largest channel value found.
+    largest: f32,
+    /// Where it was.
+    at: (u32, u32),
+}
+
+/// Clamps every colour channel above 1 to 1; `None` when none was.
+fn clamp_albedo(image: &mut Image) -> Option<Clamped> {
+    let mut clamped: Option<Clamped> = None;
+    let width = image.width;
+    for (i, texel) in image.texels.iter_mut().enumerate() {
+        let largest = texel[..3].iter().copied().fold(f32::MIN, f32::max);
+        if largest <= 1.0 {
+            continue;
+        }
+        let i = i as u32;
+        let entry = clamped.get_or_insert(Clamped {
+            count: 0,
+            largest,
+            at: (i % width, i / width),
+        });
+        entry.count += 1;
+        if largest > entry.largest {
+            entry.largest = largest;
+            entry.at = (i % width, i / width);
+        }
+        for channel in &mut texel[..3] {
+            *channel = channel.min(1.0);
+        }
+    }
+    clamped
 }
 
 /// One material, checked and turned into the flat model record.
@@ -349,8 +471,8 @@ fn tabulated(
     images: &mut ImageTable<'_>,
 ) -> Result<Material, SceneError> {
     let file = item.require("brdf_map", raw.brdf_map.as_deref())?;
-    let index = images.index_of(item, "brdf_map", file)?;
-    let image = &images.images[index as usize];
+    let index = images.index_of(item, "brdf_map", file, ImageRole::BrdfMap)?;
+    let image = &images.images[index as usize].0;
     if image.width != image.height || image.width < 2 {
         return Err(item.fail(format_args!(
             "brdf_map `{file}` ({}): the map must be square and at least 2x2 (θi across, \
@@ -365,13 +487,6 @@ fn tabulated(
         emission: emission(item, raw)?,
         ..Material::blank(MaterialKind::Tabulated)
     })
-}
-
-/// Loads an image named by `field`, relative to the scene file's directory.
-fn load(item: &Item<'_>, field: &str, file: &str, base: &Path) -> Result<Image, SceneError> {
-    let path = base.join(file);
-    load_image(&path)
-        .map_err(|e| item.fail(format_args!("{field} `{file}` ({}): {e}", path.display())))
 }
 
 /// The optional albedo texture and its mapping.
@@ -403,7 +518,8 @@ fn texture(
         }
         material.texture_scale = scale;
     }
-    material.albedo_texture = Some(images.index_of(item, "albedo_texture", file)?);
+    material.albedo_texture =
+        Some(images.index_of(item, "albedo_texture", file, ImageRole::Albedo)?);
     Ok(material)
 }
 

@@ -9,8 +9,10 @@ mod check;
 mod lights;
 mod materials;
 mod objects;
+mod paths;
 mod raw;
 mod settings;
+mod structure;
 
 use std::io::Read;
 use std::path::Path;
@@ -18,35 +20,135 @@ use std::path::Path;
 use self::check::Source;
 pub use self::materials::CONDUCTOR_PRESETS;
 use self::objects::MaterialTable;
+pub use self::paths::confined_path;
 use self::raw::RawScene;
-use super::{Scene, SceneError};
+use super::image::not_a_regular_file;
+use super::{Scene, SceneError, SceneWarning};
 
 /// Largest scene file accepted, in bytes (64 MiB).
 pub const MAX_SCENE_FILE_BYTES: u64 = 64 * 1024 * 1024;
 /// Largest accepted number of objects plus polygon and triangle vertices.
 pub const MAX_SCENE_ELEMENTS: usize = 1_000_000;
+/// Largest accepted number of TOML values (tables, arrays, numbers, strings), counted
+/// before parsing as the `=`, `,`, `[` and `{` outside strings and comments (an upper
+/// bound). Loading needs about 375 bytes per counted value at its peak (measured:
+/// 742k spheres, 6.7M counted, 2.5 GB), so this bounds it at about 3 GB; the largest
+/// legitimate files (64 MiB of spheres, or the 1,000,000-element limit in triangles,
+/// 4.2M counted) are below it, while 64 MiB of `[],` counts 44.7 million.
+pub const MAX_SCENE_VALUES: u64 = 8_000_000;
+
+/// How a scene file is loaded: whether the files it names are confined to its folder,
+/// and who hears about progress and warnings. The default confines nothing and is
+/// silent, as [`load_scene`] is.
+#[derive(Clone, Copy, Default)]
+pub struct LoadOptions<'a> {
+    /// Confine the files the scene names (albedo textures, BRDF maps) to the scene
+    /// file's folder: refuse absolute paths, `..` and links that lead out of it (see
+    /// [`confined_path`]). Without it a scene file is trusted input, like a program:
+    /// it may name any file the user can read.
+    pub sandbox: bool,
+    /// Told what the loader is doing as it goes, for a progress display. Called often
+    /// (for every item), so it should be cheap.
+    pub progress: Option<&'a (dyn Fn(LoadProgress) + Sync)>,
+    /// Told about each suspicious input that was accepted, and what was done about it
+    /// (an albedo texel above 1, clamped to 1).
+    pub warning: Option<&'a (dyn Fn(&SceneWarning) + Sync)>,
+}
+
+impl std::fmt::Debug for LoadOptions<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LoadOptions")
+            .field("sandbox", &self.sandbox)
+            .field("progress", &self.progress.is_some())
+            .field("warning", &self.warning.is_some())
+            .finish()
+    }
+}
+
+/// What the loader is doing, for [`LoadOptions::progress`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum LoadProgress {
+    /// Reading the file, `bytes` long.
+    Reading {
+        /// The file's size.
+        bytes: u64,
+    },
+    /// Parsing `bytes` of TOML (one step; the longest for a large file).
+    Parsing {
+        /// The text's size.
+        bytes: u64,
+    },
+    /// Checking the items (materials, lights, objects): `done` of `total`.
+    Checking {
+        /// Items checked so far.
+        done: u64,
+        /// All items.
+        total: u64,
+    },
+}
+
+impl LoadOptions<'_> {
+    fn report(&self, progress: LoadProgress) {
+        if let Some(hook) = self.progress {
+            hook(progress);
+        }
+    }
+}
 
 /// Reads and validates the scene file at `path`.
 ///
-/// Fails without reading when `path` is a directory or larger than
-/// `MAX_SCENE_FILE_BYTES` (64 MiB); an OS error (missing file, no permission) is named.
+/// Fails without reading when `path` is not a regular file (a directory, a FIFO, a
+/// device) or larger than `MAX_SCENE_FILE_BYTES` (64 MiB); an OS error (missing file,
+/// no permission) is named.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let text = read_scene_file(path)?;
-    parse_scene(&text, path)
+    load_scene_with(path, &LoadOptions::default())
 }
 
-/// Parses and validates scene text; `path` is only used in error messages.
+/// [`load_scene`] with options: a sandbox, a progress hook and a warning hook.
+pub fn load_scene_with(path: &Path, options: &LoadOptions<'_>) -> Result<Scene, SceneError> {
+    let text = read_scene_file(path, options)?;
+    parse_scene_with(&text, path, options)
+}
+
+/// Parses and validates scene text; `path` is only used in error messages and to
+/// resolve the image files the scene names.
 pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
+    parse_scene_with(text, path, &LoadOptions::default())
+}
+
+/// [`parse_scene`] with options: a sandbox, a progress hook and a warning hook.
+pub fn parse_scene_with(
+    text: &str,
+    path: &Path,
+    options: &LoadOptions<'_>,
+) -> Result<Scene, SceneError> {
     let source = Source { path, text };
     if text.len() as u64 > MAX_SCENE_FILE_BYTES {
         return Err(source.error(None, too_large_message(text.len() as u64)));
     }
-    let raw: RawScene = toml::from_str(text).map_err(|e| toml_error(&source, &e))?;
+    let structure = structure::scan(text);
+    if structure.values > MAX_SCENE_VALUES {
+        return Err(source.error(
+            None,
+            format!(
+                "the scene file holds up to {} values (every `=`, `,`, `[` and `{{` outside \
+                 strings and comments starts one), more than the {MAX_SCENE_VALUES} accepted: \
+                 the TOML parser keeps every value in memory (200 to 400 bytes each, so \
+                 several GB for this file)",
+                structure.values
+            ),
+        ));
+    }
+    options.report(LoadProgress::Parsing {
+        bytes: text.len() as u64,
+    });
+    let raw: RawScene = toml::from_str(text).map_err(|e| toml_error(&source, &structure, &e))?;
     check_element_count(&source, &raw)?;
-    build_scene(&source, raw)
+    build_scene(&source, raw, options)
 }
 
-fn read_scene_file(path: &Path) -> Result<String, SceneError> {
+fn read_scene_file(path: &Path, options: &LoadOptions<'_>) -> Result<String, SceneError> {
     let fail = |message: String| SceneError {
         path: path.to_path_buf(),
         location: None,
@@ -54,12 +156,17 @@ fn read_scene_file(path: &Path) -> Result<String, SceneError> {
     };
     let metadata =
         std::fs::metadata(path).map_err(|e| fail(format!("cannot read the scene file: {e}")))?;
-    if metadata.is_dir() {
-        return Err(fail("cannot read the scene file: it is a directory".into()));
+    if let Some(kind) = not_a_regular_file(&metadata) {
+        return Err(fail(format!(
+            "cannot read the scene file: it is {kind}, not a regular file"
+        )));
     }
     if metadata.len() > MAX_SCENE_FILE_BYTES {
         return Err(fail(too_large_message(metadata.len())));
     }
+    options.report(LoadProgress::Reading {
+        bytes: metadata.len(),
+    });
     let file =
         std::fs::File::open(path).map_err(|e| fail(format!("cannot read the scene file: {e}")))?;
     let mut bytes = Vec::new();
@@ -84,13 +191,55 @@ fn too_large_message(bytes: u64) -> String {
 }
 
 /// A TOML syntax or type error, located at its span, with the key path it concerns.
-fn toml_error(source: &Source<'_>, error: &toml::de::Error) -> SceneError {
-    let location = error.span().map(|span| source.location(span.start));
-    let message = match toml_error_keys(error) {
+/// The parser's bare "duplicate key" gets the key's name, and its "recursion limit"
+/// (a dotted key of too many parts, which it reports without a place) gets the place
+/// and the number of parts of the longest key.
+fn toml_error(
+    source: &Source<'_>,
+    structure: &structure::Structure,
+    error: &toml::de::Error,
+) -> SceneError {
+    let span = error.span();
+    let mut location = span.clone().map(|span| source.location(span.start));
+    let mut message = match toml_error_keys(error) {
         Some(keys) => format!("{keys}: {}", error.message()),
         None => error.message().to_owned(),
     };
+    if error.message() == "duplicate key"
+        && let Some(span) = span
+    {
+        message = duplicate_key_message(source.text, span);
+    } else if error.message() == "recursion limit"
+        && location.is_none()
+        && let Some((start, parts)) = structure.longest_key
+    {
+        location = Some(source.location(start));
+        message = format!(
+            "recursion limit: a dotted key has {parts} parts (`{}…`); the TOML parser accepts at most 80",
+            source.text[start..].chars().take(24).collect::<String>()
+        );
+    }
     source.error(location, message)
+}
+
+/// "duplicate key `eye`" or, for a table header, "duplicate table `[materials.a]`".
+fn duplicate_key_message(text: &str, span: std::ops::Range<usize>) -> String {
+    let key = text.get(span.clone()).unwrap_or("?");
+    let line_start = text[..span.start.min(text.len())]
+        .rfind('\n')
+        .map_or(0, |i| i + 1);
+    let line_end = text[line_start..]
+        .find('\n')
+        .map_or(text.len(), |i| line_start + i);
+    let line = text[line_start..line_end].trim();
+    if line.starts_with('[') {
+        let header = line.split('#').next().unwrap_or(line).trim();
+        format!(
+            "duplicate table `{header}` (each table may be defined once; use [[...]] for a list)"
+        )
+    } else {
+        format!("duplicate key `{key}` (each key may be given once per table)")
+    }
 }
 
 /// The dotted key path (`objects.radius`) a toml error concerns, if it says.
@@ -129,32 +278,49 @@ fn check_element_count(source: &Source<'_>, raw: &RawScene) -> Result<(), SceneE
 }
 
 /// Validates every table and item, in file order within each section.
-fn build_scene(source: &Source<'_>, raw: RawScene) -> Result<Scene, SceneError> {
+fn build_scene(
+    source: &Source<'_>,
+    raw: RawScene,
+    options: &LoadOptions<'_>,
+) -> Result<Scene, SceneError> {
     let render = settings::render(source, raw.render)?;
     let camera = settings::camera(source, raw.camera)?;
     let environment = settings::environment(source, raw.environment)?;
+    let total = (raw.materials.len() + raw.lights.len() + raw.objects.len()) as u64;
+    let mut done = 0;
+    let mut checked = || {
+        done += 1;
+        options.report(LoadProgress::Checking { done, total });
+    };
     let mut material_names = Vec::with_capacity(raw.materials.len());
     let mut materials = Vec::with_capacity(raw.materials.len());
-    let mut images = materials::ImageTable {
-        base: source.path.parent().unwrap_or(std::path::Path::new("")),
-        images: Vec::new(),
-    };
+    let mut images = materials::ImageTable::new(
+        source.path.parent().unwrap_or(std::path::Path::new("")),
+        options,
+    );
     for (name, material) in raw.materials {
         materials.push(materials::material(source, &name, material, &mut images)?);
         material_names.push(name);
+        checked();
     }
     let lights = raw
         .lights
         .into_iter()
         .enumerate()
-        .map(|(i, light)| lights::light(source, i, light))
+        .map(|(i, light)| {
+            checked();
+            lights::light(source, i, light)
+        })
         .collect::<Result<_, _>>()?;
     let table = MaterialTable::new(&material_names);
     let shapes = raw
         .objects
         .into_iter()
         .enumerate()
-        .map(|(i, object)| objects::object(source, &table, i, object))
+        .map(|(i, object)| {
+            checked();
+            objects::object(source, &table, i, object)
+        })
         .collect::<Result<_, _>>()?;
     Ok(Scene {
         render,
@@ -164,7 +330,7 @@ fn build_scene(source: &Source<'_>, raw: RawScene) -> Result<Scene, SceneError> 
         material_names,
         lights,
         shapes,
-        images: images.images,
+        images: images.into_images(),
     })
 }
 

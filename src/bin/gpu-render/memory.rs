@@ -1,0 +1,206 @@
+//! The memory a render will need, estimated before it starts, and the cap on it.
+//!
+//! The figures are peak resident memory measured with `/usr/bin/time -v` on this
+//! project's machines (see `docs/reliability.md` for the table and the commands):
+//! a fixed part, plus so many bytes per pixel for each backend and output format, plus
+//! the scene itself. They must be measured again when the GPU engine or the writers
+//! change how many copies of the image they hold.
+
+use std::fmt;
+
+use gpu_render::output::OutputFormat;
+use gpu_render::scene::Scene;
+
+/// The default of `--max-memory`, in GiB.
+pub const DEFAULT_MAX_MEMORY_GIB: f64 = 4.0;
+
+/// Resident memory of the program apart from the image: code, the scene's loader and,
+/// for the GPU, the device and its pipelines (measured at a 1x1 image: 7 MB on the CPU,
+/// 84-115 MB on lavapipe; a GPU `--compare-gamma` keeps about 240 MB more, measured as
+/// the offset of its peaks at 2048x2048 and 4096x4096).
+fn fixed_bytes(backend: BackendKind, compare_gamma: bool) -> u64 {
+    match (backend, compare_gamma) {
+        (BackendKind::Cpu, _) => 16 << 20,
+        (BackendKind::Gpu, false) => 128 << 20,
+        (BackendKind::Gpu, true) => 256 << 20,
+    }
+}
+
+/// Where the render runs, as far as memory goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BackendKind {
+    /// The wgpu tracer (on lavapipe its textures and buffers are host memory too).
+    Gpu,
+    /// The CPU reference.
+    Cpu,
+}
+
+/// Peak bytes per pixel of one render written as `format`, and of a `--compare-gamma`
+/// render per pixel of each half: the growth of the peak from 2048x2048 to 4096x4096
+/// (see `docs/reliability.md`). The CPU holds the linear image (16 bytes) and the
+/// display image (4); `.hdr` adds its RGB copy (12); `--compare-gamma` holds both
+/// renders and the joined image. On lavapipe the GPU's textures and buffers are host
+/// memory too, so its figure is the upper bound for a discrete GPU's host memory.
+fn bytes_per_pixel(backend: BackendKind, format: OutputFormat, compare_gamma: bool) -> u64 {
+    match (backend, compare_gamma, format) {
+        (BackendKind::Cpu, false, OutputFormat::Png | OutputFormat::Exr) => 20,
+        (BackendKind::Cpu, false, OutputFormat::Hdr) => 32,
+        (BackendKind::Cpu, true, _) => 80,
+        (BackendKind::Gpu, false, _) => 86,
+        (BackendKind::Gpu, true, _) => 99,
+    }
+}
+
+/// An estimate of a render's peak memory, with its parts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Estimate {
+    /// Pixels of one pass.
+    pub pixels: u64,
+    /// Bytes per pixel for this backend and format.
+    pub per_pixel: u64,
+    /// Bytes of the scene's shapes and images.
+    pub scene: u64,
+    /// Bytes of the program apart from the image and the scene.
+    pub fixed: u64,
+    /// The whole estimate in bytes.
+    pub total: u64,
+}
+
+impl Estimate {
+    /// The estimate for rendering `scene` (at its settings) on `backend` into `format`.
+    pub fn new(
+        scene: &Scene,
+        backend: BackendKind,
+        format: OutputFormat,
+        compare_gamma: bool,
+    ) -> Self {
+        let pixels = u64::from(scene.render.width) * u64::from(scene.render.height);
+        let per_pixel = bytes_per_pixel(backend, format, compare_gamma);
+        let scene_bytes = scene_bytes(scene);
+        let fixed = fixed_bytes(backend, compare_gamma);
+        Self {
+            pixels,
+            per_pixel,
+            scene: scene_bytes,
+            fixed,
+            total: fixed + scene_bytes + pixels * per_pixel,
+        }
+    }
+}
+
+impl fmt::Display for Estimate {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} ({} pixels x {} bytes, scene {}, program {})",
+            gib(self.total),
+            self.pixels,
+            self.per_pixel,
+            gib(self.scene),
+            gib(self.fixed)
+        )
+    }
+}
+
+/// Bytes of the scene the render holds: shapes, polygon vertices and image texels, in
+/// the model and (for the GPU) once more in upload form.
+fn scene_bytes(scene: &Scene) -> u64 {
+    use gpu_render::scene::Shape;
+    let vertices: usize = scene
+        .shapes
+        .iter()
+        .map(|shape| match shape {
+            Shape::Polygon { vertices, .. } => vertices.len(),
+            _ => 0,
+        })
+        .sum();
+    let texels: usize = scene.images.iter().map(|image| image.texels.len()).sum();
+    let bytes = scene.shapes.len() * std::mem::size_of::<Shape>() + vertices * 24 + texels * 16;
+    2 * bytes as u64
+}
+
+/// `bytes` as GiB with two decimals.
+pub fn gib(bytes: u64) -> String {
+    format!("{:.2} GiB", bytes as f64 / f64::from(1u32 << 30))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gpu_render::scene::parse_scene;
+
+    fn scene(width: u32, height: u32) -> Scene {
+        let text = format!(
+            "[render]\nwidth = {width}\nheight = {height}\n[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\n"
+        );
+        parse_scene(&text, std::path::Path::new("<test>")).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn compare_gamma_at_the_largest_size_on_the_cpu_passes_the_default_cap() {
+        let estimate = Estimate::new(
+            &scene(16384, 8192),
+            BackendKind::Cpu,
+            OutputFormat::Png,
+            true,
+        );
+        let cap = (DEFAULT_MAX_MEMORY_GIB * f64::from(1u32 << 30)) as u64;
+        assert!(estimate.total > cap, "{estimate}");
+        let single = Estimate::new(
+            &scene(16384, 8192),
+            BackendKind::Cpu,
+            OutputFormat::Png,
+            false,
+        );
+        assert!(single.total < cap, "{single}");
+    }
+
+    #[test]
+    fn the_estimate_matches_the_measured_peaks() {
+        // Peaks measured at 2048x2048 and 4096x4096 (docs/reliability.md), in kB; the
+        // estimate may be above by at most 15%, never below.
+        let cases = [
+            (BackendKind::Cpu, OutputFormat::Png, false, 2048, 89_676),
+            (BackendKind::Cpu, OutputFormat::Png, false, 4096, 335_820),
+            (BackendKind::Cpu, OutputFormat::Exr, false, 4096, 335_352),
+            (BackendKind::Cpu, OutputFormat::Hdr, false, 2048, 138_108),
+            (BackendKind::Cpu, OutputFormat::Hdr, false, 4096, 531_544),
+            (BackendKind::Cpu, OutputFormat::Png, true, 2048, 334_612),
+            (BackendKind::Cpu, OutputFormat::Png, true, 4096, 1_317_764),
+            (BackendKind::Gpu, OutputFormat::Png, false, 2048, 478_068),
+            (BackendKind::Gpu, OutputFormat::Exr, false, 4096, 1_528_196),
+            (BackendKind::Gpu, OutputFormat::Hdr, false, 4096, 1_528_220),
+            (BackendKind::Gpu, OutputFormat::Png, true, 2048, 642_248),
+            (BackendKind::Gpu, OutputFormat::Png, true, 4096, 1_855_856),
+        ];
+        for (backend, format, compare, side, kilobytes) in cases {
+            let measured = kilobytes as f64 * 1024.0;
+            let estimate = Estimate::new(&scene(side, side), backend, format, compare).total as f64;
+            assert!(
+                estimate >= measured && estimate <= 1.15 * measured,
+                "{backend:?} {format} {compare} {side}: estimate {estimate}, measured {measured}"
+            );
+        }
+    }
+
+    #[test]
+    fn estimate_grows_with_pixels_and_names_its_parts() {
+        let small = Estimate::new(&scene(64, 64), BackendKind::Gpu, OutputFormat::Exr, false);
+        let large = Estimate::new(
+            &scene(4096, 4096),
+            BackendKind::Gpu,
+            OutputFormat::Exr,
+            false,
+        );
+        assert!(large.total > small.total);
+        assert_eq!(
+            large.total - small.total,
+            (4096 * 4096 - 64 * 64) * large.per_pixel
+        );
+        let shown = large.to_string();
+        assert!(
+            shown.contains("16777216 pixels") && shown.contains("GiB"),
+            "{shown}"
+        );
+    }
+}

@@ -1,0 +1,108 @@
+//! Resolving the files a scene names (textures, BRDF maps, and later model files),
+//! relative to the scene file's folder, optionally confined to it.
+
+use std::path::{Component, Path, PathBuf};
+
+/// The path of `file`, as a scene file in folder `scene_dir` names it, confined to that
+/// folder: `file` must be relative, must not contain `..` (or a drive or root), and
+/// must not lead out of `scene_dir` through a symbolic link. Returns the joined path
+/// (`scene_dir/file`), or a message (without the scene's path, which the caller names)
+/// saying why the file is refused.
+///
+/// This is the `--sandbox` rule: without it a scene file is trusted input, like a
+/// program, and may name any file the user can read.
+///
+/// ```
+/// use std::path::Path;
+/// use gpu_render::scene::confined_path;
+/// assert!(confined_path(Path::new("scenes"), "textures/wood.png").is_ok());
+/// assert!(confined_path(Path::new("scenes"), "../secret.png").is_err());
+/// assert!(confined_path(Path::new("scenes"), "/etc/passwd").is_err());
+/// ```
+pub fn confined_path(scene_dir: &Path, file: &str) -> Result<PathBuf, String> {
+    let relative = Path::new(file);
+    if relative.is_absolute() || relative.has_root() {
+        return Err(format!(
+            "`{file}` is an absolute path; a sandboxed scene may only name files inside its folder"
+        ));
+    }
+    for component in relative.components() {
+        match component {
+            Component::ParentDir => {
+                return Err(format!(
+                    "`{file}` contains `..`; a sandboxed scene may only name files inside its folder"
+                ));
+            }
+            Component::Prefix(_) | Component::RootDir => {
+                return Err(format!(
+                    "`{file}` names a drive or root; a sandboxed scene may only name files inside its folder"
+                ));
+            }
+            Component::CurDir | Component::Normal(_) => {}
+        }
+    }
+    let joined = scene_dir.join(relative);
+    // A symbolic link inside the folder may still point out of it. A file that does
+    // not exist cannot be resolved; reading it fails later with the OS's reason.
+    let base = if scene_dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        scene_dir
+    };
+    if let (Ok(resolved), Ok(base)) = (joined.canonicalize(), base.canonicalize())
+        && !resolved.starts_with(&base)
+    {
+        return Err(format!(
+            "`{file}` leads out of the scene's folder (to {}) through a symbolic link; \
+             a sandboxed scene may only name files inside its folder",
+            resolved.display()
+        ));
+    }
+    Ok(joined)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plain_relative_paths_are_joined() {
+        let dir = Path::new("scenes");
+        assert_eq!(
+            confined_path(dir, "textures/wood.png"),
+            Ok(PathBuf::from("scenes/textures/wood.png"))
+        );
+        assert_eq!(
+            confined_path(dir, "./wood.png"),
+            Ok(PathBuf::from("scenes/./wood.png"))
+        );
+    }
+
+    #[test]
+    fn escapes_are_refused() {
+        let dir = Path::new("scenes");
+        for (file, why) in [
+            ("/etc/passwd", "absolute"),
+            ("../secret.png", "`..`"),
+            ("textures/../../secret.png", "`..`"),
+        ] {
+            let err = confined_path(dir, file).expect_err(file);
+            assert!(err.contains(why) && err.contains(file), "{err}");
+        }
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_out_of_the_folder_is_refused() {
+        let outside = tempfile::tempdir().expect("tempdir");
+        let secret = outside.path().join("secret.png");
+        std::fs::write(&secret, b"x").expect("write");
+        let scene_dir = tempfile::tempdir().expect("tempdir");
+        std::os::unix::fs::symlink(&secret, scene_dir.path().join("innocent.png"))
+            .expect("symlink");
+        std::fs::write(scene_dir.path().join("inside.png"), b"x").expect("write");
+        let err = confined_path(scene_dir.path(), "innocent.png").expect_err("escapes");
+        assert!(err.contains("symbolic link"), "{err}");
+        assert!(confined_path(scene_dir.path(), "inside.png").is_ok());
+    }
+}
