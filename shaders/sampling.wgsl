@@ -1,7 +1,8 @@
 // The pinhole camera and the pixel sample pattern.
-// CPU twin: src/camera.rs (pcg_hash, unit_from_hash, strata_grid, largest_partial_quotient,
-// lattice_generator, sample_offset,
-// CameraFrame::ray_direction -> camera_ray_direction).
+// CPU twin: src/camera.rs (pcg_hash, unit_from_hash, strata_grid, sample_offset,
+// CameraFrame::ray_direction -> camera_ray_direction). The lattice generator of the
+// sample count is computed once on the host (camera::lattice_generator) and arrives in
+// frame.lattice_generator.
 
 // PCG hash of one 32-bit word (Jarzynski and Olano, "Hash Functions for GPU Rendering",
 // JCGT 2020). u32 arithmetic wraps, as Rust's wrapping_mul/wrapping_add do.
@@ -23,57 +24,10 @@ fn strata_grid(samples_per_pixel: u32) -> vec2<u32> {
     return vec2<u32>(n, n);
 }
 
-// The largest partial quotient of the continued fraction of n/g (Euclid's algorithm),
-// or 0xffffffff when n and g are not coprime.
-fn largest_partial_quotient(n: u32, g: u32) -> u32 {
-    var a = n;
-    var b = g;
-    var largest = 0u;
-    loop {
-        if b == 0u {
-            break;
-        }
-        largest = max(largest, a / b);
-        let t = a % b;
-        a = b;
-        b = t;
-    }
-    if a == 1u {
-        return largest;
-    }
-    return 0xffffffffu;
-}
-
-// The generator of the rank-1 (Fibonacci) lattice of n points: of the 17 integers
-// nearest n/phi (40503 = round(2^16/phi), exact in u32 for n <= 65536), the one coprime
-// with n whose continued fraction n/g has the smallest largest partial quotient, the
-// nearest on a tie.
-fn lattice_generator(n: u32) -> u32 {
-    let nearest = (n * 40503u + 32768u) >> 16u;
-    var best_quality = 0xffffffffu;
-    var best = 1u;
-    for (var k = 0u; k < 17u; k += 1u) {
-        let step = (k + 1u) / 2u;
-        var g = nearest - step;
-        if k % 2u == 1u {
-            g = nearest + step;
-        }
-        if g == 0u || g >= n {
-            continue;
-        }
-        let quality = largest_partial_quotient(n, g);
-        if quality < best_quality {
-            best_quality = quality;
-            best = g;
-        }
-    }
-    return best;
-}
-
 // Offset in [0, 1)^2 of sample `index` inside pixel (px, py): the pixel centre for one
 // sample; otherwise column `index` and row (index * g + shift) mod n of the n x n strata
-// (one sample per column and per row, on a Fibonacci lattice shifted by a hash of the
-// pixel), jittered inside the cell by a hash of pixel and sample index.
+// (one sample per column and per row, on a Fibonacci lattice of generator g =
+// frame.lattice_generator, shifted by a hash of the pixel), jittered inside the cell by a hash of pixel and sample index.
 fn sample_offset(px: u32, py: u32, index: u32) -> vec2<f32> {
     let spp = frame.samples_per_pixel;
     if spp <= 1u {
@@ -84,7 +38,7 @@ fn sample_offset(px: u32, py: u32, index: u32) -> vec2<f32> {
     let shift = pcg_hash(pixel_index) % grid.y;
     let column = index % grid.x;
     // column * g + shift < 65535 * 65535 + 65536 < 2^32: no overflow for n <= 65536.
-    let row = (column * lattice_generator(spp) + shift) % grid.y;
+    let row = (column * frame.lattice_generator + shift) % grid.y;
     let seed = pcg_hash(pixel_index * spp + index);
     let jitter = vec2<f32>(unit_from_hash(seed), unit_from_hash(pcg_hash(seed)));
     let cell = vec2<f32>(f32(column), f32(row));

@@ -34,7 +34,7 @@ struct FrameUniforms {
     flags: u32,
     offset_scale: f32,
     min_ray_weight: f32,
-    _pad0: u32,
+    lattice_generator: u32,
     _pad1: u32,
 }
 

@@ -120,6 +120,51 @@ fn largest_partial_quotient(n: u32, g: u32) -> u32 {
     if a == 1 { largest } else { u32::MAX }
 }
 
+/// The sample pattern of one render: [`sample_offset`] with the lattice generator of
+/// its sample count computed once (the GPU receives it in its frame constants).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SamplePattern {
+    /// Image width (the pixel index is `y · width + x`).
+    pub width: u32,
+    /// Samples per pixel.
+    pub samples_per_pixel: u32,
+    /// [`lattice_generator`] of `samples_per_pixel`.
+    pub lattice_generator: u32,
+}
+
+impl SamplePattern {
+    /// The pattern of a render with `settings`.
+    pub fn new(settings: &RenderSettings) -> Self {
+        Self {
+            width: settings.width,
+            samples_per_pixel: settings.samples_per_pixel,
+            lattice_generator: lattice_generator(settings.samples_per_pixel),
+        }
+    }
+
+    /// [`sample_offset`] of sample `index` of pixel (`px`, `py`).
+    pub fn offset(&self, px: u32, py: u32, index: u32) -> (f64, f64) {
+        let spp = self.samples_per_pixel;
+        if spp <= 1 {
+            return (0.5, 0.5);
+        }
+        let (columns, rows) = strata_grid(spp);
+        let pixel_index = py.wrapping_mul(self.width).wrapping_add(px);
+        let shift = pcg_hash(pixel_index) % rows;
+        let column = index % columns;
+        // In u64 for safety; the WGSL twin's u32 cannot overflow either for n <= 65536.
+        let row = ((u64::from(column) * u64::from(self.lattice_generator) + u64::from(shift))
+            % u64::from(rows)) as u32;
+        let seed = pcg_hash(pixel_index.wrapping_mul(spp).wrapping_add(index));
+        let jitter_x = unit_from_hash(seed);
+        let jitter_y = unit_from_hash(pcg_hash(seed));
+        (
+            (f64::from(column) + jitter_x) / f64::from(columns),
+            (f64::from(row) + jitter_y) / f64::from(rows),
+        )
+    }
+}
+
 /// The offset inside pixel (`px`, `py`) of sample `index`, in [0, 1)². One sample goes
 /// through the pixel centre (as in the lecture). With `n > 1` samples, sample `i` lies
 /// in column `i` and row `(i·g + s) mod n` of the `n × n` [`strata_grid`], where `g` is
@@ -129,24 +174,7 @@ fn largest_partial_quotient(n: u32, g: u32) -> u32 {
 /// they are spread in 2D too. Each sample is jittered inside its cell by a hash of the
 /// pixel and sample index, so both backends pick identical positions.
 pub fn sample_offset(px: u32, py: u32, index: u32, settings: &RenderSettings) -> (f64, f64) {
-    let spp = settings.samples_per_pixel;
-    if spp <= 1 {
-        return (0.5, 0.5);
-    }
-    let (columns, rows) = strata_grid(spp);
-    let pixel_index = py.wrapping_mul(settings.width).wrapping_add(px);
-    let shift = pcg_hash(pixel_index) % rows;
-    let column = index % columns;
-    // In u64 for safety; the WGSL twin's u32 cannot overflow either for n <= 65536.
-    let row = ((u64::from(column) * u64::from(lattice_generator(spp)) + u64::from(shift))
-        % u64::from(rows)) as u32;
-    let seed = pcg_hash(pixel_index.wrapping_mul(spp).wrapping_add(index));
-    let jitter_x = unit_from_hash(seed);
-    let jitter_y = unit_from_hash(pcg_hash(seed));
-    (
-        (f64::from(column) + jitter_x) / f64::from(columns),
-        (f64::from(row) + jitter_y) / f64::from(rows),
-    )
+    SamplePattern::new(settings).offset(px, py, index)
 }
 
 #[cfg(test)]

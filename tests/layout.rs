@@ -57,7 +57,7 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 flags,
                 offset_scale,
                 min_ray_weight,
-                _pad0,
+                lattice_generator,
                 _pad1,
             }),
         ),

@@ -88,6 +88,7 @@ fn gpu_sample_offsets_match_the_cpu() {
             width: WIDTH,
             height: 1080,
             samples_per_pixel: n,
+            lattice_generator: gpu_render::camera::lattice_generator(n),
             ..bytemuck::Zeroable::zeroed()
         };
         let uniform_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

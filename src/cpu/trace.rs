@@ -9,7 +9,7 @@ use super::intersect::{Hit, Ray, offset_ray_origin};
 use super::texture::shading_albedo;
 use super::traverse::{intersect_scene, occluded};
 use crate::accel::SceneGeometry;
-use crate::camera::{CameraFrame, sample_offset};
+use crate::camera::{CameraFrame, SamplePattern};
 pub use crate::scene::MediumStack;
 use crate::scene::{Image, Light, Material, RenderSettings, Scene};
 
@@ -21,6 +21,8 @@ pub struct PreparedScene {
     pub settings: RenderSettings,
     /// The camera basis.
     pub camera: CameraFrame,
+    /// Where each sample lies in its pixel.
+    pub samples: SamplePattern,
     /// Radiance of escaping rays.
     pub background: DVec3,
     /// Whitted ambient radiance.
@@ -50,6 +52,7 @@ impl PreparedScene {
         Self {
             settings: scene.render,
             camera: CameraFrame::new(&scene.camera, scene.render.width, scene.render.height),
+            samples: SamplePattern::new(&scene.render),
             background: scene.environment.background,
             ambient: scene.environment.ambient,
             materials: scene.materials.clone(),
@@ -106,7 +109,7 @@ pub fn trace_pixel(scene: &PreparedScene, x: u32, y: u32) -> PixelResult {
     let mut sum = DVec3::ZERO;
     let mut rays = 0;
     for index in 0..settings.samples_per_pixel {
-        let (dx, dy) = sample_offset(x, y, index, settings);
+        let (dx, dy) = scene.samples.offset(x, y, index);
         let direction = scene.camera.ray_direction(
             f64::from(x) + dx,
             f64::from(y) + dy,

@@ -76,8 +76,9 @@ pub struct FrameUniforms {
     pub offset_scale: f32,
     /// Branches whose weight is not above this are not traced.
     pub min_ray_weight: f32,
-    /// Padding.
-    pub _pad0: u32,
+    /// The sample pattern's lattice generator (`crate::camera::lattice_generator` of
+    /// the samples per pixel).
+    pub lattice_generator: u32,
     /// Padding.
     pub _pad1: u32,
 }

@@ -293,7 +293,7 @@ pub fn frame_uniforms(scene: &Scene, geometry: &SceneGeometry) -> FrameUniforms 
         flags: 0,
         offset_scale: geometry.offset_scale as f32,
         min_ray_weight: settings.min_ray_weight as f32,
-        _pad0: 0,
+        lattice_generator: crate::camera::lattice_generator(settings.samples_per_pixel),
         _pad1: 0,
     }
 }
