@@ -4,6 +4,7 @@
 mod error;
 mod file;
 mod image;
+pub mod import;
 mod model;
 
 pub use error::SceneError;
