@@ -116,11 +116,19 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError
 /// where it knows them.
 fn parse_error(path: &Path, e: ::gltf::Error) -> SceneError {
     match e {
-        ::gltf::Error::Deserialize(json) if json.line() > 0 => SceneError {
-            path: path.to_path_buf(),
-            location: Some((json.line(), json.column())),
-            message: format!("not a valid glTF file: {json}"),
-        },
+        ::gltf::Error::Deserialize(json) if json.line() > 0 => {
+            let (line, column) = (json.line(), json.column());
+            let text = json.to_string();
+            let suffix = format!(" at line {line} column {column}");
+            SceneError {
+                path: path.to_path_buf(),
+                location: Some((line, column.max(1))),
+                message: format!(
+                    "not a valid glTF file: {}",
+                    text.strip_suffix(&suffix).unwrap_or(&text)
+                ),
+            }
+        }
         ::gltf::Error::Binary(binary) => error(
             path,
             format!("not a valid GLB file (truncated or corrupt): {binary}"),
@@ -136,7 +144,13 @@ fn validate(document: &Document, path: &Path) -> Result<(), SceneError> {
     let root = document.as_json();
     let mut problems = Vec::new();
     root.validate(root, ::gltf::json::Path::new, &mut |where_, what| {
-        problems.push(format!("{}: {what}", where_()));
+        let where_ = where_();
+        // POSITION's min and max are required (§3.7.2.1) but only serve to bound the
+        // mesh without reading it; some exporters leave them out, and we read it anyway.
+        let bounds = where_.as_str().contains(r#"["POSITION"].m"#);
+        if !(bounds && what == ::gltf::json::validation::Error::Missing) {
+            problems.push(format!("{where_}: {what}"));
+        }
     });
     if problems.is_empty() {
         return Ok(());
@@ -683,7 +697,7 @@ impl Importer<'_> {
         } else {
             if ior.is_some_and(|ior| ior != DEFAULT_IOR) {
                 self.warn(format!(
-                    "{name}: KHR_materials_ior without transmission is not supported (the metal/roughness model's F0 is 0.04); ignored"
+                    "{name}: ior is only used for transmissive, non-metallic materials (the metal/roughness model's F0 is 0.04); ignored"
                 ));
             }
             Material {
