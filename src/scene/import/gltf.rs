@@ -140,15 +140,36 @@ fn parse_error(path: &Path, e: ::gltf::Error) -> SceneError {
 /// Runs the `gltf` crate's validation (references in range, required properties present,
 /// enumerations valid), which its accessors rely on.
 fn validate(document: &Document, path: &Path) -> Result<(), SceneError> {
-    use ::gltf::json::validation::Validate;
+    use ::gltf::json::validation::{Checked, Validate};
     let root = document.as_json();
+    // gltf-json 1.4's validation indexes the accessors with POSITION's index unchecked
+    // (`primitive_validate_hook`), so that index is checked here first.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = primitive
+                .attributes
+                .get(&Checked::Valid(::gltf::Semantic::Positions));
+            if let Some(index) = position
+                && index.value() >= root.accessors.len()
+            {
+                return Err(error(
+                    path,
+                    format!(
+                        "not a valid glTF file: meshes[{m}].primitives[{p}].attributes[\"POSITION\"] refers to accessor {}, but there are {} accessors",
+                        index.value(),
+                        root.accessors.len()
+                    ),
+                ));
+            }
+        }
+    }
     let mut problems = Vec::new();
     root.validate(root, ::gltf::json::Path::new, &mut |where_, what| {
         let where_ = where_();
         // POSITION's min and max are required (§3.7.2.1) but only serve to bound the
-        // mesh without reading it; some exporters leave them out, and we read it anyway.
-        let bounds = where_.as_str().contains(r#"["POSITION"].m"#);
-        if !(bounds && what == ::gltf::json::validation::Error::Missing) {
+        // mesh without reading it; some exporters leave them out or get them wrong, and
+        // the positions are read (and checked) anyway.
+        if !where_.as_str().contains(r#"["POSITION"].m"#) {
             problems.push(format!("{where_}: {what}"));
         }
     });
