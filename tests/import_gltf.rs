@@ -290,6 +290,9 @@ fn embedded_external_and_glb_buffers_give_the_same_model() {
     let mesh = &embedded.meshes[0];
     assert_eq!(mesh.normals.as_deref(), Some(&[DVec3::Z; 3][..]));
     assert_eq!(mesh.uvs.as_ref().map(|u| u[1].x), Some(1.0));
+    // A byte-order mark before the JSON is tolerated.
+    let bom = [b"\xEF\xBB\xBF".as_slice(), doc.embedded(&body).as_bytes()].concat();
+    assert_eq!(imported("bom.gltf", &bom).meshes, embedded.meshes);
     // A .glb by content, whatever its name.
     let renamed = imported("binary.gltf", &doc.glb(&body));
     assert_eq!(renamed.meshes, glb.meshes);
@@ -582,7 +585,7 @@ fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
     let scene = r#""scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}]"#;
     let ok = doc.embedded(&format!("{scene},{meshes}"));
     let mut cases: Vec<(&'static str, Vec<u8>, &'static str)> = vec![
-        ("empty", Vec::new(), "not a valid glTF file"),
+        ("empty", Vec::new(), "not a valid glTF file: the file is empty"),
         ("not json", b"solid cube\nfacet".to_vec(), "not a valid glTF file"),
         (
             "truncated json",
@@ -604,6 +607,12 @@ fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
             "dangling reference",
             ok.replace(r#"{"mesh":0}"#, r#"{"mesh":7}"#).into_bytes(),
             "not a valid glTF file: nodes[0].mesh: Index out of bounds",
+        ),
+        (
+            // gltf-json's own validation would index the accessors with it (and panic).
+            "POSITION accessor out of range",
+            ok.replace(r#""POSITION":0"#, r#""POSITION":9"#).into_bytes(),
+            "meshes[0].primitives[0].attributes[\"POSITION\"] refers to accessor 9, but there are 2 accessors",
         ),
         (
             "two parents",

@@ -533,6 +533,14 @@ fn missing_and_unreadable_files_are_named() {
 }
 
 #[test]
+fn a_byte_order_mark_is_skipped() {
+    let bytes = "\u{feff}v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".as_bytes();
+    let model = parse_obj(bytes, Path::new("bom.obj")).expect("imports");
+    assert_eq!(model.meshes.len(), 1);
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+}
+
+#[test]
 fn invalid_utf8_is_read_with_a_warning() {
     let bytes = b"# caf\xe9\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
     let model = parse_obj(bytes, Path::new("latin1.obj")).expect("imports");

@@ -61,6 +61,11 @@ pub fn import_gltf(path: &Path) -> Result<ImportedModel, SceneError> {
 /// Reads glTF or GLB from `bytes`; `path` names the file in messages and its directory
 /// is where external buffers and images are looked up.
 pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError> {
+    // glTF JSON must not start with a byte-order mark (§3.2), but some writers add one.
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    if bytes.is_empty() {
+        return Err(error(path, "not a valid glTF file: the file is empty"));
+    }
     let gltf =
         ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| parse_error(path, e))?;
     let version = &gltf.as_json().asset.version;

@@ -56,7 +56,9 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError>
             path.display()
         ));
     }
-    let scan = scan_obj(&text, path, &mut model.warnings)?;
+    // A byte-order mark would hide the first line's keyword.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let scan = scan_obj(text, path, &mut model.warnings)?;
     let directory = path.parent().unwrap_or(Path::new("")).to_path_buf();
     let libraries = RefCell::new(Libraries::default());
     let options = tobj::LoadOptions {
@@ -531,7 +533,8 @@ impl Libraries {
         bytes: &[u8],
     ) -> Result<(Vec<tobj::Material>, HashMap<String, usize>), SceneError> {
         let text = String::from_utf8_lossy(bytes);
-        let (clean, lines) = scan_mtl(&text, library)?;
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+        let (clean, lines) = scan_mtl(text, library)?;
         let (materials, names) =
             tobj::load_mtl_buf(&mut Cursor::new(clean.as_bytes())).map_err(|e| {
                 error(
