@@ -468,6 +468,35 @@ fn materials_map_with_their_textures_and_wrap_modes() {
 }
 
 #[test]
+fn jpeg_textures_load() {
+    let (doc, _) = triangle_doc();
+    let image = image::RgbImage::from_pixel(4, 2, image::Rgb([200, 100, 50]));
+    let mut jpeg = std::io::Cursor::new(Vec::new());
+    image
+        .write_to(&mut jpeg, image::ImageFormat::Jpeg)
+        .expect("encode jpeg");
+    let body = r#""scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1,"material":0}]}],
+        "materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],
+        "textures":[{"source":0}],"images":[{"uri":"photo.jpg","mimeType":"image/jpeg"}]"#;
+    let (_dir, result) = import(&[
+        ("photo.gltf", doc.embedded(body).as_bytes()),
+        ("photo.jpg", &jpeg.into_inner()),
+    ]);
+    let model = result.expect("imports");
+    let texture = model.materials[0].base_color_texture.expect("texture");
+    let image = &model.images[texture.image as usize];
+    assert_eq!((image.width, image.height), (4, 2));
+    // JPEG is lossy: within a few 8-bit steps of the sRGB value, linearised.
+    let expected = srgb_decode(200.0 / 255.0) as f32;
+    assert!(
+        (image.texel(1, 1)[0] - expected).abs() < 0.03,
+        "{:?}",
+        image.texel(1, 1)
+    );
+}
+
+#[test]
 fn a_model_without_camera_or_lights_gets_the_default_framing() {
     let (doc, meshes) = triangle_doc();
     let body = format!(r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],{meshes}"#);
