@@ -412,7 +412,7 @@ fn materials_map_with_their_textures_and_wrap_modes() {
                 "extensions":{{"KHR_materials_transmission":{{"transmissionFactor":1}},"KHR_materials_ior":{{"ior":1.33}}}}}}],
            "samplers":[{{"wrapS":33071,"wrapT":33648}}],
            "textures":[{{"source":0,"sampler":0}},{{"source":1}},{{"source":2}}],
-           "images":[{{"uri":"base.png"}},{{"uri":"{mr_uri}"}},{{"bufferView":{emissive_view},"mimeType":"image/png"}}]"#
+           "images":[{{"uri":"base.png"}},{{"uri":"{mr_uri}"}},{{"bufferView":{emissive_view}}}]"#
     );
     let base_png = png(2, 1, &[[128, 128, 128, 255], [255, 255, 255, 255]]);
     let (_dir, result) = import(&[
@@ -731,6 +731,29 @@ fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
             "light 0: intensity -1 is negative or not finite",
         ),
         (
+            "light index without lights",
+            ok.replace(
+                r#"{"mesh":0}"#,
+                r#"{"mesh":0,"extensions":{"KHR_lights_punctual":{"light":0}}}"#,
+            )
+            .into_bytes(),
+            "nodes[0].extensions.khrLightsPunctual.light: Index out of bounds",
+        ),
+        (
+            "light index out of range",
+            ok.replacen(
+                '{',
+                r#"{"extensions":{"KHR_lights_punctual":{"lights":[{"type":"point","intensity":1}]}},"#,
+                1,
+            )
+            .replace(
+                r#"{"mesh":0}"#,
+                r#"{"mesh":0,"extensions":{"KHR_lights_punctual":{"light":3}}}"#,
+            )
+            .into_bytes(),
+            "nodes[0].extensions.khrLightsPunctual.light: Index out of bounds",
+        ),
+        (
             "missing texture",
             ok.replace(
                 r#""indices":1}"#,
@@ -743,6 +766,17 @@ fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
             )
             .into_bytes(),
             "material 0 ('m'): baseColorTexture: image 0: the texture",
+        ),
+        (
+            "image without a source",
+            ok.replace(r#""indices":1}"#, r#""indices":1,"material":0}"#)
+                .replacen(
+                    '{',
+                    r#"{"materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],"textures":[{"source":0}],"images":[{"mimeType":"image/png"}],"#,
+                    1,
+                )
+                .into_bytes(),
+            "material 0: baseColorTexture: image 0: it has neither a uri nor a bufferView",
         ),
         (
             "out of range factor",

@@ -776,14 +776,21 @@ impl Importer<'_> {
         let image_name = describe("image", image.index(), image.name());
         let fail = |e: String| error(self.path, format!("{material}: {slot}: {image_name}: {e}"));
         let label = format!("{}#{image_name}", self.path.display());
-        let index = match image.source() {
-            ::gltf::image::Source::View { view, .. } => {
+        // The image's JSON, not `Image::source`, which unwraps a missing `uri` or (for a
+        // buffer view) `mimeType` (gltf 1.4).
+        let json = &self.document.as_json().images[image.index()];
+        let index = match (&json.buffer_view, &json.uri) {
+            (Some(view), _) => {
+                let view =
+                    self.document.views().nth(view.value()).ok_or_else(|| {
+                        fail(format!("bufferView {} does not exist", view.value()))
+                    })?;
                 let bytes = view_bytes(&view, &self.buffers).map_err(fail)?.to_vec();
                 self.textures
                     .bytes(&bytes, &label, encoding, &mut self.budget)
                     .map_err(fail)?
             }
-            ::gltf::image::Source::Uri { uri, .. } => match data_uri(uri) {
+            (None, Some(uri)) => match data_uri(uri) {
                 Some(decoded) => {
                     let bytes = decoded.map_err(fail)?;
                     self.textures
@@ -797,6 +804,7 @@ impl Importer<'_> {
                         .map_err(fail)?
                 }
             },
+            (None, None) => return Err(fail("it has neither a uri nor a bufferView".into())),
         };
         let sampler = texture.sampler();
         let wrap = |mode: WrappingMode| match mode {
