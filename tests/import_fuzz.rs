@@ -360,7 +360,14 @@ fn gltf_seeds() -> Vec<GltfSeed> {
     let glb_json = serde_json::from_slice(&glb[20..20 + json_length]).expect("glb json");
     let glb_bin = glb[20 + json_length + 8..].to_vec();
     let external = manifest("tests/fixtures/models/trimesh_scene.gltf");
+    let (features_json, features_bin) = features_document();
     vec![
+        GltfSeed {
+            path: manifest("tests/fixtures/models/features.glb"),
+            json: features_json,
+            bin: features_bin,
+            container: Container::Glb,
+        },
         GltfSeed {
             path: vase,
             json,
@@ -382,8 +389,107 @@ fn gltf_seeds() -> Vec<GltfSeed> {
     ]
 }
 
-/// Imports a (mutated) glTF seed, put back together.
-fn check_gltf_seed(seed: &GltfSeed) {
+/// A document that uses every feature the importer reads, so that the structural
+/// mutations reach the code for each: a node hierarchy of TRS and matrix transforms,
+/// instancing, a strip, a fan and a sparse accessor, normals and normalized `u16` UVs,
+/// textures from a data URI and from a buffer view with samplers, transmission, IOR and
+/// emissive strength, three kinds of light and two cameras.
+fn features_document() -> (serde_json::Value, Vec<u8>) {
+    use base64::Engine;
+    let png = |rgba: [u8; 4]| {
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        image::RgbaImage::from_pixel(2, 2, image::Rgba(rgba))
+            .write_to(&mut bytes, image::ImageFormat::Png)
+            .expect("png");
+        bytes.into_inner()
+    };
+    let mut bin = Vec::new();
+    let mut views = Vec::new();
+    let mut view = |bin: &mut Vec<u8>, bytes: &[u8]| {
+        while !bin.len().is_multiple_of(4) {
+            bin.push(0);
+        }
+        views.push(
+            serde_json::json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len()}),
+        );
+        bin.extend_from_slice(bytes);
+        views.len() - 1
+    };
+    let f32s = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+    let square = f32s(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0]);
+    let positions = view(&mut bin, &square);
+    let normals = view(&mut bin, &f32s(&[0.0, 0.0, 1.0].repeat(4)));
+    let uvs: Vec<u8> = [0u16, 0, 65535, 0, 0, 65535, 65535, 65535]
+        .iter()
+        .flat_map(|x| x.to_le_bytes())
+        .collect();
+    let uvs = view(&mut bin, &uvs);
+    let strip: Vec<u8> = [0u8, 1, 2, 3].to_vec();
+    let strip = view(&mut bin, &strip);
+    let sparse_indices = view(&mut bin, &[3u8]);
+    let sparse_values = view(&mut bin, &f32s(&[2.0, 2.0, 0.5]));
+    let texture = view(&mut bin, &png([200, 100, 50, 255]));
+    let data_png = format!(
+        "data:image/png;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(png([0, 128, 255, 255]))
+    );
+    let json = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_emissive_strength",
+                           "KHR_materials_ior", "KHR_materials_transmission"],
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "point", "intensity": 100, "color": [1, 0.9, 0.8]},
+            {"type": "spot", "intensity": 50, "spot": {"innerConeAngle": 0.1, "outerConeAngle": 0.6}},
+            {"type": "directional", "intensity": 3}]}},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 5]}],
+        "nodes": [
+            {"translation": [0, 1, 0], "rotation": [0, 0.38268343, 0, 0.9238795], "children": [1, 2, 3, 4]},
+            {"mesh": 0, "scale": [2, 2, 2]},
+            {"mesh": 0, "matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 3, 0, 0, 1]},
+            {"camera": 0, "translation": [0, 0, 5], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+            {"mesh": 1, "extensions": {"KHR_lights_punctual": {"light": 1}}},
+            {"camera": 1, "rotation": [-0.38268343, 0, 0, 0.9238795],
+             "extensions": {"KHR_lights_punctual": {"light": 2}}}],
+        "cameras": [
+            {"type": "perspective", "perspective": {"yfov": 0.7, "aspectRatio": 1.5, "znear": 0.1, "zfar": 100}},
+            {"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}}],
+        "meshes": [
+            {"name": "square", "primitives": [
+                {"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3, "mode": 5, "material": 0},
+                {"attributes": {"POSITION": 4}, "mode": 6, "material": 1}]},
+            {"name": "plain", "primitives": [{"attributes": {"POSITION": 0}, "mode": 4}]}],
+        "materials": [
+            {"name": "textured",
+             "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0.5, "roughnessFactor": 0.5,
+                "baseColorTexture": {"index": 0}, "metallicRoughnessTexture": {"index": 1}},
+             "emissiveFactor": [0.1, 0.2, 0.3], "emissiveTexture": {"index": 0},
+             "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 2}}},
+            {"name": "glass", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
+             "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
+                            "KHR_materials_ior": {"ior": 1.5}}}],
+        "samplers": [{"wrapS": 33071, "wrapT": 33648}],
+        "textures": [{"source": 0, "sampler": 0}, {"source": 1}],
+        "images": [{"bufferView": texture, "mimeType": "image/png"}, {"uri": data_png}],
+        "accessors": [
+            {"bufferView": positions, "componentType": 5126, "count": 4, "type": "VEC3",
+             "min": [0, 0, 0], "max": [1, 1, 0]},
+            {"bufferView": normals, "componentType": 5126, "count": 4, "type": "VEC3"},
+            {"bufferView": uvs, "componentType": 5123, "normalized": true, "count": 4, "type": "VEC2"},
+            {"bufferView": strip, "componentType": 5121, "count": 4, "type": "SCALAR"},
+            {"bufferView": positions, "componentType": 5126, "count": 4, "type": "VEC3",
+             "min": [0, 0, 0], "max": [2, 2, 0.5],
+             "sparse": {"count": 1, "indices": {"bufferView": sparse_indices, "componentType": 5121},
+                        "values": {"bufferView": sparse_values}}}],
+        "bufferViews": views,
+        "buffers": [{"byteLength": bin.len()}],
+    });
+    (json, bin)
+}
+
+/// A (mutated) glTF seed put back together: the path to parse it as, its bytes, and
+/// the temporary directory that holds its external buffer, if any.
+fn assemble(seed: &GltfSeed) -> (PathBuf, Vec<u8>, Option<tempfile::TempDir>) {
     use base64::Engine;
     let mut json = seed.json.clone();
     match seed.container {
@@ -396,13 +502,13 @@ fn check_gltf_seed(seed: &GltfSeed) {
                 buffer["uri"] = uri.into();
             }
             let text = serde_json::to_vec(&json).expect("serialise");
-            check_model_bytes(&seed.path, &text);
+            (seed.path.clone(), text, None)
         }
         Container::External => {
             let dir = tempfile::tempdir().expect("temporary directory");
             std::fs::write(dir.path().join("gltf_buffer.bin"), &seed.bin).expect("bin");
             let text = serde_json::to_vec(&json).expect("serialise");
-            check_model_bytes(&dir.path().join("scene.gltf"), &text);
+            (dir.path().join("scene.gltf"), text, Some(dir))
         }
         Container::Glb => {
             let mut text = serde_json::to_vec(&json).expect("serialise");
@@ -422,9 +528,15 @@ fn check_gltf_seed(seed: &GltfSeed) {
             glb.extend_from_slice(&(bin.len() as u32).to_le_bytes());
             glb.extend_from_slice(b"BIN\0");
             glb.extend_from_slice(&bin);
-            check_model_bytes(&seed.path, &glb);
+            (seed.path.clone(), glb, None)
         }
     }
+}
+
+/// Imports a (mutated) glTF seed through [`check_model_bytes`].
+fn check_gltf_seed(seed: &GltfSeed) {
+    let (path, bytes, _dir) = assemble(seed);
+    check_model_bytes(&path, &bytes);
 }
 
 /// JSON numbers that stay valid JSON: edges of glTF's integer and f32 ranges.
@@ -591,7 +703,7 @@ proptest! {
 
     #[test]
     fn gltf_with_mutated_values_and_buffers_never_panics(
-        seed in 0..3usize,
+        seed in 0..4usize,
         edits in prop::collection::vec(gltf_edit_strategy(), 1..5),
     ) {
         let mut seed = gltf_seeds().swap_remove(seed);
@@ -629,4 +741,20 @@ fn seed_models_import_and_render_through_the_check() {
     for seed in gltf_seeds() {
         check_gltf_seed(&seed);
     }
+    // The feature seed imports whole, with each feature it is there for.
+    let (path, bytes, _dir) = assemble(&gltf_seeds()[0]);
+    let model = import(&path, &bytes).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(model.meshes.len(), 3);
+    assert_eq!(model.meshes[0].instances.len(), 2);
+    assert!(model.meshes[0].uvs.is_some() && model.meshes[0].normals.is_some());
+    assert_eq!(
+        model.meshes[1].positions[3],
+        glam::DVec3::new(2.0, 2.0, 0.5),
+        "sparse"
+    );
+    assert_eq!(model.lights.len(), 3);
+    assert!(model.camera.is_some());
+    assert_eq!(model.images.len(), 2);
+    let kinds: Vec<MaterialKind> = model.materials.iter().map(|m| m.material.kind).collect();
+    assert!(kinds.contains(&MaterialKind::Dielectric) && kinds.contains(&MaterialKind::Pbr));
 }
