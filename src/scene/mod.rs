@@ -5,6 +5,7 @@ mod error;
 mod file;
 mod image;
 mod medium;
+pub mod import;
 mod model;
 
 pub use error::{SceneError, SceneWarning};

@@ -1,0 +1,1009 @@
+//! glTF 2.0 (Khronos, "glTF 2.0 Specification", 2021), as `.gltf` JSON with external or
+//! embedded (data URI) buffers or as binary `.glb`, read through the `gltf` crate (its
+//! JSON model and validation; buffers, accessors and images are read here, with every
+//! range checked).
+
+use std::collections::{BTreeSet, HashMap};
+use std::path::{Path, PathBuf};
+
+use ::gltf::Document;
+use ::gltf::accessor::{DataType, Dimensions};
+use ::gltf::camera::Projection;
+use ::gltf::khr_lights_punctual::Kind;
+use ::gltf::mesh::Mode;
+use ::gltf::texture::WrappingMode;
+use base64::Engine;
+use glam::{DMat4, DQuat, DVec2, DVec3};
+
+use super::accessor::{Expect, read, view_bytes};
+use super::mesh::{Budget, RawMesh, finish_mesh};
+use super::texture::{Encoding, Textures};
+use super::{
+    ImportedCamera, ImportedMaterial, ImportedMesh, ImportedModel, MAX_MODEL_TRIANGLES,
+    MAX_MODEL_VERTICES, TextureRef, WrapMode, error, read_file,
+};
+use crate::scene::{Camera, Light, Material, MaterialKind, SceneError};
+
+/// Luminous efficacy used to turn `KHR_lights_punctual`'s photometric intensities into
+/// our radiometric ones, in lm/W: 683, the peak of the photopic curve at 555 nm (the
+/// definition of the candela, SI Brochure §2.3.1). A point or spot light of `I` cd
+/// becomes `I / 683` W/sr, a directional light of `E` lux becomes `E / 683` W/m², each
+/// times the light's linear `color`. This treats every light as if all its power were at
+/// 555 nm, the convention of Blender's glTF exporter in its "Standard" lighting mode.
+pub const LUMENS_PER_WATT: f64 = 683.0;
+
+/// The extensions this importer understands; a file that requires any other is refused.
+const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_transmission",
+];
+/// Index of refraction of `KHR_materials_ior`'s default (and of glass without it).
+const DEFAULT_IOR: f64 = 1.5;
+/// Most validation problems quoted in one error message.
+const QUOTED_PROBLEMS: usize = 5;
+
+/// Reads the glTF 2.0 file at `path`: JSON (`.gltf`, with buffers and images in
+/// external files relative to it or embedded as data URIs) or binary (`.glb`), told
+/// apart by content.
+///
+/// Fails, naming the file and the element (buffer, accessor, mesh and primitive, node,
+/// material, texture, camera, light), on a missing, truncated or malformed file, an
+/// extension it requires that is not supported, a primitive that is not made of
+/// triangles, an index or range out of bounds, a non-finite position or transform, a
+/// texture that does not load, or a model beyond the size limits.
+pub fn import_gltf(path: &Path) -> Result<ImportedModel, SceneError> {
+    let bytes = read_file(path, path, "the model file")?;
+    parse_gltf(&bytes, path)
+}
+
+/// Reads glTF or GLB from `bytes`; `path` names the file in messages and its directory
+/// is where external buffers and images are looked up.
+pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError> {
+    // glTF JSON must not start with a byte-order mark (§3.2), but some writers add one.
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    if bytes.is_empty() {
+        return Err(error(path, "not a valid glTF file: the file is empty"));
+    }
+    let gltf =
+        ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| parse_error(path, e))?;
+    let version = &gltf.as_json().asset.version;
+    if !version.starts_with("2.") {
+        return Err(error(
+            path,
+            format!("glTF version {version} is not supported (only 2.x)"),
+        ));
+    }
+    for extension in gltf.extensions_required() {
+        if !SUPPORTED_EXTENSIONS.contains(&extension) {
+            return Err(error(
+                path,
+                format!(
+                    "the file requires the extension {extension}, which is not supported (supported: {})",
+                    SUPPORTED_EXTENSIONS.join(", ")
+                ),
+            ));
+        }
+    }
+    validate(&gltf.document, path)?;
+    let mut importer = Importer {
+        path,
+        directory: path.parent().unwrap_or(Path::new("")).to_path_buf(),
+        document: &gltf.document,
+        buffers: Vec::new(),
+        model: ImportedModel::empty(path),
+        budget: Budget::default(),
+        textures: Textures::default(),
+        materials: HashMap::new(),
+        warned: BTreeSet::new(),
+    };
+    for extension in gltf.extensions_used() {
+        if !SUPPORTED_EXTENSIONS.contains(&extension) {
+            importer.warn(format!(
+                "uses the extension {extension}, which is not supported; what it adds is ignored"
+            ));
+        }
+    }
+    importer.buffers = load_buffers(
+        &gltf.document,
+        gltf.blob.as_deref(),
+        path,
+        &importer.directory,
+    )?;
+    importer.import()?;
+    let mut model = importer.model;
+    model.images = importer.textures.images;
+    Ok(model)
+}
+
+/// The error for a file the `gltf` crate cannot parse, with the JSON line and column
+/// where it knows them.
+fn parse_error(path: &Path, e: ::gltf::Error) -> SceneError {
+    match e {
+        ::gltf::Error::Deserialize(json) if json.line() > 0 => {
+            let (line, column) = (json.line(), json.column());
+            let text = json.to_string();
+            let suffix = format!(" at line {line} column {column}");
+            SceneError {
+                path: path.to_path_buf(),
+                location: Some((line, column.max(1))),
+                message: format!(
+                    "not a valid glTF file: {}",
+                    text.strip_suffix(&suffix).unwrap_or(&text)
+                ),
+            }
+        }
+        ::gltf::Error::Binary(binary) => error(
+            path,
+            format!("not a valid GLB file (truncated or corrupt): {binary}"),
+        ),
+        other => error(path, format!("not a valid glTF file: {other}")),
+    }
+}
+
+/// Runs the `gltf` crate's validation (references in range, required properties present,
+/// enumerations valid), which its accessors rely on.
+fn validate(document: &Document, path: &Path) -> Result<(), SceneError> {
+    use ::gltf::json::validation::{Checked, Validate};
+    let root = document.as_json();
+    // gltf-json 1.4's validation indexes the accessors with POSITION's index unchecked
+    // (`primitive_validate_hook`), so that index is checked here first.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = primitive
+                .attributes
+                .get(&Checked::Valid(::gltf::Semantic::Positions));
+            if let Some(index) = position
+                && index.value() >= root.accessors.len()
+            {
+                return Err(error(
+                    path,
+                    format!(
+                        "not a valid glTF file: meshes[{m}].primitives[{p}].attributes[\"POSITION\"] refers to accessor {}, but there are {} accessors",
+                        index.value(),
+                        root.accessors.len()
+                    ),
+                ));
+            }
+        }
+    }
+    let mut problems = Vec::new();
+    root.validate(root, ::gltf::json::Path::new, &mut |where_, what| {
+        let where_ = where_();
+        // POSITION's min and max are required (§3.7.2.1) but only serve to bound the
+        // mesh without reading it; some exporters leave them out or get them wrong, and
+        // the positions are read (and checked) anyway.
+        if !where_.as_str().contains(r#"["POSITION"].m"#) {
+            problems.push(format!("{where_}: {what}"));
+        }
+    });
+    if problems.is_empty() {
+        return Ok(());
+    }
+    let more = problems.len().saturating_sub(QUOTED_PROBLEMS);
+    problems.truncate(QUOTED_PROBLEMS);
+    Err(error(
+        path,
+        format!(
+            "not a valid glTF file: {}{}",
+            problems.join("; "),
+            if more > 0 {
+                format!(" (and {more} more)")
+            } else {
+                String::new()
+            }
+        ),
+    ))
+}
+
+/// A data URI's bytes (RFC 2397), base64 or percent-encoded.
+fn data_uri(uri: &str) -> Option<Result<Vec<u8>, String>> {
+    let rest = uri.strip_prefix("data:")?;
+    let Some((header, data)) = rest.split_once(',') else {
+        return Some(Err("the data URI has no ',' before its data".into()));
+    };
+    Some(if header.ends_with(";base64") {
+        let engine = base64::engine::GeneralPurpose::new(
+            &base64::alphabet::STANDARD,
+            base64::engine::GeneralPurposeConfig::new()
+                .with_decode_padding_mode(base64::engine::DecodePaddingMode::Indifferent),
+        );
+        engine
+            .decode(data.trim())
+            .map_err(|e| format!("the data URI is not valid base64: {e}"))
+    } else {
+        Ok(percent_decode(data))
+    })
+}
+
+/// Undoes URI percent-encoding (`%20` → space); malformed escapes stay as they are.
+fn percent_decode(text: &str) -> Vec<u8> {
+    let bytes = text.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = |b: u8| (b as char).to_digit(16);
+        if bytes[i] == b'%'
+            && i + 2 < bytes.len()
+            && let (Some(h), Some(l)) = (hex(bytes[i + 1]), hex(bytes[i + 2]))
+        {
+            out.push((h * 16 + l) as u8);
+            i += 3;
+            continue;
+        }
+        out.push(bytes[i]);
+        i += 1;
+    }
+    out
+}
+
+/// The file a relative URI names, or why it names none.
+fn uri_file(directory: &Path, uri: &str) -> Result<PathBuf, String> {
+    let scheme = uri.split_once(':').map(|(s, _)| s);
+    if scheme.is_some_and(|s| {
+        s.len() > 1
+            && s.chars()
+                .all(|c| c.is_ascii_alphanumeric() || "+-.".contains(c))
+    }) {
+        return Err(format!(
+            "the URI {uri} is neither a relative file path nor a data URI (nothing is fetched from the network)"
+        ));
+    }
+    let decoded = String::from_utf8_lossy(&percent_decode(uri)).into_owned();
+    Ok(directory.join(decoded))
+}
+
+/// Loads every buffer: the GLB binary chunk, a data URI or a file relative to the model.
+fn load_buffers(
+    document: &Document,
+    blob: Option<&[u8]>,
+    path: &Path,
+    directory: &Path,
+) -> Result<Vec<Vec<u8>>, SceneError> {
+    let mut buffers = Vec::new();
+    for buffer in document.buffers() {
+        let name = match buffer.name() {
+            Some(name) => format!("buffer {} ('{name}')", buffer.index()),
+            None => format!("buffer {}", buffer.index()),
+        };
+        let fail = |message: String| error(path, format!("{name}: {message}"));
+        let data = match buffer.source() {
+            ::gltf::buffer::Source::Bin => blob
+                .ok_or_else(|| {
+                    fail("refers to the GLB binary chunk, but the file has none".into())
+                })?
+                .to_vec(),
+            ::gltf::buffer::Source::Uri(uri) => match data_uri(uri) {
+                Some(decoded) => decoded.map_err(fail)?,
+                None => {
+                    let file = uri_file(directory, uri).map_err(fail)?;
+                    read_file(&file, path, &format!("{name} {}", file.display()))?
+                }
+            },
+        };
+        if data.len() < buffer.length() {
+            return Err(fail(format!(
+                "holds {} bytes, fewer than its byteLength {} (truncated?)",
+                data.len(),
+                buffer.length()
+            )));
+        }
+        buffers.push(data);
+    }
+    Ok(buffers)
+}
+
+/// The state of one import.
+struct Importer<'a> {
+    path: &'a Path,
+    directory: PathBuf,
+    document: &'a Document,
+    buffers: Vec<Vec<u8>>,
+    model: ImportedModel,
+    budget: Budget,
+    textures: Textures,
+    /// glTF material index (`None`: the default material) → index in the model.
+    materials: HashMap<Option<usize>, u32>,
+    /// Warnings already given once per file.
+    warned: BTreeSet<&'static str>,
+}
+
+/// `what N ('name')`, or `what N` for an unnamed element.
+fn describe(what: &str, index: usize, name: Option<&str>) -> String {
+    match name {
+        Some(name) if !name.is_empty() => format!("{what} {index} ('{name}')"),
+        _ => format!("{what} {index}"),
+    }
+}
+
+/// A glTF matrix or translation/rotation/scale as a matrix, exactly from its `f32`s.
+fn local_transform(node: &::gltf::Node<'_>) -> Result<DMat4, String> {
+    match node.transform() {
+        ::gltf::scene::Transform::Matrix { matrix } => {
+            let matrix = DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from)));
+            if !matrix.is_finite() {
+                return Err("its matrix has a component that is not finite".into());
+            }
+            Ok(matrix)
+        }
+        ::gltf::scene::Transform::Decomposed {
+            translation,
+            rotation,
+            scale,
+        } => {
+            let [x, y, z, w] = rotation.map(f64::from);
+            let rotation = DQuat::from_xyzw(x, y, z, w);
+            let length = rotation.length();
+            if !length.is_finite() || length == 0.0 {
+                return Err(format!(
+                    "its rotation quaternion {rotation} is not a rotation"
+                ));
+            }
+            let translation = DVec3::from_array(translation.map(f64::from));
+            let scale = DVec3::from_array(scale.map(f64::from));
+            if !translation.is_finite() || !scale.is_finite() {
+                return Err("its translation or scale has a component that is not finite".into());
+            }
+            Ok(DMat4::from_scale_rotation_translation(
+                scale,
+                rotation / length,
+                translation,
+            ))
+        }
+    }
+}
+
+impl Importer<'_> {
+    fn warn(&mut self, message: String) {
+        self.model
+            .warnings
+            .push(format!("{}: {message}", self.path.display()));
+    }
+
+    /// Warns about `message` once per file, keyed by `key`.
+    fn warn_once(&mut self, key: &'static str, message: String) {
+        if self.warned.insert(key) {
+            self.warn(message);
+        }
+    }
+
+    fn fail(&self, message: impl Into<String>) -> SceneError {
+        error(self.path, message)
+    }
+
+    /// Walks the scene's node trees, parents before children, composing transforms, and
+    /// imports the meshes, lights and camera they place.
+    fn import(&mut self) -> Result<(), SceneError> {
+        let document = self.document;
+        let scene = document
+            .default_scene()
+            .or_else(|| document.scenes().next());
+        let roots: Vec<::gltf::Node<'_>> = match &scene {
+            Some(scene) => {
+                if document.scenes().len() > 1 {
+                    self.warn(format!(
+                        "the file has {} scenes; only {} is imported",
+                        document.scenes().len(),
+                        describe("scene", scene.index(), scene.name())
+                    ));
+                }
+                scene.nodes().collect()
+            }
+            None => {
+                // No scene: every node that is nobody's child is a root.
+                let mut child = vec![false; document.nodes().len()];
+                for node in document.nodes() {
+                    for c in node.children() {
+                        child[c.index()] = true;
+                    }
+                }
+                document.nodes().filter(|n| !child[n.index()]).collect()
+            }
+        };
+        if document.animations().len() > 0 {
+            self.warn("animations are ignored: the nodes' static transforms are imported".into());
+        }
+        let mut visited = vec![false; document.nodes().len()];
+        let mut placements: Vec<Vec<DMat4>> = vec![Vec::new(); document.meshes().len()];
+        let mut stack: Vec<(::gltf::Node<'_>, DMat4)> = roots
+            .into_iter()
+            .rev()
+            .map(|n| (n, DMat4::IDENTITY))
+            .collect();
+        while let Some((node, parent)) = stack.pop() {
+            let name = describe("node", node.index(), node.name());
+            if std::mem::replace(&mut visited[node.index()], true) {
+                return Err(self.fail(format!(
+                    "{name} is reached twice: it has two parents or is its own ancestor (glTF nodes form trees, §3.5.2)"
+                )));
+            }
+            let local = local_transform(&node).map_err(|e| self.fail(format!("{name}: {e}")))?;
+            let world = parent * local;
+            if !world.is_finite() {
+                return Err(self.fail(format!(
+                    "{name}: its transform composed with its parents' is not finite"
+                )));
+            }
+            if let Some(mesh) = node.mesh() {
+                if node.skin().is_some() {
+                    self.warn_once(
+                        "skin",
+                        "skins are ignored: skinned meshes are placed by their nodes' transforms in the bind pose".into(),
+                    );
+                }
+                let determinant = world.determinant();
+                if determinant == 0.0 || !world.inverse().is_finite() {
+                    self.warn(format!(
+                        "{name}: its transform is singular (a scale of 0?); its mesh is not placed"
+                    ));
+                } else {
+                    placements[mesh.index()].push(world);
+                }
+            }
+            if let Some(camera) = node.camera() {
+                self.camera(&camera, &name, world)?;
+            }
+            if let Some(light) = node.light() {
+                self.light(&light, &name, world)?;
+            }
+            for child in node.children().collect::<Vec<_>>().into_iter().rev() {
+                stack.push((child, world));
+            }
+        }
+        for mesh in document.meshes() {
+            let instances = std::mem::take(&mut placements[mesh.index()]);
+            if !instances.is_empty() {
+                self.mesh(&mesh, instances)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Imports each primitive of `mesh` as one mesh placed at `instances`.
+    fn mesh(&mut self, mesh: &::gltf::Mesh<'_>, instances: Vec<DMat4>) -> Result<(), SceneError> {
+        let mesh_name = describe("mesh", mesh.index(), mesh.name());
+        if mesh.primitives().any(|p| p.morph_targets().len() > 0) {
+            self.warn_once(
+                "morph",
+                "morph targets are ignored: meshes are imported in their base shape".into(),
+            );
+        }
+        for primitive in mesh.primitives() {
+            let name = format!("{mesh_name}, primitive {}", primitive.index());
+            let raw = self
+                .primitive(&primitive)
+                .map_err(|e| self.fail(format!("{name}: {e}")))?;
+            let material = self.material(primitive.material().index())?;
+            self.budget
+                .charge_instances(instances.len())
+                .map_err(|e| self.fail(e))?;
+            if let Some(imported) =
+                finish_mesh(name, self.path, raw, material, &mut self.model.warnings)
+                    .map_err(|e| self.fail(e))?
+            {
+                self.model.meshes.push(ImportedMesh {
+                    instances: instances.clone(),
+                    ..imported
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads one primitive's positions, normals, `TEXCOORD_0` and triangles.
+    fn primitive(&mut self, primitive: &::gltf::Primitive<'_>) -> Result<RawMesh, String> {
+        let mode = primitive.mode();
+        if !matches!(
+            mode,
+            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+        ) {
+            return Err(format!(
+                "its mode is {mode:?}; only triangles, triangle strips and triangle fans are supported"
+            ));
+        }
+        let positions_accessor = primitive
+            .get(&::gltf::Semantic::Positions)
+            .ok_or("it has no POSITION attribute")?;
+        let count = positions_accessor.count();
+        if count > MAX_MODEL_VERTICES {
+            return Err(format!(
+                "{count} vertices, more than the {MAX_MODEL_VERTICES} accepted"
+            ));
+        }
+        let index_count = primitive.indices().map_or(count, |a| a.count());
+        let triangle_count = match mode {
+            Mode::Triangles => index_count / 3,
+            _ => index_count.saturating_sub(2),
+        };
+        if triangle_count > MAX_MODEL_TRIANGLES {
+            return Err(format!(
+                "{triangle_count} triangles, more than the {MAX_MODEL_TRIANGLES} accepted"
+            ));
+        }
+        self.budget.charge_mesh(count, triangle_count)?;
+        let vec3 = |values: Vec<f64>| -> Vec<DVec3> {
+            values
+                .chunks_exact(3)
+                .map(|c| DVec3::new(c[0], c[1], c[2]))
+                .collect()
+        };
+        let positions = vec3(read(
+            &positions_accessor,
+            &Expect {
+                name: "POSITION",
+                dimensions: Dimensions::Vec3,
+                types: &[DataType::F32],
+                normalized: false,
+            },
+            &self.buffers,
+        )?);
+        let same_count = |accessor: &::gltf::Accessor<'_>, name: &str| {
+            if accessor.count() == count {
+                Ok(())
+            } else {
+                Err(format!(
+                    "{name} has {} elements but POSITION has {count}",
+                    accessor.count()
+                ))
+            }
+        };
+        let normals = match primitive.get(&::gltf::Semantic::Normals) {
+            Some(accessor) => {
+                same_count(&accessor, "NORMAL")?;
+                Some(vec3(read(
+                    &accessor,
+                    &Expect {
+                        name: "NORMAL",
+                        dimensions: Dimensions::Vec3,
+                        types: &[DataType::F32],
+                        normalized: false,
+                    },
+                    &self.buffers,
+                )?))
+            }
+            None => None,
+        };
+        let uvs = match primitive.get(&::gltf::Semantic::TexCoords(0)) {
+            Some(accessor) => {
+                same_count(&accessor, "TEXCOORD_0")?;
+                let values = read(
+                    &accessor,
+                    &Expect {
+                        name: "TEXCOORD_0",
+                        dimensions: Dimensions::Vec2,
+                        types: &[DataType::F32, DataType::U8, DataType::U16],
+                        normalized: true,
+                    },
+                    &self.buffers,
+                )?;
+                Some(
+                    values
+                        .chunks_exact(2)
+                        .map(|c| DVec2::new(c[0], c[1]))
+                        .collect(),
+                )
+            }
+            None => None,
+        };
+        let indices: Vec<u32> = match primitive.indices() {
+            Some(accessor) => read(
+                &accessor,
+                &Expect {
+                    name: "indices",
+                    dimensions: Dimensions::Scalar,
+                    types: &[DataType::U8, DataType::U16, DataType::U32],
+                    normalized: false,
+                },
+                &self.buffers,
+            )?
+            .into_iter()
+            .map(|i| i as u32)
+            .collect(),
+            None => (0..count as u32).collect(),
+        };
+        let triangles = triangles(mode, &indices);
+        if mode == Mode::Triangles && !indices.len().is_multiple_of(3) {
+            self.warn(format!(
+                "a triangle list of {} indices (not a multiple of 3): the last {} ignored",
+                indices.len(),
+                indices.len() % 3
+            ));
+        }
+        Ok(RawMesh {
+            positions,
+            normals,
+            uvs,
+            triangles,
+        })
+    }
+
+    /// The model's index of glTF material `index` (`None`: the default material, glTF
+    /// 2.0 §3.9.6), mapping it on first use.
+    fn material(&mut self, index: Option<usize>) -> Result<u32, SceneError> {
+        if let Some(&ours) = self.materials.get(&index) {
+            return Ok(ours);
+        }
+        let imported = match index.and_then(|i| self.document.materials().nth(i)) {
+            Some(material) => self.map_material(&material)?,
+            None => ImportedMaterial {
+                name: "default".into(),
+                // glTF's default material: white, fully metallic and rough... which is
+                // black under Whitted lighting; a white dielectric PBR is what viewers show.
+                material: Material {
+                    diffuse: DVec3::ONE,
+                    metallic: 0.0,
+                    roughness: 1.0,
+                    ..Material::blank(MaterialKind::Pbr)
+                },
+                base_color_texture: None,
+                metallic_roughness_texture: None,
+                emissive_texture: None,
+            },
+        };
+        let ours = self.model.materials.len() as u32;
+        self.model.materials.push(imported);
+        self.materials.insert(index, ours);
+        Ok(ours)
+    }
+
+    /// Maps a glTF metallic-roughness material onto ours (the table in `docs/models.md`).
+    fn map_material(
+        &mut self,
+        material: &::gltf::Material<'_>,
+    ) -> Result<ImportedMaterial, SceneError> {
+        let name = describe("material", material.index().unwrap_or(0), material.name());
+        let pbr = material.pbr_metallic_roughness();
+        let [r, g, b, _alpha] = pbr.base_color_factor().map(f64::from);
+        let base = DVec3::new(r, g, b);
+        let metallic = f64::from(pbr.metallic_factor());
+        let roughness = f64::from(pbr.roughness_factor());
+        let strength = f64::from(material.emissive_strength().unwrap_or(1.0));
+        let emissive = DVec3::from_array(material.emissive_factor().map(f64::from));
+        let in_unit = |v: f64| (0.0..=1.0).contains(&v);
+        if !base.to_array().into_iter().all(in_unit) || !in_unit(metallic) || !in_unit(roughness) {
+            return Err(self.fail(format!(
+                "{name}: baseColorFactor {base}, metallicFactor {metallic} and roughnessFactor {roughness} must lie in [0, 1]"
+            )));
+        }
+        if !(emissive.to_array().into_iter().all(in_unit)
+            && strength.is_finite()
+            && strength >= 0.0)
+        {
+            return Err(self.fail(format!(
+                "{name}: emissiveFactor {emissive} must lie in [0, 1] and emissiveStrength {strength} be finite and not negative"
+            )));
+        }
+        if material.alpha_mode() != ::gltf::material::AlphaMode::Opaque {
+            self.warn(format!(
+                "{name}: alphaMode {:?} is not supported; the material is opaque",
+                material.alpha_mode()
+            ));
+        }
+        if material.normal_texture().is_some() || material.occlusion_texture().is_some() {
+            self.warn(format!(
+                "{name}: normal and occlusion textures are not supported; ignored"
+            ));
+        }
+        let emission = emissive * strength;
+        let transmission = material
+            .transmission()
+            .map_or(0.0, |t| f64::from(t.transmission_factor()));
+        let ior = material.ior().map(f64::from);
+        let ours = if transmission > 0.0 && metallic < 1.0 {
+            let ior = match ior {
+                Some(ior) if ior.is_finite() && ior >= 1.0 => ior,
+                Some(ior) => {
+                    self.warn(format!(
+                        "{name}: ior {ior} is not supported; {DEFAULT_IOR} is used"
+                    ));
+                    DEFAULT_IOR
+                }
+                None => DEFAULT_IOR,
+            };
+            if metallic > 0.0 || roughness > 0.0 {
+                self.warn(format!(
+                    "{name}: a transmissive material is imported as smooth glass; metallicFactor {metallic} and roughnessFactor {roughness} are ignored"
+                ));
+            }
+            if material
+                .transmission()
+                .is_some_and(|t| t.transmission_texture().is_some())
+            {
+                self.warn(format!(
+                    "{name}: transmissionTexture is not supported; ignored"
+                ));
+            }
+            Material {
+                ior,
+                transmittance: (base * transmission.clamp(0.0, 1.0)).clamp(DVec3::ZERO, DVec3::ONE),
+                emission,
+                ..Material::blank(MaterialKind::Dielectric)
+            }
+        } else {
+            if ior.is_some_and(|ior| ior != DEFAULT_IOR) {
+                self.warn(format!(
+                    "{name}: ior is only used for transmissive, non-metallic materials (the metal/roughness model's F0 is 0.04); ignored"
+                ));
+            }
+            Material {
+                diffuse: base,
+                metallic,
+                roughness,
+                emission,
+                ..Material::blank(MaterialKind::Pbr)
+            }
+        };
+        let base_color_texture = match pbr.base_color_texture() {
+            Some(info) => Some(self.texture(&info, Encoding::Color, &name, "baseColorTexture")?),
+            None => None,
+        };
+        let metallic_roughness_texture = match pbr.metallic_roughness_texture() {
+            Some(info) => {
+                Some(self.texture(&info, Encoding::Data, &name, "metallicRoughnessTexture")?)
+            }
+            None => None,
+        };
+        let emissive_texture = match material.emissive_texture() {
+            Some(info) => Some(self.texture(&info, Encoding::Color, &name, "emissiveTexture")?),
+            None => None,
+        };
+        Ok(ImportedMaterial {
+            name: material.name().map_or_else(|| name.clone(), str::to_string),
+            material: ours,
+            base_color_texture,
+            metallic_roughness_texture,
+            emissive_texture,
+        })
+    }
+
+    /// Loads the image of a material's texture and keeps its sampler's wrap modes.
+    fn texture(
+        &mut self,
+        info: &::gltf::texture::Info<'_>,
+        encoding: Encoding,
+        material: &str,
+        slot: &str,
+    ) -> Result<TextureRef, SceneError> {
+        if info.tex_coord() != 0 {
+            self.warn(format!(
+                "{material}: {slot} uses TEXCOORD_{}, which is not imported; TEXCOORD_0 is used",
+                info.tex_coord()
+            ));
+        }
+        let texture = info.texture();
+        let image = texture.source();
+        let image_name = describe("image", image.index(), image.name());
+        let fail = |e: String| error(self.path, format!("{material}: {slot}: {image_name}: {e}"));
+        let label = format!("{}#{image_name}", self.path.display());
+        // The image's JSON, not `Image::source`, which unwraps a missing `uri` or (for a
+        // buffer view) `mimeType` (gltf 1.4).
+        let json = &self.document.as_json().images[image.index()];
+        let index = match (&json.buffer_view, &json.uri) {
+            (Some(view), _) => {
+                let view =
+                    self.document.views().nth(view.value()).ok_or_else(|| {
+                        fail(format!("bufferView {} does not exist", view.value()))
+                    })?;
+                let bytes = view_bytes(&view, &self.buffers).map_err(fail)?.to_vec();
+                self.textures
+                    .bytes(&bytes, &label, encoding, &mut self.budget)
+                    .map_err(fail)?
+            }
+            (None, Some(uri)) => match data_uri(uri) {
+                Some(decoded) => {
+                    let bytes = decoded.map_err(fail)?;
+                    self.textures
+                        .bytes(&bytes, &label, encoding, &mut self.budget)
+                        .map_err(fail)?
+                }
+                None => {
+                    let file = uri_file(&self.directory, uri).map_err(fail)?;
+                    self.textures
+                        .file(&file, encoding, &mut self.budget)
+                        .map_err(fail)?
+                }
+            },
+            (None, None) => return Err(fail("it has neither a uri nor a bufferView".into())),
+        };
+        let sampler = texture.sampler();
+        let wrap = |mode: WrappingMode| match mode {
+            WrappingMode::Repeat => WrapMode::Repeat,
+            WrappingMode::ClampToEdge => WrapMode::ClampToEdge,
+            WrappingMode::MirroredRepeat => WrapMode::MirroredRepeat,
+        };
+        Ok(TextureRef {
+            image: index,
+            wrap_u: wrap(sampler.wrap_s()),
+            wrap_v: wrap(sampler.wrap_t()),
+        })
+    }
+
+    /// Keeps the first perspective camera placed by a node.
+    fn camera(
+        &mut self,
+        camera: &::gltf::Camera<'_>,
+        node: &str,
+        world: DMat4,
+    ) -> Result<(), SceneError> {
+        let name = describe("camera", camera.index(), camera.name());
+        let Projection::Perspective(perspective) = camera.projection() else {
+            self.warn(format!(
+                "{name} on {node} is orthographic, which is not supported; ignored"
+            ));
+            return Ok(());
+        };
+        if self.model.camera.is_some() {
+            self.warn(format!(
+                "{name} on {node}: only the first camera is imported; ignored"
+            ));
+            return Ok(());
+        }
+        let yfov = f64::from(perspective.yfov());
+        if !(yfov > 0.0 && yfov < std::f64::consts::PI) {
+            return Err(self.fail(format!("{name}: yfov {yfov} rad is not in (0, π)")));
+        }
+        let aspect_ratio = perspective.aspect_ratio().map(f64::from);
+        if aspect_ratio.is_some_and(|a| !(a.is_finite() && a > 0.0)) {
+            return Err(self.fail(format!(
+                "{name}: aspectRatio {} is not positive",
+                aspect_ratio.unwrap_or_default()
+            )));
+        }
+        // glTF 2.0 §3.10.1: the camera looks along its local -z with +y up.
+        let eye = world.transform_point3(DVec3::ZERO);
+        let forward = world.transform_vector3(-DVec3::Z).normalize_or_zero();
+        let up = world.transform_vector3(DVec3::Y).normalize_or_zero();
+        if forward == DVec3::ZERO || up == DVec3::ZERO || forward.cross(up).length() < 1e-6 {
+            self.warn(format!(
+                "{name} on {node}: its transform leaves no view direction and up (singular or sheared); ignored"
+            ));
+            return Ok(());
+        }
+        self.model.camera = Some(ImportedCamera {
+            name: camera.name().map_or_else(|| name.clone(), str::to_string),
+            camera: Camera {
+                eye,
+                look_at: eye + forward,
+                up,
+                fov_y_degrees: yfov.to_degrees(),
+            },
+            aspect_ratio,
+        });
+        Ok(())
+    }
+
+    /// Converts a `KHR_lights_punctual` light into our units (see [`LUMENS_PER_WATT`]).
+    fn light(
+        &mut self,
+        light: &::gltf::khr_lights_punctual::Light<'_>,
+        node: &str,
+        world: DMat4,
+    ) -> Result<(), SceneError> {
+        let name = describe("light", light.index(), light.name());
+        let intensity = f64::from(light.intensity());
+        let color = DVec3::from_array(light.color().map(f64::from));
+        if !(intensity.is_finite() && intensity >= 0.0) {
+            return Err(self.fail(format!(
+                "{name}: intensity {intensity} is negative or not finite"
+            )));
+        }
+        if !color
+            .to_array()
+            .into_iter()
+            .all(|c| (0.0..=1.0).contains(&c))
+        {
+            return Err(self.fail(format!("{name}: color {color} must lie in [0, 1]")));
+        }
+        if light.range().is_some() {
+            self.warn(format!(
+                "{name}: range is ignored (our lights fall off with the inverse square to any distance)"
+            ));
+        }
+        let strength = color * intensity / LUMENS_PER_WATT;
+        let position = world.transform_point3(DVec3::ZERO);
+        let point = Light::Point {
+            position,
+            intensity: strength,
+        };
+        let converted = match light.kind() {
+            Kind::Point => point,
+            Kind::Spot { .. } => {
+                self.warn(format!(
+                    "{name} on {node} is a spot light; imported as a point light of the same intensity (the cone is ignored)"
+                ));
+                point
+            }
+            Kind::Directional => {
+                // §KHR_lights_punctual: directional lights shine along the node's local -z.
+                let direction = world.transform_vector3(-DVec3::Z).normalize_or_zero();
+                if direction == DVec3::ZERO {
+                    self.warn(format!(
+                        "{name} on {node}: its transform leaves no direction (singular); ignored"
+                    ));
+                    return Ok(());
+                }
+                Light::Directional {
+                    direction,
+                    irradiance: strength,
+                }
+            }
+        };
+        self.model.lights.push(converted);
+        Ok(())
+    }
+}
+
+/// Triangles from a primitive's index list (glTF 2.0 §3.7.2.1): a list, a strip
+/// (triangle `i` is `(i, i+1, i+2)` for even `i` and `(i, i+2, i+1)` for odd `i`, which
+/// keeps the winding) or a fan (`(i+1, i+2, 0)`).
+fn triangles(mode: Mode, indices: &[u32]) -> Vec<[u32; 3]> {
+    match mode {
+        Mode::TriangleStrip => indices
+            .windows(3)
+            .enumerate()
+            .map(|(i, w)| {
+                if i % 2 == 0 {
+                    [w[0], w[1], w[2]]
+                } else {
+                    [w[0], w[2], w[1]]
+                }
+            })
+            .collect(),
+        Mode::TriangleFan => match indices.split_first() {
+            Some((&first, rest)) => rest.windows(2).map(|w| [w[0], w[1], first]).collect(),
+            None => Vec::new(),
+        },
+        _ => indices
+            .chunks_exact(3)
+            .map(|t| [t[0], t[1], t[2]])
+            .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strips_and_fans_keep_the_winding() {
+        assert_eq!(
+            triangles(Mode::TriangleStrip, &[0, 1, 2, 3, 4]),
+            vec![[0, 1, 2], [1, 3, 2], [2, 3, 4]]
+        );
+        assert_eq!(
+            triangles(Mode::TriangleFan, &[0, 1, 2, 3]),
+            vec![[1, 2, 0], [2, 3, 0]]
+        );
+        assert_eq!(triangles(Mode::TriangleFan, &[]), Vec::<[u32; 3]>::new());
+        assert_eq!(triangles(Mode::Triangles, &[0, 1, 2, 3]), vec![[0, 1, 2]]);
+    }
+
+    #[test]
+    fn data_uris_and_percent_escapes_decode() {
+        assert_eq!(
+            data_uri("data:application/octet-stream;base64,AAEC").map(Result::ok),
+            Some(Some(vec![0, 1, 2]))
+        );
+        assert_eq!(
+            data_uri("data:application/octet-stream;base64,AAE").map(Result::ok),
+            Some(Some(vec![0, 1]))
+        );
+        assert!(data_uri("data:;base64,!!").is_some_and(|r| r.is_err()));
+        assert!(data_uri("buffer.bin").is_none());
+        assert_eq!(percent_decode("my%20file.bin"), b"my file.bin");
+        assert_eq!(percent_decode("100%"), b"100%");
+        assert_eq!(percent_decode("%4"), b"%4");
+    }
+
+    #[test]
+    fn only_relative_uris_name_files() {
+        let dir = Path::new("models");
+        assert_eq!(
+            uri_file(dir, "tex%201.png"),
+            Ok(PathBuf::from("models/tex 1.png"))
+        );
+        assert!(uri_file(dir, "https://example.com/a.bin").is_err());
+        assert!(uri_file(dir, "file:///etc/passwd").is_err());
+    }
+}

@@ -1,0 +1,276 @@
+//! Checks shared by the importers: finite vertices, triangle indices in range, degenerate
+//! triangles, unit normals, and the model-wide size limits.
+
+use glam::{DVec2, DVec3};
+
+use super::{
+    ImportedMesh, MAX_MODEL_INSTANCES, MAX_MODEL_TEXELS, MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES,
+};
+
+/// Twice the area, relative to the squared longest edge, below which a triangle counts
+/// as degenerate: the scene format's rule (`src/scene/file/objects.rs`).
+const DEGENERACY_TOLERANCE: f64 = 1e-12;
+
+/// Whether a triangle has (nearly) no area relative to its longest edge, or a coordinate
+/// that is not finite.
+pub(super) fn is_degenerate([a, b, c]: [DVec3; 3]) -> bool {
+    let longest = (b - a)
+        .length_squared()
+        .max((c - b).length_squared())
+        .max((a - c).length_squared());
+    let twice_area = (b - a).cross(c - a).length();
+    // Written so that NaN counts as degenerate.
+    twice_area.partial_cmp(&(DEGENERACY_TOLERANCE * longest)) != Some(std::cmp::Ordering::Greater)
+}
+
+/// The box around a mesh's positions in its own space.
+pub(super) fn local_bounds(mesh: &ImportedMesh) -> Option<(DVec3, DVec3)> {
+    let first = *mesh.positions.first()?;
+    Some(
+        mesh.positions
+            .iter()
+            .fold((first, first), |(low, high), p| (low.min(*p), high.max(*p))),
+    )
+}
+
+/// Geometry as read from a file, before the checks.
+pub(super) struct RawMesh {
+    pub positions: Vec<DVec3>,
+    pub normals: Option<Vec<DVec3>>,
+    pub uvs: Option<Vec<DVec2>>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Checks `raw` and makes it a mesh named `name`, read from `file`. Fails (with a message
+/// naming the mesh, which the caller reports against the file) on a non-finite position
+/// or an index out of range; drops normals or UVs that are not usable and skips
+/// degenerate triangles, saying so in `warnings`. Returns `None` (with a warning) when no
+/// triangle is left.
+pub(super) fn finish_mesh(
+    name: String,
+    file: &std::path::Path,
+    raw: RawMesh,
+    material: u32,
+    warnings: &mut Vec<String>,
+) -> Result<Option<ImportedMesh>, String> {
+    let RawMesh {
+        positions,
+        normals,
+        uvs,
+        triangles,
+    } = raw;
+    let mut warn = |message: String| warnings.push(format!("{}: {message}", file.display()));
+    if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(format!(
+            "{name}: vertex {i} has a position that is not a finite number ({})",
+            positions[i]
+        ));
+    }
+    let count = positions.len();
+    let normals = normals.and_then(|normals| {
+        if normals.len() != count {
+            warn(format!(
+                "{name}: {} normals for {count} vertices; the normals are ignored",
+                normals.len()
+            ));
+            return None;
+        }
+        let unit: Vec<DVec3> = normals.iter().map(|n| n.normalize_or_zero()).collect();
+        match unit.iter().position(|n| *n == DVec3::ZERO) {
+            Some(i) => {
+                warn(format!(
+                    "{name}: the normal of vertex {i} is zero or not finite ({}); the normals are ignored",
+                    normals[i]
+                ));
+                None
+            }
+            None => Some(unit),
+        }
+    });
+    let uvs = uvs.and_then(|uvs| {
+        if uvs.len() != count {
+            warn(format!(
+                "{name}: {} texture coordinates for {count} vertices; the texture coordinates are ignored",
+                uvs.len()
+            ));
+            return None;
+        }
+        match uvs.iter().position(|uv| !uv.is_finite()) {
+            Some(i) => {
+                warn(format!(
+                    "{name}: the texture coordinates of vertex {i} are not finite ({}); the texture coordinates are ignored",
+                    uvs[i]
+                ));
+                None
+            }
+            None => Some(uvs),
+        }
+    });
+    let total = triangles.len();
+    let mut kept = Vec::with_capacity(total);
+    for (t, triangle) in triangles.into_iter().enumerate() {
+        if let Some(&index) = triangle.iter().find(|&&i| i as usize >= count) {
+            return Err(format!(
+                "{name}: triangle {t} refers to vertex {index}, but there are only {count} vertices"
+            ));
+        }
+        if !is_degenerate(triangle.map(|i| positions[i as usize])) {
+            kept.push(triangle);
+        }
+    }
+    let skipped = total - kept.len();
+    if kept.is_empty() {
+        warn(if total == 0 {
+            format!("{name}: no triangles; skipped")
+        } else {
+            format!("{name}: all {total} triangles are degenerate; skipped")
+        });
+        return Ok(None);
+    }
+    if skipped > 0 {
+        warn(format!(
+            "{name}: skipped {skipped} degenerate triangle{} (of {total}): (nearly) no area",
+            if skipped == 1 { "" } else { "s" }
+        ));
+    }
+    Ok(Some(ImportedMesh {
+        name,
+        positions,
+        normals,
+        uvs,
+        triangles: kept,
+        material,
+        instances: vec![glam::DMat4::IDENTITY],
+    }))
+}
+
+/// The model-wide totals, checked against the limits as the importers go.
+#[derive(Debug, Default)]
+pub(super) struct Budget {
+    vertices: usize,
+    triangles: usize,
+    instances: usize,
+    texels: u64,
+}
+
+impl Budget {
+    /// Counts a mesh of `vertices` vertices and `triangles` triangles (before it is read,
+    /// so that an absurd count is refused without allocating).
+    pub fn charge_mesh(&mut self, vertices: usize, triangles: usize) -> Result<(), String> {
+        self.vertices = self.vertices.saturating_add(vertices);
+        self.triangles = self.triangles.saturating_add(triangles);
+        if self.vertices > MAX_MODEL_VERTICES {
+            return Err(format!(
+                "the model has more than {MAX_MODEL_VERTICES} vertices, more than accepted"
+            ));
+        }
+        if self.triangles > MAX_MODEL_TRIANGLES {
+            return Err(format!(
+                "the model has more than {MAX_MODEL_TRIANGLES} triangles, more than accepted"
+            ));
+        }
+        Ok(())
+    }
+
+    /// Counts `count` more placements of meshes.
+    pub fn charge_instances(&mut self, count: usize) -> Result<(), String> {
+        self.instances = self.instances.saturating_add(count);
+        if self.instances > MAX_MODEL_INSTANCES {
+            return Err(format!(
+                "the model places meshes more than {MAX_MODEL_INSTANCES} times, more than accepted"
+            ));
+        }
+        Ok(())
+    }
+
+    /// Counts a texture of `width × height` texels.
+    pub fn charge_texels(&mut self, width: u32, height: u32) -> Result<(), String> {
+        self.texels = self
+            .texels
+            .saturating_add(u64::from(width) * u64::from(height));
+        if self.texels > MAX_MODEL_TEXELS {
+            return Err(format!(
+                "the model's textures hold more than {MAX_MODEL_TEXELS} texels, more than accepted"
+            ));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn raw(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> RawMesh {
+        RawMesh {
+            positions,
+            normals: None,
+            uvs: None,
+            triangles,
+        }
+    }
+
+    #[test]
+    fn degenerate_triangles_are_skipped_and_counted() {
+        let p = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::X * 2.0];
+        let mut warnings = Vec::new();
+        let mesh = finish_mesh(
+            "m".into(),
+            std::path::Path::new("f"),
+            raw(p, vec![[0, 1, 2], [0, 1, 3], [2, 2, 1]]),
+            0,
+            &mut warnings,
+        )
+        .expect("valid")
+        .expect("one triangle left");
+        assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert!(warnings[0].contains("skipped 2 degenerate triangles (of 3)"));
+    }
+
+    #[test]
+    fn an_index_out_of_range_is_an_error() {
+        let p = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
+        let e = finish_mesh(
+            "m".into(),
+            std::path::Path::new("f"),
+            raw(p, vec![[0, 1, 3]]),
+            0,
+            &mut Vec::new(),
+        )
+        .expect_err("index 3 of 3 vertices");
+        assert!(e.contains("triangle 0 refers to vertex 3"), "{e}");
+    }
+
+    #[test]
+    fn a_nan_position_is_an_error() {
+        let p = vec![DVec3::ZERO, DVec3::new(f64::NAN, 0.0, 0.0), DVec3::Y];
+        let e = finish_mesh(
+            "m".into(),
+            std::path::Path::new("f"),
+            raw(p, vec![[0, 1, 2]]),
+            0,
+            &mut Vec::new(),
+        )
+        .expect_err("NaN");
+        assert!(e.contains("vertex 1"), "{e}");
+    }
+
+    #[test]
+    fn zero_normals_are_dropped_with_a_warning() {
+        let mut mesh = raw(vec![DVec3::ZERO, DVec3::X, DVec3::Y], vec![[0, 1, 2]]);
+        mesh.normals = Some(vec![DVec3::Z, DVec3::ZERO, DVec3::Z * 3.0]);
+        let mut warnings = Vec::new();
+        let mesh = finish_mesh(
+            "m".into(),
+            std::path::Path::new("f"),
+            mesh,
+            0,
+            &mut warnings,
+        )
+        .expect("valid")
+        .expect("kept");
+        assert!(mesh.normals.is_none());
+        assert!(warnings[0].contains("vertex 1"), "{warnings:?}");
+    }
+}

@@ -1,0 +1,94 @@
+//! Loading a model's textures, each file once, through [`load_image`].
+
+use std::collections::HashMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use super::mesh::Budget;
+use crate::color::srgb_encode;
+use crate::scene::{Image, load_image};
+
+/// How a texture's values are meant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub(super) enum Encoding {
+    /// Colours, sRGB-encoded in 8- and 16-bit files and linearised on load (base colour,
+    /// emission).
+    Color,
+    /// Numbers (glTF's metallic-roughness texture): the file's values, not linearised.
+    Data,
+}
+
+/// The textures loaded so far, shared by the materials that name the same source.
+#[derive(Default)]
+pub(super) struct Textures {
+    pub images: Vec<Image>,
+    loaded: HashMap<(String, Encoding), u32>,
+}
+
+impl Textures {
+    /// The index of the texture read from the file `path`, loading it on first use.
+    /// Fails with a message naming the file (the caller names the material).
+    pub fn file(
+        &mut self,
+        path: &Path,
+        encoding: Encoding,
+        budget: &mut Budget,
+    ) -> Result<u32, String> {
+        let key = (path.display().to_string(), encoding);
+        if let Some(&index) = self.loaded.get(&key) {
+            return Ok(index);
+        }
+        let image = load_image(path)
+            .map_err(|e| format!("the texture {} does not load: {e}", path.display()))?;
+        self.add(key, image, encoding, budget)
+    }
+
+    /// The index of the texture decoded from `bytes` (an image embedded in the model),
+    /// called `name` in messages and in [`Image::path`].
+    pub fn bytes(
+        &mut self,
+        bytes: &[u8],
+        name: &str,
+        encoding: Encoding,
+        budget: &mut Budget,
+    ) -> Result<u32, String> {
+        let key = (name.to_string(), encoding);
+        if let Some(&index) = self.loaded.get(&key) {
+            return Ok(index);
+        }
+        // `load_image` reads files; the embedded bytes go through a temporary file so
+        // that every texture is decoded and linearised by the one function.
+        let fail = |e: std::io::Error| format!("the texture {name} does not load: {e}");
+        let mut file = tempfile::NamedTempFile::new().map_err(fail)?;
+        file.write_all(bytes).map_err(fail)?;
+        file.flush().map_err(fail)?;
+        let mut image = load_image(file.path())
+            .map_err(|e| format!("the texture {name} does not load: {e}"))?;
+        image.path = PathBuf::from(name);
+        self.add(key, image, encoding, budget)
+    }
+
+    fn add(
+        &mut self,
+        key: (String, Encoding),
+        mut image: Image,
+        encoding: Encoding,
+        budget: &mut Budget,
+    ) -> Result<u32, String> {
+        budget.charge_texels(image.width, image.height)?;
+        if encoding == Encoding::Data {
+            // `load_image` linearised the 8/16-bit values as sRGB; glTF images are PNG or
+            // JPEG (glTF 2.0 §3.8.3), never float, so encoding again restores the
+            // file's values (to f32 rounding).
+            for texel in &mut image.texels {
+                for channel in &mut texel[..3] {
+                    *channel = srgb_encode(f64::from(*channel)) as f32;
+                }
+            }
+        }
+        let index = self.images.len() as u32;
+        self.images.push(image);
+        self.loaded.insert(key, index);
+        Ok(index)
+    }
+}

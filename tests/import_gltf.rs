@@ -1,0 +1,899 @@
+//! The glTF 2.0 importer against small documents built here with known answers (node
+//! transforms, instancing, strips and fans, the three kinds of buffers, cameras, lights,
+//! materials and textures), the round trip through a file written by Python's trimesh,
+//! the shipped vase, and every kind of bad input (each a clear error naming the file and
+//! the element, never a panic).
+
+use std::path::{Path, PathBuf};
+
+use base64::Engine;
+use glam::{DMat4, DQuat, DVec3};
+use gpu_render::camera::CameraFrame;
+use gpu_render::color::srgb_decode;
+use gpu_render::scene::import::{
+    ImportedModel, LUMENS_PER_WATT, WrapMode, import_gltf, import_model, parse_gltf,
+};
+use gpu_render::scene::{Light, MaterialKind};
+
+/// A glTF document under construction: one binary buffer and its views and accessors.
+#[derive(Default)]
+struct Doc {
+    bin: Vec<u8>,
+    views: Vec<String>,
+    accessors: Vec<String>,
+}
+
+impl Doc {
+    fn view(&mut self, bytes: &[u8]) -> usize {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        self.views.push(format!(
+            r#"{{"buffer":0,"byteOffset":{},"byteLength":{}}}"#,
+            self.bin.len(),
+            bytes.len()
+        ));
+        self.bin.extend_from_slice(bytes);
+        self.views.len() - 1
+    }
+
+    fn accessor(&mut self, json: String) -> usize {
+        self.accessors.push(json);
+        self.accessors.len() - 1
+    }
+
+    fn vec3(&mut self, data: &[[f32; 3]]) -> usize {
+        let bytes: Vec<u8> = data
+            .iter()
+            .flatten()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let view = self.view(&bytes);
+        self.accessor(format!(
+            r#"{{"bufferView":{view},"componentType":5126,"count":{},"type":"VEC3"}}"#,
+            data.len()
+        ))
+    }
+
+    fn vec2(&mut self, data: &[[f32; 2]]) -> usize {
+        let bytes: Vec<u8> = data
+            .iter()
+            .flatten()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let view = self.view(&bytes);
+        self.accessor(format!(
+            r#"{{"bufferView":{view},"componentType":5126,"count":{},"type":"VEC2"}}"#,
+            data.len()
+        ))
+    }
+
+    fn indices(&mut self, data: &[u16]) -> usize {
+        let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let view = self.view(&bytes);
+        self.accessor(format!(
+            r#"{{"bufferView":{view},"componentType":5123,"count":{},"type":"SCALAR"}}"#,
+            data.len()
+        ))
+    }
+
+    /// The JSON text with `body` (the other top-level properties) and a buffer whose
+    /// `uri` is `uri` (none: the GLB binary chunk).
+    fn json(&self, body: &str, uri: Option<&str>) -> String {
+        let uri = uri.map_or(String::new(), |u| format!(r#","uri":"{u}""#));
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},{body},"bufferViews":[{}],"accessors":[{}],"buffers":[{{"byteLength":{}{uri}}}]}}"#,
+            self.views.join(","),
+            self.accessors.join(","),
+            self.bin.len()
+        )
+    }
+
+    fn data_uri(&self) -> String {
+        format!(
+            "data:application/octet-stream;base64,{}",
+            base64::engine::general_purpose::STANDARD.encode(&self.bin)
+        )
+    }
+
+    fn embedded(&self, body: &str) -> String {
+        self.json(body, Some(&self.data_uri()))
+    }
+
+    /// A binary glTF (GLB) container: header, JSON chunk, BIN chunk (glTF 2.0 §4.4).
+    fn glb(&self, body: &str) -> Vec<u8> {
+        let mut json = self.json(body, None).into_bytes();
+        while !json.len().is_multiple_of(4) {
+            json.push(b' ');
+        }
+        let mut bin = self.bin.clone();
+        while !bin.len().is_multiple_of(4) {
+            bin.push(0);
+        }
+        let total = 12 + 8 + json.len() + 8 + bin.len();
+        let mut out = Vec::new();
+        out.extend_from_slice(b"glTF");
+        out.extend_from_slice(&2u32.to_le_bytes());
+        out.extend_from_slice(&(total as u32).to_le_bytes());
+        out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"JSON");
+        out.extend_from_slice(&json);
+        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"BIN\0");
+        out.extend_from_slice(&bin);
+        out
+    }
+}
+
+/// A unit right triangle in the z = 0 plane, with indices, as mesh 0 ('tri'), and the
+/// document built so far.
+fn triangle_doc() -> (Doc, String) {
+    let mut doc = Doc::default();
+    let positions = doc.vec3(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    let indices = doc.indices(&[0, 1, 2]);
+    let meshes = format!(
+        r#""meshes":[{{"name":"tri","primitives":[{{"attributes":{{"POSITION":{positions}}},"indices":{indices}}}]}}]"#
+    );
+    (doc, meshes)
+}
+
+/// Writes `files` into a fresh directory and imports the first.
+fn import(files: &[(&str, &[u8])]) -> (tempfile::TempDir, Result<ImportedModel, String>) {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    for (name, bytes) in files {
+        std::fs::write(dir.path().join(name), bytes).expect("write fixture");
+    }
+    let result = import_gltf(&dir.path().join(files[0].0)).map_err(|e| e.to_string());
+    (dir, result)
+}
+
+fn imported(name: &str, bytes: &[u8]) -> ImportedModel {
+    let (_dir, result) = import(&[(name, bytes)]);
+    result.unwrap_or_else(|e| panic!("import failed: {e}"))
+}
+
+fn failure(name: &str, bytes: &[u8]) -> String {
+    let (_dir, result) = import(&[(name, bytes)]);
+    result.expect_err("the import succeeded")
+}
+
+fn assert_close(a: DVec3, b: DVec3, tolerance: f64) {
+    assert!((a - b).length() <= tolerance, "{a} vs {b}");
+}
+
+#[test]
+fn a_transformed_node_s_triangle_lands_where_the_matrices_say() {
+    let (doc, meshes) = triangle_doc();
+    // Parent: translate (1, 2, 3) · rotate 90° about z · scale 2; child: a matrix
+    // (column-major) translating by (0, 0, -1).
+    let body = format!(
+        r#""scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[
+            {{"translation":[1,2,3],"rotation":[0,0,0.70710677,0.70710677],"scale":[2,2,2],"children":[1]}},
+            {{"matrix":[1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,-1,1],"mesh":0}}],{meshes}"#
+    );
+    let model = imported("node.gltf", doc.embedded(&body).as_bytes());
+    let world: Vec<_> = model.world_triangles().collect();
+    assert_eq!(world.len(), 1);
+    // By hand: (x, y, z) → (x, y, z - 1) → ×2 → rotate 90° about z: (-y, x, z) → + (1, 2, 3).
+    let expected = [
+        DVec3::new(1.0, 2.0, 1.0),
+        DVec3::new(1.0, 4.0, 1.0),
+        DVec3::new(-1.0, 2.0, 1.0),
+    ];
+    for (got, want) in world[0].vertices.iter().zip(expected) {
+        assert_close(*got, want, 1e-6);
+    }
+    // And exactly the composed matrices of the file's f32 values.
+    let q = DQuat::from_xyzw(
+        0.0,
+        0.0,
+        f64::from(0.707_106_77f32),
+        f64::from(0.707_106_77f32),
+    );
+    let parent = DMat4::from_scale_rotation_translation(
+        DVec3::splat(2.0),
+        q.normalize(),
+        DVec3::new(1.0, 2.0, 3.0),
+    );
+    let child = DMat4::from_translation(DVec3::new(0.0, 0.0, -1.0));
+    let instance = model.meshes[0].instances[0];
+    assert!(instance.abs_diff_eq(parent * child, 1e-12), "{instance}");
+}
+
+#[test]
+fn a_mesh_under_two_nodes_is_stored_once_with_two_instances() {
+    let (doc, meshes) = triangle_doc();
+    let body = format!(
+        r#""scenes":[{{"nodes":[0]}}],"nodes":[
+            {{"children":[1,2]}},
+            {{"mesh":0,"translation":[-5,0,0]}},
+            {{"mesh":0,"translation":[5,0,0]}}],{meshes}"#
+    );
+    let model = imported("twice.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(model.meshes.len(), 1);
+    assert_eq!(model.meshes[0].instances.len(), 2);
+    assert_eq!(model.world_triangle_count(), 2);
+    let world: Vec<_> = model.world_triangles().collect();
+    assert_eq!(world[0].vertices[0], DVec3::new(-5.0, 0.0, 0.0));
+    assert_eq!(world[1].vertices[0], DVec3::new(5.0, 0.0, 0.0));
+    let (low, high) = model.bounds().expect("bounds");
+    assert_eq!(
+        (low, high),
+        (DVec3::new(-5.0, 0.0, 0.0), DVec3::new(6.0, 1.0, 0.0))
+    );
+}
+
+#[test]
+fn strips_and_fans_become_triangles_and_indices_are_optional() {
+    let mut doc = Doc::default();
+    let square = doc.vec3(&[
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+    ]);
+    let strip = doc.indices(&[0, 1, 2, 3]);
+    let fan = doc.vec3(&[
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ]);
+    let body = format!(
+        r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],"meshes":[{{"primitives":[
+            {{"attributes":{{"POSITION":{square}}},"indices":{strip},"mode":5}},
+            {{"attributes":{{"POSITION":{fan}}},"mode":6}},
+            {{"attributes":{{"POSITION":{square}}},"mode":4}}]}}]"#
+    );
+    let model = imported("modes.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(model.meshes.len(), 3);
+    assert_eq!(model.meshes[0].triangles, vec![[0, 1, 2], [1, 3, 2]]);
+    assert_eq!(model.meshes[1].triangles, vec![[1, 2, 0], [2, 3, 0]]);
+    // A list of 4 vertices: one triangle and a warning about the one left over.
+    assert_eq!(model.meshes[2].triangles, vec![[0, 1, 2]]);
+    assert!(
+        model
+            .warnings
+            .iter()
+            .any(|w| w.contains("not a multiple of 3"))
+    );
+    // Every strip and fan triangle faces +z, as the square's vertices are ordered.
+    for triangle in model.world_triangles() {
+        let [a, b, c] = triangle.vertices;
+        assert!((b - a).cross(c - a).z > 0.0, "{triangle:?}");
+    }
+    assert_eq!(model.meshes[0].name, "mesh 0, primitive 0");
+}
+
+#[test]
+fn embedded_external_and_glb_buffers_give_the_same_model() {
+    let mut doc = Doc::default();
+    let positions = doc.vec3(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    let normals = doc.vec3(&[[0.0, 0.0, 1.0]; 3]);
+    let uvs = doc.vec2(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+    let body = format!(
+        r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0,"translation":[0,0,-2]}}],
+           "meshes":[{{"primitives":[{{"attributes":{{"POSITION":{positions},"NORMAL":{normals},"TEXCOORD_0":{uvs}}}}}]}}]"#
+    );
+    let embedded = imported("embedded.gltf", doc.embedded(&body).as_bytes());
+    let (_dir, external) = import(&[
+        (
+            "external.gltf",
+            doc.json(&body, Some("data%20file.bin")).as_bytes(),
+        ),
+        ("data file.bin", &doc.bin),
+    ]);
+    let external = external.expect("external buffer");
+    let glb = imported("binary.glb", &doc.glb(&body));
+    assert_eq!(embedded.meshes, external.meshes);
+    assert_eq!(embedded.meshes, glb.meshes);
+    let mesh = &embedded.meshes[0];
+    assert_eq!(mesh.normals.as_deref(), Some(&[DVec3::Z; 3][..]));
+    assert_eq!(mesh.uvs.as_ref().map(|u| u[1].x), Some(1.0));
+    // A byte-order mark before the JSON is tolerated.
+    let bom = [b"\xEF\xBB\xBF".as_slice(), doc.embedded(&body).as_bytes()].concat();
+    assert_eq!(imported("bom.gltf", &bom).meshes, embedded.meshes);
+    // A .glb by content, whatever its name.
+    let renamed = imported("binary.gltf", &doc.glb(&body));
+    assert_eq!(renamed.meshes, glb.meshes);
+}
+
+#[test]
+fn a_gltf_camera_reproduces_a_known_view() {
+    // At (0, 2, 2), turned 45° down about x: it looks at the origin along (0, -1, -1).
+    let (doc, meshes) = triangle_doc();
+    let s = (-22.5f64).to_radians().sin();
+    let c = (-22.5f64).to_radians().cos();
+    let body = format!(
+        r#""scenes":[{{"nodes":[0,1]}}],"nodes":[{{"mesh":0}},
+            {{"camera":0,"translation":[0,2,2],"rotation":[{s},0,0,{c}]}}],
+           "cameras":[{{"name":"view","type":"perspective","perspective":{{"yfov":0.5,"aspectRatio":1.5,"znear":0.1}}}}],{meshes}"#
+    );
+    let model = imported("camera.gltf", doc.embedded(&body).as_bytes());
+    let imported = model.camera.as_ref().expect("a camera");
+    assert_eq!(imported.name, "view");
+    assert_eq!(imported.aspect_ratio, Some(1.5));
+    let camera = imported.camera;
+    assert_close(camera.eye, DVec3::new(0.0, 2.0, 2.0), 1e-6);
+    assert!((camera.fov_y_degrees - 0.5f64.to_degrees()).abs() < 1e-5);
+    let frame = CameraFrame::new(&camera, 300, 200);
+    // The centre of the image looks at the origin...
+    let centre = frame.ray_direction(150.0, 100.0, 300, 200);
+    assert_close(centre, -camera.eye.normalize(), 1e-6);
+    // ... with +y up on screen (the top edge's centre is higher in the world) ...
+    let top = frame.ray_direction(150.0, 0.0, 300, 200);
+    assert!(top.y > centre.y);
+    // ... and the top edge is yfov / 2 away from the centre.
+    assert!((top.angle_between(centre) - 0.25).abs() < 1e-6);
+    assert_eq!(model.camera_or_default(2.0), camera);
+}
+
+#[test]
+fn punctual_lights_convert_to_our_units() {
+    let (doc, meshes) = triangle_doc();
+    let s = (-45f64).to_radians().sin();
+    let c = (-45f64).to_radians().cos();
+    let body = format!(
+        r#""extensionsUsed":["KHR_lights_punctual"],
+           "extensions":{{"KHR_lights_punctual":{{"lights":[
+              {{"type":"point","intensity":683,"color":[1,0.5,0.25]}},
+              {{"type":"directional","intensity":1366}},
+              {{"type":"spot","intensity":68.3,"range":10,"spot":{{"outerConeAngle":0.5}}}}]}}}},
+           "scenes":[{{"nodes":[0,1,2,3]}}],"nodes":[{{"mesh":0}},
+            {{"translation":[1,2,3],"extensions":{{"KHR_lights_punctual":{{"light":0}}}}}},
+            {{"rotation":[{s},0,0,{c}],"extensions":{{"KHR_lights_punctual":{{"light":1}}}}}},
+            {{"translation":[0,5,0],"extensions":{{"KHR_lights_punctual":{{"light":2}}}}}}],{meshes}"#
+    );
+    let model = imported("lights.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(model.lights.len(), 3);
+    let Light::Point {
+        position,
+        intensity,
+    } = model.lights[0]
+    else {
+        panic!("not a point light: {:?}", model.lights[0]);
+    };
+    assert_eq!(position, DVec3::new(1.0, 2.0, 3.0));
+    assert_close(intensity, DVec3::new(1.0, 0.5, 0.25), 1e-12);
+    let Light::Directional {
+        direction,
+        irradiance,
+    } = model.lights[1]
+    else {
+        panic!("not directional: {:?}", model.lights[1]);
+    };
+    // -z turned -90° about x points down.
+    assert_close(direction, DVec3::new(0.0, -1.0, 0.0), 1e-6);
+    assert_close(irradiance, DVec3::splat(1366.0 / LUMENS_PER_WATT), 1e-12);
+    assert!(matches!(model.lights[2], Light::Point { position, .. } if position.y == 5.0));
+    let warnings = model.warnings.join("\n");
+    assert!(
+        warnings.contains("light 2 on node 3 is a spot light"),
+        "{warnings}"
+    );
+    assert!(warnings.contains("light 2: range is ignored"), "{warnings}");
+    assert_eq!(model.lights_or_default(), model.lights);
+}
+
+/// A PNG file's bytes.
+fn png(width: u32, height: u32, texels: &[[u8; 4]]) -> Vec<u8> {
+    let raw: Vec<u8> = texels.iter().flatten().copied().collect();
+    let image = image::RgbaImage::from_raw(width, height, raw).expect("texel count");
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    image
+        .write_to(&mut bytes, image::ImageFormat::Png)
+        .expect("encode png");
+    bytes.into_inner()
+}
+
+#[test]
+fn materials_map_with_their_textures_and_wrap_modes() {
+    let (mut doc, _) = triangle_doc();
+    let emissive_png = png(1, 1, &[[255, 128, 0, 255]]);
+    let emissive_view = doc.view(&emissive_png);
+    let mr_png = png(1, 1, &[[0, 128, 64, 255]]);
+    let mr_uri = format!(
+        "data:image/png;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&mr_png)
+    );
+    let body = format!(
+        r#""extensionsUsed":["KHR_materials_emissive_strength","KHR_materials_transmission","KHR_materials_ior"],
+           "scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+           "meshes":[{{"primitives":[
+              {{"attributes":{{"POSITION":0}},"indices":1,"material":0}},
+              {{"attributes":{{"POSITION":0}},"indices":1,"material":1}},
+              {{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+           "materials":[
+              {{"name":"painted","pbrMetallicRoughness":{{"baseColorFactor":[0.5,0.6,0.7,1],"metallicFactor":0.25,"roughnessFactor":0.75,
+                  "baseColorTexture":{{"index":0}},"metallicRoughnessTexture":{{"index":1}}}},
+                "emissiveFactor":[1,0.5,0],"emissiveTexture":{{"index":2}},
+                "extensions":{{"KHR_materials_emissive_strength":{{"emissiveStrength":4}}}}}},
+              {{"name":"water","pbrMetallicRoughness":{{"baseColorFactor":[0.8,0.9,1,1],"metallicFactor":0,"roughnessFactor":0}},
+                "extensions":{{"KHR_materials_transmission":{{"transmissionFactor":1}},"KHR_materials_ior":{{"ior":1.33}}}}}}],
+           "samplers":[{{"wrapS":33071,"wrapT":33648}}],
+           "textures":[{{"source":0,"sampler":0}},{{"source":1}},{{"source":2}}],
+           "images":[{{"uri":"base.png"}},{{"uri":"{mr_uri}"}},{{"bufferView":{emissive_view}}}]"#
+    );
+    let base_png = png(2, 1, &[[128, 128, 128, 255], [255, 255, 255, 255]]);
+    let (_dir, result) = import(&[
+        ("materials.gltf", doc.embedded(&body).as_bytes()),
+        ("base.png", &base_png),
+    ]);
+    let model = result.expect("imports");
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let painted = &model.materials[model.meshes[0].material as usize];
+    assert_eq!(painted.name, "painted");
+    let m = painted.material;
+    assert_eq!(m.kind, MaterialKind::Pbr);
+    assert_close(m.diffuse, DVec3::new(0.5, 0.6, 0.7), 1e-7);
+    assert_eq!((m.metallic, m.roughness), (0.25, 0.75));
+    assert_close(m.emission, DVec3::new(4.0, 2.0, 0.0), 1e-12);
+
+    let base = painted.base_color_texture.expect("base colour texture");
+    assert_eq!(
+        (base.wrap_u, base.wrap_v),
+        (WrapMode::ClampToEdge, WrapMode::MirroredRepeat)
+    );
+    let texel = model.images[base.image as usize].texel(0, 0);
+    assert!(
+        (texel[0] - srgb_decode(128.0 / 255.0) as f32).abs() < 1e-6,
+        "sRGB linearised"
+    );
+    let mr = painted
+        .metallic_roughness_texture
+        .expect("metallic-roughness texture");
+    assert_eq!((mr.wrap_u, mr.wrap_v), (WrapMode::Repeat, WrapMode::Repeat));
+    let texel = model.images[mr.image as usize].texel(0, 0);
+    assert!(
+        (texel[1] - 128.0 / 255.0).abs() < 1e-6,
+        "data, not linearised: {texel:?}"
+    );
+    assert!(
+        (texel[2] - 64.0 / 255.0).abs() < 1e-6,
+        "data, not linearised: {texel:?}"
+    );
+    let emissive = painted.emissive_texture.expect("emissive texture");
+    let texel = model.images[emissive.image as usize].texel(0, 0);
+    assert!((texel[1] - srgb_decode(128.0 / 255.0) as f32).abs() < 1e-6);
+    assert_eq!(model.images.len(), 3);
+
+    let water = model.materials[model.meshes[1].material as usize].material;
+    assert_eq!(water.kind, MaterialKind::Dielectric);
+    assert!((water.ior - 1.33).abs() < 1e-6);
+    assert_close(water.transmittance, DVec3::new(0.8, 0.9, 1.0), 1e-7);
+
+    let default = model.materials[model.meshes[2].material as usize].material;
+    assert_eq!(default.kind, MaterialKind::Pbr);
+    assert_eq!((default.diffuse, default.metallic), (DVec3::ONE, 0.0));
+}
+
+#[test]
+fn jpeg_textures_load() {
+    let (doc, _) = triangle_doc();
+    let image = image::RgbImage::from_pixel(4, 2, image::Rgb([200, 100, 50]));
+    let mut jpeg = std::io::Cursor::new(Vec::new());
+    image
+        .write_to(&mut jpeg, image::ImageFormat::Jpeg)
+        .expect("encode jpeg");
+    let body = r#""scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1,"material":0}]}],
+        "materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],
+        "textures":[{"source":0}],"images":[{"uri":"photo.jpg","mimeType":"image/jpeg"}]"#;
+    let (_dir, result) = import(&[
+        ("photo.gltf", doc.embedded(body).as_bytes()),
+        ("photo.jpg", &jpeg.into_inner()),
+    ]);
+    let model = result.expect("imports");
+    let texture = model.materials[0].base_color_texture.expect("texture");
+    let image = &model.images[texture.image as usize];
+    assert_eq!((image.width, image.height), (4, 2));
+    // JPEG is lossy: within a few 8-bit steps of the sRGB value, linearised.
+    let expected = srgb_decode(200.0 / 255.0) as f32;
+    assert!(
+        (image.texel(1, 1)[0] - expected).abs() < 0.03,
+        "{:?}",
+        image.texel(1, 1)
+    );
+}
+
+#[test]
+fn a_model_without_camera_or_lights_gets_the_default_framing() {
+    let (doc, meshes) = triangle_doc();
+    let body = format!(r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],{meshes}"#);
+    let model = imported("plain.gltf", doc.embedded(&body).as_bytes());
+    assert!(model.camera.is_none() && model.lights.is_empty());
+    let camera = model.camera_or_default(1.0);
+    assert_close(camera.look_at, DVec3::new(0.5, 0.5, 0.0), 1e-12);
+    assert!(camera.eye.z > 0.0, "in front of the model (+z)");
+    assert_eq!(model.lights_or_default().len(), 3);
+}
+
+fn manifest(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
+}
+
+/// The round trip: a scene exported by trimesh (`scripts/make_gltf_fixture.py`) imports
+/// as the world-space triangles trimesh itself computed for it.
+#[test]
+fn a_scene_exported_by_trimesh_imports_as_trimesh_sees_it() {
+    let expected: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(manifest(
+            "tests/fixtures/models/trimesh_scene.expected.json",
+        ))
+        .expect("expected geometry"),
+    )
+    .expect("json");
+    let point = |v: &serde_json::Value| {
+        let c: Vec<f64> = v
+            .as_array()
+            .expect("point")
+            .iter()
+            .map(|x| x.as_f64().expect("number"))
+            .collect();
+        DVec3::new(c[0], c[1], c[2])
+    };
+    let triangles: Vec<[DVec3; 3]> = expected["triangles"]
+        .as_array()
+        .expect("triangles")
+        .iter()
+        .map(|t| {
+            let corners: Vec<DVec3> = t.as_array().expect("corners").iter().map(point).collect();
+            [corners[0], corners[1], corners[2]]
+        })
+        .collect();
+    for file in ["trimesh_scene.glb", "trimesh_scene.gltf"] {
+        let model = import_model(&manifest(&format!("tests/fixtures/models/{file}")))
+            .unwrap_or_else(|e| panic!("{file}: {e}"));
+        let world: Vec<_> = model.world_triangles().collect();
+        assert_eq!(world.len(), triangles.len(), "{file}");
+        // Each of trimesh's triangles is one of ours, with the same winding (up to a
+        // rotation of its corners); f32 storage gives ~1e-7 relative error.
+        let mut used = vec![false; world.len()];
+        for want in &triangles {
+            let found = world.iter().enumerate().position(|(i, got)| {
+                !used[i]
+                    && (0..3)
+                        .any(|r| (0..3).all(|k| got.vertices[(k + r) % 3].distance(want[k]) < 1e-5))
+            });
+            let found = found.unwrap_or_else(|| panic!("{file}: no triangle {want:?}"));
+            used[found] = true;
+        }
+        let box_mesh = model
+            .meshes
+            .iter()
+            .find(|m| m.name.contains("'box'"))
+            .expect("the box");
+        assert_eq!(box_mesh.instances.len(), 2, "{file}: one mesh, two nodes");
+        for (name, want) in expected["materials"].as_object().expect("materials") {
+            let got = model
+                .materials
+                .iter()
+                .find(|m| &m.name == name)
+                .unwrap_or_else(|| panic!("{file}: no material {name}"))
+                .material;
+            assert_eq!(got.kind, MaterialKind::Pbr);
+            assert_close(got.diffuse, point(&want["base_color"]), 1e-6);
+            assert!((got.metallic - want["metallic"].as_f64().expect("metallic")).abs() < 1e-6);
+            assert!((got.roughness - want["roughness"].as_f64().expect("roughness")).abs() < 1e-6);
+        }
+        let (low, high) = model.bounds().expect("bounds");
+        let bounds = expected["bounds"].as_array().expect("bounds");
+        // Our box is conservative for the rotated instance; trimesh's is exact.
+        let (want_low, want_high) = (point(&bounds[0]), point(&bounds[1]));
+        assert!(low.cmple(want_low + 1e-5).all() && high.cmpge(want_high - 1e-5).all());
+    }
+}
+
+#[test]
+fn the_shipped_vase_imports_cleanly() {
+    let model = import_model(&manifest("scenes/models/vase.gltf")).expect("imports");
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    assert_eq!(model.meshes.len(), 2, "two primitives");
+    for mesh in &model.meshes {
+        assert_eq!(mesh.instances.len(), 2, "placed by two nodes");
+        assert!(mesh.normals.is_some());
+    }
+    assert_eq!(model.meshes[0].triangles.len(), 6 * 10 * 2);
+    assert_eq!(model.meshes[1].triangles.len(), 10, "the fan bottom");
+    assert_eq!(model.materials.len(), 1);
+    assert_eq!(model.materials[0].material.kind, MaterialKind::Pbr);
+    for triangle in model.world_triangles() {
+        let [a, b, c] = triangle.vertices;
+        let geometric = (b - a).cross(c - a);
+        let normals = triangle.normals.expect("normals");
+        assert!(
+            normals.iter().all(|n| n.dot(geometric) > 0.0),
+            "flat normals follow the winding"
+        );
+    }
+}
+
+/// Documents with one thing wrong, and what the message must say.
+fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
+    let (doc, meshes) = triangle_doc();
+    let scene = r#""scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}]"#;
+    let ok = doc.embedded(&format!("{scene},{meshes}"));
+    let mut cases: Vec<(&'static str, Vec<u8>, &'static str)> = vec![
+        ("empty", Vec::new(), "not a valid glTF file: the file is empty"),
+        ("not json", b"solid cube\nfacet".to_vec(), "not a valid glTF file"),
+        (
+            "truncated json",
+            ok.as_bytes()[..ok.len() / 2].to_vec(),
+            "not a valid glTF file: EOF while parsing",
+        ),
+        (
+            "glTF 1",
+            ok.replace(r#""version":"2.0""#, r#""version":"1.0""#).into_bytes(),
+            "glTF version 1.0 is not supported",
+        ),
+        (
+            "required extension",
+            ok.replacen('{', r#"{"extensionsRequired":["KHR_draco_mesh_compression"],"#, 1)
+                .into_bytes(),
+            "requires the extension KHR_draco_mesh_compression, which is not supported",
+        ),
+        (
+            "dangling reference",
+            ok.replace(r#"{"mesh":0}"#, r#"{"mesh":7}"#).into_bytes(),
+            "not a valid glTF file: nodes[0].mesh: Index out of bounds",
+        ),
+        (
+            // gltf-json's own validation would index the accessors with it (and panic).
+            "POSITION accessor out of range",
+            ok.replace(r#""POSITION":0"#, r#""POSITION":9"#).into_bytes(),
+            "meshes[0].primitives[0].attributes[\"POSITION\"] refers to accessor 9, but there are 2 accessors",
+        ),
+        (
+            "two parents",
+            ok.replace(
+                r#""nodes":[{"mesh":0}]"#,
+                r#""nodes":[{"mesh":0,"children":[1]},{"children":[0]}]"#,
+            )
+            .into_bytes(),
+            "node 0 is reached twice",
+        ),
+        (
+            "infinite matrix",
+            ok.replace(
+                r#"{"mesh":0}"#,
+                r#"{"mesh":0,"matrix":[1e39,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1]}"#,
+            )
+            .into_bytes(),
+            "node 0: its matrix has a component that is not finite",
+        ),
+        (
+            "lines",
+            ok.replace(r#""indices":1}"#, r#""indices":1,"mode":1}"#).into_bytes(),
+            "mesh 0 ('tri'), primitive 0: its mode is Lines; only triangles, triangle strips and triangle fans are supported",
+        ),
+        (
+            "remote buffer",
+            doc.json(&format!("{scene},{meshes}"), Some("https://example.com/tri.bin"))
+                .into_bytes(),
+            "buffer 0: the URI https://example.com/tri.bin is neither a relative file path nor a data URI",
+        ),
+        (
+            "missing buffer file",
+            doc.json(&format!("{scene},{meshes}"), Some("nowhere.bin")).into_bytes(),
+            "cannot read buffer 0",
+        ),
+        (
+            "short buffer",
+            ok.replace(
+                &format!(r#""byteLength":{}"#, doc.bin.len()),
+                &format!(r#""byteLength":{}"#, doc.bin.len() + 100),
+            )
+            .into_bytes(),
+            "buffer 0: holds 42 bytes, fewer than its byteLength 142",
+        ),
+        (
+            "bad base64",
+            doc.json(&format!("{scene},{meshes}"), Some("data:application/octet-stream;base64,%%%"))
+                .into_bytes(),
+            "buffer 0: the data URI is not valid base64",
+        ),
+        (
+            "accessor past its view",
+            ok.replace(r#""count":3,"type":"VEC3""#, r#""count":30,"type":"VEC3""#)
+                .into_bytes(),
+            "mesh 0 ('tri'), primitive 0: POSITION (accessor 0): 30 elements of 12 bytes every 12 from byte 0 do not fit in bufferView 0 (36 bytes)",
+        ),
+        (
+            "absurd count",
+            ok.replace(r#""count":3,"type":"VEC3""#, r#""count":4000000000,"type":"VEC3""#)
+                .into_bytes(),
+            "mesh 0 ('tri'), primitive 0: 4000000000 vertices, more than the 16777216 accepted",
+        ),
+        (
+            "wrong type",
+            ok.replace(r#""count":3,"type":"VEC3""#, r#""count":3,"type":"VEC2""#)
+                .into_bytes(),
+            "POSITION (accessor 0): holds Vec2 elements, expected Vec3",
+        ),
+        (
+            "view past its buffer",
+            ok.replace(r#""byteOffset":0,"byteLength":36"#, r#""byteOffset":20,"byteLength":36"#)
+                .into_bytes(),
+            "bufferView 0 (bytes 20..20+36) lies outside buffer 0, which holds 42 bytes",
+        ),
+        (
+            "negative light",
+            ok.replacen(
+                '{',
+                r#"{"extensions":{"KHR_lights_punctual":{"lights":[{"type":"point","intensity":-1}]}},"#,
+                1,
+            )
+            .replace(
+                r#"{"mesh":0}"#,
+                r#"{"mesh":0,"extensions":{"KHR_lights_punctual":{"light":0}}}"#,
+            )
+            .into_bytes(),
+            "light 0: intensity -1 is negative or not finite",
+        ),
+        (
+            "light index without lights",
+            ok.replace(
+                r#"{"mesh":0}"#,
+                r#"{"mesh":0,"extensions":{"KHR_lights_punctual":{"light":0}}}"#,
+            )
+            .into_bytes(),
+            "nodes[0].extensions.khrLightsPunctual.light: Index out of bounds",
+        ),
+        (
+            "light index out of range",
+            ok.replacen(
+                '{',
+                r#"{"extensions":{"KHR_lights_punctual":{"lights":[{"type":"point","intensity":1}]}},"#,
+                1,
+            )
+            .replace(
+                r#"{"mesh":0}"#,
+                r#"{"mesh":0,"extensions":{"KHR_lights_punctual":{"light":3}}}"#,
+            )
+            .into_bytes(),
+            "nodes[0].extensions.khrLightsPunctual.light: Index out of bounds",
+        ),
+        (
+            "missing texture",
+            ok.replace(
+                r#""indices":1}"#,
+                r#""indices":1,"material":0}"#,
+            )
+            .replacen(
+                '{',
+                r#"{"materials":[{"name":"m","pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],"textures":[{"source":0}],"images":[{"uri":"missing.png"}],"#,
+                1,
+            )
+            .into_bytes(),
+            "material 0 ('m'): baseColorTexture: image 0: the texture",
+        ),
+        (
+            "image without a source",
+            ok.replace(r#""indices":1}"#, r#""indices":1,"material":0}"#)
+                .replacen(
+                    '{',
+                    r#"{"materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],"textures":[{"source":0}],"images":[{"mimeType":"image/png"}],"#,
+                    1,
+                )
+                .into_bytes(),
+            "material 0: baseColorTexture: image 0: it has neither a uri nor a bufferView",
+        ),
+        (
+            "out of range factor",
+            ok.replace(r#""indices":1}"#, r#""indices":1,"material":0}"#)
+                .replacen(
+                    '{',
+                    r#"{"materials":[{"pbrMetallicRoughness":{"baseColorFactor":[2,0,0,1]}}],"#,
+                    1,
+                )
+                .into_bytes(),
+            "material 0: baseColorFactor",
+        ),
+    ];
+    // Index 5 of 3 vertices, and a NaN position: the buffer itself is edited.
+    let mut bad_index = Doc::default();
+    let positions = bad_index.vec3(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    let indices = bad_index.indices(&[0, 1, 5]);
+    let body = format!(
+        r#"{scene},"meshes":[{{"name":"tri","primitives":[{{"attributes":{{"POSITION":{positions}}},"indices":{indices}}}]}}]"#
+    );
+    cases.push((
+        "index out of range",
+        bad_index.embedded(&body).into_bytes(),
+        "mesh 0 ('tri'), primitive 0: triangle 0 refers to vertex 5, but there are only 3 vertices",
+    ));
+    let mut nan = Doc::default();
+    let positions = nan.vec3(&[[0.0, 0.0, 0.0], [f32::NAN, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    let body = format!(
+        r#"{scene},"meshes":[{{"name":"tri","primitives":[{{"attributes":{{"POSITION":{positions}}}}}]}}]"#
+    );
+    cases.push((
+        "NaN position",
+        nan.embedded(&body).into_bytes(),
+        "mesh 0 ('tri'), primitive 0: vertex 1 has a position that is not a finite number",
+    ));
+    cases
+}
+
+#[test]
+fn bad_gltf_files_name_the_file_and_the_element() {
+    for (what, bytes, expected) in bad_documents() {
+        let message = failure("bad.gltf", &bytes);
+        assert!(
+            message.contains("bad.gltf") && message.contains(expected),
+            "{what}: expected {expected:?} in {message:?}"
+        );
+    }
+}
+
+#[test]
+fn truncated_glb_files_are_errors() {
+    let (doc, meshes) = triangle_doc();
+    let glb = doc.glb(&format!(
+        r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],{meshes}"#
+    ));
+    imported("whole.glb", &glb);
+    for cut in [4, 12, 19, 40, glb.len() / 2, glb.len() - 30, glb.len() - 1] {
+        let message = failure("cut.glb", &glb[..cut]);
+        assert!(message.contains("cut.glb: "), "cut at {cut}: {message}");
+        assert!(
+            message.contains("GLB") || message.contains("glTF") || message.contains("buffer"),
+            "cut at {cut}: {message}"
+        );
+    }
+}
+
+#[test]
+fn degenerate_triangles_are_skipped_and_counted() {
+    let mut doc = Doc::default();
+    let positions = doc.vec3(&[
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [2.0, 0.0, 0.0],
+    ]);
+    let indices = doc.indices(&[0, 1, 2, 0, 1, 3, 2, 2, 0]);
+    let body = format!(
+        r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],"meshes":[{{"name":"thin","primitives":[{{"attributes":{{"POSITION":{positions}}},"indices":{indices}}}]}}]"#
+    );
+    let model = imported("thin.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(model.meshes[0].triangles, vec![[0, 1, 2]]);
+    assert!(
+        model.warnings.iter().any(|w| w.contains(
+            "thin.gltf: mesh 0 ('thin'), primitive 0: skipped 2 degenerate triangles (of 3)"
+        )),
+        "{:?}",
+        model.warnings
+    );
+}
+
+#[test]
+fn unsupported_features_that_are_not_required_are_warnings() {
+    let (doc, meshes) = triangle_doc();
+    let body = format!(
+        r#""extensionsUsed":["KHR_texture_transform"],"scenes":[{{"nodes":[0]}},{{"nodes":[]}}],
+           "nodes":[{{"mesh":0}},{{"mesh":0,"scale":[0,0,0]}},{{"camera":0}}],
+           "cameras":[{{"type":"orthographic","orthographic":{{"xmag":1,"ymag":1,"zfar":10,"znear":0.1}}}}],{meshes}"#
+    );
+    let body = body.replace(
+        r#""scenes":[{"nodes":[0]}"#,
+        r#""scenes":[{"nodes":[0,1,2]}"#,
+    );
+    let model = parse_gltf(doc.embedded(&body).as_bytes(), Path::new("odd.gltf")).expect("imports");
+    let warnings = model.warnings.join("\n");
+    assert!(
+        warnings.contains("KHR_texture_transform, which is not supported"),
+        "{warnings}"
+    );
+    assert!(warnings.contains("the file has 2 scenes"), "{warnings}");
+    assert!(
+        warnings.contains("node 1: its transform is singular"),
+        "{warnings}"
+    );
+    assert!(
+        warnings.contains("camera 0 on node 2 is orthographic"),
+        "{warnings}"
+    );
+    assert_eq!(model.meshes[0].instances.len(), 1);
+    assert!(model.camera.is_none());
+}
