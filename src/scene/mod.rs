@@ -4,8 +4,8 @@
 mod error;
 mod file;
 mod image;
-mod medium;
 pub mod import;
+mod medium;
 mod model;
 
 pub use error::{SceneError, SceneWarning};
