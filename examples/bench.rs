@@ -56,6 +56,11 @@ struct Args {
     /// The GPU schedule: `fused` or `wavefront` (default: the adapter's).
     #[arg(long)]
     schedule: Option<String>,
+    /// Print the BVH's build figures and the nodes and primitives a camera ray and a
+    /// shadow ray (to the first light) visit on average, counted by the CPU traversal
+    /// at one ray per pixel.
+    #[arg(long)]
+    traversal: bool,
 }
 
 fn median(mut values: Vec<f64>) -> f64 {
@@ -75,6 +80,9 @@ fn main() -> Result<()> {
             ..RenderOverrides::default()
         })
         .map_err(anyhow::Error::msg)?;
+    if args.traversal {
+        traversal_figures(&scene);
+    }
     let gpu = HeadlessGpu::new(&AdapterChoice::Default).context("no GPU adapter")?;
     let mut renderer = GpuRenderer::new(&gpu.device)?;
     match args.schedule.as_deref() {
@@ -260,4 +268,81 @@ fn compare_schedules(
         wavefront / fused
     );
     Ok(())
+}
+
+/// Builds `scene`'s BVH with both builders and prints their figures, then the average
+/// work of one camera ray per pixel (through the pixel centre) and of one shadow ray
+/// from each hit to the scene's first light.
+fn traversal_figures(scene: &gpu_render::scene::Scene) {
+    use gpu_render::accel::{BuildMethod, SceneGeometry};
+    use gpu_render::cpu::intersect::{Ray, hit_record};
+    use gpu_render::cpu::traverse::{TraversalCounts, closest_hit_counted, occluded_counted};
+    for method in [BuildMethod::Sah, BuildMethod::MedianSplit] {
+        let geometry = SceneGeometry::with_method(scene, method);
+        let stats = geometry.bvh.stats;
+        let prims = geometry.bounded_count();
+        let camera = gpu_render::camera::CameraFrame::new(
+            &scene.camera,
+            scene.render.width,
+            scene.render.height,
+        );
+        let (mut primary, mut shadow) = (TraversalCounts::default(), TraversalCounts::default());
+        let (mut primary_rays, mut shadow_rays) = (0u64, 0u64);
+        for y in 0..scene.render.height {
+            for x in 0..scene.render.width {
+                let ray = Ray {
+                    origin: camera.eye,
+                    direction: camera.ray_direction(
+                        f64::from(x) + 0.5,
+                        f64::from(y) + 0.5,
+                        scene.render.width,
+                        scene.render.height,
+                    ),
+                };
+                primary_rays += 1;
+                let Some((t, prim)) =
+                    closest_hit_counted(&geometry, &ray, f64::INFINITY, &mut primary)
+                else {
+                    continue;
+                };
+                let hit = hit_record(&geometry, prim, &ray, t);
+                if let Some(gpu_render::scene::Light::Point { position, .. }) = scene.lights.first()
+                {
+                    let n = if ray.direction.dot(hit.normal) < 0.0 {
+                        hit.normal
+                    } else {
+                        -hit.normal
+                    };
+                    let origin = gpu_render::cpu::intersect::offset_ray_origin(
+                        hit.position,
+                        n,
+                        geometry.offset_scale,
+                    );
+                    let to_light = *position - origin;
+                    let distance = to_light.length();
+                    let shadow_ray = Ray {
+                        origin,
+                        direction: to_light / distance,
+                    };
+                    shadow_rays += 1;
+                    occluded_counted(&geometry, &shadow_ray, distance, &mut shadow);
+                }
+            }
+        }
+        let per = |count: u64, rays: u64| count as f64 / rays.max(1) as f64;
+        println!(
+            "BVH {method:?}: {prims} primitives, built in {:.1} ms ({:.2} M primitives/s), {} nodes, \
+             depth {}, SAH cost {:.1}; camera rays visit {:.1} nodes and test {:.1} primitives, \
+             shadow rays {:.1} nodes and {:.1} primitives",
+            stats.build_time.as_secs_f64() * 1e3,
+            prims as f64 / stats.build_time.as_secs_f64().max(1e-9) / 1e6,
+            stats.nodes,
+            stats.depth,
+            stats.sah_cost,
+            per(primary.nodes, primary_rays),
+            per(primary.primitives, primary_rays),
+            per(shadow.nodes, shadow_rays),
+            per(shadow.primitives, shadow_rays),
+        );
+    }
 }
