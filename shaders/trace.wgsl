@@ -46,6 +46,10 @@
 // nothing: I / r² would be infinite or NaN. Twin of MIN_LIGHT_DISTANCE_SQUARED.
 const MIN_LIGHT_DISTANCE_SQUARED: f32 = 1.17549435e-38;
 
+// Branches whose weight is not above the smallest normal f32 are not traced, whatever
+// the cutoff. Twin of MIN_BRANCH_WEIGHT.
+const MIN_BRANCH_WEIGHT: f32 = 1.17549435e-38;
+
 // The dielectrics a ray is inside, outermost first (the per-path medium stack; the
 // rule is documented on the CPU twin, MediumStack in src/scene/medium.rs): a refracted
 // ray entering a dielectric pushes its index, one leaving pops; reflected rays keep
@@ -119,7 +123,8 @@ fn ray_stack_index(slot: u32, level: u32) -> u32 {
 // Pushes a branch if it carries more than the weight cutoff and the stack has room;
 // otherwise the branch is dropped (both backends alike).
 fn push_branch(slot: u32, path: ptr<function, PathState>, entry: StackEntry) {
-    if max_component(entry.weight) > frame.min_ray_weight && (*path).stack_len < frame.stack_size {
+    let cutoff = max(frame.min_ray_weight, MIN_BRANCH_WEIGHT);
+    if max_component(entry.weight) > cutoff && (*path).stack_len < frame.stack_size {
         ray_stack[ray_stack_index(slot, (*path).stack_len)] = entry;
         (*path).stack_len += 1u;
     }

@@ -70,6 +70,13 @@ impl PreparedScene {
 /// same threshold.
 pub const MIN_LIGHT_DISTANCE_SQUARED: f64 = f32::MIN_POSITIVE as f64;
 
+/// Branch weights (largest channel) at or below this, the smallest normal `f32`
+/// (2^-126), are not traced, whatever the cutoff: the GPU's `f32` weights cannot hold
+/// less (most GPUs flush such denormals to zero), and such a branch adds nothing any
+/// image format can show. Both backends use the same floor, so that deep glass, whose
+/// inner reflections shrink a weight by about 0.04 each, traces the same rays on both.
+pub const MIN_BRANCH_WEIGHT: f64 = f32::MIN_POSITIVE as f64;
+
 /// Whether a radiance value is finite and stays finite when rounded to `f32`: the
 /// final guard of [`trace_radiance`]. A contribution that fails it (an overflowing
 /// product, a NaN from some unforeseen 0·∞) is dropped rather than allowed to poison
@@ -144,6 +151,7 @@ pub fn trace_pixel(scene: &PreparedScene, x: u32, y: u32) -> PixelResult {
 /// when [`finite_radiance`]; no NaN or infinity reaches the image.
 pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
     let capacity = scene.settings.stack_size as usize;
+    let cutoff = scene.settings.min_ray_weight.max(MIN_BRANCH_WEIGHT);
     let mut stack: Vec<StackEntry> = Vec::with_capacity(capacity);
     stack.push(StackEntry {
         ray: primary,
@@ -180,7 +188,7 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
         ];
         for ((weight, ray), medium) in branches {
             let weight = entry.weight * weight;
-            if weight.max_element() > scene.settings.min_ray_weight && stack.len() < capacity {
+            if weight.max_element() > cutoff && stack.len() < capacity {
                 stack.push(StackEntry {
                     ray,
                     weight,
