@@ -355,3 +355,50 @@ fn a_loop_the_driver_cuts_is_an_error_not_a_short_image() {
         result.unwrap_or_else(|e| panic!("{name} has no loop limit, yet: {e}"));
     }
 }
+
+/// A degenerate tree: identical triangles, all at one place. A million build without
+/// recursion or a chain (the SAH finds no split and falls back to the median by
+/// count); ten thousand render on both backends alike, every ray that hits them
+/// testing them all across many resumed dispatches.
+#[test]
+fn identical_triangles_build_a_bounded_tree_and_render() {
+    let triangle = [
+        DVec3::new(-0.5, 0.2, 0.0),
+        DVec3::new(0.5, 0.2, 0.0),
+        DVec3::new(0.0, 1.2, 0.0),
+    ];
+    let many = |n: usize| -> Vec<Shape> {
+        (0..n)
+            .map(|_| Shape::Triangle {
+                vertices: triangle,
+                material: 1,
+            })
+            .collect()
+    };
+    let million = gpu_render::accel::SceneGeometry::from_shapes(
+        &many(1_000_000),
+        gpu_render::accel::BuildMethod::Sah,
+    );
+    let stats = million.bvh.stats;
+    assert!(
+        stats.depth <= 20,
+        "depth {} for a million identical triangles",
+        stats.depth
+    );
+    assert_eq!(million.bvh.prims.len(), 1_000_000);
+
+    let mut shapes = many(10_000);
+    shapes.push(floor(0));
+    let scene = scene(
+        settings(8, 8, 1, 0),
+        DVec3::new(0.0, 0.7, 3.0),
+        DVec3::new(0.0, 0.6, 0.0),
+        vec![
+            Material::lambert(DVec3::splat(0.6)),
+            Material::lambert(DVec3::new(0.9, 0.6, 0.2)),
+        ],
+        vec![point_light(DVec3::new(1.0, 3.0, 3.0), 10.0)],
+        shapes,
+    );
+    assert_backends_agree("identical-triangles", &scene, 1e-3);
+}
