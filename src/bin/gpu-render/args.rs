@@ -244,6 +244,18 @@ pub struct RenderArgs {
     #[arg(long, value_name = "list|INDEX|NAME", value_parser = parse_adapter, help_heading = "Device")]
     pub adapter: Option<AdapterArg>,
 
+    /// GPU only: the most loop iterations one shader invocation runs per dispatch
+    /// [default: the adapter's; on llvmpipe its loop limit over its SIMD lanes]. The
+    /// image does not depend on it.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..), help_heading = "Device")]
+    pub iteration_budget: Option<u32>,
+
+    /// GPU only: give up with an error when one wait for the GPU takes longer than
+    /// this many seconds [default: wait as long as it takes; each submission's work is
+    /// bounded, and a hung device is reported lost by its driver].
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds, help_heading = "Device")]
+    pub gpu_timeout: Option<std::time::Duration>,
+
     /// Confine the files the scene names (textures, BRDF maps) to the scene file's
     /// folder: refuse absolute paths, `..` and links out of it. Without it a scene
     /// file is trusted like a program: it may name any file you can read.
@@ -263,6 +275,17 @@ pub struct RenderArgs {
     /// Print nothing but errors: no progress, warnings, notes or summary.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// A positive, finite number of seconds.
+fn parse_seconds(text: &str) -> Result<std::time::Duration, String> {
+    let seconds: f64 = text
+        .parse()
+        .map_err(|_| format!("must be a number of seconds, got {text:?}"))?;
+    if !(seconds.is_finite() && seconds > 0.0) {
+        return Err(format!("must be a positive number of seconds, got {text}"));
+    }
+    std::time::Duration::try_from_secs_f64(seconds).map_err(|e| format!("{text}: {e}"))
 }
 
 impl RenderArgs {

@@ -20,6 +20,15 @@ pub struct Frame {
     pub stats: RenderStats,
 }
 
+/// The GPU renderer's options from the command line.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct GpuOptions {
+    /// `--iteration-budget`.
+    pub iteration_budget: Option<u32>,
+    /// `--gpu-timeout`.
+    pub timeout: Option<std::time::Duration>,
+}
+
 /// An opened backend, ready to render any number of scenes.
 pub enum Backend {
     /// The wgpu tracer on an opened device.
@@ -32,14 +41,22 @@ pub enum Backend {
         adapter_name: String,
     },
     /// The CPU reference tracer.
-    Cpu,
+    Cpu {
+        /// Why `--backend auto` chose it, for the summary (`None` when asked for).
+        reason: Option<String>,
+    },
 }
 
 impl Backend {
     /// Opens the backend `choice` asks for. With `auto` and no usable adapter, prints
     /// a one-line note (unless `quiet`) and falls back to the CPU. An explicit
     /// `--adapter` demands a GPU (except with `cpu`, which the caller refuses earlier).
-    pub fn open(choice: BackendArg, adapter: Option<&AdapterArg>, quiet: bool) -> Result<Self> {
+    pub fn open(
+        choice: BackendArg,
+        adapter: Option<&AdapterArg>,
+        options: &GpuOptions,
+        quiet: bool,
+    ) -> Result<Self> {
         let adapter_choice = match adapter {
             None => AdapterChoice::Default,
             Some(AdapterArg::Index(index)) => AdapterChoice::Index(*index),
@@ -47,22 +64,29 @@ impl Backend {
             Some(AdapterArg::List) => bail!("--adapter list does not select an adapter"),
         };
         match choice {
-            BackendArg::Cpu => Ok(Backend::Cpu),
-            BackendArg::Gpu => Self::open_gpu(&adapter_choice),
-            BackendArg::Auto if adapter.is_some() => Self::open_gpu(&adapter_choice),
+            BackendArg::Cpu => Ok(Backend::Cpu { reason: None }),
+            BackendArg::Gpu => Self::open_gpu(&adapter_choice, options),
+            BackendArg::Auto if adapter.is_some() => Self::open_gpu(&adapter_choice, options),
             BackendArg::Auto => match HeadlessGpu::new(&adapter_choice) {
-                Ok(gpu) => Self::with_device(gpu),
+                Ok(gpu) => match auto_rule(&gpu.adapter_info()) {
+                    Some(reason) => Ok(Backend::Cpu {
+                        reason: Some(reason),
+                    }),
+                    None => Self::with_device(gpu, options),
+                },
                 Err(e) => {
                     if !quiet {
                         eprintln!("no GPU adapter found ({e}); rendering on the CPU reference");
                     }
-                    Ok(Backend::Cpu)
+                    Ok(Backend::Cpu {
+                        reason: Some("no GPU adapter".into()),
+                    })
                 }
             },
         }
     }
 
-    fn open_gpu(choice: &AdapterChoice) -> Result<Self> {
+    fn open_gpu(choice: &AdapterChoice, options: &GpuOptions) -> Result<Self> {
         let gpu = HeadlessGpu::new(choice).with_context(|| match choice {
             AdapterChoice::Default => {
                 "cannot open a GPU (use --backend cpu to render on the CPU)".to_owned()
@@ -72,13 +96,19 @@ impl Backend {
                 format!("cannot open a GPU adapter named like {name:?} (see --adapter list)")
             }
         })?;
-        Self::with_device(gpu)
+        Self::with_device(gpu, options)
     }
 
-    fn with_device(gpu: HeadlessGpu) -> Result<Self> {
+    fn with_device(gpu: HeadlessGpu, options: &GpuOptions) -> Result<Self> {
         let adapter_name = gpu.adapter_info().name;
-        let renderer = GpuRenderer::new(&gpu.device)
+        let mut renderer = GpuRenderer::new(&gpu.device)
             .with_context(|| format!("cannot set up the GPU tracer on {adapter_name}"))?;
+        if let Some(budget) = options.iteration_budget {
+            renderer = renderer.with_iteration_budget(budget);
+        }
+        if let Some(timeout) = options.timeout {
+            renderer = renderer.with_poll_timeout(timeout);
+        }
         Ok(Backend::Gpu {
             gpu: Box::new(gpu),
             renderer,
@@ -86,11 +116,15 @@ impl Backend {
         })
     }
 
-    /// A short description for the summary: `GPU (name)` or `CPU reference`.
+    /// A short description for the summary: `GPU (name)` or `CPU reference`, with
+    /// the reason when `--backend auto` chose the CPU.
     pub fn describe(&self) -> String {
         match self {
             Backend::Gpu { adapter_name, .. } => format!("GPU ({adapter_name})"),
-            Backend::Cpu => "CPU reference".to_owned(),
+            Backend::Cpu { reason: None } => "CPU reference".to_owned(),
+            Backend::Cpu {
+                reason: Some(reason),
+            } => format!("CPU reference (auto: {reason})"),
         }
     }
 
@@ -107,7 +141,7 @@ impl Backend {
                     stats: rendered.stats,
                 })
             }
-            Backend::Cpu => {
+            Backend::Cpu { .. } => {
                 let rendered = cpu::render(scene, Some(progress));
                 let display_rgba8 = rendered
                     .image
@@ -120,6 +154,20 @@ impl Backend {
             }
         }
     }
+}
+
+/// The rule of `--backend auto` for the adapter wgpu prefers: a real GPU is used; a CPU
+/// device (lavapipe, llvmpipe, WARP: a software rasteriser on the same cores) is not,
+/// because on it the CPU reference is faster, as measured in `BENCHMARKS.md`
+/// ("--backend auto"). Returns why the CPU reference is chosen instead, if it is.
+pub fn auto_rule(adapter: &wgpu::AdapterInfo) -> Option<String> {
+    (adapter.device_type == wgpu::DeviceType::Cpu).then(|| {
+        format!(
+            "the only adapter, {}, is a CPU device, on which the CPU reference is faster \
+             (BENCHMARKS.md); --backend gpu uses it anyway",
+            adapter.name
+        )
+    })
 }
 
 /// Prints the GPU adapters wgpu can see, one a line, on stdout.
@@ -146,5 +194,34 @@ pub fn print_adapters() -> Result<()> {
         // `gpu-render --adapter list | head -1` is fine.
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
         other => other.context("cannot write the adapter list to stdout"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::auto_rule;
+
+    fn adapter(name: &str, device_type: wgpu::DeviceType) -> wgpu::AdapterInfo {
+        wgpu::AdapterInfo {
+            name: name.into(),
+            ..wgpu::AdapterInfo::new(device_type, wgpu::Backend::Vulkan)
+        }
+    }
+
+    #[test]
+    fn auto_uses_real_gpus_and_not_cpu_devices() {
+        let lavapipe = adapter("llvmpipe (LLVM 15.0.6, 256 bits)", wgpu::DeviceType::Cpu);
+        let reason = auto_rule(&lavapipe).expect("a CPU device is not used");
+        assert!(
+            reason.contains("llvmpipe") && reason.contains("CPU device"),
+            "{reason}"
+        );
+        for kind in [
+            wgpu::DeviceType::DiscreteGpu,
+            wgpu::DeviceType::IntegratedGpu,
+            wgpu::DeviceType::VirtualGpu,
+        ] {
+            assert_eq!(auto_rule(&adapter("NVIDIA H200", kind)), None, "{kind:?}");
+        }
     }
 }

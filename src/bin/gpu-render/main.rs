@@ -26,7 +26,7 @@ use gpu_render::output::{self, HDR_MAX, OutputFormat, Written};
 use gpu_render::scene::{self, LightingSpace, LoadOptions, RenderSettings, Scene, SceneWarning};
 
 use crate::args::{AdapterArg, BackendArg, Cli, RenderArgs};
-use crate::backend::{Backend, Frame};
+use crate::backend::{Backend, Frame, GpuOptions};
 use crate::memory::{BackendKind, Estimate};
 use crate::progress::Progress;
 use crate::summary::Summary;
@@ -135,7 +135,16 @@ fn render(args: &RenderArgs, scene_path: &Path, output_path: &Path) -> Result<()
     scene.render = apply_overrides(args, scene.render, Some(scene_path))?;
     check_inputs_survive(output_path, scene_path, &scene)?;
 
-    let backend = Backend::open(args.backend, args.adapter.as_ref(), args.quiet)?;
+    let gpu_options = GpuOptions {
+        iteration_budget: args.iteration_budget,
+        timeout: args.gpu_timeout,
+    };
+    let backend = Backend::open(
+        args.backend,
+        args.adapter.as_ref(),
+        &gpu_options,
+        args.quiet,
+    )?;
     check_memory(
         &scene,
         &backend,
@@ -213,7 +222,7 @@ fn check_memory(
 ) -> Result<()> {
     let kind = match backend {
         Backend::Gpu { .. } => BackendKind::Gpu,
-        Backend::Cpu => BackendKind::Cpu,
+        Backend::Cpu { .. } => BackendKind::Cpu,
     };
     let estimate = Estimate::new(scene, kind, format, compare_gamma);
     let cap = max_memory_gib * f64::from(1u32 << 30);

@@ -10,7 +10,7 @@ use gpu_render::tradeoff::{
 };
 
 use crate::args::TradeoffArgs;
-use crate::backend::{Backend, Frame};
+use crate::backend::{Backend, Frame, GpuOptions};
 use crate::progress::Progress;
 
 /// The files written into `--out-dir`.
@@ -60,7 +60,7 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
     for name in OUTPUT_FILES {
         gpu_render::output::check_output_path(&args.out_dir.join(name))?;
     }
-    let backend = Backend::open(args.backend, None, false)?;
+    let backend = Backend::open(args.backend, None, &GpuOptions::default(), false)?;
 
     let progress = Progress::new("rendering the reference", true);
     let reference = backend.render(&reference_scene, &|done, total| {
