@@ -1,6 +1,7 @@
 # Shared helpers for the scripts in this directory; source it, do not run it.
 #
 #   ensure_lavapipe   install Mesa's software Vulkan driver (lavapipe) if it is missing
+#                     (on Debian 12 from bookworm-backports: Mesa 25)
 #   ensure_rust_components  rustfmt and clippy (rustup component add) if missing
 #   setup_gpu_env     XDG_RUNTIME_DIR and WGPU_BACKEND defaults for headless wgpu
 #   section TITLE     print a section header
@@ -26,23 +27,59 @@ have_lavapipe() {
         compgen -G '/etc/vulkan/icd.d/lvp_icd*.json' >/dev/null
 }
 
+# The Debian release this machine runs ("bookworm" for Debian 12), or nothing.
+debian_codename() {
+    # shellcheck disable=SC1091
+    [ -r /etc/os-release ] && (. /etc/os-release && echo "${VERSION_CODENAME:-}")
+}
+
+# The Mesa version of the installed lavapipe ("25.0.7-2~bpo12+1"), or nothing.
+installed_mesa_version() {
+    dpkg-query -W -f='${Version}' mesa-vulkan-drivers 2>/dev/null
+}
+
 # Installs mesa-vulkan-drivers (lavapipe) and the Vulkan loader with apt when the
-# lavapipe ICD is missing, so wgpu finds at least a software adapter. Without apt (or
-# without root) it warns and carries on: the GPU tests then skip or fall back.
+# lavapipe ICD is missing, so wgpu finds at least a software adapter. On Debian 12 it
+# takes Mesa from bookworm-backports (25.0.x) rather than bookworm's 22.3.6: the GPU
+# tracer runs about 3x faster on it and its loops have no 65,535-iteration limit
+# (BENCHMARKS.md, "lavapipe versions"). GPU_RENDER_LAVAPIPE=stock keeps the release's
+# own Mesa. Without apt (or without root) it warns and carries on: the GPU tests then
+# skip or fall back.
 ensure_lavapipe() {
     if have_lavapipe; then
-        echo "lavapipe (software Vulkan) is installed"
+        echo "lavapipe (software Vulkan) is installed: Mesa $(installed_mesa_version)"
+        case "$(installed_mesa_version)" in
+            2[0-4].*)
+                echo "note: Mesa 25 from bookworm-backports runs the GPU tracer about 3x faster" \
+                    "(see BENCHMARKS.md); this Mesa works, with a smaller iteration budget" >&2
+                ;;
+        esac
         return 0
     fi
     if ! command -v apt-get >/dev/null 2>&1; then
         echo "warning: no lavapipe ICD and no apt-get; GPU tests may find no adapter" >&2
         return 0
     fi
-    echo "installing lavapipe: mesa-vulkan-drivers libvulkan1"
+    local target=()
+    if [ "$(debian_codename)" = bookworm ] && [ "${GPU_RENDER_LAVAPIPE:-backports}" != stock ]; then
+        local list=/etc/apt/sources.list.d/gpu-render-bookworm-backports.list
+        if [ ! -e "$list" ]; then
+            echo "deb http://deb.debian.org/debian bookworm-backports main" |
+                as_root tee "$list" >/dev/null || true
+        fi
+        target=(-t bookworm-backports)
+    fi
+    echo "installing lavapipe: mesa-vulkan-drivers libvulkan1 ${target[*]}"
     if as_root apt-get update -qq &&
         as_root env DEBIAN_FRONTEND=noninteractive \
-            apt-get install -y -qq --no-install-recommends mesa-vulkan-drivers libvulkan1; then
+            apt-get install -y -qq --no-install-recommends "${target[@]}" \
+            mesa-vulkan-drivers libvulkan1; then
         have_lavapipe || echo "warning: installed, but no lavapipe ICD found" >&2
+        echo "lavapipe installed: Mesa $(installed_mesa_version)"
+    elif [ "${#target[@]}" -gt 0 ] &&
+        as_root env DEBIAN_FRONTEND=noninteractive \
+            apt-get install -y -qq --no-install-recommends mesa-vulkan-drivers libvulkan1; then
+        echo "warning: bookworm-backports failed; installed the release's Mesa $(installed_mesa_version)" >&2
     else
         echo "warning: could not install lavapipe; GPU tests may find no adapter" >&2
     fi

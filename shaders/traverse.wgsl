@@ -127,6 +127,9 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
             exited = true;
             break;
         }
+        if steps > 0u && (frame.flags & FLAG_SIMULATE_LOOP_CUT) != 0u {
+            break;
+        }
         if steps > 0u && iterations + MAX_STEP_COST > frame.iteration_budget {
             exited = true;
             break;

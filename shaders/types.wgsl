@@ -40,6 +40,9 @@ struct FrameUniforms {
 
 // FrameUniforms.flags: also store each finished pixel's sample sum in `accumulation`.
 const FLAG_STORE_SUM: u32 = 1u;
+// FrameUniforms.flags, for tests: traversals leave their loop early without reaching
+// an exit, as a driver that cuts loops makes them do.
+const FLAG_SIMULATE_LOOP_CUT: u32 = 2u;
 
 struct Sphere {
     center: vec3<f32>,

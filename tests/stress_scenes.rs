@@ -11,7 +11,7 @@ mod common;
 use common::compare::{Tolerance, assert_images_match};
 use common::geometry::{SplitMix, uv_sphere};
 use glam::DVec3;
-use gpu_render::gpu::{GpuError, GpuRenderer};
+use gpu_render::gpu::{GpuError, GpuRenderer, Schedule};
 use gpu_render::scene::{
     Camera, Environment, Light, LightingSpace, Material, MaterialKind, RenderOverrides,
     RenderSettings, Scene, Shape,
@@ -314,19 +314,16 @@ fn a_glass_box_before_walls_of_emissive_squares() {
     assert_backends_agree("glass-box-before-emitters", &scene, 1e-3);
 }
 
-/// With a budget past llvmpipe's real loop limit, one slot tracing a whole image runs
-/// far more than 65,535 iterations in one dispatch: the driver cuts its loops, the
-/// kernels notice, and the host returns an error instead of the short image. On
-/// devices without such a limit the same render simply succeeds.
+/// The host never returns an image whose loops were cut short. A driver that cuts
+/// loops (llvmpipe before Mesa 25, `gpu::driver_loop_limit`) is simulated on any
+/// device: the traversals leave their loop without reaching an exit, the kernels
+/// notice, and the render fails with `TraceIncomplete`. And where the driver really
+/// has the limit, a budget past it makes the driver cut the loops, with the same end.
 #[test]
 fn a_loop_the_driver_cuts_is_an_error_not_a_short_image() {
     let Some(gpu) = common::gpu::headless_gpu() else {
         return;
     };
-    let renderer = GpuRenderer::new(&gpu.device)
-        .expect("renderer")
-        .with_slot_count(1)
-        .with_iteration_budget(u32::MAX);
     let scene = scene(
         settings(16, 16, 64, 1),
         DVec3::new(0.0, 1.0, 4.0),
@@ -342,17 +339,32 @@ fn a_loop_the_driver_cuts_is_an_error_not_a_short_image() {
             },
         ],
     );
-    let result = renderer.render(&gpu.device, &gpu.queue, &scene, None);
-    let name = gpu.adapter_info().name;
-    if name.contains("llvmpipe") {
-        match result {
-            Err(GpuError::TraceIncomplete(message)) => {
-                assert!(message.contains("cut short"), "{message}")
-            }
-            other => panic!("expected TraceIncomplete on {name}, got {other:?}"),
+    let expect_cut = |renderer: GpuRenderer, what: &str| match renderer.render(
+        &gpu.device,
+        &gpu.queue,
+        &scene,
+        None,
+    ) {
+        Err(GpuError::TraceIncomplete(message)) => {
+            assert!(message.contains("cut short"), "{what}: {message}")
         }
-    } else {
-        result.unwrap_or_else(|e| panic!("{name} has no loop limit, yet: {e}"));
+        other => panic!("{what}: expected TraceIncomplete, got {other:?}"),
+    };
+    for schedule in [Schedule::Fused, Schedule::Wavefront] {
+        let simulated = GpuRenderer::new(&gpu.device)
+            .expect("renderer")
+            .with_schedule(schedule)
+            .with_simulated_loop_cut(true);
+        expect_cut(simulated, &format!("simulated cut, {schedule:?}"));
+    }
+    let info = gpu.adapter_info();
+    if let Some(limit) = gpu_render::gpu::driver_loop_limit(&info) {
+        // One slot tracing the whole image in one dispatch runs far past the limit.
+        let unbounded = GpuRenderer::new(&gpu.device)
+            .expect("renderer")
+            .with_slot_count(1)
+            .with_iteration_budget(u32::MAX);
+        expect_cut(unbounded, &format!("{} (limit {limit})", info.name));
     }
 }
 

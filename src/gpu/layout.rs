@@ -86,6 +86,9 @@ pub struct FrameUniforms {
 /// `FrameUniforms.flags`: store each finished pixel's sample sum in the accumulation
 /// buffer.
 pub const FLAG_STORE_SUM: u32 = 1;
+/// `FrameUniforms.flags`, for tests: traversals leave their loop without reaching an
+/// exit, as a driver that cuts loops makes them do.
+pub const FLAG_SIMULATE_LOOP_CUT: u32 = 2;
 
 /// One traversal of one ray, resumable (`TraceRay` in WGSL). Only the shaders read and
 /// write it; the host zeroes it (`TRACE_IDLE`).

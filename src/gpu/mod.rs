@@ -45,5 +45,5 @@ pub use renderer::{GpuRendered, GpuRenderer, TraceRegion, image_tiles};
 pub use scene_buffers::PreparedScene;
 pub use wavefront::{
     LLVMPIPE_LOOP_LIMIT, Schedule, TARGET_SUBMISSION, default_schedule, default_slot_count,
-    iteration_budget_for,
+    driver_loop_limit, iteration_budget_for,
 };

@@ -52,6 +52,7 @@ pub struct GpuRenderer {
     iteration_budget: Option<u32>,
     slot_count: Option<u32>,
     schedule: Option<Schedule>,
+    simulate_loop_cut: bool,
 }
 
 /// The result of [`GpuRenderer::render`].
@@ -148,6 +149,7 @@ impl GpuRenderer {
             iteration_budget: None,
             slot_count: None,
             schedule: None,
+            simulate_loop_cut: false,
         })
     }
 
@@ -201,6 +203,15 @@ impl GpuRenderer {
     /// ([`super::default_schedule`]). The image does not depend on it.
     pub fn with_schedule(mut self, schedule: Schedule) -> Self {
         self.schedule = Some(schedule);
+        self
+    }
+
+    /// For tests of the safety net: with `true`, every traversal leaves its loop early
+    /// without reaching an exit, as when a driver cuts loops (llvmpipe before Mesa 25:
+    /// [`super::driver_loop_limit`]), so that the kernels report it and every render
+    /// fails with [`GpuError::TraceIncomplete`] instead of returning a short image.
+    pub fn with_simulated_loop_cut(mut self, simulate: bool) -> Self {
+        self.simulate_loop_cut = simulate;
         self
     }
 
@@ -330,7 +341,11 @@ impl GpuRenderer {
             end_sample: prepared.samples_per_pixel(),
             slot_count,
             iteration_budget: self.iteration_budget(device),
-            flags: 0,
+            flags: if self.simulate_loop_cut {
+                super::layout::FLAG_SIMULATE_LOOP_CUT
+            } else {
+                0
+            },
             ..prepared.frame
         };
         let done = AtomicU64::new(0);

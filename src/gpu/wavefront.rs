@@ -38,20 +38,42 @@ fn llvmpipe_lanes(adapter: &wgpu::AdapterInfo) -> u32 {
     bits.map_or(16, |bits| (bits / 32).max(1))
 }
 
+/// The Mesa version an adapter's driver reports in its driver info, for example
+/// `(25, 0)` from "Mesa 25.0.7-2~bpo12+1 (LLVM 15.0.6)".
+fn mesa_version(adapter: &wgpu::AdapterInfo) -> Option<(u32, u32)> {
+    let rest = &adapter.driver_info[adapter.driver_info.find("Mesa ")? + 5..];
+    let mut numbers = rest.split(|c: char| !c.is_ascii_digit());
+    let major = numbers.next()?.parse().ok()?;
+    let minor = numbers.next()?.parse().ok()?;
+    Some((major, minor))
+}
+
+/// The loop limit `adapter`'s driver imposes on one shader invocation, where one is
+/// known: llvmpipe before Mesa 25 ends every loop of an invocation once its vector of
+/// lanes has run [`LLVMPIPE_LOOP_LIMIT`] iterations in all (measured on Mesa 22.3.6;
+/// Mesa 25.0.7 counted a loop of 10,000,000 iterations to the end:
+/// `examples/loop_probe.rs`). An llvmpipe whose version cannot be read is taken to have
+/// the limit.
+pub fn driver_loop_limit(adapter: &wgpu::AdapterInfo) -> Option<u32> {
+    let llvmpipe = |s: &str| s.to_lowercase().contains("llvmpipe");
+    let is_llvmpipe =
+        llvmpipe(&adapter.name) || llvmpipe(&adapter.driver) || llvmpipe(&adapter.driver_info);
+    let fixed = mesa_version(adapter).is_some_and(|(major, _)| major >= 25);
+    (is_llvmpipe && !fixed).then_some(LLVMPIPE_LOOP_LIMIT)
+}
+
 /// The iteration budget of one invocation per dispatch on `adapter`.
 ///
-/// On llvmpipe a vector of lanes shares the loop limit ([`LLVMPIPE_LOOP_LIMIT`]) and
-/// iterates only while one of its lanes does, so its count is at most the sum of its
-/// lanes': each lane gets the limit divided by the lanes per vector, less 2048 for
-/// what a lane may run past its budget (the planes of a traversal's start, at most
-/// [`crate::accel::MAX_PLANES`], and its one guaranteed step). Elsewhere 2^20, which
-/// no driver is known to cut and which keeps one dispatch short.
+/// Where the driver limits loops ([`driver_loop_limit`]), a vector of lanes shares
+/// the limit and iterates only while one of its lanes does, so its count is at most
+/// the sum of its lanes': each lane gets the limit divided by the lanes per vector,
+/// less 2048 for what a lane may run past its budget (the planes of a traversal's
+/// start, at most [`crate::accel::MAX_PLANES`], and its one guaranteed step).
+/// Elsewhere 2^20, which keeps one dispatch short.
 pub fn iteration_budget_for(adapter: &wgpu::AdapterInfo) -> u32 {
-    let llvmpipe = |s: &str| s.to_lowercase().contains("llvmpipe");
-    if llvmpipe(&adapter.name) || llvmpipe(&adapter.driver) || llvmpipe(&adapter.driver_info) {
-        LLVMPIPE_LOOP_LIMIT / llvmpipe_lanes(adapter) - 2048
-    } else {
-        1 << 20
+    match driver_loop_limit(adapter) {
+        Some(limit) => limit / llvmpipe_lanes(adapter) - 2048,
+        None => 1 << 20,
     }
 }
 
@@ -405,4 +427,33 @@ fn check_errors(errors: u32) -> Result<(), GpuError> {
         )));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn llvmpipe(driver_info: &str) -> wgpu::AdapterInfo {
+        wgpu::AdapterInfo {
+            name: "llvmpipe (LLVM 15.0.6, 256 bits)".into(),
+            driver: "llvmpipe".into(),
+            driver_info: driver_info.into(),
+            ..wgpu::AdapterInfo::new(wgpu::DeviceType::Cpu, wgpu::Backend::Vulkan)
+        }
+    }
+
+    #[test]
+    fn the_loop_limit_belongs_to_old_llvmpipes() {
+        let old = llvmpipe("Mesa 22.3.6 (LLVM 15.0.6)");
+        assert_eq!(driver_loop_limit(&old), Some(LLVMPIPE_LOOP_LIMIT));
+        // 8 lanes of a 256-bit vector share the limit.
+        assert_eq!(iteration_budget_for(&old), 65_535 / 8 - 2048);
+        let new = llvmpipe("Mesa 25.0.7-2~bpo12+1 (LLVM 15.0.6)");
+        assert_eq!(mesa_version(&new), Some((25, 0)));
+        assert_eq!(driver_loop_limit(&new), None);
+        assert_eq!(iteration_budget_for(&new), 1 << 20);
+        assert_eq!(driver_loop_limit(&llvmpipe("")), Some(LLVMPIPE_LOOP_LIMIT));
+        let gpu = wgpu::AdapterInfo::new(wgpu::DeviceType::DiscreteGpu, wgpu::Backend::Vulkan);
+        assert_eq!(driver_loop_limit(&gpu), None);
+    }
 }
