@@ -149,14 +149,31 @@ fn intersect_polygon(ray: Ray, polygon: Polygon, t_max: f32) -> f32 {
 }
 //#endif
 
-//#if TRIANGLES
-// Watertight ray/triangle of Woop, Benthin and Wald, "Watertight Ray/Triangle
-// Intersection" (JCGT 2(1), 2013), Listing 1: shear the triangle so the ray becomes
-// the +z axis of a permuted frame, then test the signs of the 2D edge functions U, V, W.
-// Triangles sharing an edge get exactly opposite values for it, and 0 counts as
-// inside, so no ray slips between them. The paper's double-precision re-test of zero
-// edge functions is left out (WGSL has no f64); see the CPU twin's notes.
-fn intersect_triangle(ray: Ray, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, t_max: f32) -> f32 {
+// The per-ray part of the watertight ray/triangle test (Woop, Benthin and Wald 2013,
+// Listing 1, "calculate dimension where the ray direction is maximal" and "calculate
+// shear constants"): the permutation that makes the largest direction component z
+// (x and y follow it cyclically, swapped when it is negative to keep the winding), and
+// the shear. Computed once per traversal; every triangle test of the ray reuses it.
+struct ShearedRay {
+    origin: vec3<f32>,
+    // The permutation kx, ky, kz as the component index of each of x, y, z.
+    axes: vec3<u32>,
+    // shear_x, shear_y, shear_z.
+    shear: vec3<f32>,
+}
+
+// Component `k` (0, 1 or 2) of `v`, picked with selects rather than a dynamic index.
+fn vector_component(v: vec3<f32>, k: u32) -> f32 {
+    return select(select(v.x, v.y, k == 1u), v.z, k == 2u);
+}
+
+// `v` with its components reordered to (kx, ky, kz).
+fn permute(v: vec3<f32>, axes: vec3<u32>) -> vec3<f32> {
+    return vec3<f32>(vector_component(v, axes.x), vector_component(v, axes.y),
+                     vector_component(v, axes.z));
+}
+
+fn shear_ray(ray: Ray) -> ShearedRay {
     let d = ray.direction;
     let m = abs(d);
     var kz = 2u;
@@ -169,23 +186,35 @@ fn intersect_triangle(ray: Ray, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, t_m
     }
     var kx = (kz + 1u) % 3u;
     var ky = (kx + 1u) % 3u;
-    if d[kz] < 0.0 {
+    let dz = vector_component(d, kz);
+    if dz < 0.0 {
         let swap = kx;
         kx = ky;
         ky = swap;
     }
-    let shear_x = d[kx] / d[kz];
-    let shear_y = d[ky] / d[kz];
-    let shear_z = 1.0 / d[kz];
-    let a = v0 - ray.origin;
-    let b = v1 - ray.origin;
-    let c = v2 - ray.origin;
-    let ax = a[kx] - shear_x * a[kz];
-    let ay = a[ky] - shear_y * a[kz];
-    let bx = b[kx] - shear_x * b[kz];
-    let by = b[ky] - shear_y * b[kz];
-    let cx = c[kx] - shear_x * c[kz];
-    let cy = c[ky] - shear_y * c[kz];
+    let axes = vec3<u32>(kx, ky, kz);
+    let p = permute(d, axes);
+    return ShearedRay(ray.origin, axes, vec3<f32>(p.x / p.z, p.y / p.z, 1.0 / p.z));
+}
+
+//#if TRIANGLES
+// Watertight ray/triangle of Woop, Benthin and Wald, "Watertight Ray/Triangle
+// Intersection" (JCGT 2(1), 2013), Listing 1: shear the triangle so the ray becomes
+// the +z axis of a permuted frame (`ray`, from shear_ray), then test the signs of the
+// 2D edge functions U, V, W. Triangles sharing an edge get exactly opposite values for
+// it, and 0 counts as inside, so no ray slips between them. The paper's
+// double-precision re-test of zero edge functions is left out (WGSL has no f64); see
+// the CPU twin's notes.
+fn intersect_triangle(ray: ShearedRay, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, t_max: f32) -> f32 {
+    let a = permute(v0 - ray.origin, ray.axes);
+    let b = permute(v1 - ray.origin, ray.axes);
+    let c = permute(v2 - ray.origin, ray.axes);
+    let ax = a.x - ray.shear.x * a.z;
+    let ay = a.y - ray.shear.y * a.z;
+    let bx = b.x - ray.shear.x * b.z;
+    let by = b.y - ray.shear.y * b.z;
+    let cx = c.x - ray.shear.x * c.z;
+    let cy = c.y - ray.shear.y * c.z;
     let u = cx * by - cy * bx;
     let v = ax * cy - ay * cx;
     let w = bx * ay - by * ax;
@@ -196,7 +225,7 @@ fn intersect_triangle(ray: Ray, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, t_m
     if determinant == 0.0 {
         return NO_HIT;
     }
-    let t = shear_z * (u * a[kz] + v * b[kz] + w * c[kz]) / determinant;
+    let t = ray.shear.z * (u * a.z + v * b.z + w * c.z) / determinant;
     if t > 0.0 && t < t_max {
         return t;
     }
@@ -213,7 +242,8 @@ fn prim_index(prim: u32) -> u32 {
 }
 
 // The ray parameter of primitive `prim`'s nearest hit in (0, t_max), or NO_HIT.
-fn intersect_prim(prim: u32, ray: Ray, t_max: f32) -> f32 {
+// `sheared` is shear_ray(ray) (used by triangles; ignored without them).
+fn intersect_prim(prim: u32, ray: Ray, sheared: ShearedRay, t_max: f32) -> f32 {
     let i = prim_index(prim);
     switch prim_kind(prim) {
         //#if SPHERES
@@ -236,7 +266,7 @@ fn intersect_prim(prim: u32, ray: Ray, t_max: f32) -> f32 {
         //#if TRIANGLES
         case PRIM_TRIANGLE: {
             let triangle = triangles[i];
-            return intersect_triangle(ray, triangle.v0, triangle.v1, triangle.v2, t_max);
+            return intersect_triangle(sheared, triangle.v0, triangle.v1, triangle.v2, t_max);
         }
         //#endif
         default: {

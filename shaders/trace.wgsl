@@ -65,7 +65,10 @@ fn medium_ior_at(medium: MediumStack, level: u32) -> f32 {
     if level == 0u {
         return 1.0;
     }
-    return medium.iors[min(level, 4u) - 1u];
+    // Entry min(level, 4) - 1, picked with selects rather than a dynamic index.
+    let i = min(level, 4u) - 1u;
+    let v = medium.iors;
+    return select(select(select(v.x, v.y, i == 1u), v.z, i == 2u), v.w, i == 3u);
 }
 //#endif
 
@@ -85,9 +88,9 @@ fn medium_outside_ior(medium: MediumStack, entering: bool) -> f32 {
 fn medium_after_refraction(medium: MediumStack, entering: bool, ior: f32) -> MediumStack {
     var next = medium;
     if entering {
-        if next.depth < 4u {
-            next.iors[next.depth] = ior;
-        }
+        // Entry `depth` (if below 4) becomes `ior`, set with a select rather than a
+        // dynamic index.
+        next.iors = select(next.iors, vec4<f32>(ior), vec4<u32>(0u, 1u, 2u, 3u) == vec4<u32>(next.depth));
         next.depth += 1u;
     } else if next.depth > 0u {
         next.depth -= 1u;

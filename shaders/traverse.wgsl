@@ -80,6 +80,7 @@ fn traversal_stack_index(slot: u32, level: u32) -> u32 {
 fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
     let ray = Ray((*trace).origin, (*trace).direction);
     let inverse = inverse_direction(ray.direction);
+    let sheared = shear_ray(ray);
     let any_hit = (*trace).any_hit != 0u;
     var best_t = (*trace).best_t;
     var best_prim = (*trace).best_prim;
@@ -97,7 +98,7 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
             }
             iterations += 1u;
             let prim = (PRIM_PLANE << PRIM_KIND_SHIFT) | i;
-            let t = intersect_prim(prim, ray, tie_limit(prim, best_t, best_prim));
+            let t = intersect_prim(prim, ray, sheared, tie_limit(prim, best_t, best_prim));
             if t != NO_HIT {
                 best_t = t;
                 best_prim = prim;
@@ -140,7 +141,7 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
             // The next primitive of the current leaf.
             let prim = bvh_prims[cursor];
             cursor += 1u;
-            let t = intersect_prim(prim, ray, tie_limit(prim, best_t, best_prim));
+            let t = intersect_prim(prim, ray, sheared, tie_limit(prim, best_t, best_prim));
             if t != NO_HIT {
                 best_t = t;
                 best_prim = prim;

@@ -60,7 +60,8 @@ fn traverse_rays(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 fn consider(prim: u32, ray: Ray, best: ptr<function, vec2<u32>>) {
-    let t = intersect_prim(prim, ray, tie_limit(prim, bitcast<f32>((*best).x), (*best).y));
+    let t = intersect_prim(prim, ray, shear_ray(ray),
+                           tie_limit(prim, bitcast<f32>((*best).x), (*best).y));
     if t != NO_HIT {
         *best = vec2<u32>(bitcast<u32>(t), prim);
     }

@@ -42,11 +42,13 @@ pub struct Hit {
     pub prim: PrimRef,
 }
 
-/// The ray parameter of `prim`'s nearest hit along `ray` in (0, `t_max`).
+/// The ray parameter of `prim`'s nearest hit along `ray` in (0, `t_max`); `sheared`
+/// is [`shear_ray`] of `ray`, for triangles.
 pub fn intersect_prim(
     geometry: &SceneGeometry,
     prim: PrimRef,
     ray: &Ray,
+    sheared: &ShearedRay,
     t_max: f64,
 ) -> Option<f64> {
     let i = prim.index();
@@ -59,7 +61,7 @@ pub fn intersect_prim(
             let p = &geometry.polygons[i];
             intersect_polygon(ray, &p.plane, &p.vertices, t_max)
         }
-        PrimKind::Triangle => intersect_triangle(ray, &geometry.triangles[i].vertices, t_max),
+        PrimKind::Triangle => intersect_triangle(sheared, &geometry.triangles[i].vertices, t_max),
         PrimKind::Plane => {
             let p = &geometry.planes[i];
             intersect_plane(ray, p.normal, p.offset, t_max)
@@ -223,26 +225,24 @@ pub fn point_in_polygon(point: DVec3, vertices: &[DVec3], dropped_axis: u32) -> 
     inside
 }
 
-/// Watertight ray/triangle intersection of Woop, Benthin and Wald, "Watertight
-/// Ray/Triangle Intersection" (JCGT 2(1), 2013), Listing 1.
-///
-/// The triangle is translated to the ray origin and sheared so that the ray becomes
-/// the +z axis of a permuted coordinate frame (`kz` = the largest direction
-/// component). The 2D edge functions `U`, `V`, `W` of the sheared vertices then decide
-/// the hit. Two triangles sharing an edge evaluate that edge's function from the same
-/// sheared vertices with the same operations in swapped order, so they get exactly
-/// opposite values: a ray can never pass between them. A value of exactly 0 counts as
-/// inside (the test rejects only mixed signs), so a ray through a shared edge or
-/// vertex hits every triangle there and the nearest `t` wins. The paper re-evaluates
-/// zero edge functions in double precision to learn their true sign; neither backend
-/// has a wider type (the CPU already works in `f64`, WGSL has no `f64`), and treating 0
-/// as inside keeps the test watertight without it.
-///
-/// Returns the ray parameter in (0, `t_max`); a non-finite `t` is a miss.
-pub fn intersect_triangle(ray: &Ray, vertices: &[DVec3; 3], t_max: f64) -> Option<f64> {
+/// The per-ray part of the watertight ray/triangle test (Woop, Benthin and Wald,
+/// "Watertight Ray/Triangle Intersection", JCGT 2(1), 2013, Listing 1): the
+/// permutation that makes the largest direction component z (x and y follow it
+/// cyclically, swapped when it is negative to keep the winding), and the shear.
+/// Computed once per query ([`shear_ray`]) and reused by every triangle test.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShearedRay {
+    /// The ray's origin.
+    pub origin: DVec3,
+    /// `kx, ky, kz`: the component of the original frame that becomes x, y and z.
+    pub axes: [usize; 3],
+    /// `shear_x, shear_y, shear_z`.
+    pub shear: DVec3,
+}
+
+/// The [`ShearedRay`] of `ray`.
+pub fn shear_ray(ray: &Ray) -> ShearedRay {
     let d = ray.direction;
-    // The largest component of the direction becomes z; x and y follow it cyclically,
-    // swapped when d.z' < 0 to keep the winding (Woop et al., §3).
     let abs = d.abs();
     let kz = if abs.x > abs.y {
         if abs.x > abs.z { 0 } else { 2 }
@@ -256,10 +256,32 @@ pub fn intersect_triangle(ray: &Ray, vertices: &[DVec3; 3], t_max: f64) -> Optio
     if d[kz] < 0.0 {
         std::mem::swap(&mut kx, &mut ky);
     }
-    // Shear constants.
-    let shear_x = d[kx] / d[kz];
-    let shear_y = d[ky] / d[kz];
-    let shear_z = 1.0 / d[kz];
+    ShearedRay {
+        origin: ray.origin,
+        axes: [kx, ky, kz],
+        shear: DVec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]),
+    }
+}
+
+/// Watertight ray/triangle intersection of Woop, Benthin and Wald, "Watertight
+/// Ray/Triangle Intersection" (JCGT 2(1), 2013), Listing 1.
+///
+/// The triangle is translated to the ray origin and sheared so that the ray becomes
+/// the +z axis of a permuted coordinate frame (`ray`, from [`shear_ray`]). The 2D edge
+/// functions `U`, `V`, `W` of the sheared vertices then decide the hit. Two triangles
+/// sharing an edge evaluate that edge's function from the same sheared vertices with
+/// the same operations in swapped order, so they get exactly opposite values: a ray
+/// can never pass between them. A value of exactly 0 counts as inside (the test rejects
+/// only mixed signs), so a ray through a shared edge or vertex hits every triangle
+/// there and the nearest `t` wins. The paper re-evaluates zero edge functions in double
+/// precision to learn their true sign; neither backend has a wider type (the CPU
+/// already works in `f64`, WGSL has no `f64`), and treating 0 as inside keeps the test
+/// watertight without it.
+///
+/// Returns the ray parameter in (0, `t_max`); a non-finite `t` is a miss.
+pub fn intersect_triangle(ray: &ShearedRay, vertices: &[DVec3; 3], t_max: f64) -> Option<f64> {
+    let [kx, ky, kz] = ray.axes;
+    let (shear_x, shear_y, shear_z) = (ray.shear.x, ray.shear.y, ray.shear.z);
     let a = vertices[0] - ray.origin;
     let b = vertices[1] - ray.origin;
     let c = vertices[2] - ray.origin;
@@ -393,9 +415,12 @@ mod tests {
             DVec3::new(0.0, 1.0, 0.0),
         ];
         let r = ray(DVec3::new(0.25, 0.25, 2.0), DVec3::NEG_Z);
-        assert_eq!(intersect_triangle(&r, &tri, f64::INFINITY), Some(2.0));
+        assert_eq!(
+            intersect_triangle(&shear_ray(&r), &tri, f64::INFINITY),
+            Some(2.0)
+        );
         let outside = ray(DVec3::new(0.75, 0.75, 2.0), DVec3::NEG_Z);
-        assert!(intersect_triangle(&outside, &tri, f64::INFINITY).is_none());
+        assert!(intersect_triangle(&shear_ray(&outside), &tri, f64::INFINITY).is_none());
     }
 
     /// The 12 triangles of the cube [-1, 1]³, wound outwards.
@@ -440,17 +465,32 @@ mod tests {
             DVec3::new(-0.2, 0.1, -1.0),
         ] {
             let r = ray(DVec3::new(0.1, 0.2, 3.0), direction);
-            let t = intersect_triangle(&r, &tri, f64::INFINITY).expect("hit");
+            let t = intersect_triangle(&shear_ray(&r), &tri, f64::INFINITY).expect("hit");
             assert!(r.at(t).z.abs() < 1e-14, "{direction}");
             // Both windings hit (no back-face culling).
             let flipped = [tri[0], tri[2], tri[1]];
-            assert_eq!(intersect_triangle(&r, &flipped, f64::INFINITY), Some(t));
+            assert_eq!(
+                intersect_triangle(&shear_ray(&r), &flipped, f64::INFINITY),
+                Some(t)
+            );
         }
         // A ray in the triangle's plane misses; so does one aimed away.
         assert!(
-            intersect_triangle(&ray(DVec3::new(-5.0, 0.0, 0.0), DVec3::X), &tri, 1e9).is_none()
+            intersect_triangle(
+                &shear_ray(&ray(DVec3::new(-5.0, 0.0, 0.0), DVec3::X)),
+                &tri,
+                1e9
+            )
+            .is_none()
         );
-        assert!(intersect_triangle(&ray(DVec3::new(0.0, 0.0, 3.0), DVec3::Z), &tri, 1e9).is_none());
+        assert!(
+            intersect_triangle(
+                &shear_ray(&ray(DVec3::new(0.0, 0.0, 3.0), DVec3::Z)),
+                &tri,
+                1e9
+            )
+            .is_none()
+        );
     }
 
     #[test]
@@ -481,9 +521,9 @@ mod tests {
                 for target in &targets {
                     for origin in [inside, *target + (*target - inside) * 3.7] {
                         let r = ray(origin, *target - origin);
-                        let hit = cube
-                            .iter()
-                            .any(|tri| intersect_triangle(&r, tri, f64::INFINITY).is_some());
+                        let hit = cube.iter().any(|tri| {
+                            intersect_triangle(&shear_ray(&r), tri, f64::INFINITY).is_some()
+                        });
                         assert!(
                             hit,
                             "scale {scale}: ray {origin} -> {target} slipped through"

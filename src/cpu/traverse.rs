@@ -2,13 +2,13 @@
 //! function names, the same nodes, the same rules, in `f64`).
 //!
 //! Both queries test the planes first, then descend the tree nearest child first with
-//! a stack of [`MAX_BVH_DEPTH`] entries. Of two hits at exactly the same distance the
+//! a stack of [`MAX_BVH_DEPTH`] entries, one function for both as in WGSL. Of two hits at exactly the same distance the
 //! smaller [`PrimRef`] wins, so the nearest hit does not depend on the visiting order
 //! and equals [`closest_hit_brute_force`], which tests every primitive.
 
 use glam::DVec3;
 
-use super::intersect::{Hit, Ray, hit_record, intersect_prim};
+use super::intersect::{Hit, Ray, hit_record, intersect_prim, shear_ray};
 use crate::accel::{BvhNode, MAX_BVH_DEPTH, PrimKind, PrimRef, SceneGeometry};
 
 /// Direction components smaller than this in magnitude are replaced by it (with their
@@ -79,19 +79,25 @@ fn limit_for(prim: PrimRef, best_t: f64, best: Option<PrimRef>) -> f64 {
     }
 }
 
-/// The nearest primitive along `ray` in (0, `t_max`) and its distance, counting the
-/// work into `counts`.
-pub fn closest_hit_counted(
+/// The traversal both queries share, twin of `advance_traversal` in
+/// `shaders/traverse.wgsl` (without its budget: the CPU never suspends a traversal):
+/// the planes, then the tree nearest child first, each leaf's primitives in order,
+/// each popped node re-tested against the best hit so far. With `any_hit` the first
+/// hit ends it. Returns the best hit, counting the work into `counts`.
+fn traverse(
     geometry: &SceneGeometry,
     ray: &Ray,
     t_max: f64,
+    any_hit: bool,
     counts: &mut TraversalCounts,
 ) -> Option<(f64, PrimRef)> {
+    let sheared = shear_ray(ray);
     let mut best_t = t_max;
     let mut best: Option<PrimRef> = None;
     let mut consider = |prim: PrimRef, best_t: &mut f64, best: &mut Option<PrimRef>| {
         counts.primitives += 1;
-        if let Some(t) = intersect_prim(geometry, prim, ray, limit_for(prim, *best_t, *best)) {
+        let limit = limit_for(prim, *best_t, *best);
+        if let Some(t) = intersect_prim(geometry, prim, ray, &sheared, limit) {
             *best_t = t;
             *best = Some(prim);
         }
@@ -111,7 +117,22 @@ pub fn closest_hit_counted(
         Some(root) if slab.enter(root, best_t).is_some() => Some(0u32),
         _ => None,
     };
-    while let Some(index) = current {
+    loop {
+        if any_hit && best.is_some() {
+            break;
+        }
+        let Some(index) = current else {
+            // Pop; a node pushed earlier may lie beyond a hit found since.
+            if stack_len == 0 {
+                break;
+            }
+            stack_len -= 1;
+            let candidate = stack[stack_len];
+            current = slab
+                .enter(&nodes[candidate as usize], best_t)
+                .map(|_| candidate);
+            continue;
+        };
         counts.nodes += 1;
         let node = &nodes[index as usize];
         current = None;
@@ -120,34 +141,40 @@ pub fn closest_hit_counted(
                 &geometry.bvh.prims[node.first as usize..(node.first + node.count) as usize]
             {
                 consider(prim, &mut best_t, &mut best);
-            }
-        } else {
-            let (a, b) = (node.first, node.first + 1);
-            let enter_a = slab.enter(&nodes[a as usize], best_t);
-            let enter_b = slab.enter(&nodes[b as usize], best_t);
-            current = match (enter_a, enter_b) {
-                (Some(ta), Some(tb)) => {
-                    // Nearest child first; the other waits on the stack.
-                    let (near, far) = if tb < ta { (b, a) } else { (a, b) };
-                    stack[stack_len] = far;
-                    stack_len += 1;
-                    Some(near)
+                if any_hit && best.is_some() {
+                    break;
                 }
-                (Some(_), None) => Some(a),
-                (None, Some(_)) => Some(b),
-                (None, None) => None,
-            };
-        }
-        while current.is_none() && stack_len > 0 {
-            stack_len -= 1;
-            let candidate = stack[stack_len];
-            // A node pushed earlier may lie beyond a hit found since.
-            if slab.enter(&nodes[candidate as usize], best_t).is_some() {
-                current = Some(candidate);
             }
+            continue;
         }
+        let (a, b) = (node.first, node.first + 1);
+        let enter_a = slab.enter(&nodes[a as usize], best_t);
+        let enter_b = slab.enter(&nodes[b as usize], best_t);
+        current = match (enter_a, enter_b) {
+            (Some(ta), Some(tb)) => {
+                // Nearest child first; the other waits on the stack.
+                let (near, far) = if tb < ta { (b, a) } else { (a, b) };
+                stack[stack_len] = far;
+                stack_len += 1;
+                Some(near)
+            }
+            (Some(_), None) => Some(a),
+            (None, Some(_)) => Some(b),
+            (None, None) => None,
+        };
     }
     best.map(|prim| (best_t, prim))
+}
+
+/// The nearest primitive along `ray` in (0, `t_max`) and its distance, counting the
+/// work into `counts`.
+pub fn closest_hit_counted(
+    geometry: &SceneGeometry,
+    ray: &Ray,
+    t_max: f64,
+    counts: &mut TraversalCounts,
+) -> Option<(f64, PrimRef)> {
+    traverse(geometry, ray, t_max, false, counts)
 }
 
 /// The nearest hit along `ray` in (0, `t_max`), its point re-projected onto the
@@ -172,52 +199,7 @@ pub fn occluded_counted(
     t_max: f64,
     counts: &mut TraversalCounts,
 ) -> bool {
-    for i in 0..geometry.planes.len() {
-        counts.primitives += 1;
-        if intersect_prim(
-            geometry,
-            PrimRef::new(PrimKind::Plane, i as u32),
-            ray,
-            t_max,
-        )
-        .is_some()
-        {
-            return true;
-        }
-    }
-    let nodes = &geometry.bvh.nodes;
-    let slab = SlabRay::new(ray);
-    let mut stack = [0u32; MAX_BVH_DEPTH as usize];
-    let mut stack_len = 0usize;
-    if let Some(root) = nodes.first()
-        && slab.enter(root, t_max).is_some()
-    {
-        stack[0] = 0;
-        stack_len = 1;
-    }
-    while stack_len > 0 {
-        stack_len -= 1;
-        let node = &nodes[stack[stack_len] as usize];
-        counts.nodes += 1;
-        if node.is_leaf() {
-            for &prim in
-                &geometry.bvh.prims[node.first as usize..(node.first + node.count) as usize]
-            {
-                counts.primitives += 1;
-                if intersect_prim(geometry, prim, ray, t_max).is_some() {
-                    return true;
-                }
-            }
-        } else {
-            for child in [node.first + 1, node.first] {
-                if slab.enter(&nodes[child as usize], t_max).is_some() {
-                    stack[stack_len] = child;
-                    stack_len += 1;
-                }
-            }
-        }
-    }
-    false
+    traverse(geometry, ray, t_max, true, counts).is_some()
 }
 
 /// The nearest hit by testing every primitive, with the same tie rule: the oracle of
@@ -235,10 +217,12 @@ pub fn closest_hit_brute_force(
         (PrimKind::Polygon, geometry.polygons.len()),
         (PrimKind::Triangle, geometry.triangles.len()),
     ];
+    let sheared = shear_ray(ray);
     for (kind, count) in kinds {
         for i in 0..count {
             let prim = PrimRef::new(kind, i as u32);
-            if let Some(t) = intersect_prim(geometry, prim, ray, limit_for(prim, best_t, best)) {
+            let limit = limit_for(prim, best_t, best);
+            if let Some(t) = intersect_prim(geometry, prim, ray, &sheared, limit) {
                 best_t = t;
                 best = Some(prim);
             }
