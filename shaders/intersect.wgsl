@@ -114,17 +114,17 @@ fn project_to_plane(p: vec3<f32>, dropped_axis: u32) -> vec2<f32> {
 
 //#if POLYGONS
 // Even-odd (crossing number) inside test in the projection that drops the polygon's
-// dominant axis (Haines, "Point in Polygon Strategies", Graphics Gems IV).
+// dominant axis (Haines, "Point in Polygon Strategies", Graphics Gems IV). The vertices
+// come projected already (`polygon_points`, the same f32 coordinates).
 fn point_in_polygon(p: vec3<f32>, polygon: Polygon) -> bool {
     // Its loop's iterations count against the invocation's budget (traverse.wgsl).
     iterations += polygon.vertex_count;
     let point = project_to_plane(p, polygon.dropped_axis);
     var inside = false;
     let last = polygon.first_vertex + polygon.vertex_count - 1u;
-    var previous = project_to_plane(polygon_vertices[last].xyz, polygon.dropped_axis);
+    var previous = polygon_points[last];
     for (var i = 0u; i < polygon.vertex_count; i += 1u) {
-        let current = project_to_plane(polygon_vertices[polygon.first_vertex + i].xyz,
-                                       polygon.dropped_axis);
+        let current = polygon_points[polygon.first_vertex + i];
         if (current.y > point.y) != (previous.y > point.y) {
             let crossing_u = current.x
                 + (point.y - current.y) * (previous.x - current.x) / (previous.y - current.y);

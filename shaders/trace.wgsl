@@ -23,7 +23,8 @@
 @group(0) @binding(1) var<storage, read> spheres: array<Sphere>;
 @group(0) @binding(2) var<storage, read> planes: array<Plane>;
 @group(0) @binding(3) var<storage, read> polygons: array<Polygon>;
-@group(0) @binding(4) var<storage, read> polygon_vertices: array<vec4<f32>>;
+// Each polygon vertex projected for the inside test (the plane's dropped axis removed).
+@group(0) @binding(4) var<storage, read> polygon_points: array<vec2<f32>>;
 @group(0) @binding(5) var<storage, read> triangles: array<Triangle>;
 @group(0) @binding(6) var<storage, read> materials: array<Material>;
 @group(0) @binding(7) var<storage, read> lights: array<Light>;

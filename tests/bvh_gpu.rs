@@ -27,7 +27,7 @@ const KERNELS: &str = r"
 @group(0) @binding(1) var<storage, read> spheres: array<Sphere>;
 @group(0) @binding(2) var<storage, read> planes: array<Plane>;
 @group(0) @binding(3) var<storage, read> polygons: array<Polygon>;
-@group(0) @binding(4) var<storage, read> polygon_vertices: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> polygon_points: array<vec2<f32>>;
 @group(0) @binding(5) var<storage, read> triangles: array<Triangle>;
 @group(0) @binding(9) var<storage, read_write> counters: Counters;
 @group(0) @binding(12) var<storage, read> bvh_nodes: array<BvhNode>;
@@ -179,7 +179,7 @@ fn run_kernel(
         (3, storage(bytemuck::cast_slice(&records.polygons), none)),
         (
             4,
-            storage(bytemuck::cast_slice(&records.polygon_vertices), none),
+            storage(bytemuck::cast_slice(&records.polygon_points), none),
         ),
         (5, storage(bytemuck::cast_slice(&records.triangles), none)),
         (

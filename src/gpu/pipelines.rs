@@ -19,7 +19,7 @@ pub const LINEAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 /// Bindings of the trace module (`shaders/trace.wgsl`): 0 uniforms; 1–7 spheres,
-/// planes, polygons, polygon vertices, triangles, materials, lights; 8 the linear
+/// planes, polygons, polygon points, triangles, materials, lights; 8 the linear
 /// output; 9 counters; 10 accumulation; 11 images; 12–13 BVH nodes and primitives;
 /// 14–17 path states, bounce stacks, traces, traversal stacks.
 pub(crate) mod binding {
@@ -27,7 +27,7 @@ pub(crate) mod binding {
     pub const SPHERES: u32 = 1;
     pub const PLANES: u32 = 2;
     pub const POLYGONS: u32 = 3;
-    pub const POLYGON_VERTICES: u32 = 4;
+    pub const POLYGON_POINTS: u32 = 4;
     pub const TRIANGLES: u32 = 5;
     pub const MATERIALS: u32 = 6;
     pub const LIGHTS: u32 = 7;
@@ -141,7 +141,7 @@ impl Pipelines {
                         storage_entry(SPHERES, true),
                         storage_entry(PLANES, true),
                         storage_entry(POLYGONS, true),
-                        storage_entry(POLYGON_VERTICES, true),
+                        storage_entry(POLYGON_POINTS, true),
                         storage_entry(TRIANGLES, true),
                         storage_entry(MATERIALS, true),
                         storage_entry(LIGHTS, true),

@@ -15,7 +15,7 @@ pub(crate) struct SceneBuffers {
     pub spheres: wgpu::Buffer,
     pub planes: wgpu::Buffer,
     pub polygons: wgpu::Buffer,
-    pub polygon_vertices: wgpu::Buffer,
+    pub polygon_points: wgpu::Buffer,
     pub triangles: wgpu::Buffer,
     pub materials: wgpu::Buffer,
     pub lights: wgpu::Buffer,
@@ -141,9 +141,9 @@ pub(crate) fn upload_scene(
         spheres: upload("sphere", bytemuck::cast_slice(&padded.spheres))?,
         planes: upload("plane", bytemuck::cast_slice(&padded.planes))?,
         polygons: upload("polygon", bytemuck::cast_slice(&padded.polygons))?,
-        polygon_vertices: upload(
-            "polygon vertex",
-            bytemuck::cast_slice(&padded.polygon_vertices),
+        polygon_points: upload(
+            "polygon point",
+            bytemuck::cast_slice(&padded.polygon_points),
         )?,
         triangles: upload("triangle", bytemuck::cast_slice(&padded.triangles))?,
         materials: upload("material", bytemuck::cast_slice(&padded.materials))?,

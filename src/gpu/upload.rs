@@ -16,7 +16,7 @@ use crate::accel::{BvhNode, PolygonShape, SceneGeometry};
 use crate::camera::CameraFrame;
 use crate::scene::{
     FresnelModel, Image, Light, Material, MaterialKind, MediumStack, MicrofacetDistribution, Scene,
-    TextureMapping,
+    TextureMapping, project_to_plane,
 };
 
 /// Every record list of a scene, ready for upload. The lists hold exactly the scene's
@@ -28,10 +28,12 @@ pub struct SceneRecords {
     /// Planes, in [`SceneGeometry::planes`] order.
     pub planes: Vec<GpuPlane>,
     /// Polygons, in [`SceneGeometry::polygons`] order; their vertices are in
-    /// `polygon_vertices`.
+    /// `polygon_points`.
     pub polygons: Vec<GpuPolygon>,
-    /// The vertices of all polygons, concatenated, as `vec4` with `w = 0`.
-    pub polygon_vertices: Vec<[f32; 4]>,
+    /// The vertices of all polygons, concatenated, each as the two coordinates of its
+    /// polygon's inside-test projection ([`crate::scene::project_to_plane`] by the
+    /// plane's dropped axis): all the inside test reads, in half the bytes.
+    pub polygon_points: Vec<[f32; 2]>,
     /// Triangles, in [`SceneGeometry::triangles`] order.
     pub triangles: Vec<GpuTriangle>,
     /// Materials, indexed by the shapes' `material`.
@@ -86,13 +88,13 @@ impl SceneRecords {
             ..Self::default()
         };
         for polygon in &geometry.polygons {
-            let first_vertex = records.polygon_vertices.len();
-            records.polygon_vertices.extend(
-                polygon
-                    .vertices
-                    .iter()
-                    .map(|v| [v.x as f32, v.y as f32, v.z as f32, 0.0]),
-            );
+            let first_vertex = records.polygon_points.len();
+            records
+                .polygon_points
+                .extend(polygon.vertices.iter().map(|v| {
+                    let (u, w) = project_to_plane(*v, polygon.plane.dropped_axis);
+                    [u as f32, w as f32]
+                }));
             records.polygons.push(polygon_record(polygon, first_vertex));
         }
         records.materials = scene
@@ -112,7 +114,7 @@ impl SceneRecords {
             spheres: pad(&self.spheres),
             planes: pad(&self.planes),
             polygons: pad(&self.polygons),
-            polygon_vertices: pad(&self.polygon_vertices),
+            polygon_points: pad(&self.polygon_points),
             triangles: pad(&self.triangles),
             materials: pad(&self.materials),
             lights: pad(&self.lights),
@@ -422,7 +424,7 @@ mod tests {
         assert_eq!(padded.spheres, vec![GpuSphere::zeroed()]);
         assert_eq!(padded.planes.len(), 1);
         assert_eq!(padded.polygons.len(), 1);
-        assert_eq!(padded.polygon_vertices, vec![[0.0; 4]]);
+        assert_eq!(padded.polygon_points, vec![[0.0; 2]]);
         assert_eq!(padded.triangles.len(), 1);
         assert_eq!(padded.lights.len(), 1);
         assert_eq!(padded.bvh_nodes.len(), 1);
@@ -490,8 +492,10 @@ mod tests {
             (r.polygons[1].first_vertex, r.polygons[1].vertex_count),
             (4, 3)
         );
-        assert_eq!(r.polygon_vertices.len(), 7);
-        assert_eq!(r.polygon_vertices[5], [1.0, 0.0, 0.0, 0.0]);
+        assert_eq!(r.polygon_points.len(), 7);
+        // The square's plane is z = 0: its points are (x, y).
+        assert_eq!(r.polygon_points[5], [1.0, 0.0]);
+        assert_eq!(r.polygon_points[2], [1.0, 1.0]);
         assert_eq!(r.polygons[0].dropped_axis, 2);
         assert_eq!(r.triangles[0].v2, [0.0, 0.0, 1.0]);
         assert_eq!(r.lights[0].kind, LIGHT_POINT);

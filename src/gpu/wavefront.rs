@@ -257,7 +257,7 @@ impl SlotBuffers {
                     buffer(binding::SPHERES, &s.spheres),
                     buffer(binding::PLANES, &s.planes),
                     buffer(binding::POLYGONS, &s.polygons),
-                    buffer(binding::POLYGON_VERTICES, &s.polygon_vertices),
+                    buffer(binding::POLYGON_POINTS, &s.polygon_points),
                     buffer(binding::TRIANGLES, &s.triangles),
                     buffer(binding::MATERIALS, &s.materials),
                     buffer(binding::LIGHTS, &s.lights),
