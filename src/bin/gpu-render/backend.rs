@@ -54,6 +54,7 @@ impl Backend {
     pub fn open(
         choice: BackendArg,
         adapter: Option<&AdapterArg>,
+        scene: &Scene,
         options: &GpuOptions,
         quiet: bool,
     ) -> Result<Self> {
@@ -68,7 +69,7 @@ impl Backend {
             BackendArg::Gpu => Self::open_gpu(&adapter_choice, options),
             BackendArg::Auto if adapter.is_some() => Self::open_gpu(&adapter_choice, options),
             BackendArg::Auto => match HeadlessGpu::new(&adapter_choice) {
-                Ok(gpu) => match auto_rule(&gpu.adapter_info()) {
+                Ok(gpu) => match auto_rule(&gpu.adapter_info(), scene) {
                     Some(reason) => Ok(Backend::Cpu {
                         reason: Some(reason),
                     }),
@@ -156,18 +157,33 @@ impl Backend {
     }
 }
 
-/// The rule of `--backend auto` for the adapter wgpu prefers: a real GPU is used; a CPU
-/// device (lavapipe, llvmpipe, WARP: a software rasteriser on the same cores) is not,
-/// because on it the CPU reference is faster, as measured in `BENCHMARKS.md`
-/// ("--backend auto"). Returns why the CPU reference is chosen instead, if it is.
-pub fn auto_rule(adapter: &wgpu::AdapterInfo) -> Option<String> {
-    (adapter.device_type == wgpu::DeviceType::Cpu).then(|| {
-        format!(
-            "the only adapter, {}, is a CPU device, on which the CPU reference is faster \
-             (BENCHMARKS.md); --backend gpu uses it anyway",
-            adapter.name
-        )
-    })
+/// The rule of `--backend auto` for the adapter wgpu prefers and `scene`, from the
+/// figures in `BENCHMARKS.md` ("--backend auto"): a real GPU is always used. A CPU
+/// device (lavapipe, llvmpipe, WARP: software on the same cores as the CPU reference)
+/// is used only where it measured faster than the CPU reference: llvmpipe from Mesa 25
+/// (whose loops have no limit, `gpu::driver_loop_limit`) on scenes without polygons
+/// and without glass (2.7x on the direct-light scene, 1.2x on spheres and planes);
+/// polygons and refraction make it slower (0.45x on `glass.toml`, 0.5x on the
+/// showcase), and so is every scene on older Mesa. Returns why the CPU reference is
+/// chosen instead, if it is.
+pub fn auto_rule(adapter: &wgpu::AdapterInfo, scene: &Scene) -> Option<String> {
+    if adapter.device_type != wgpu::DeviceType::Cpu {
+        return None;
+    }
+    let why = if gpu::driver_loop_limit(adapter).is_some() {
+        "on this driver version the CPU reference is faster for every scene measured"
+    } else {
+        let features = gpu::ShaderFeatures::for_scene(scene);
+        if !(features.polygons || features.refraction) {
+            return None;
+        }
+        "for scenes with polygons or glass the CPU reference is faster"
+    };
+    Some(format!(
+        "the only adapter, {}, is a CPU device, and {why} (BENCHMARKS.md); --backend gpu \
+         uses it anyway",
+        adapter.name
+    ))
 }
 
 /// Prints the GPU adapters wgpu can see, one a line, on stdout.
@@ -208,20 +224,46 @@ mod tests {
         }
     }
 
+    fn scene(text: &str) -> gpu_render::scene::Scene {
+        gpu_render::scene::parse_scene(text, std::path::Path::new("<test>")).expect("scene")
+    }
+
     #[test]
-    fn auto_uses_real_gpus_and_not_cpu_devices() {
-        let lavapipe = adapter("llvmpipe (LLVM 15.0.6, 256 bits)", wgpu::DeviceType::Cpu);
-        let reason = auto_rule(&lavapipe).expect("a CPU device is not used");
+    fn auto_uses_real_gpus_and_cpu_devices_only_where_they_measured_faster() {
+        let camera = "[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\n";
+        let sphere =
+            "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n";
+        let spheres = scene(&format!(
+            "{camera}[materials.m]\ntype = \"lambert\"\nalbedo = 0.5\n{sphere}"
+        ));
+        let glass = scene(&format!(
+            "{camera}[materials.m]\ntype = \"dielectric\"\nior = 1.5\n{sphere}"
+        ));
+        let lavapipe = |mesa: &str| wgpu::AdapterInfo {
+            driver: "llvmpipe".into(),
+            driver_info: format!("Mesa {mesa} (LLVM 15.0.6)"),
+            ..adapter("llvmpipe (LLVM 15.0.6, 256 bits)", wgpu::DeviceType::Cpu)
+        };
+        let new = lavapipe("25.0.7");
+        assert_eq!(auto_rule(&new, &spheres), None);
+        let reason = auto_rule(&new, &glass).expect("glass renders on the CPU");
         assert!(
-            reason.contains("llvmpipe") && reason.contains("CPU device"),
+            reason.contains("llvmpipe") && reason.contains("glass"),
             "{reason}"
         );
+        let old = lavapipe("22.3.6");
+        let reason = auto_rule(&old, &spheres).expect("old llvmpipe is not used");
+        assert!(reason.contains("every scene"), "{reason}");
         for kind in [
             wgpu::DeviceType::DiscreteGpu,
             wgpu::DeviceType::IntegratedGpu,
             wgpu::DeviceType::VirtualGpu,
         ] {
-            assert_eq!(auto_rule(&adapter("NVIDIA H200", kind)), None, "{kind:?}");
+            assert_eq!(
+                auto_rule(&adapter("NVIDIA H200", kind), &glass),
+                None,
+                "{kind:?}"
+            );
         }
     }
 }

@@ -142,6 +142,7 @@ fn render(args: &RenderArgs, scene_path: &Path, output_path: &Path) -> Result<()
     let backend = Backend::open(
         args.backend,
         args.adapter.as_ref(),
+        &scene,
         &gpu_options,
         args.quiet,
     )?;

@@ -60,7 +60,7 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
     for name in OUTPUT_FILES {
         gpu_render::output::check_output_path(&args.out_dir.join(name))?;
     }
-    let backend = Backend::open(args.backend, None, &GpuOptions::default(), false)?;
+    let backend = Backend::open(args.backend, None, &scene, &GpuOptions::default(), false)?;
 
     let progress = Progress::new("rendering the reference", true);
     let reference = backend.render(&reference_scene, &|done, total| {
