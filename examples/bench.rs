@@ -30,7 +30,7 @@ use gpu_render::scene::{RenderOverrides, load_scene};
 
 #[derive(Parser)]
 struct Args {
-    /// Scene file.
+    /// Scene file, or `generated:million` for the million-triangle terrain.
     scene: PathBuf,
     /// Image width override.
     #[arg(long)]
@@ -68,9 +68,131 @@ fn median(mut values: Vec<f64>) -> f64 {
     values[values.len() / 2]
 }
 
+/// The million-triangle benchmark scene, generated: a terrain of 708 x 708 quads (two
+/// triangles each, 1,002,528 triangles) under a sun and a point light, three Lambert
+/// spheres, a mirror sphere and a glass sphere; 1920x1080, 1 spp, depth 4.
+fn million_triangle_scene() -> gpu_render::scene::Scene {
+    use glam::DVec3;
+    use gpu_render::scene::{
+        Camera, Environment, Light, LightingSpace, Material, MaterialKind, RenderSettings, Scene,
+        Shape,
+    };
+    let n = 708;
+    let size = 40.0;
+    let height = |i: usize, j: usize| {
+        let (x, z) = (
+            i as f64 / n as f64 * size - size / 2.0,
+            j as f64 / n as f64 * size - size / 2.0,
+        );
+        0.6 * (0.35 * x).sin() * (0.3 * z).cos()
+            + 0.15 * (1.7 * x + 0.4).sin() * (1.3 * z).sin()
+            + 0.04 * (7.0 * x).cos() * (6.0 * z + 1.0).sin()
+    };
+    let point = |i: usize, j: usize| {
+        DVec3::new(
+            i as f64 / n as f64 * size - size / 2.0,
+            height(i, j) - 1.0,
+            j as f64 / n as f64 * size - size / 2.0,
+        )
+    };
+    let mut shapes = Vec::with_capacity(2 * n * n + 8);
+    for i in 0..n {
+        for j in 0..n {
+            let (a, b, c, d) = (
+                point(i, j),
+                point(i + 1, j),
+                point(i + 1, j + 1),
+                point(i, j + 1),
+            );
+            shapes.push(Shape::Triangle {
+                vertices: [a, d, c],
+                material: 0,
+            });
+            shapes.push(Shape::Triangle {
+                vertices: [a, c, b],
+                material: 0,
+            });
+        }
+    }
+    for (k, (x, z)) in [(-3.0, -2.0), (0.0, -4.0), (3.0, -2.5)]
+        .into_iter()
+        .enumerate()
+    {
+        shapes.push(Shape::Sphere {
+            center: DVec3::new(x, 0.2, z),
+            radius: 0.9,
+            material: 1 + k as u32 % 2,
+        });
+    }
+    shapes.push(Shape::Sphere {
+        center: DVec3::new(-1.2, 0.3, 0.5),
+        radius: 0.8,
+        material: 3,
+    });
+    shapes.push(Shape::Sphere {
+        center: DVec3::new(1.5, 0.3, 0.8),
+        radius: 0.8,
+        material: 4,
+    });
+    let lambert = |r, g, b| Material::lambert(DVec3::new(r, g, b));
+    Scene {
+        render: RenderSettings {
+            width: 1920,
+            height: 1080,
+            samples_per_pixel: 1,
+            max_depth: 4,
+            stack_size: 5,
+            lighting_space: LightingSpace::Linear,
+            min_ray_weight: 0.0,
+        },
+        camera: Camera {
+            eye: DVec3::new(0.0, 2.5, 7.0),
+            look_at: DVec3::new(0.0, 0.0, -1.0),
+            up: DVec3::Y,
+            fov_y_degrees: 55.0,
+        },
+        environment: Environment {
+            background: DVec3::new(0.35, 0.45, 0.6),
+            ambient: DVec3::ZERO,
+        },
+        materials: vec![
+            lambert(0.45, 0.5, 0.35),
+            lambert(0.8, 0.3, 0.25),
+            lambert(0.25, 0.4, 0.8),
+            Material {
+                reflectance: DVec3::splat(0.9),
+                ..Material::blank(MaterialKind::Mirror)
+            },
+            Material {
+                ior: 1.5,
+                ..Material::blank(MaterialKind::Dielectric)
+            },
+        ],
+        material_names: ["terrain", "red", "blue", "mirror", "glass"]
+            .map(String::from)
+            .to_vec(),
+        lights: vec![
+            Light::Directional {
+                direction: DVec3::new(-0.4, -1.0, -0.3).normalize(),
+                irradiance: DVec3::splat(2.5),
+            },
+            Light::Point {
+                position: DVec3::new(2.0, 4.0, 3.0),
+                intensity: DVec3::splat(15.0),
+            },
+        ],
+        shapes,
+        images: vec![],
+    }
+}
+
 fn main() -> Result<()> {
     let args = Args::parse();
-    let mut scene = load_scene(&args.scene)?;
+    let mut scene = if args.scene.as_os_str() == "generated:million" {
+        million_triangle_scene()
+    } else {
+        load_scene(&args.scene)?
+    };
     scene.render = scene
         .render
         .with_overrides(&RenderOverrides {
@@ -111,6 +233,16 @@ fn main() -> Result<()> {
     }
     // Warm-up: the first dispatch compiles the pipeline (lavapipe runs LLVM then).
     renderer.render(&gpu.device, &gpu.queue, &scene, None)?;
+    let prepared = renderer.prepare(&gpu.device, &gpu.queue, &scene)?;
+    let primitives = gpu_render::accel::SceneGeometry::new(&scene).bounded_count();
+    println!(
+        "GPU scene buffers: {} bytes for {primitives} bounded primitives ({:.1} bytes each, \
+         BVH included); BVH built in {:.1} ms",
+        prepared.scene_bytes(),
+        prepared.scene_bytes() as f64 / primitives.max(1) as f64,
+        prepared.bvh_stats().build_time.as_secs_f64() * 1e3
+    );
+    drop(prepared);
     if !args.gpu_only {
         gpu_render::cpu::render(&scene, None);
     }
@@ -306,27 +438,28 @@ fn traversal_figures(scene: &gpu_render::scene::Scene) {
                     continue;
                 };
                 let hit = hit_record(&geometry, prim, &ray, t);
-                if let Some(gpu_render::scene::Light::Point { position, .. }) = scene.lights.first()
-                {
-                    let n = if ray.direction.dot(hit.normal) < 0.0 {
-                        hit.normal
-                    } else {
-                        -hit.normal
-                    };
-                    let origin = gpu_render::cpu::intersect::offset_ray_origin(
-                        hit.position,
-                        n,
-                        geometry.offset_scale,
-                    );
-                    let to_light = *position - origin;
-                    let distance = to_light.length();
-                    let shadow_ray = Ray {
-                        origin,
-                        direction: to_light / distance,
-                    };
-                    shadow_rays += 1;
-                    occluded_counted(&geometry, &shadow_ray, distance, &mut shadow);
-                }
+                let n = if ray.direction.dot(hit.normal) < 0.0 {
+                    hit.normal
+                } else {
+                    -hit.normal
+                };
+                let origin = gpu_render::cpu::intersect::offset_ray_origin(
+                    hit.position,
+                    n,
+                    geometry.offset_scale,
+                );
+                let (direction, distance) = match scene.lights.first() {
+                    Some(gpu_render::scene::Light::Point { position, .. }) => {
+                        let to_light = *position - origin;
+                        (to_light.normalize(), to_light.length())
+                    }
+                    Some(gpu_render::scene::Light::Directional { direction, .. }) => {
+                        (-*direction, f64::INFINITY)
+                    }
+                    None => continue,
+                };
+                shadow_rays += 1;
+                occluded_counted(&geometry, &Ray { origin, direction }, distance, &mut shadow);
             }
         }
         let per = |count: u64, rays: u64| count as f64 / rays.max(1) as f64;

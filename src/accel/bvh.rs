@@ -22,7 +22,7 @@
 use std::time::{Duration, Instant};
 
 use bytemuck::{Pod, Zeroable};
-use glam::DVec3;
+use glam::{DVec3, Vec3A};
 
 use super::geometry::PrimRef;
 
@@ -116,19 +116,6 @@ impl Aabb32 {
         }
         Self::around(lo, hi)
     }
-
-    fn union(&self, other: &Self) -> Self {
-        let mut out = *self;
-        for axis in 0..3 {
-            out.min[axis] = out.min[axis].min(other.min[axis]);
-            out.max[axis] = out.max[axis].max(other.max[axis]);
-        }
-        out
-    }
-
-    fn centroid(&self) -> [f32; 3] {
-        [0, 1, 2].map(|a| 0.5 * self.min[a] + 0.5 * self.max[a])
-    }
 }
 
 /// Which builder makes the tree.
@@ -214,160 +201,243 @@ pub const MEDIAN_SPLIT_DEPTH: u32 = 30;
 /// Subtrees with fewer primitives than this are built on the current thread.
 const PARALLEL_THRESHOLD: usize = 50_000;
 
-/// What the builders work on: the primitives' boxes and centroids.
-struct BuildInput<'a> {
-    boxes: &'a [(PrimRef, Aabb32)],
-    centroids: Vec<[f32; 3]>,
-    method: BuildMethod,
+/// One primitive as the builders move it around: its box (the lanes' fourth float
+/// holds its position in the input). Kept contiguous and reordered in place, so each
+/// pass over a node's primitives reads memory in order.
+#[derive(Debug, Clone, Copy)]
+struct BuildPrim {
+    min: Vec3A,
+    max: Vec3A,
+    index: u32,
+}
+
+impl BuildPrim {
+    /// Twice the box's centre: the factor cancels in every comparison.
+    fn centroid(&self) -> Vec3A {
+        self.min + self.max
+    }
+}
+
+/// A box during the build, in SIMD lanes (no NaN reaches the builder: validated
+/// geometry only).
+#[derive(Debug, Clone, Copy)]
+struct SimdBox {
+    min: Vec3A,
+    max: Vec3A,
+}
+
+impl SimdBox {
+    const EMPTY: Self = Self {
+        min: Vec3A::INFINITY,
+        max: Vec3A::NEG_INFINITY,
+    };
+
+    fn union(&self, other: &Self) -> Self {
+        Self {
+            min: self.min.min(other.min),
+            max: self.max.max(other.max),
+        }
+    }
+
+    fn half_area(&self) -> f32 {
+        let e = (self.max - self.min).max(Vec3A::ZERO);
+        e.x * e.y + e.y * e.z + e.z * e.x
+    }
+
+    fn to_aabb(self) -> Aabb32 {
+        Aabb32 {
+            min: self.min.to_array(),
+            max: self.max.to_array(),
+        }
+    }
+}
+
+/// The bounds a node is built with: its primitives' box and their centroids' box.
+#[derive(Debug, Clone, Copy)]
+struct NodeBounds {
+    boxes: SimdBox,
+    centroids: SimdBox,
+}
+
+impl NodeBounds {
+    const EMPTY: Self = Self {
+        boxes: SimdBox::EMPTY,
+        centroids: SimdBox::EMPTY,
+    };
+
+    fn add(&mut self, prim: &BuildPrim) {
+        self.boxes.min = self.boxes.min.min(prim.min);
+        self.boxes.max = self.boxes.max.max(prim.max);
+        let centroid = prim.centroid();
+        self.centroids.min = self.centroids.min.min(centroid);
+        self.centroids.max = self.centroids.max.max(centroid);
+    }
+
+    fn union(&self, other: &Self) -> Self {
+        Self {
+            boxes: self.boxes.union(&other.boxes),
+            centroids: self.centroids.union(&other.centroids),
+        }
+    }
+
+    fn of(prims: &[BuildPrim]) -> Self {
+        let mut bounds = Self::EMPTY;
+        prims.iter().for_each(|p| bounds.add(p));
+        bounds
+    }
 }
 
 fn build_tree(primitives: &[(PrimRef, Aabb32)], method: BuildMethod) -> Bvh {
     if primitives.is_empty() {
         return Bvh::default();
     }
-    let input = BuildInput {
-        boxes: primitives,
-        centroids: primitives.iter().map(|(_, b)| b.centroid()).collect(),
-        method,
-    };
-    let mut order: Vec<u32> = (0..primitives.len() as u32).collect();
+    let mut prims: Vec<BuildPrim> = primitives
+        .iter()
+        .enumerate()
+        .map(|(i, (_, b))| BuildPrim {
+            min: Vec3A::from_array(b.min),
+            max: Vec3A::from_array(b.max),
+            index: i as u32,
+        })
+        .collect();
     let threads = std::thread::available_parallelism().map_or(1, usize::from);
     let mut arena = Vec::with_capacity(2 * primitives.len() / MAX_LEAF_PRIMITIVES as usize + 1);
-    build_subtree(&input, &mut order, 0, 1, threads, &mut arena);
-    let prims: Vec<PrimRef> = order.iter().map(|&i| primitives[i as usize].0).collect();
-    let mut bvh = flatten(&arena, &prims);
+    let bounds = NodeBounds::of(&prims);
+    build_subtree(method, &mut prims, bounds, 0, 1, threads, &mut arena);
+    let order: Vec<PrimRef> = prims
+        .iter()
+        .map(|p| primitives[p.index as usize].0)
+        .collect();
+    let mut bvh = flatten(&arena, &order);
     bvh.stats.method = method;
     bvh
 }
 
-/// The box around the primitives `order` names, and the box around their centroids.
-fn bounds_of(input: &BuildInput<'_>, order: &[u32]) -> (Aabb32, Aabb32) {
-    let mut boxes = Aabb32::EMPTY;
-    let mut centroids = Aabb32::EMPTY;
-    for &i in order {
-        boxes = boxes.union(&input.boxes[i as usize].1);
-        let c = input.centroids[i as usize];
-        centroids = centroids.union(&Aabb32 { min: c, max: c });
-    }
-    (boxes, centroids)
-}
-
-/// Half the surface area of a box (0 for an empty one).
-fn half_area(b: &Aabb32) -> f32 {
-    let e = [0, 1, 2].map(|a| (b.max[a] - b.min[a]).max(0.0));
-    e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
-}
-
-/// Reorders `order` for a split and returns how many primitives go left (between 1
-/// and `order.len() - 1`).
-fn split(input: &BuildInput<'_>, order: &mut [u32], centroids: &Aabb32, depth: u32) -> usize {
-    let extent = [0, 1, 2].map(|a| centroids.max[a] - centroids.min[a]);
+/// Reorders `prims` for a split and returns how many go left (between 1 and
+/// `prims.len() - 1`) with both children's bounds.
+fn split(
+    method: BuildMethod,
+    prims: &mut [BuildPrim],
+    bounds: &NodeBounds,
+    depth: u32,
+) -> (usize, NodeBounds, NodeBounds) {
+    let centroids = &bounds.centroids;
+    let extent = (centroids.max - centroids.min).to_array();
     let axis = (0..3)
         .max_by(|&a, &b| extent[a].total_cmp(&extent[b]))
         .unwrap_or(0);
-    let median = |order: &mut [u32]| {
-        let mid = order.len() / 2;
+    let median = |prims: &mut [BuildPrim]| {
+        let mid = prims.len() / 2;
         // Ties (identical centroids) are split by count all the same.
-        order.select_nth_unstable_by(mid, |&x, &y| {
-            input.centroids[x as usize][axis].total_cmp(&input.centroids[y as usize][axis])
+        prims.select_nth_unstable_by(mid, |x, y| {
+            x.centroid()[axis].total_cmp(&y.centroid()[axis])
         });
-        mid
+        (
+            mid,
+            NodeBounds::of(&prims[..mid]),
+            NodeBounds::of(&prims[mid..]),
+        )
     };
-    if input.method == BuildMethod::MedianSplit
+    if method == BuildMethod::MedianSplit
         || depth >= MEDIAN_SPLIT_DEPTH
         || extent[axis].is_nan()
         || extent[axis] <= 0.0
     {
-        return median(order);
+        return median(prims);
     }
     // Bin the centroids along the axis (Wald 2007, §3).
     let scale = SAH_BINS as f32 / extent[axis];
-    let bin_of = |i: u32| {
-        let c = input.centroids[i as usize][axis];
-        (((c - centroids.min[axis]) * scale) as usize).min(SAH_BINS - 1)
-    };
-    let mut bins = [(Aabb32::EMPTY, 0usize); SAH_BINS];
-    for &i in order.iter() {
-        let bin = &mut bins[bin_of(i)];
-        bin.0 = bin.0.union(&input.boxes[i as usize].1);
+    let origin = centroids.min[axis];
+    let bin_of =
+        |p: &BuildPrim| (((p.centroid()[axis] - origin) * scale) as usize).min(SAH_BINS - 1);
+    let mut bins = [(NodeBounds::EMPTY, 0usize); SAH_BINS];
+    for p in prims.iter() {
+        let bin = &mut bins[bin_of(p)];
+        bin.0.add(p);
         bin.1 += 1;
     }
     // The cost of every plane between bins: sweep from the right, then from the left.
-    let mut right_cost = [0.0f32; SAH_BINS];
-    let mut acc = (Aabb32::EMPTY, 0usize);
+    let mut right = [(NodeBounds::EMPTY, 0usize); SAH_BINS];
+    let mut acc = (NodeBounds::EMPTY, 0usize);
     for b in (1..SAH_BINS).rev() {
         acc = (acc.0.union(&bins[b].0), acc.1 + bins[b].1);
-        right_cost[b] = half_area(&acc.0) * acc.1 as f32;
+        right[b] = acc;
     }
-    let mut best = (f32::INFINITY, 0usize);
-    let mut acc = (Aabb32::EMPTY, 0usize);
+    let mut best: Option<(f32, usize, NodeBounds)> = None;
+    let mut acc = (NodeBounds::EMPTY, 0usize);
     for b in 0..SAH_BINS - 1 {
         acc = (acc.0.union(&bins[b].0), acc.1 + bins[b].1);
-        if acc.1 == 0 || acc.1 == order.len() {
+        if acc.1 == 0 || acc.1 == prims.len() {
             continue;
         }
-        let cost = half_area(&acc.0) * acc.1 as f32 + right_cost[b + 1];
-        if cost < best.0 {
-            best = (cost, b);
+        let cost = acc.0.boxes.half_area() * acc.1 as f32
+            + right[b + 1].0.boxes.half_area() * right[b + 1].1 as f32;
+        if best.is_none_or(|(c, _, _)| cost < c) {
+            best = Some((cost, b, acc.0));
         }
     }
-    if !best.0.is_finite() {
-        return median(order);
-    }
-    // Partition in place: bins 0..=best go left.
+    let Some((_, plane, left_bounds)) = best.filter(|(c, _, _)| c.is_finite()) else {
+        return median(prims);
+    };
+    // Partition in place: bins 0..=plane go left.
     let mut left = 0;
-    for k in 0..order.len() {
-        if bin_of(order[k]) <= best.1 {
-            order.swap(left, k);
+    for k in 0..prims.len() {
+        if bin_of(&prims[k]) <= plane {
+            prims.swap(left, k);
             left += 1;
         }
     }
-    left
+    (left, left_bounds, right[plane + 1].0)
 }
 
-/// Builds the subtree over `order` (whose first entry is entry `offset` of the whole
-/// build order) into `arena` and returns its index there. With `threads > 1` and
-/// enough primitives, the right child is built on a second thread.
+/// Builds the subtree over `prims` (whose first entry is entry `offset` of the whole
+/// build order, and whose bounds are `bounds`) into `arena` and returns its index
+/// there. With `threads > 1` and enough primitives, the right child is built on a
+/// second thread.
 fn build_subtree(
-    input: &BuildInput<'_>,
-    order: &mut [u32],
+    method: BuildMethod,
+    prims: &mut [BuildPrim],
+    bounds: NodeBounds,
     offset: usize,
     depth: u32,
     threads: usize,
     arena: &mut Vec<BuildNode>,
 ) -> usize {
-    let (aabb, centroids) = bounds_of(input, order);
     let index = arena.len();
-    if order.len() <= MAX_LEAF_PRIMITIVES as usize {
+    if prims.len() <= MAX_LEAF_PRIMITIVES as usize {
         arena.push(BuildNode::Leaf {
-            aabb,
+            aabb: bounds.boxes.to_aabb(),
             start: offset,
-            count: order.len(),
+            count: prims.len(),
         });
         return index;
     }
-    let parallel = threads > 1 && order.len() >= PARALLEL_THRESHOLD;
-    let mid = split(input, order, &centroids, depth);
+    let parallel = threads > 1 && prims.len() >= PARALLEL_THRESHOLD;
+    let (mid, left_bounds, right_bounds) = split(method, prims, &bounds, depth);
     arena.push(BuildNode::Inner {
-        aabb,
+        aabb: bounds.boxes.to_aabb(),
         children: [usize::MAX; 2],
     });
-    let (left, right) = order.split_at_mut(mid);
+    let (left, right) = prims.split_at_mut(mid);
     let children = if parallel {
         let mut right_arena = Vec::new();
         let left_root = std::thread::scope(|scope| {
             let worker = scope.spawn(|| {
+                let half = threads / 2;
+                let at = offset + mid;
                 build_subtree(
-                    input,
+                    method,
                     right,
-                    offset + mid,
+                    right_bounds,
+                    at,
                     depth + 1,
-                    threads / 2,
+                    half,
                     &mut right_arena,
                 )
             });
+            let rest = threads - threads / 2;
             let left_root =
-                build_subtree(input, left, offset, depth + 1, threads - threads / 2, arena);
+                build_subtree(method, left, left_bounds, offset, depth + 1, rest, arena);
             // A panic in the worker is a bug in this builder: raise it here.
             if let Err(panic) = worker.join() {
                 std::panic::resume_unwind(panic);
@@ -376,8 +446,16 @@ fn build_subtree(
         });
         [left_root, append_arena(arena, right_arena)]
     } else {
-        let left_root = build_subtree(input, left, offset, depth + 1, 1, arena);
-        let right_root = build_subtree(input, right, offset + mid, depth + 1, 1, arena);
+        let left_root = build_subtree(method, left, left_bounds, offset, depth + 1, 1, arena);
+        let right_root = build_subtree(
+            method,
+            right,
+            right_bounds,
+            offset + mid,
+            depth + 1,
+            1,
+            arena,
+        );
         [left_root, right_root]
     };
     if let BuildNode::Inner { children: c, .. } = &mut arena[index] {
