@@ -122,23 +122,89 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
     var exited = false;
     // At least one step per call, so that any budget makes progress.
     var steps = 0u;
+    // "While-while" (Aila and Laine, "Understanding the Efficiency of Ray Traversal on
+    // GPUs", HPG 2009): descend to the next leaf, then test its primitives, each in a
+    // loop of its own, so that the lanes of a SIMD vector run one kind of step at a
+    // time.
+    var suspended = false;
     loop {
         if (any_hit && best_prim != NO_PRIM) || (cursor >= leaf_end && node == NO_NODE && stack_len == 0u) {
             finished = true;
             exited = true;
             break;
         }
-        if steps > 0u && (frame.flags & FLAG_SIMULATE_LOOP_CUT) != 0u {
-            break;
-        }
-        if steps > 0u && iterations + MAX_STEP_COST > frame.iteration_budget {
+        if suspended {
             exited = true;
             break;
         }
-        steps += 1u;
-        iterations += 1u;
-        if cursor < leaf_end {
-            // The next primitive of the current leaf.
+        if steps > 0u && (frame.flags & FLAG_SIMULATE_LOOP_CUT) != 0u {
+            break;
+        }
+        // Descend: pop and visit inner nodes until a leaf is reached or none is left.
+        loop {
+            if cursor < leaf_end || (node == NO_NODE && stack_len == 0u) {
+                break;
+            }
+            if steps > 0u && iterations + MAX_STEP_COST > frame.iteration_budget {
+                suspended = true;
+                break;
+            }
+            steps += 1u;
+            iterations += 1u;
+            if node == NO_NODE {
+                // Pop; a node pushed earlier may lie beyond a hit found since.
+                stack_len -= 1u;
+                let candidate = traversal_stack[traversal_stack_index(slot, stack_len)];
+                if slab_enter(candidate, ray.origin, inverse, best_t) != NO_HIT {
+                    node = candidate;
+                }
+                continue;
+            }
+            let current = bvh_nodes[node];
+            if current.count > 0u {
+                cursor = current.first;
+                leaf_end = current.first + current.count;
+                node = NO_NODE;
+                continue;
+            }
+            let a = current.first;
+            let b = current.first + 1u;
+            let enter_a = slab_enter(a, ray.origin, inverse, best_t);
+            let enter_b = slab_enter(b, ray.origin, inverse, best_t);
+            if enter_a != NO_HIT && enter_b != NO_HIT {
+                // Nearest child first; the other waits on the stack.
+                var near = a;
+                var far = b;
+                if enter_b < enter_a {
+                    near = b;
+                    far = a;
+                }
+                if stack_len < MAX_BVH_DEPTH {
+                    traversal_stack[traversal_stack_index(slot, stack_len)] = far;
+                    stack_len += 1u;
+                } else {
+                    atomicOr(&counters.errors, ERROR_TRAVERSAL_STACK);
+                }
+                node = near;
+            } else if enter_a != NO_HIT {
+                node = a;
+            } else if enter_b != NO_HIT {
+                node = b;
+            } else {
+                node = NO_NODE;
+            }
+        }
+        // Test the leaf's primitives.
+        loop {
+            if suspended || cursor >= leaf_end || (any_hit && best_prim != NO_PRIM) {
+                break;
+            }
+            if steps > 0u && iterations + MAX_STEP_COST > frame.iteration_budget {
+                suspended = true;
+                break;
+            }
+            steps += 1u;
+            iterations += 1u;
             let prim = bvh_prims[cursor];
             cursor += 1u;
             let t = intersect_prim(prim, ray, sheared, tie_limit(prim, best_t, best_prim));
@@ -146,49 +212,6 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
                 best_t = t;
                 best_prim = prim;
             }
-            continue;
-        }
-        if node == NO_NODE {
-            // Pop; a node pushed earlier may lie beyond a hit found since.
-            stack_len -= 1u;
-            let candidate = traversal_stack[traversal_stack_index(slot, stack_len)];
-            if slab_enter(candidate, ray.origin, inverse, best_t) != NO_HIT {
-                node = candidate;
-            }
-            continue;
-        }
-        let current = bvh_nodes[node];
-        if current.count > 0u {
-            cursor = current.first;
-            leaf_end = current.first + current.count;
-            node = NO_NODE;
-            continue;
-        }
-        let a = current.first;
-        let b = current.first + 1u;
-        let enter_a = slab_enter(a, ray.origin, inverse, best_t);
-        let enter_b = slab_enter(b, ray.origin, inverse, best_t);
-        if enter_a != NO_HIT && enter_b != NO_HIT {
-            // Nearest child first; the other waits on the stack.
-            var near = a;
-            var far = b;
-            if enter_b < enter_a {
-                near = b;
-                far = a;
-            }
-            if stack_len < MAX_BVH_DEPTH {
-                traversal_stack[traversal_stack_index(slot, stack_len)] = far;
-                stack_len += 1u;
-            } else {
-                atomicOr(&counters.errors, ERROR_TRAVERSAL_STACK);
-            }
-            node = near;
-        } else if enter_a != NO_HIT {
-            node = a;
-        } else if enter_b != NO_HIT {
-            node = b;
-        } else {
-            node = NO_NODE;
         }
     }
     if !exited {
