@@ -127,6 +127,7 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
     // loop of its own, so that the lanes of a SIMD vector run one kind of step at a
     // time.
     var suspended = false;
+    var simulated_cut = false;
     loop {
         if (any_hit && best_prim != NO_PRIM) || (cursor >= leaf_end && node == NO_NODE && stack_len == 0u) {
             finished = true;
@@ -137,12 +138,16 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
             exited = true;
             break;
         }
-        if steps > 0u && (frame.flags & FLAG_SIMULATE_LOOP_CUT) != 0u {
+        if simulated_cut {
             break;
         }
         // Descend: pop and visit inner nodes until a leaf is reached or none is left.
         loop {
             if cursor < leaf_end || (node == NO_NODE && stack_len == 0u) {
+                break;
+            }
+            if steps > 0u && (frame.flags & FLAG_SIMULATE_LOOP_CUT) != 0u {
+                simulated_cut = true;
                 break;
             }
             if steps > 0u && iterations + MAX_STEP_COST > frame.iteration_budget {
@@ -196,7 +201,11 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
         }
         // Test the leaf's primitives.
         loop {
-            if suspended || cursor >= leaf_end || (any_hit && best_prim != NO_PRIM) {
+            if suspended || simulated_cut || cursor >= leaf_end || (any_hit && best_prim != NO_PRIM) {
+                break;
+            }
+            if steps > 0u && (frame.flags & FLAG_SIMULATE_LOOP_CUT) != 0u {
+                simulated_cut = true;
                 break;
             }
             if steps > 0u && iterations + MAX_STEP_COST > frame.iteration_budget {
