@@ -11,6 +11,7 @@ pub mod texture;
 pub mod trace;
 pub mod traverse;
 
+use std::ops::Range;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 use std::time::Instant;
@@ -86,4 +87,112 @@ pub fn render(scene: &Scene, progress: Option<ProgressFn<'_>>) -> Rendered {
             gpu_time: None,
         },
     }
+}
+
+/// A region handed to [`render_region`] that is empty or does not lie inside the image.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "region columns {columns:?}, rows {rows:?} is empty or lies outside the {width}x{height} image"
+)]
+pub struct RegionOutsideImage {
+    /// The columns asked for.
+    pub columns: Range<u32>,
+    /// The rows asked for.
+    pub rows: Range<u32>,
+    /// The image's width.
+    pub width: u32,
+    /// The image's height.
+    pub height: u32,
+}
+
+/// Renders only the pixels in `columns × rows` of `scene`'s image, on all CPU cores,
+/// rows handed out one at a time. The result is the region's: its image is
+/// `columns.len() × rows.len()` pixels whose (0, 0) is pixel `(columns.start,
+/// rows.start)` of the whole image, each bit-identical to that pixel of [`render`]
+/// (a pixel's samples depend only on the pixel and the sample index). `progress` is
+/// told the number of finished rows of the region after each row.
+///
+/// ```
+/// # use gpu_render::scene::parse_scene;
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// let scene = parse_scene(
+///     "[render]\nwidth = 8\nheight = 6\n[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\n",
+///     std::path::Path::new("<inline>"),
+/// )?;
+/// let whole = gpu_render::cpu::render(&scene, None);
+/// let corner = gpu_render::cpu::render_region(&scene, 4..8, 3..6, None)?;
+/// assert_eq!((corner.image.width, corner.image.height), (4, 3));
+/// assert_eq!(corner.image.pixel(0, 0), whole.image.pixel(4, 3));
+/// # Ok(())
+/// # }
+/// ```
+///
+/// Errors: [`RegionOutsideImage`] for an empty region or one past the image's edge.
+pub fn render_region(
+    scene: &Scene,
+    columns: Range<u32>,
+    rows: Range<u32>,
+    progress: Option<ProgressFn<'_>>,
+) -> Result<Rendered, RegionOutsideImage> {
+    let (width, height) = (scene.render.width, scene.render.height);
+    if columns.is_empty() || rows.is_empty() || columns.end > width || rows.end > height {
+        return Err(RegionOutsideImage {
+            columns,
+            rows,
+            width,
+            height,
+        });
+    }
+    let started = Instant::now();
+    let prepared = PreparedScene::new(scene);
+    let region_width = columns.end - columns.start;
+    let region_height = rows.end - rows.start;
+    let mut image = LinearImage::new(region_width, region_height);
+    let pending: Vec<(u32, &mut [[f32; 4]])> = image
+        .pixels
+        .chunks_mut(region_width as usize)
+        .zip(rows.clone())
+        .map(|(row, y)| (y, row))
+        .collect();
+    let queue = Mutex::new(pending);
+    let rays = AtomicU64::new(0);
+    let rows_done = AtomicU32::new(0);
+    let threads = std::thread::available_parallelism().map_or(1, usize::from);
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| {
+                loop {
+                    let next = queue
+                        .lock()
+                        .unwrap_or_else(std::sync::PoisonError::into_inner)
+                        .pop();
+                    let Some((y, row)) = next else { break };
+                    let mut row_rays = 0;
+                    for (x, pixel) in columns.clone().zip(row.iter_mut()) {
+                        let result = trace_pixel(&prepared, x, y);
+                        *pixel = [
+                            result.radiance.x as f32,
+                            result.radiance.y as f32,
+                            result.radiance.z as f32,
+                            1.0,
+                        ];
+                        row_rays += result.rays;
+                    }
+                    rays.fetch_add(row_rays, Ordering::Relaxed);
+                    let done = rows_done.fetch_add(1, Ordering::Relaxed) + 1;
+                    if let Some(report) = progress {
+                        report(done, region_height);
+                    }
+                }
+            });
+        }
+    });
+    Ok(Rendered {
+        image,
+        stats: RenderStats {
+            rays_traced: rays.into_inner(),
+            elapsed: started.elapsed(),
+            gpu_time: None,
+        },
+    })
 }

@@ -5,7 +5,8 @@
 //!   `Rgba32Float` texture, blocking until every pixel is done;
 //! - [`GpuRenderer::encode_display`] records the sRGB display pass into the caller's
 //!   encoder;
-//! - the conveniences [`GpuRenderer::render`] (tiles, display pass, readback) and
+//! - the conveniences [`GpuRenderer::render`] (tiles, display pass, readback),
+//!   [`GpuRenderer::render_region`] (the same for a window of the image) and
 //!   [`GpuRenderer::render_to_texture`] are built on these.
 //!
 //! The renderer owns no device: every method takes the device (and queue where it
@@ -55,7 +56,8 @@ pub struct GpuRenderer {
     simulate_loop_cut: bool,
 }
 
-/// The result of [`GpuRenderer::render`].
+/// The result of [`GpuRenderer::render`], and of [`GpuRenderer::render_region`] (whose
+/// images are the region's).
 #[derive(Debug, Clone, PartialEq)]
 pub struct GpuRendered {
     /// The linear radiance image, as traced.
@@ -515,6 +517,182 @@ impl GpuRenderer {
                 width,
                 height,
                 pixels,
+            },
+            display_rgba8,
+            stats,
+        })
+    }
+
+    /// Renders only the pixels of `region` of a scene already uploaded: traces them
+    /// (in tiles of at most the device's limits, as [`GpuRenderer::render_prepared`]
+    /// does), runs the display pass and reads both images back. The result is the
+    /// region's: `image` is `columns × rows` pixels whose (0, 0) is the region's first
+    /// pixel, and `region.target_origin` is not used. Each pixel is bit-identical to
+    /// the same pixel of a whole render (`docs/model.md`, "Bounded work"), so regions
+    /// rendered apart, even in other processes, assemble into the whole image.
+    /// `progress(rows_done, region_rows)` follows the finished pixels in rows' worth.
+    ///
+    /// ```no_run
+    /// use gpu_render::gpu::{AdapterChoice, GpuRenderer, HeadlessGpu, TraceRegion};
+    /// # fn demo(scene: &gpu_render::scene::Scene) -> Result<(), gpu_render::gpu::GpuError> {
+    /// let gpu = HeadlessGpu::new(&AdapterChoice::Default)?;
+    /// let renderer = GpuRenderer::new(&gpu.device)?;
+    /// let prepared = renderer.prepare(&gpu.device, &gpu.queue, scene)?;
+    /// // The bottom half of the image.
+    /// let region = TraceRegion {
+    ///     columns: 0..prepared.width(),
+    ///     rows: prepared.height() / 2..prepared.height(),
+    ///     target_origin: (0, 0),
+    /// };
+    /// let half = renderer.render_region(&gpu.device, &gpu.queue, &prepared, &region, None)?;
+    /// assert_eq!(half.image.height, prepared.height() - prepared.height() / 2);
+    /// # Ok(())
+    /// # }
+    /// ```
+    ///
+    /// Errors: [`GpuError::Validation`] for a region that is empty or lies outside
+    /// the image; otherwise as [`GpuRenderer::render_prepared`].
+    pub fn render_region(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        prepared: &PreparedScene,
+        region: &TraceRegion,
+        progress: Option<ProgressFn<'_>>,
+    ) -> Result<GpuRendered, GpuError> {
+        let (width, height) = region.size();
+        if width == 0
+            || height == 0
+            || region.columns.end > prepared.width()
+            || region.rows.end > prepared.height()
+        {
+            return Err(GpuError::Validation(format!(
+                "region columns {:?}, rows {:?} is empty or lies outside the {}x{} image",
+                region.columns,
+                region.rows,
+                prepared.width(),
+                prepared.height()
+            )));
+        }
+        let limits = device.limits();
+        // A tile must fit one texture and one display dispatch's workgroup count.
+        let tile_limit = limits.max_texture_dimension_2d.min(
+            limits
+                .max_compute_workgroups_per_dimension
+                .saturating_mul(WORKGROUP_SIZE),
+        );
+        let (x0, y0) = (region.columns.start, region.rows.start);
+        let tiles = image_tiles(width, height, tile_limit)
+            .into_iter()
+            .map(|tile| TraceRegion {
+                columns: tile.columns.start + x0..tile.columns.end + x0,
+                rows: tile.rows.start + y0..tile.rows.end + y0,
+                target_origin: (tile.columns.start + x0, tile.rows.start + y0),
+            });
+        let mut pixels = vec![[0.0f32; 4]; width as usize * height as usize];
+        let mut display_rgba8 = vec![0u8; width as usize * height as usize * 4];
+        let finished = AtomicU64::new(0);
+        let report = |new: u64| {
+            let done = finished.fetch_add(new, Ordering::Relaxed) + new;
+            if let Some(progress) = progress {
+                progress((done / u64::from(width)) as u32, height);
+            }
+        };
+        let mut stats = RenderStats::default();
+        let mut gpu_time = Some(Duration::ZERO);
+        for tile in tiles {
+            let traced = self.render_tile(device, queue, prepared, &tile, &report)?;
+            stats.rays_traced += traced.stats.rays_traced;
+            stats.elapsed += traced.stats.elapsed;
+            gpu_time = gpu_time.zip(traced.stats.gpu_time).map(|(a, b)| a + b);
+            let tile_width = traced.image.width as usize;
+            for (row, y) in tile.rows.clone().enumerate() {
+                let start = (y - y0) as usize * width as usize + (tile.columns.start - x0) as usize;
+                pixels[start..start + tile_width].copy_from_slice(
+                    &traced.image.pixels[row * tile_width..(row + 1) * tile_width],
+                );
+                display_rgba8[start * 4..(start + tile_width) * 4].copy_from_slice(
+                    &traced.display_rgba8[row * tile_width * 4..(row + 1) * tile_width * 4],
+                );
+            }
+        }
+        stats.gpu_time = gpu_time;
+        Ok(GpuRendered {
+            image: LinearImage {
+                width,
+                height,
+                pixels,
+            },
+            display_rgba8,
+            stats,
+        })
+    }
+
+    /// Traces one `tile` (which fits the device's limits) into textures of its own
+    /// size, runs the display pass and reads both back; `report(new_pixels)` is told
+    /// the pixels finished since its last call.
+    fn render_tile(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        prepared: &PreparedScene,
+        tile: &TraceRegion,
+        report: &dyn Fn(u64),
+    ) -> Result<GpuRendered, GpuError> {
+        let (tile_width, tile_height) = tile.size();
+        let linear = create_texture(
+            device,
+            "gpu-render linear image",
+            tile_width,
+            tile_height,
+            LINEAR_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+        )?;
+        let display = create_texture(
+            device,
+            "gpu-render display image",
+            tile_width,
+            tile_height,
+            DISPLAY_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        )?;
+        let linear_view = linear.create_view(&wgpu::TextureViewDescriptor::default());
+        let display_view = display.create_view(&wgpu::TextureViewDescriptor::default());
+        let last = AtomicU64::new(0);
+        let tile_progress = |done: u64, _: u64| {
+            let before = last.swap(done, Ordering::Relaxed);
+            report(done - before);
+        };
+        let stats = self.trace_into(
+            device,
+            queue,
+            prepared,
+            &linear_view,
+            tile,
+            Some(&tile_progress),
+        )?;
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("gpu-render display pass"),
+        });
+        self.encode_display(
+            device,
+            &mut encoder,
+            &linear_view,
+            &display_view,
+            prepared.display_encodes_srgb(),
+        )?;
+        submit_and_wait(device, queue, encoder, "display pass", self.poll_timeout)?;
+        let linear_bytes = read_texture(device, queue, &linear, 16, self.poll_timeout)?;
+        let display_rgba8 = read_texture(device, queue, &display, 4, self.poll_timeout)?;
+        Ok(GpuRendered {
+            image: LinearImage {
+                width: tile_width,
+                height: tile_height,
+                // pod_collect_to_vec copies, so the byte vector's alignment does not
+                // matter.
+                pixels: bytemuck::pod_collect_to_vec(&linear_bytes),
             },
             display_rgba8,
             stats,
