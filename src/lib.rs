@@ -13,6 +13,8 @@
 //! - [`output`]: writing PNG, EXR and HDR files atomically.
 //! - [`plausibility`]: the lecture's three rules checked on a tabulated BRDF map.
 //! - [`quality`]: the named presets chosen from the measured front.
+//! - [`tiles`]: windows of an image rendered apart, their EXR tile files and merging
+//!   them into the whole image.
 //! - [`tradeoff`]: measuring time against error for the speed/accuracy knobs.
 
 #![warn(missing_docs)]
@@ -27,4 +29,5 @@ pub mod output;
 pub mod plausibility;
 pub mod quality;
 pub mod scene;
+pub mod tiles;
 pub mod tradeoff;

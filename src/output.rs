@@ -156,6 +156,15 @@ pub enum OutputError {
         /// The encoder's error (in the message; not repeated as a source).
         error: image::ImageError,
     },
+    /// The OpenEXR encoder of tiles (the `exr` crate, which writes data windows and
+    /// custom attributes) failed for a reason other than writing.
+    #[error("{}: cannot encode the OpenEXR tile: {message}", .path.display())]
+    EncodeExr {
+        /// The output file.
+        path: PathBuf,
+        /// The encoder's words.
+        message: String,
+    },
     /// Creating, writing, syncing or renaming the file failed.
     #[error("{}: cannot {action}: {error}", .path.display())]
     Io {
@@ -397,6 +406,22 @@ pub fn write_png_rgba8(
     })
 }
 
+/// An OpenEXR image of one layer of any channels, as the `exr` crate builds it.
+pub(crate) type ExrImage =
+    exr::image::Image<exr::image::Layer<exr::image::AnyChannels<exr::image::FlatSamples>>>;
+
+/// Writes `image` (a tile with its data window and attributes, built by
+/// [`crate::tiles::write_tile`]) to the OpenEXR file `path`, atomically.
+pub(crate) fn write_exr(path: &Path, image: &ExrImage) -> Result<(), OutputError> {
+    use exr::prelude::WritableImage;
+    write_atomically(path, |writer| {
+        image
+            .write()
+            .to_buffered(&mut *writer)
+            .map_err(EncodeFailure::Exr)
+    })
+}
+
 /// Writes `text` to `path` atomically (a CSV table, say).
 pub fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
     write_atomically(path, |writer| {
@@ -512,6 +537,8 @@ fn discard(temp: tempfile::NamedTempFile) {
 enum EncodeFailure {
     /// The image encoder's error, while writing this format.
     Image(OutputFormat, image::ImageError),
+    /// The `exr` crate's error, while writing a tile.
+    Exr(exr::error::Error),
     /// A plain write failed.
     Io(io::Error),
 }
@@ -587,6 +614,10 @@ fn encode_to(
             path: path.to_path_buf(),
             format,
             error,
+        }),
+        (Err(EncodeFailure::Exr(error)), None) => Err(OutputError::EncodeExr {
+            path: path.to_path_buf(),
+            message: error.to_string(),
         }),
         (Ok(()), None) => flushed.map_err(write_error),
     }
