@@ -1,6 +1,7 @@
 //! The scene: its in-memory model and the TOML scene-file format that fills it
 //! (documented field by field in `docs/scene-format.md`).
 
+mod animation;
 mod error;
 mod file;
 mod image;
@@ -8,10 +9,11 @@ pub mod import;
 mod medium;
 mod model;
 
+pub use animation::{CameraKey, CameraPath, Interpolation, MAX_FRAMES};
 pub use error::{SceneError, SceneWarning};
 pub use file::{
-    CONDUCTOR_PRESETS, LoadOptions, LoadProgress, MAX_SCENE_FILE_BYTES, confined_path, load_scene,
-    load_scene_with, parse_scene, parse_scene_with,
+    CONDUCTOR_PRESETS, LoadOptions, LoadProgress, MAX_SCENE_FILE_BYTES, SceneFile, confined_path,
+    load_scene, load_scene_file, load_scene_with, parse_scene, parse_scene_file, parse_scene_with,
 };
 pub use image::{MAX_IMAGE_SIDE, load_image};
 pub use medium::{MEDIUM_STACK_SIZE, MediumStack};

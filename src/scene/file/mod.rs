@@ -5,6 +5,7 @@
 //! the offending item (or, for syntax and type errors, the offending token) begins,
 //! and the problem.
 
+mod animation;
 mod check;
 mod lights;
 mod materials;
@@ -23,7 +24,7 @@ use self::objects::MaterialTable;
 pub use self::paths::confined_path;
 use self::raw::RawScene;
 use super::image::not_a_regular_file;
-use super::{Scene, SceneError, SceneWarning};
+use super::{CameraPath, Scene, SceneError, SceneWarning};
 
 /// Largest scene file accepted, in bytes (64 MiB).
 pub const MAX_SCENE_FILE_BYTES: u64 = 64 * 1024 * 1024;
@@ -107,8 +108,24 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
 
 /// [`load_scene`] with options: a sandbox, a progress hook and a warning hook.
 pub fn load_scene_with(path: &Path, options: &LoadOptions<'_>) -> Result<Scene, SceneError> {
+    load_scene_file(path, options).map(|file| file.scene)
+}
+
+/// What a scene file defines: the scene (with the `[camera]` table's camera) and,
+/// if it has an `[animation]` table, its camera path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneFile {
+    /// The scene, as [`load_scene`] returns it.
+    pub scene: Scene,
+    /// The camera path of `[animation]`, if there is one; render frame `k` with
+    /// [`CameraPath::frame_camera`].
+    pub camera_path: Option<CameraPath>,
+}
+
+/// [`load_scene_with`], keeping the camera path of an `[animation]` table.
+pub fn load_scene_file(path: &Path, options: &LoadOptions<'_>) -> Result<SceneFile, SceneError> {
     let text = read_scene_file(path, options)?;
-    parse_scene_with(&text, path, options)
+    parse_scene_file(&text, path, options)
 }
 
 /// Parses and validates scene text; `path` is only used in error messages and to
@@ -123,6 +140,15 @@ pub fn parse_scene_with(
     path: &Path,
     options: &LoadOptions<'_>,
 ) -> Result<Scene, SceneError> {
+    parse_scene_file(text, path, options).map(|file| file.scene)
+}
+
+/// [`parse_scene_with`], keeping the camera path of an `[animation]` table.
+pub fn parse_scene_file(
+    text: &str,
+    path: &Path,
+    options: &LoadOptions<'_>,
+) -> Result<SceneFile, SceneError> {
     let source = Source { path, text };
     if text.len() as u64 > MAX_SCENE_FILE_BYTES {
         return Err(source.error(None, too_large_message(text.len() as u64)));
@@ -282,9 +308,10 @@ fn build_scene(
     source: &Source<'_>,
     raw: RawScene,
     options: &LoadOptions<'_>,
-) -> Result<Scene, SceneError> {
+) -> Result<SceneFile, SceneError> {
     let render = settings::render(source, raw.render)?;
     let camera = settings::camera(source, raw.camera)?;
+    let camera_path = animation::animation(source, raw.animation, &camera)?;
     let environment = settings::environment(source, raw.environment)?;
     let total = (raw.materials.len() + raw.lights.len() + raw.objects.len()) as u64;
     let mut done = 0;
@@ -322,7 +349,7 @@ fn build_scene(
             objects::object(source, &table, i, object)
         })
         .collect::<Result<_, _>>()?;
-    Ok(Scene {
+    let scene = Scene {
         render,
         camera,
         environment,
@@ -331,7 +358,8 @@ fn build_scene(
         lights,
         shapes,
         images: images.into_images(),
-    })
+    };
+    Ok(SceneFile { scene, camera_path })
 }
 
 #[cfg(test)]

@@ -34,6 +34,28 @@ pub struct RawScene {
     /// `[[objects]]`, in file order.
     #[serde(default)]
     pub objects: Vec<Spanned<RawObject>>,
+    /// `[animation]`, optional: a camera path.
+    pub animation: Option<Spanned<RawAnimation>>,
+}
+
+/// `[animation]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawAnimation {
+    pub fps: Option<f64>,
+    pub frames: Option<u32>,
+    pub interpolation: Option<String>,
+    #[serde(default)]
+    pub keyframes: Vec<Spanned<RawKeyframe>>,
+}
+
+/// `[[animation.keyframes]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawKeyframe {
+    pub time: Option<f64>,
+    pub eye: Option<RawVec3>,
+    pub look_at: Option<RawVec3>,
 }
 
 /// `[render]`.

@@ -64,24 +64,32 @@ pub fn camera(source: &Source<'_>, raw: Option<Spanned<RawCamera>>) -> Result<Ca
             "fov_y_degrees must be in (0, 180), got {fov_y_degrees}"
         )));
     }
-    let Some(view) = (look_at - eye).try_normalize() else {
-        return Err(
-            item.fail("eye and look_at are the same point; the view direction is undefined")
-        );
-    };
-    let Some(up_unit) = up.try_normalize() else {
-        return Err(item.fail("up is the zero vector"));
-    };
-    if view.cross(up_unit).length() < PARALLEL_TOLERANCE {
-        return Err(item.fail(format_args!(
-            "up {up} is parallel to the view direction {view} (look_at - eye); choose another up"
-        )));
+    if let Some(problem) = view_problem(eye, look_at, up) {
+        return Err(item.fail(problem));
     }
     Ok(Camera {
         eye,
         look_at,
         up,
         fov_y_degrees,
+    })
+}
+
+/// What makes a view undefined, if anything: `eye` and `look_at` the same point, a
+/// zero `up`, or an `up` parallel to the view direction.
+pub fn view_problem(eye: DVec3, look_at: DVec3, up: DVec3) -> Option<String> {
+    let Some(view) = (look_at - eye).try_normalize() else {
+        return Some(
+            "eye and look_at are the same point; the view direction is undefined".to_owned(),
+        );
+    };
+    let Some(up_unit) = up.try_normalize() else {
+        return Some("up is the zero vector".to_owned());
+    };
+    (view.cross(up_unit).length() < PARALLEL_TOLERANCE).then(|| {
+        format!(
+            "up {up} is parallel to the view direction {view} (look_at - eye); choose another up"
+        )
     })
 }
 

@@ -177,3 +177,87 @@ fn documented_example_parses() {
     assert_eq!(scene.lights.len(), 2);
     assert_eq!(scene.shapes.len(), 5);
 }
+
+const ANIMATION: &str = "[animation]\nfps = 4\ninterpolation = \"catmull_rom\"\n\
+    [[animation.keyframes]]\ntime = 0\neye = [0, 1, 5]\nlook_at = [0, 0, 0]\n\
+    [[animation.keyframes]]\ntime = 1.5\neye = [5, 1, 0]\nlook_at = [0, 0.5, 0]\n";
+
+#[test]
+fn an_animation_defines_a_camera_path() {
+    let file = super::parse_scene_file(
+        &format!("{CAMERA}{ANIMATION}"),
+        Path::new("test.toml"),
+        &super::LoadOptions::default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let Some(path) = file.camera_path else {
+        panic!("no camera path");
+    };
+    assert_eq!(path.interpolation, crate::scene::Interpolation::CatmullRom);
+    // 1.5 s at 4 fps: frames 0 to 6.
+    assert_eq!(path.frame_count, 7);
+    assert_eq!(path.keys[1].eye, DVec3::new(5.0, 1.0, 0.0));
+    let last = path.frame_camera(&file.scene.camera, 6);
+    assert_eq!(
+        (last.eye, last.look_at),
+        (path.keys[1].eye, path.keys[1].look_at)
+    );
+    // The still camera is the [camera] table's.
+    assert_eq!(file.scene.camera.eye, DVec3::new(0.0, 1.0, 5.0));
+    let frames = parse(&format!(
+        "{CAMERA}[animation]\nfps = 24\nframes = 3\n\
+        [[animation.keyframes]]\ntime = 2\neye = [1, 1, 1]\nlook_at = [0, 0, 0]\n"
+    ));
+    assert_eq!(frames.camera.eye, DVec3::new(0.0, 1.0, 5.0));
+}
+
+#[test]
+fn animation_errors_are_located() {
+    let fail = |animation: &str| {
+        parse_scene(&format!("{CAMERA}{animation}"), Path::new("test.toml"))
+            .map(|_| ())
+            .expect_err(animation)
+            .to_string()
+    };
+    let message = fail(&ANIMATION.replace("time = 1.5", "time = 0"));
+    assert!(
+        message.starts_with("test.toml:12:1: animation.keyframes[1]: time 0 is not after"),
+        "{message}"
+    );
+    let message = fail(&ANIMATION.replace("fps = 4", "fps = 0"));
+    assert!(
+        message.starts_with("test.toml:4:1: animation: fps must be > 0"),
+        "{message}"
+    );
+    let message = fail(&ANIMATION.replace("catmull_rom", "bezier"));
+    assert!(
+        message.contains("\"linear\" or \"catmull_rom\""),
+        "{message}"
+    );
+    let message = fail("[animation]\nfps = 24\n");
+    assert!(
+        message.contains("at least one [[animation.keyframes]]"),
+        "{message}"
+    );
+    let message = fail(&ANIMATION.replace("look_at = [0, 0.5, 0]", "look_at = [5, 1, 0]"));
+    assert!(
+        message.contains("keyframes[1]: eye and look_at are the same"),
+        "{message}"
+    );
+    // A straight path through the look-at point: fine at both keys, not at frame 2.
+    let through = "[animation]\nfps = 2\n\
+        [[animation.keyframes]]\ntime = 0\neye = [0, 0, -2]\nlook_at = [0, 0, 0]\n\
+        [[animation.keyframes]]\ntime = 2\neye = [0, 0, 2]\nlook_at = [0, 0, 0]\n";
+    let message = fail(through);
+    assert!(
+        message.contains("animation: at frame 2 (t = 1 s): eye and look_at are the same point"),
+        "{message}"
+    );
+    let message = fail(&ANIMATION.replace("fps = 4", "fps = 4\nframes = 0"));
+    assert!(
+        message.contains("frames must be between 1 and"),
+        "{message}"
+    );
+    let message = fail(&ANIMATION.replace("time = 1.5\n", "time = 1.5\nfov = 3\n"));
+    assert!(message.contains("unknown field `fov`"), "{message}");
+}
