@@ -7,6 +7,7 @@ use gpu_render::quality::QualityPreset;
 use gpu_render::scene::{
     LightingSpace, MAX_DEPTH_LIMIT, MAX_IMAGE_DIMENSION, MAX_SAMPLES_PER_PIXEL, RenderOverrides,
 };
+use gpu_render::tiles::PixelWindow;
 
 use crate::memory::DEFAULT_MAX_MEMORY_GIB;
 
@@ -21,9 +22,16 @@ Examples:
   gpu-render scene.toml -o scene.exr --spp 64 --max-depth 8
   gpu-render scene.toml -o gamma.png --compare-gamma --backend cpu
   gpu-render scene.toml -o draft.png --quality draft
+  gpu-render scene.toml --tile 2/4 -o tile-{tile}.exr
+  gpu-render merge tile-*.exr -o scene.png
+  gpu-render animated.toml --frame 12 -o frame-{frame}.png
+  gpu-render estimate scene.toml --tiles 4
   gpu-render tradeoff scenes/showcase.toml --out-dir tradeoff
   gpu-render brdf-check scenes/brdf/plausible.png
-  gpu-render --adapter list";
+  gpu-render --adapter list
+
+Tiles, frames and the recipes for Slurm, Kubernetes and GNU parallel:
+docs/distributed.md";
 
 /// Renders a scene file with the GPU ray tracer (or its CPU reference).
 #[derive(Debug, Parser)]
@@ -34,7 +42,7 @@ Examples:
     long_about = "Renders a TOML scene file with a Whitted-style, physically based ray \
                   tracer that runs in WGSL compute shaders through wgpu, or with the CPU \
                   reference tracer.",
-    override_usage = "gpu-render [OPTIONS] SCENE --output <PATH>\n       gpu-render tradeoff SCENE [OPTIONS]\n       gpu-render brdf-check FILE\n       gpu-render --adapter list",
+    override_usage = "gpu-render [OPTIONS] SCENE --output <PATH>\n       gpu-render merge TILE.exr... --output <PATH>\n       gpu-render estimate SCENE [OPTIONS]\n       gpu-render tradeoff SCENE [OPTIONS]\n       gpu-render brdf-check FILE\n       gpu-render --adapter list",
     after_help = AFTER_HELP,
     args_conflicts_with_subcommands = true,
     subcommand_negates_reqs = true
@@ -59,6 +67,15 @@ pub enum Command {
     /// time and error (linear RMSE and FLIP) with the Pareto front, as a table, a CSV
     /// and a PNG plot.
     Tradeoff(TradeoffArgs),
+
+    /// Assemble the EXR tiles of `--tile` or `--crop` renders into the whole image,
+    /// after checking that they cover it exactly once and come from the same scene,
+    /// frame, settings and backend. The result is byte for byte the whole render's.
+    Merge(MergeArgs),
+
+    /// Print the expected time of each tile (and frame) on the chosen backend, from a
+    /// short calibration render at a fraction of the pixels.
+    Estimate(EstimateArgs),
 
     /// Reports whether a tabulated BRDF map (a square image, θi across, θr down,
     /// texels holding π·f) is physically plausible: positivity, energy conservation
@@ -131,6 +148,112 @@ pub struct TradeoffArgs {
     pub sandbox: bool,
 }
 
+/// The arguments of `gpu-render merge`.
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// The tiles (EXR files written with --tile or --crop), in any order.
+    #[arg(value_name = "TILE.exr", required = true, num_args = 1..)]
+    pub tiles: Vec<PathBuf>,
+
+    /// The whole image; its extension picks the format (.png, .exr or .hdr).
+    #[arg(short, long, value_name = "PATH")]
+    pub output: PathBuf,
+
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// The arguments of `gpu-render estimate`.
+#[derive(Debug, Args)]
+pub struct EstimateArgs {
+    /// The scene file (TOML).
+    #[arg(value_name = "SCENE")]
+    pub scene: PathBuf,
+
+    /// Estimate each of this many tiles (the split of --tile).
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = parse_in_range::<1, MAX_IMAGE_DIMENSION>)]
+    pub tiles: u32,
+
+    /// Estimate this frame of the scene's animation [default: the still camera, or for
+    /// an animated scene up to 5 frames spread over it].
+    #[arg(long, value_name = "K", value_parser = parse_whole)]
+    pub frame: Option<u32>,
+
+    /// Pixels of the calibration render, a scaled-down copy of the image (at least
+    /// one row per tile); the whole image if it has fewer.
+    #[arg(long, value_name = "N", default_value_t = 16_384, value_parser = parse_in_range::<1, 134_217_728>)]
+    pub calibration_pixels: u32,
+
+    /// Image size, samples, depth and lighting, over the scene's.
+    #[command(flatten)]
+    pub settings: SettingsArgs,
+
+    /// Where and how to trace.
+    #[command(flatten)]
+    pub device: DeviceArgs,
+
+    /// Confine the files the scene names to its folder (see the render options).
+    #[arg(long)]
+    pub sandbox: bool,
+}
+
+/// `--tile I/N`: tile `index` of `count`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TileArg {
+    /// 0-based.
+    pub index: u32,
+    /// At least 1, above `index`.
+    pub count: u32,
+}
+
+/// `I/N` with `0 <= I < N`.
+fn parse_tile(text: &str) -> Result<TileArg, String> {
+    let usage = || format!("must be I/N, tile I (0-based) of N, like 0/4, got `{text}`");
+    let (index, count) = text.split_once('/').ok_or_else(usage)?;
+    let number = |part: &str| {
+        let part = part.trim();
+        (!part.is_empty() && part.bytes().all(|b| b.is_ascii_digit()))
+            .then(|| part.parse::<u32>().ok())
+            .flatten()
+            .ok_or_else(usage)
+    };
+    let (index, count) = (number(index)?, number(count)?);
+    if count == 0 || index >= count {
+        return Err(format!(
+            "tile {index} of {count}: the index must be below the count (0 to N-1), got `{text}`"
+        ));
+    }
+    Ok(TileArg { index, count })
+}
+
+/// `x0,y0,x1,y1` with `x0 < x1`, `y0 < y1` (checked against the image later).
+fn parse_crop(text: &str) -> Result<PixelWindow, String> {
+    let usage = || format!("must be x0,y0,x1,y1 (whole pixels, x1 and y1 excluded), got `{text}`");
+    let values: Vec<u32> = text
+        .split(',')
+        .map(|part| {
+            let part = part.trim();
+            (!part.is_empty() && part.bytes().all(|b| b.is_ascii_digit()))
+                .then(|| part.parse::<u32>().ok())
+                .flatten()
+                .ok_or_else(usage)
+        })
+        .collect::<Result<_, _>>()?;
+    let [x0, y0, x1, y1] = values[..] else {
+        return Err(usage());
+    };
+    if x0 >= x1 || y0 >= y1 {
+        return Err(format!(
+            "the window {x0},{y0},{x1},{y1} is empty: x0 < x1 and y0 < y1 are needed"
+        ));
+    }
+    Ok(PixelWindow {
+        columns: x0..x1,
+        rows: y0..y1,
+    })
+}
+
 /// The arguments of a render.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
@@ -142,6 +265,72 @@ pub struct RenderArgs {
     #[arg(short, long, value_name = "PATH", required_unless_present = "adapter")]
     pub output: Option<PathBuf>,
 
+    /// Image size, samples, depth and lighting, over the scene's.
+    #[command(flatten)]
+    pub settings: SettingsArgs,
+
+    /// Render twice, in linear and in naive gamma space, and write both side by side
+    /// (linear on the left) into a .png.
+    #[arg(long, conflicts_with = "lighting", help_heading = "Render settings")]
+    pub compare_gamma: bool,
+
+    /// Where and how to trace.
+    #[command(flatten)]
+    pub device: DeviceArgs,
+
+    /// Render only tile I of N (0-based): the band of rows from I·H/N to (I+1)·H/N
+    /// (rounded down), every column. Writes a linear EXR tile (give an .exr output)
+    /// that records its window, for `gpu-render merge`. `{tile}` in the output name
+    /// becomes I, zero-padded to the digits of N - 1.
+    #[arg(long, value_name = "I/N", value_parser = parse_tile, conflicts_with = "crop", help_heading = "Pieces")]
+    pub tile: Option<TileArg>,
+
+    /// Render only the pixels x0 <= x < x1, y0 <= y < y1 (0,0 is the top-left pixel).
+    /// Writes a linear EXR tile like --tile.
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop, help_heading = "Pieces")]
+    pub crop: Option<PixelWindow>,
+
+    /// Render frame K (0-based) of the scene's [animation] camera path instead of its
+    /// [camera]. `{frame}` in the output name becomes K, zero-padded to at least 4
+    /// digits (more when the animation has more frames).
+    #[arg(long, value_name = "K", value_parser = parse_whole, help_heading = "Pieces")]
+    pub frame: Option<u32>,
+
+    /// Confine the files the scene names (textures, BRDF maps) to the scene file's
+    /// folder: refuse absolute paths, `..` and links out of it. Without it a scene
+    /// file is trusted like a program: it may name any file you can read.
+    #[arg(long)]
+    pub sandbox: bool,
+
+    /// Refuse, before rendering, a render whose estimated peak memory is above this
+    /// many GiB (see docs/reliability.md for the estimate per backend and format).
+    #[arg(
+        long,
+        value_name = "GIB",
+        default_value_t = DEFAULT_MAX_MEMORY_GIB,
+        value_parser = parse_gib
+    )]
+    pub max_memory: f64,
+
+    /// Print nothing but errors: no progress, warnings, notes or summary.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// A positive, finite number of seconds.
+fn parse_seconds(text: &str) -> Result<std::time::Duration, String> {
+    let seconds: f64 = text
+        .parse()
+        .map_err(|_| format!("must be a number of seconds, got {text:?}"))?;
+    if !(seconds.is_finite() && seconds > 0.0) {
+        return Err(format!("must be a positive number of seconds, got {text}"));
+    }
+    std::time::Duration::try_from_secs_f64(seconds).map_err(|e| format!("{text}: {e}"))
+}
+
+/// The render settings that override the scene's.
+#[derive(Debug, Args)]
+pub struct SettingsArgs {
     /// Image width in pixels [default: the scene's].
     #[arg(
         long,
@@ -223,12 +412,11 @@ pub struct RenderArgs {
         help_heading = "Render settings"
     )]
     pub lighting: Option<LightingArg>,
+}
 
-    /// Render twice, in linear and in naive gamma space, and write both side by side
-    /// (linear on the left) into a .png.
-    #[arg(long, conflicts_with = "lighting", help_heading = "Render settings")]
-    pub compare_gamma: bool,
-
+/// Where and how to trace.
+#[derive(Debug, Args)]
+pub struct DeviceArgs {
     /// Where to trace: the GPU if one is found (auto), the GPU only, or the CPU
     /// reference tracer.
     #[arg(
@@ -255,40 +443,9 @@ pub struct RenderArgs {
     /// bounded, and a hung device is reported lost by its driver].
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds, help_heading = "Device")]
     pub gpu_timeout: Option<std::time::Duration>,
-
-    /// Confine the files the scene names (textures, BRDF maps) to the scene file's
-    /// folder: refuse absolute paths, `..` and links out of it. Without it a scene
-    /// file is trusted like a program: it may name any file you can read.
-    #[arg(long)]
-    pub sandbox: bool,
-
-    /// Refuse, before rendering, a render whose estimated peak memory is above this
-    /// many GiB (see docs/reliability.md for the estimate per backend and format).
-    #[arg(
-        long,
-        value_name = "GIB",
-        default_value_t = DEFAULT_MAX_MEMORY_GIB,
-        value_parser = parse_gib
-    )]
-    pub max_memory: f64,
-
-    /// Print nothing but errors: no progress, warnings, notes or summary.
-    #[arg(short, long)]
-    pub quiet: bool,
 }
 
-/// A positive, finite number of seconds.
-fn parse_seconds(text: &str) -> Result<std::time::Duration, String> {
-    let seconds: f64 = text
-        .parse()
-        .map_err(|_| format!("must be a number of seconds, got {text:?}"))?;
-    if !(seconds.is_finite() && seconds > 0.0) {
-        return Err(format!("must be a positive number of seconds, got {text}"));
-    }
-    std::time::Duration::try_from_secs_f64(seconds).map_err(|e| format!("{text}: {e}"))
-}
-
-impl RenderArgs {
+impl SettingsArgs {
     /// The command-line settings that override the scene file's.
     pub fn overrides(&self) -> RenderOverrides {
         let preset = self
@@ -485,10 +642,18 @@ mod tests {
             .expect("parses");
         let message = "samples_per_pixel must be between 1 and 65536, got 0";
         assert_eq!(
-            cli.render.flag_for_setting_message(message).as_deref(),
+            cli.render
+                .settings
+                .flag_for_setting_message(message)
+                .as_deref(),
             Some("--spp 0")
         );
-        assert_eq!(cli.render.flag_for_setting_message("width must be"), None);
+        assert_eq!(
+            cli.render
+                .settings
+                .flag_for_setting_message("width must be"),
+            None
+        );
     }
 
     #[test]
@@ -528,6 +693,44 @@ mod tests {
     }
 
     #[test]
+    fn tiles_and_crops_parse_or_say_what_they_must_be() {
+        assert_eq!(parse_tile("2/4"), Ok(TileArg { index: 2, count: 4 }));
+        for bad in ["4/4", "0/0", "1", "-1/4", "a/b", "1/2/3", "/4"] {
+            let err = parse_tile(bad).expect_err(bad);
+            assert!(err.contains(bad), "{err}");
+        }
+        assert_eq!(
+            parse_crop("0, 10,64,20"),
+            Ok(PixelWindow {
+                columns: 0..64,
+                rows: 10..20
+            })
+        );
+        for bad in [
+            "1,2,3",
+            "0,0,0,5",
+            "4,0,2,5",
+            "0,0,1,1,1",
+            "0,0,x,1",
+            "-1,0,2,2",
+        ] {
+            let err = parse_crop(bad).expect_err(bad);
+            assert!(err.contains(bad), "{err}");
+        }
+        let cli = Cli::try_parse_from([
+            "gpu-render",
+            "s.toml",
+            "-o",
+            "t.exr",
+            "--tile",
+            "0/2",
+            "--crop",
+            "0,0,1,1",
+        ]);
+        assert!(cli.is_err(), "--tile and --crop together");
+    }
+
+    #[test]
     fn adapter_list_needs_no_scene() {
         let cli = Cli::try_parse_from(["gpu-render", "--adapter", "list"]).expect("parses");
         assert_eq!(cli.render.adapter, Some(AdapterArg::List));
@@ -543,6 +746,7 @@ mod tests {
             Cli::try_parse_from(argv)
                 .expect("parses")
                 .render
+                .settings
                 .overrides()
         };
         let draft = parse(&["--quality", "draft"]);

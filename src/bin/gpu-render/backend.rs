@@ -5,8 +5,9 @@ use std::io::Write;
 use anyhow::{Context, Result, bail};
 use gpu_render::cpu;
 use gpu_render::film::{LinearImage, ProgressFn, RenderStats};
-use gpu_render::gpu::{self, AdapterChoice, GpuRenderer, HeadlessGpu};
+use gpu_render::gpu::{self, AdapterChoice, GpuRenderer, HeadlessGpu, TraceRegion};
 use gpu_render::scene::Scene;
+use gpu_render::tiles::PixelWindow;
 
 use crate::args::{AdapterArg, BackendArg};
 
@@ -126,6 +127,68 @@ impl Backend {
             Backend::Cpu {
                 reason: Some(reason),
             } => format!("CPU reference (auto: {reason})"),
+        }
+    }
+
+    /// `gpu` or `cpu`, as a tile records it.
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Backend::Gpu { .. } => "gpu",
+            Backend::Cpu { .. } => "cpu",
+        }
+    }
+
+    /// The adapter's name, or `CPU reference`, as a tile records it.
+    pub fn device_name(&self) -> String {
+        match self {
+            Backend::Gpu { adapter_name, .. } => adapter_name.clone(),
+            Backend::Cpu { .. } => "CPU reference".to_owned(),
+        }
+    }
+
+    /// Renders the pixels of `window` of `scene` (a frame the window's size),
+    /// reporting the window's rows done to `progress`.
+    pub fn render_region(
+        &self,
+        scene: &Scene,
+        window: &PixelWindow,
+        progress: ProgressFn<'_>,
+    ) -> Result<Frame> {
+        match self {
+            Backend::Gpu { gpu, renderer, .. } => {
+                let prepared = renderer
+                    .prepare(&gpu.device, &gpu.queue, scene)
+                    .context("cannot upload the scene to the GPU")?;
+                let region = TraceRegion {
+                    columns: window.columns.clone(),
+                    rows: window.rows.clone(),
+                    target_origin: (window.columns.start, window.rows.start),
+                };
+                let rendered = renderer
+                    .render_region(&gpu.device, &gpu.queue, &prepared, &region, Some(progress))
+                    .context("GPU render failed")?;
+                Ok(Frame {
+                    image: rendered.image,
+                    display_rgba8: rendered.display_rgba8,
+                    stats: rendered.stats,
+                })
+            }
+            Backend::Cpu { .. } => {
+                let rendered = cpu::render_region(
+                    scene,
+                    window.columns.clone(),
+                    window.rows.clone(),
+                    Some(progress),
+                )?;
+                let display_rgba8 = rendered
+                    .image
+                    .to_display_rgba8(scene.display_encodes_srgb());
+                Ok(Frame {
+                    image: rendered.image,
+                    display_rgba8,
+                    stats: rendered.stats,
+                })
+            }
         }
     }
 

@@ -9,7 +9,10 @@
 mod args;
 mod backend;
 mod compare;
+mod estimate;
 mod memory;
+mod merge;
+mod naming;
 mod progress;
 mod signals;
 mod summary;
@@ -23,9 +26,12 @@ use std::time::Instant;
 use anyhow::{Result, anyhow, bail};
 use clap::{CommandFactory, Parser, error::ErrorKind};
 use gpu_render::output::{self, HDR_MAX, OutputFormat, Written};
-use gpu_render::scene::{self, LightingSpace, LoadOptions, RenderSettings, Scene, SceneWarning};
+use gpu_render::scene::{
+    self, LightingSpace, LoadOptions, RenderSettings, Scene, SceneFile, SceneWarning,
+};
+use gpu_render::tiles::{Fingerprint, PixelWindow, Tile, TileInfo, tile_window};
 
-use crate::args::{AdapterArg, BackendArg, Cli, RenderArgs};
+use crate::args::{AdapterArg, BackendArg, Cli, RenderArgs, SettingsArgs};
 use crate::backend::{Backend, Frame, GpuOptions};
 use crate::memory::{BackendKind, Estimate};
 use crate::progress::Progress;
@@ -50,11 +56,13 @@ fn run(cli: Cli) -> Result<()> {
     if let Some(command) = cli.command {
         return match command {
             args::Command::Tradeoff(args) => tradeoff::run(&args),
+            args::Command::Merge(args) => merge::run(&args),
+            args::Command::Estimate(args) => estimate::run(&args),
             args::Command::BrdfCheck { file } => brdf_check(&file),
         };
     }
     let args = cli.render;
-    if args.adapter == Some(AdapterArg::List) {
+    if args.device.adapter == Some(AdapterArg::List) {
         return backend::print_adapters();
     }
     let (Some(scene_path), Some(output_path)) = (args.scene.as_deref(), args.output.as_deref())
@@ -115,33 +123,80 @@ fn brdf_check(file: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Validates everything cheap, then renders and writes the image.
-fn render(args: &RenderArgs, scene_path: &Path, output_path: &Path) -> Result<()> {
-    let format = output::check_output_path(output_path)?;
+/// Validates everything cheap, then renders and writes the image (or, with `--tile`
+/// or `--crop`, the tile).
+fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result<()> {
+    let piece = args.tile.is_some() || args.crop.is_some();
+    let format = OutputFormat::from_path(output_pattern)?;
+    if piece && format != OutputFormat::Exr {
+        bail!(
+            "{}: --tile and --crop write a linear EXR tile that records its window (for              `gpu-render merge`), so the output must be an .exr",
+            output_pattern.display()
+        );
+    }
     if args.compare_gamma && format != OutputFormat::Png {
         bail!(
             "{}: --compare-gamma writes a side-by-side 8-bit display image, so the output must be a .png",
-            output_path.display()
+            output_pattern.display()
         );
     }
-    if args.backend == BackendArg::Cpu && args.adapter.is_some() {
+    if args.compare_gamma && piece {
+        bail!("--compare-gamma renders two whole images side by side; it cannot be a tile");
+    }
+    if args.device.backend == BackendArg::Cpu && args.device.adapter.is_some() {
         bail!("--adapter selects a GPU adapter; it cannot be used with --backend cpu");
     }
+    let tile = args.tile.map(|t| (t.index, t.count));
+    // Without a {frame}, every check of the output happens before the scene is read.
+    let named_by_frame = naming::contains(output_pattern, naming::FRAME);
+    if !named_by_frame {
+        let output_path = naming::expand(output_pattern, None, tile)?;
+        output::check_output_path(&output_path)?;
+        output::check_not_an_input(&output_path, [(scene_path, "scene file")])?;
+    } else if args.frame.is_none() {
+        naming::expand(output_pattern, None, tile)?;
+    }
     // Values out of range whatever the scene says (`--width 0`) fail before loading it.
-    apply_overrides(args, minimal_settings(), None)?;
-    output::check_not_an_input(output_path, [(scene_path, "scene file")])?;
+    apply_overrides(&args.settings, minimal_settings(), None)?;
 
-    let mut scene = load(scene_path, args.sandbox, args.quiet)?;
-    scene.render = apply_overrides(args, scene.render, Some(scene_path))?;
-    check_inputs_survive(output_path, scene_path, &scene)?;
+    let file = load(scene_path, args.sandbox, args.quiet)?;
+    let mut scene = file.scene;
+    scene.render = apply_overrides(&args.settings, scene.render, Some(scene_path))?;
+    let frame = match args.frame {
+        None => None,
+        Some(frame) => {
+            let Some(path) = &file.camera_path else {
+                bail!(
+                    "{}: --frame {frame}: the scene has no [animation] camera path",
+                    scene_path.display()
+                );
+            };
+            if frame >= path.frame_count {
+                bail!(
+                    "{}: --frame {frame}: the animation has {} frames (0 to {})",
+                    scene_path.display(),
+                    path.frame_count,
+                    path.frame_count - 1
+                );
+            }
+            scene.camera = path.frame_camera(&scene.camera, frame);
+            Some((frame, path.frame_count))
+        }
+    };
+    let output_path = naming::expand(output_pattern, frame, tile)?;
+    if named_by_frame {
+        output::check_output_path(&output_path)?;
+    }
+    check_inputs_survive(&output_path, scene_path, &scene)?;
+    let window = piece_window(args, &scene.render)?;
 
     let gpu_options = GpuOptions {
-        iteration_budget: args.iteration_budget,
-        timeout: args.gpu_timeout,
+        iteration_budget: args.device.iteration_budget,
+        timeout: args.device.gpu_timeout,
     };
     let backend = Backend::open(
-        args.backend,
-        args.adapter.as_ref(),
+        args.device.backend,
+        args.device.adapter.as_ref(),
         &scene,
         &gpu_options,
         args.quiet,
@@ -151,10 +206,15 @@ fn render(args: &RenderArgs, scene_path: &Path, output_path: &Path) -> Result<()
         &backend,
         format,
         args.compare_gamma,
+        window.as_ref(),
         args.max_memory,
     )?;
+    let piece_name = window.as_ref().map(|window| match args.tile {
+        Some(t) => format!("tile {}/{} ({window})", t.index, t.count),
+        None => format!("crop {window}"),
+    });
     let started = Instant::now();
-    let frame = if args.compare_gamma {
+    let rendered = if args.compare_gamma {
         let linear = render_pass(&backend, &scene, Some(LightingSpace::Linear), args.quiet)?;
         let naive = render_pass(
             &backend,
@@ -163,31 +223,90 @@ fn render(args: &RenderArgs, scene_path: &Path, output_path: &Path) -> Result<()
             args.quiet,
         )?;
         compare::side_by_side(&linear, &naive)?
+    } else if let Some(window) = &window {
+        let progress = Progress::new(
+            format!("rendering {}", piece_name.as_deref().unwrap_or("")),
+            !args.quiet,
+        );
+        let report = |done: u32, total: u32| progress.update(done, total);
+        let rendered = backend.render_region(&scene, window, &report);
+        progress.finish();
+        rendered?
     } else {
         render_pass(&backend, &scene, None, args.quiet)?
     };
     let wall = started.elapsed();
 
-    let written = output::write_image(output_path, &frame.image, &frame.display_rgba8)?;
+    let written = match &window {
+        Some(window) => {
+            let tile = Tile {
+                info: TileInfo {
+                    image_width: scene.render.width,
+                    image_height: scene.render.height,
+                    window: window.clone(),
+                    tile,
+                    frame: frame.map(|(k, _)| k),
+                    fingerprint: Fingerprint::of(&scene),
+                    settings: gpu_render::tiles::describe_settings(&scene.render),
+                    backend: backend.kind_name().to_owned(),
+                    device: backend.device_name(),
+                    scene_name: scene_path
+                        .file_name()
+                        .map(|name| name.to_string_lossy().into_owned())
+                        .unwrap_or_default(),
+                    version: env!("CARGO_PKG_VERSION").to_owned(),
+                },
+                image: rendered.image,
+                display_rgba8: rendered.display_rgba8,
+            };
+            gpu_render::tiles::write_tile(&output_path, &tile)?;
+            Written::default()
+        }
+        None => output::write_image(&output_path, &rendered.image, &rendered.display_rgba8)?,
+    };
 
     if !args.quiet {
-        warn_clamped(output_path, written);
+        warn_clamped(&output_path, written);
         let summary = Summary {
             settings: &scene.render,
             passes: if args.compare_gamma { 2 } else { 1 },
+            piece: piece_name.as_deref(),
+            frame: frame.map(|(k, _)| k),
             backend: &backend.describe(),
             wall,
-            stats: frame.stats,
-            output: output_path,
+            stats: rendered.stats,
+            output: &output_path,
         };
         eprintln!("{summary}");
     }
     Ok(())
 }
 
-/// Loads the scene file, with progress after a second and warnings on stderr (unless
-/// `quiet`), confined to its folder with `sandbox`.
-pub fn load(scene_path: &Path, sandbox: bool, quiet: bool) -> Result<Scene> {
+/// The window `--tile` or `--crop` asks for, checked against the image; `None` for
+/// the whole image.
+fn piece_window(args: &RenderArgs, settings: &RenderSettings) -> Result<Option<PixelWindow>> {
+    let (width, height) = (settings.width, settings.height);
+    if let Some(tile) = args.tile {
+        return tile_window(tile.index, tile.count, width, height)
+            .map(Some)
+            .map_err(|e| anyhow!("--tile {}/{}: {e}", tile.index, tile.count));
+    }
+    match &args.crop {
+        Some(crop) if !crop.fits(width, height) => bail!(
+            "--crop {},{},{},{}: the window {crop} does not lie inside the {width}x{height} image",
+            crop.columns.start,
+            crop.rows.start,
+            crop.columns.end,
+            crop.rows.end
+        ),
+        crop => Ok(crop.clone()),
+    }
+}
+
+/// Loads the scene file (and its camera path, if it has one), with progress after a
+/// second and warnings on stderr (unless `quiet`), confined to its folder with
+/// `sandbox`.
+pub fn load(scene_path: &Path, sandbox: bool, quiet: bool) -> Result<SceneFile> {
     let warn = |warning: &SceneWarning| eprintln!("warning: {warning}");
     let label = scene_path.display().to_string();
     let scene = progress::while_loading(&label, !quiet, |progress| {
@@ -196,7 +315,7 @@ pub fn load(scene_path: &Path, sandbox: bool, quiet: bool) -> Result<Scene> {
             progress: Some(progress),
             warning: (!quiet).then_some(&warn as &(dyn Fn(&SceneWarning) + Sync)),
         };
-        scene::load_scene_with(scene_path, &options)
+        scene::load_scene_file(scene_path, &options)
     })?;
     Ok(scene)
 }
@@ -219,13 +338,17 @@ fn check_memory(
     backend: &Backend,
     format: OutputFormat,
     compare_gamma: bool,
+    window: Option<&PixelWindow>,
     max_memory_gib: f64,
 ) -> Result<()> {
     let kind = match backend {
         Backend::Gpu { .. } => BackendKind::Gpu,
         Backend::Cpu { .. } => BackendKind::Cpu,
     };
-    let estimate = Estimate::new(scene, kind, format, compare_gamma);
+    let estimate = match window {
+        Some(window) => Estimate::for_tile(scene, kind, window.pixels()),
+        None => Estimate::new(scene, kind, format, compare_gamma),
+    };
     let cap = max_memory_gib * f64::from(1u32 << 30);
     if estimate.total as f64 > cap {
         let s = &scene.render;
@@ -247,7 +370,7 @@ fn check_memory(
 }
 
 /// Warns when the format could not hold every pixel and clamped some.
-fn warn_clamped(output_path: &Path, written: Written) {
+pub fn warn_clamped(output_path: &Path, written: Written) {
     if written.clamped_pixels > 0 {
         eprintln!(
             "warning: {}: {} pixels had radiance above {HDR_MAX:e}, the largest a Radiance \
@@ -286,7 +409,7 @@ fn render_pass(
 }
 
 /// The smallest valid settings, to range-check the command-line values on their own.
-fn minimal_settings() -> RenderSettings {
+pub fn minimal_settings() -> RenderSettings {
     RenderSettings {
         width: 1,
         height: 1,
@@ -299,8 +422,8 @@ fn minimal_settings() -> RenderSettings {
 }
 
 /// Applies the command-line overrides to `base`, naming the offending flag on error.
-fn apply_overrides(
-    args: &RenderArgs,
+pub fn apply_overrides(
+    args: &SettingsArgs,
     base: RenderSettings,
     scene_path: Option<&Path>,
 ) -> Result<RenderSettings> {

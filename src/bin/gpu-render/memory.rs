@@ -88,6 +88,25 @@ impl Estimate {
     }
 }
 
+impl Estimate {
+    /// The estimate for rendering `pixels` of `scene`'s image as a tile (`--tile`,
+    /// `--crop`): the `.exr` figure per pixel of the window, plus the tile's eight
+    /// channels as the `exr` encoder holds them (32 bytes per pixel) and as much
+    /// again for its compressed blocks. Those 64 bytes are counted, not measured.
+    pub fn for_tile(scene: &Scene, backend: BackendKind, pixels: u64) -> Self {
+        let per_pixel = bytes_per_pixel(backend, OutputFormat::Exr, false) + 64;
+        let scene_bytes = scene_bytes(scene);
+        let fixed = fixed_bytes(backend, false);
+        Self {
+            pixels,
+            per_pixel,
+            scene: scene_bytes,
+            fixed,
+            total: fixed + scene_bytes + pixels * per_pixel,
+        }
+    }
+}
+
 impl fmt::Display for Estimate {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(

@@ -12,6 +12,11 @@ pub struct Summary<'a> {
     pub settings: &'a RenderSettings,
     /// How many images were rendered (2 for `--compare-gamma`).
     pub passes: u32,
+    /// The piece rendered (`tile 1/4 (x 0..32, y 6..12 (32x6))`), if not the whole
+    /// image.
+    pub piece: Option<&'a str>,
+    /// The animation frame rendered, if one was.
+    pub frame: Option<u32>,
     /// `GPU (adapter)` or `CPU reference`.
     pub backend: &'a str,
     /// Wall time of the render call(s), without loading or writing.
@@ -30,13 +35,19 @@ impl std::fmt::Display for Summary<'_> {
         } else {
             String::new()
         };
+        let piece = self
+            .piece
+            .map_or(String::new(), |piece| format!("{piece} of "));
+        let frame = self
+            .frame
+            .map_or(String::new(), |frame| format!(" (frame {frame})"));
         // The trace time is GPU time where timestamps were taken, else wall time; the
         // ray rate is per that time, and the line says which it is.
         let (trace, source) = self.stats.trace_seconds();
         let (rays_per_second, _) = self.stats.trace_rays_per_second();
         write!(
             f,
-            "rendered {passes}{}x{}, {} spp, max depth {} on {} in {:.2} s: {} rays, trace {:.2} s ({source}), {:.1} Mrays/s -> {}",
+            "rendered {passes}{piece}{}x{}{frame}, {} spp, max depth {} on {} in {:.2} s: {} rays, trace {:.2} s ({source}), {:.1} Mrays/s -> {}",
             s.width,
             s.height,
             s.samples_per_pixel,
@@ -96,6 +107,8 @@ mod tests {
         let summary = Summary {
             settings: &settings,
             passes: 1,
+            piece: None,
+            frame: None,
             backend: "GPU (Test)",
             wall: Duration::from_millis(1500),
             stats: RenderStats {
@@ -119,6 +132,17 @@ mod tests {
         assert_eq!(
             timed.to_string(),
             "rendered 32x24, 4 spp, max depth 5 on GPU (Test) in 1.50 s: 3.00 M rays, trace 0.75 s (GPU timestamps), 4.0 Mrays/s -> out.png"
+        );
+        let tile = Summary {
+            piece: Some("tile 1/4 (x 0..32, y 6..12 (32x6))"),
+            frame: Some(7),
+            ..timed
+        };
+        assert!(
+            tile.to_string().starts_with(
+                "rendered tile 1/4 (x 0..32, y 6..12 (32x6)) of 32x24 (frame 7), 4 spp"
+            ),
+            "{tile}"
         );
     }
 
