@@ -733,7 +733,7 @@ mod tests {
     #[test]
     fn adapter_list_needs_no_scene() {
         let cli = Cli::try_parse_from(["gpu-render", "--adapter", "list"]).expect("parses");
-        assert_eq!(cli.render.adapter, Some(AdapterArg::List));
+        assert_eq!(cli.render.device.adapter, Some(AdapterArg::List));
         assert!(Cli::try_parse_from(["gpu-render", "s.toml"]).is_err());
         assert!(Cli::try_parse_from(["gpu-render", "-o", "x.png"]).is_err());
     }

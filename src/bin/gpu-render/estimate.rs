@@ -240,7 +240,7 @@ mod tests {
         assert_eq!(calibration_size(640, 480, 1, 16_384), (148, 111));
         assert_eq!(calibration_size(64, 48, 4, 16_384), (64, 48));
         assert_eq!(calibration_size(1920, 1080, 200, 1_000), (42, 200));
-        assert_eq!(calibration_size(10, 3, 3, 1), (1, 3));
+        assert_eq!(calibration_size(10, 3, 3, 1), (2, 3));
     }
 
     #[test]

@@ -221,7 +221,7 @@ fn animation_errors_are_located() {
     };
     let message = fail(&ANIMATION.replace("time = 1.5", "time = 0"));
     assert!(
-        message.starts_with("test.toml:12:1: animation.keyframes[1]: time 0 is not after"),
+        message.starts_with("test.toml:11:1: animation.keyframes[1]: time 0 is not after"),
         "{message}"
     );
     let message = fail(&ANIMATION.replace("fps = 4", "fps = 0"));
