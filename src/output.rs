@@ -406,19 +406,10 @@ pub fn write_png_rgba8(
     })
 }
 
-/// An OpenEXR image of one layer of any channels, as the `exr` crate builds it.
-pub(crate) type ExrImage =
-    exr::image::Image<exr::image::Layer<exr::image::AnyChannels<exr::image::FlatSamples>>>;
-
-/// Writes `image` (a tile with its data window and attributes, built by
-/// [`crate::tiles::write_tile`]) to the OpenEXR file `path`, atomically.
-pub(crate) fn write_exr(path: &Path, image: &ExrImage) -> Result<(), OutputError> {
-    use exr::prelude::WritableImage;
+/// Writes `bytes` (a file encoded in memory: a tile) to `path`, atomically.
+pub(crate) fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
     write_atomically(path, |writer| {
-        image
-            .write()
-            .to_buffered(&mut *writer)
-            .map_err(EncodeFailure::Exr)
+        writer.write_all(bytes).map_err(EncodeFailure::Io)
     })
 }
 
@@ -537,8 +528,6 @@ fn discard(temp: tempfile::NamedTempFile) {
 enum EncodeFailure {
     /// The image encoder's error, while writing this format.
     Image(OutputFormat, image::ImageError),
-    /// The `exr` crate's error, while writing a tile.
-    Exr(exr::error::Error),
     /// A plain write failed.
     Io(io::Error),
 }
@@ -614,10 +603,6 @@ fn encode_to(
             path: path.to_path_buf(),
             format,
             error,
-        }),
-        (Err(EncodeFailure::Exr(error)), None) => Err(OutputError::EncodeExr {
-            path: path.to_path_buf(),
-            message: error.to_string(),
         }),
         (Ok(()), None) => flushed.map_err(write_error),
     }

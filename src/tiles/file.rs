@@ -195,7 +195,68 @@ pub fn write_tile(path: &Path, tile: &Tile) -> Result<(), OutputError> {
         ))),
         layer,
     );
-    output::write_exr(path, &image)
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    let encoded = {
+        use exr::prelude::WritableImage;
+        image.write().to_buffered(&mut bytes)
+    };
+    let mut bytes = bytes.into_inner();
+    encoded
+        .map_err(|e| e.to_string())
+        .and_then(|()| sort_header_attributes(&mut bytes))
+        .map_err(|message| OutputError::EncodeExr {
+            path: path.to_path_buf(),
+            message,
+        })?;
+    output::write_bytes(path, &bytes)
+}
+
+/// Puts the attributes of a single-part OpenEXR file's header in name order.
+///
+/// The `exr` crate writes custom attributes in the order of a `HashMap`, which
+/// differs from process to process; sorted, the same tile is the same bytes whoever
+/// renders it. The header keeps its length, so the offsets after it stay right.
+fn sort_header_attributes(bytes: &mut [u8]) -> Result<(), String> {
+    const HEADER_START: usize = 8; // the magic number and the version field
+    let malformed = || "the encoder's header could not be read back".to_owned();
+    let mut entries: Vec<(usize, usize)> = Vec::new();
+    let mut at = HEADER_START;
+    loop {
+        let name_end = at
+            + bytes
+                .get(at..)
+                .and_then(|b| b.iter().position(|&c| c == 0))
+                .ok_or_else(malformed)?;
+        if name_end == at {
+            break; // the empty name that ends the header
+        }
+        let type_end = name_end
+            + 1
+            + bytes
+                .get(name_end + 1..)
+                .and_then(|b| b.iter().position(|&c| c == 0))
+                .ok_or_else(malformed)?;
+        let size_bytes: [u8; 4] = bytes
+            .get(type_end + 1..type_end + 5)
+            .and_then(|b| b.try_into().ok())
+            .ok_or_else(malformed)?;
+        let size = usize::try_from(i32::from_le_bytes(size_bytes)).map_err(|_| malformed())?;
+        let end = type_end + 5 + size;
+        if end > bytes.len() {
+            return Err(malformed());
+        }
+        entries.push((at, end));
+        at = end;
+    }
+    let mut sorted: Vec<&[u8]> = entries
+        .iter()
+        .map(|&(start, end)| &bytes[start..end])
+        .collect();
+    // By name: an attribute name is unique in a header.
+    sorted.sort_unstable_by_key(|entry| entry.split(|&c| c == 0).next().unwrap_or(&[]));
+    let header = sorted.concat();
+    bytes[HEADER_START..HEADER_START + header.len()].copy_from_slice(&header);
+    Ok(())
 }
 
 /// Reads what the tile at `path` records, without its pixels (only the header is
@@ -545,6 +606,22 @@ mod tests {
         // Latin-1 survives; the rest is as written.
         assert_eq!(read.info, written.info);
         assert_eq!(read_tile_header(&path).expect("header"), written.info);
+    }
+
+    #[test]
+    fn the_same_tile_is_the_same_bytes() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let window = PixelWindow {
+            columns: 0..9,
+            rows: 1..4,
+        };
+        let mut files = Vec::new();
+        for name in ["a.exr", "b.exr", "c.exr"] {
+            let path = dir.path().join(name);
+            write_tile(&path, &tile(window.clone())).expect("write");
+            files.push(std::fs::read(&path).expect("read"));
+        }
+        assert!(files.windows(2).all(|pair| pair[0] == pair[1]));
     }
 
     #[test]
