@@ -3,6 +3,7 @@
 #   ensure_lavapipe   install Mesa's software Vulkan driver (lavapipe) if it is missing
 #                     (on Debian 12 from bookworm-backports: Mesa 25)
 #   ensure_rust_components  rustfmt and clippy (rustup component add) if missing
+#   ensure_parallel   install GNU parallel (the recipe test runs it) if it is missing
 #   setup_gpu_env     XDG_RUNTIME_DIR and WGPU_BACKEND defaults for headless wgpu
 #   section TITLE     print a section header
 
@@ -82,6 +83,21 @@ ensure_lavapipe() {
         echo "warning: bookworm-backports failed; installed the release's Mesa $(installed_mesa_version)" >&2
     else
         echo "warning: could not install lavapipe; GPU tests may find no adapter" >&2
+    fi
+}
+
+# GNU parallel, whose recipe (distributed/parallel/render.sh) tests/recipes.rs runs.
+# Without apt (or root) it warns and carries on: that test then skips, except in CI.
+ensure_parallel() {
+    if command -v parallel >/dev/null 2>&1; then
+        return 0
+    fi
+    echo "installing GNU parallel"
+    if ! { command -v apt-get >/dev/null 2>&1 &&
+        as_root apt-get update -qq &&
+        as_root env DEBIAN_FRONTEND=noninteractive \
+            apt-get install -y -qq --no-install-recommends parallel; }; then
+        echo "warning: could not install GNU parallel; its recipe test will skip" >&2
     fi
 }
 

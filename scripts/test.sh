@@ -10,6 +10,7 @@ source scripts/lib.sh
 
 section "Environment"
 ensure_lavapipe
+ensure_parallel
 ensure_rust_components
 setup_gpu_env
 cargo --version
