@@ -102,13 +102,12 @@ fn intersect_plane(ray: Ray, normal: vec3<f32>, offset: f32, t_max: f32) -> f32 
 //#endif
 
 //#if POLYGONS
-// The two coordinates left when `dropped_axis` (0 = x, 1 = y, 2 = z) is removed.
+// The two coordinates left when `dropped_axis` (0 = x, 1 = y, 2 = z) is removed: (y, z),
+// (z, x) or (x, y), picked with selects (lanes testing different polygons agree on the
+// code path).
 fn project_to_plane(p: vec3<f32>, dropped_axis: u32) -> vec2<f32> {
-    switch dropped_axis {
-        case 0u: { return p.yz; }
-        case 1u: { return p.zx; }
-        default: { return p.xy; }
-    }
+    return vec2<f32>(vector_component(p, (dropped_axis + 1u) % 3u),
+                     vector_component(p, (dropped_axis + 2u) % 3u));
 }
 //#endif
 
