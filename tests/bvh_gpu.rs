@@ -106,6 +106,7 @@ fn scene_of(shapes: Vec<Shape>) -> Scene {
         material_names: vec!["grey".into()],
         lights: vec![],
         shapes,
+        meshes: vec![],
         images: vec![],
     }
 }

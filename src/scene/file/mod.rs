@@ -330,6 +330,7 @@ fn build_scene(
         material_names,
         lights,
         shapes,
+        meshes: vec![],
         images: images.into_images(),
     })
 }
