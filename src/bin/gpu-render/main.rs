@@ -1,4 +1,5 @@
-//! `gpu-render SCENE -o OUT`: renders a scene file to an image.
+//! `gpu-render SCENE -o OUT`: renders a scene file, or a model file (OBJ, glTF, GLB)
+//! on its own, to an image.
 //!
 //! Cheap checks (output format and directory, command-line settings, the scene file)
 //! all happen before a device is opened or a ray traced. Errors are printed as
@@ -131,7 +132,12 @@ fn render(args: &RenderArgs, scene_path: &Path, output_path: &Path) -> Result<()
     apply_overrides(args, minimal_settings(), None)?;
     output::check_not_an_input(output_path, [(scene_path, "scene file")])?;
 
-    let mut scene = load(scene_path, args.sandbox, args.quiet)?;
+    let mut scene = if scene::import::is_model_path(scene_path) {
+        let render = apply_overrides(args, RenderSettings::default(), Some(scene_path))?;
+        load_model(scene_path, render, args.sandbox, args.quiet)?
+    } else {
+        load(scene_path, args.sandbox, args.quiet)?
+    };
     scene.render = apply_overrides(args, scene.render, Some(scene_path))?;
     check_inputs_survive(output_path, scene_path, &scene)?;
 
@@ -198,6 +204,40 @@ pub fn load(scene_path: &Path, sandbox: bool, quiet: bool) -> Result<Scene> {
         };
         scene::load_scene_with(scene_path, &options)
     })?;
+    Ok(scene)
+}
+
+/// Imports a model file and frames it as a scene of its own
+/// ([`gpu_render::scene::import::ImportedModel::into_scene`]) with `render`'s settings;
+/// warnings on stderr unless `quiet`. A model's own references (material libraries,
+/// buffers, images) cannot be confined, so `sandbox` refuses model files.
+fn load_model(path: &Path, render: RenderSettings, sandbox: bool, quiet: bool) -> Result<Scene> {
+    if sandbox {
+        bail!(
+            "{}: --sandbox cannot render model files: the files a model names itself \
+             (material libraries, buffers, textures) are not confined",
+            path.display()
+        );
+    }
+    let model = scene::import::import_model(path)?;
+    let (scene, warnings) = model.into_scene(render);
+    if !quiet {
+        for warning in model.warnings.iter().chain(&warnings) {
+            eprintln!("warning: {warning}");
+        }
+        if model.camera.is_none() {
+            eprintln!(
+                "note: {} has no camera; framing its bounds from the front, above right",
+                path.display()
+            );
+        }
+        if model.lights.is_empty() {
+            eprintln!(
+                "note: {} has no lights; using the default three directional lights",
+                path.display()
+            );
+        }
+    }
     Ok(scene)
 }
 
