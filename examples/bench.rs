@@ -182,6 +182,7 @@ fn million_triangle_scene() -> gpu_render::scene::Scene {
             },
         ],
         shapes,
+        meshes: vec![],
         images: vec![],
     }
 }

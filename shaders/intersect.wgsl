@@ -16,7 +16,100 @@ struct Hit {
     found: bool,
     // The hit point re-projected onto the surface (Ray Tracing Gems, ch. 6, §6.2.1).
     position: vec3<f32>,
+    // The primitive hit (a PrimRef).
+    prim: u32,
+    // Unit shading normal on the side of `normal`: a mesh triangle's interpolated
+    // vertex normals, else `normal`.
+    shading_normal: vec3<f32>,
+    // A mesh triangle's interpolated texture coordinates, else (0, 0).
+    uv: vec2<f32>,
+    // Barycentric coordinates in a triangle, else (1, 0, 0).
+    barycentrics: vec3<f32>,
 }
+
+// A hit without vertex attributes: shading normal = geometric normal.
+fn flat_hit(prim: u32, t: f32, normal: vec3<f32>, material: u32, position: vec3<f32>) -> Hit {
+    return Hit(t, normal, material, true, position, prim, normal, vec2<f32>(0.0),
+               vec3<f32>(1.0, 0.0, 0.0));
+}
+
+//#if TRIANGLES
+// The barycentric coordinates of `p` (on the triangle's plane) in the triangle
+// (v0, v1, v2), clamped to it and summing to 1 (Ericson, "Real-Time Collision
+// Detection", §3.4). CPU twin: triangle_barycentrics.
+fn triangle_barycentrics(p: vec3<f32>, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> vec3<f32> {
+    let e1 = v1 - v0;
+    let e2 = v2 - v0;
+    let q = p - v0;
+    let d00 = dot(e1, e1);
+    let d01 = dot(e1, e2);
+    let d11 = dot(e2, e2);
+    let d20 = dot(q, e1);
+    let d21 = dot(q, e2);
+    let denominator = d00 * d11 - d01 * d01;
+    if !(denominator > 0.0) {
+        return vec3<f32>(1.0, 0.0, 0.0);
+    }
+    let v = (d11 * d20 - d01 * d21) / denominator;
+    let w = (d00 * d21 - d01 * d20) / denominator;
+    let b = max(vec3<f32>(1.0 - v - w, v, w), vec3<f32>(0.0));
+    let sum = b.x + b.y + b.z;
+    return select(vec3<f32>(1.0, 0.0, 0.0), b / sum, sum > 0.0);
+}
+//#endif
+
+//#if MESH_ATTRIBUTES
+// Fills a mesh triangle hit's shading normal (the interpolated vertex normals, kept
+// only where they are not degenerate and face the geometric normal's side) and texture
+// coordinates. CPU twin: the attribute part of hit_record.
+fn apply_triangle_attributes(hit: ptr<function, Hit>, index: u32) {
+    let attributes = triangle_attributes[index];
+    let b = (*hit).barycentrics;
+    if attributes.has_normals != 0u {
+        let interpolated = attributes.n0 * b.x + attributes.n1 * b.y + attributes.n2 * b.z;
+        let length_squared = dot(interpolated, interpolated);
+        if length_squared > 0.0 {
+            let shading = interpolated * inverseSqrt(length_squared);
+            if dot(shading, (*hit).normal) > 0.0 {
+                (*hit).shading_normal = shading;
+            }
+        }
+    }
+    if attributes.has_uvs != 0u {
+        (*hit).uv = attributes.uv01.xy * b.x + attributes.uv01.zw * b.y + attributes.uv2 * b.z;
+    }
+}
+
+// Where the shadow rays of a smooth-shaded mesh hit start: the hit point lifted off its
+// flat triangle towards the curved surface of the vertex normals, P' = P -
+// Σ bᵢ·min(0, (P - Vᵢ)·nᵢ)·nᵢ with the normals turned to the side of `facing` (Hanika,
+// "Hacking the Shadow Terminator", Ray Tracing Gems II, ch. 4). CPU twin:
+// shadow_terminator_point.
+fn shadow_terminator_point(hit: Hit, facing: vec3<f32>) -> vec3<f32> {
+    if prim_kind(hit.prim) != PRIM_TRIANGLE {
+        return hit.position;
+    }
+    let triangle = triangles[prim_index(hit.prim)];
+    if triangle.attributes == NO_ATTRIBUTES {
+        return hit.position;
+    }
+    let attributes = triangle_attributes[triangle.attributes];
+    if attributes.has_normals == 0u {
+        return hit.position;
+    }
+    let sign = select(1.0, -1.0, dot(facing, hit.normal) < 0.0);
+    let p = hit.position;
+    let b = hit.barycentrics;
+    let n0 = attributes.n0 * sign;
+    let n1 = attributes.n1 * sign;
+    let n2 = attributes.n2 * sign;
+    var lifted = p;
+    lifted -= n0 * (min(dot(p - triangle.v0, n0), 0.0) * b.x);
+    lifted -= n1 * (min(dot(p - triangle.v1, n1), 0.0) * b.y);
+    lifted -= n2 * (min(dot(p - triangle.v2, n2), 0.0) * b.z);
+    return lifted;
+}
+//#endif
 
 fn ray_at(ray: Ray, t: f32) -> vec3<f32> {
     return ray.origin + ray.direction * t;
@@ -102,13 +195,12 @@ fn intersect_plane(ray: Ray, normal: vec3<f32>, offset: f32, t_max: f32) -> f32 
 //#endif
 
 //#if POLYGONS
-// The two coordinates left when `dropped_axis` (0 = x, 1 = y, 2 = z) is removed.
+// The two coordinates left when `dropped_axis` (0 = x, 1 = y, 2 = z) is removed: (y, z),
+// (z, x) or (x, y), picked with selects (lanes testing different polygons agree on the
+// code path).
 fn project_to_plane(p: vec3<f32>, dropped_axis: u32) -> vec2<f32> {
-    switch dropped_axis {
-        case 0u: { return p.yz; }
-        case 1u: { return p.zx; }
-        default: { return p.xy; }
-    }
+    return vec2<f32>(vector_component(p, (dropped_axis + 1u) % 3u),
+                     vector_component(p, (dropped_axis + 2u) % 3u));
 }
 //#endif
 
@@ -285,34 +377,43 @@ fn hit_record(prim: u32, ray: Ray, t: f32) -> Hit {
         //#if SPHERES
         case PRIM_SPHERE: {
             let sphere = spheres[i];
-            return Hit(t, normalize(p - sphere.center), sphere.material, true,
-                       project_onto_sphere(p, sphere.center, sphere.radius));
+            return flat_hit(prim, t, normalize(p - sphere.center), sphere.material,
+                            project_onto_sphere(p, sphere.center, sphere.radius));
         }
         //#endif
         //#if PLANES
         case PRIM_PLANE: {
             let plane = planes[i];
-            return Hit(t, plane.normal, plane.material, true,
-                       project_onto_plane(p, plane.normal, plane.offset));
+            return flat_hit(prim, t, plane.normal, plane.material,
+                            project_onto_plane(p, plane.normal, plane.offset));
         }
         //#endif
         //#if POLYGONS
         case PRIM_POLYGON: {
             let polygon = polygons[i];
-            return Hit(t, polygon.normal, polygon.material, true,
-                       project_onto_plane(p, polygon.normal, polygon.offset));
+            return flat_hit(prim, t, polygon.normal, polygon.material,
+                            project_onto_plane(p, polygon.normal, polygon.offset));
         }
         //#endif
         //#if TRIANGLES
         case PRIM_TRIANGLE: {
             let triangle = triangles[i];
             let normal = triangle_normal(triangle.v0, triangle.v1, triangle.v2);
-            return Hit(t, normal, triangle.material, true,
-                       project_onto_plane(p, normal, dot(normal, triangle.v0)));
+            var hit = flat_hit(prim, t, normal, triangle.material,
+                               project_onto_plane(p, normal, dot(normal, triangle.v0)));
+            hit.barycentrics = triangle_barycentrics(hit.position, triangle.v0, triangle.v1, triangle.v2);
+            //#if MESH_ATTRIBUTES
+            if triangle.attributes != NO_ATTRIBUTES {
+                apply_triangle_attributes(&hit, triangle.attributes);
+            }
+            //#endif
+            return hit;
         }
         //#endif
         default: {
-            return Hit(t, vec3<f32>(0.0), 0u, false, p);
+            var hit = flat_hit(prim, t, vec3<f32>(0.0), 0u, p);
+            hit.found = false;
+            return hit;
         }
     }
 }

@@ -33,8 +33,12 @@ fn tangent_frame(n: vec3<f32>) -> TangentFrame {
 
 //#if TEXTURES
 // Spherical: u = ½ - atan2(n.z, n.x)/(2π), v = acos(n.y)/π. Planar: u = p·t/scale,
-// v = p·b/scale on the tangent frame of the geometric normal.
-fn texture_coordinates(material: Material, position: vec3<f32>, normal: vec3<f32>) -> vec2<f32> {
+// v = p·b/scale on the tangent frame of the geometric normal. UV: the mesh's
+// interpolated coordinates `uv`.
+fn texture_coordinates(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> vec2<f32> {
+    if material.texture_mapping == MAPPING_UV {
+        return uv;
+    }
     if material.texture_mapping == MAPPING_SPHERICAL {
         let y = clamp(normal.y, -1.0, 1.0);
         return vec2<f32>(0.5 - atan2(normal.z, normal.x) / (2.0 * TEXTURE_PI), acos(y) / TEXTURE_PI);
@@ -45,11 +49,21 @@ fn texture_coordinates(material: Material, position: vec3<f32>, normal: vec3<f32
 //#endif
 
 //#if TEXTURES
-// i mod n for an integer-valued i of any size, wrapped in floating point (an integer
-// conversion would saturate at 2^31 far out on an infinite plane); the clamp catches
-// rounding up to n.
-fn wrap_index(i: f32, n: u32) -> u32 {
+// The texel index of the integer-valued coordinate i on an axis of n texels under
+// `wrap` (glTF 2.0 §3.8.4.4, the OpenGL wrap modes): repeat takes i mod n, mirrored
+// repeat folds i mod 2n back, clamp holds the edge texel. The modulo is taken in
+// floating point (an integer conversion would saturate at 2^31 far out on an infinite
+// plane); the min catches rounding up to the period.
+fn wrap_index(i: f32, n: u32, wrap: u32) -> u32 {
     let m = f32(n);
+    if wrap == WRAP_CLAMP_TO_EDGE {
+        return u32(clamp(i, 0.0, m - 1.0));
+    }
+    if wrap == WRAP_MIRRORED_REPEAT {
+        let period = 2.0 * m;
+        let j = min(u32(i - period * floor(i / period)), 2u * n - 1u);
+        return select(j, 2u * n - 1u - j, j >= n);
+    }
     return min(u32(i - m * floor(i / m)), n - 1u);
 }
 //#endif
@@ -61,12 +75,13 @@ fn bilinear(layer: u32, xs: vec2<u32>, ys: vec2<u32>, f: vec2<f32>) -> vec3<f32>
 }
 
 //#if TEXTURES
-// Bilinear lookup with repeat wrapping; texel (x, y) is centred at ((x+½)/W, (y+½)/H).
-fn sample_texture(layer: u32, width: u32, height: u32, uv: vec2<f32>) -> vec3<f32> {
+// Bilinear lookup with the wrap modes `wrap` (u, v); texel (x, y) is centred at
+// ((x+½)/W, (y+½)/H).
+fn sample_texture(layer: u32, width: u32, height: u32, uv: vec2<f32>, wrap: vec2<u32>) -> vec3<f32> {
     let p = uv * vec2<f32>(f32(width), f32(height)) - 0.5;
     let p0 = floor(p);
-    let xs = vec2<u32>(wrap_index(p0.x, width), wrap_index(p0.x + 1.0, width));
-    let ys = vec2<u32>(wrap_index(p0.y, height), wrap_index(p0.y + 1.0, height));
+    let xs = vec2<u32>(wrap_index(p0.x, width, wrap.x), wrap_index(p0.x + 1.0, width, wrap.x));
+    let ys = vec2<u32>(wrap_index(p0.y, height, wrap.y), wrap_index(p0.y + 1.0, height, wrap.y));
     return bilinear(layer, xs, ys, p - p0);
 }
 //#endif
@@ -83,12 +98,14 @@ fn sample_brdf_map(layer: u32, size: u32, theta_i: f32, theta_r: f32) -> vec3<f3
 }
 //#endif
 
-// The albedo at a hit: material.diffuse, times the albedo texture where there is one.
-fn shading_albedo(material: Material, position: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
+// The albedo at a hit at `position` with geometric normal `normal` and mesh texture
+// coordinates `uv`: material.diffuse, times the albedo texture where there is one.
+fn shading_albedo(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> vec3<f32> {
     //#if TEXTURES
     if material.texture_layer != NO_IMAGE {
-        let uv = texture_coordinates(material, position, normal);
-        return material.diffuse * sample_texture(material.texture_layer, material.texture_width, material.texture_height, uv);
+        let st = texture_coordinates(material, position, normal, uv);
+        let wrap = vec2<u32>(material.texture_wrap_u, material.texture_wrap_v);
+        return material.diffuse * sample_texture(material.texture_layer, material.texture_width, material.texture_height, st, wrap);
     }
     //#endif
     return material.diffuse;

@@ -42,6 +42,8 @@
 @group(0) @binding(16) var<storage, read_write> traces: array<TraceRay>;
 // Each slot's traversal stack of MAX_BVH_DEPTH entries (interleaved across slots).
 @group(0) @binding(17) var<storage, read_write> traversal_stack: array<u32>;
+// Vertex normals and texture coordinates of mesh triangles (Triangle.attributes).
+@group(0) @binding(18) var<storage, read> triangle_attributes: array<TriangleAttributes>;
 
 // Squared point-light distances below the smallest normal f32 (2^-126) contribute
 // nothing: I / r² would be infinite or NaN. Twin of MIN_LIGHT_DISTANCE_SQUARED.
@@ -153,7 +155,9 @@ struct LightSample {
     lit: bool,
 }
 
-fn sample_light(light: Light, origin: vec3<f32>, n: vec3<f32>) -> LightSample {
+// `n` is the shading normal, `ng` the geometric one (both facing the incoming ray): a
+// light lights the point only when it is above both.
+fn sample_light(light: Light, origin: vec3<f32>, n: vec3<f32>, ng: vec3<f32>) -> LightSample {
     var sample = LightSample(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, false);
     if light.kind == LIGHT_POINT {
         let to_light = light.position_or_direction - origin;
@@ -171,9 +175,29 @@ fn sample_light(light: Light, origin: vec3<f32>, n: vec3<f32>) -> LightSample {
         sample.irradiance = light.power;
     }
     sample.cos_i = clamp(dot(n, sample.wi), -1.0, 1.0);
-    sample.lit = sample.cos_i > 0.0;
+    sample.lit = sample.cos_i > 0.0 && dot(ng, sample.wi) > 0.0;
     return sample;
 }
+
+//#if MESH_ATTRIBUTES
+// The normal a hit is shaded with (facing the ray): the shading normal `ns` when the
+// ray, its mirror direction about `ns` and its refracted direction stay on the sides of
+// the geometric surface `ng` they belong to, else `ng` (Veach's thesis, 1997, §5.3;
+// PBRT v4 §10.1.1). CPU twin: shading_frame_normal.
+fn shading_frame_normal(material: Material, direction: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>, entering: bool, outside_ior: f32) -> vec3<f32> {
+    if all(ns == ng) || -dot(direction, ns) <= 0.0 {
+        return ng;
+    }
+    if dot(reflect_direction(direction, ns), ng) <= 0.0 {
+        return ng;
+    }
+    let response = surface_response(material, direction, ns, entering, outside_ior);
+    if max_component(response.transmit) > 0.0 && dot(response.transmit_direction, ng) >= 0.0 {
+        return ng;
+    }
+    return ns;
+}
+//#endif
 
 // Shades the hit (or miss) of the path's current ray, as shade_hit and trace_radiance
 // do on the CPU: a miss adds the background; a hit pushes the refracted, then the
@@ -188,10 +212,10 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
     }
     let hit = hit_record(trace.best_prim, ray, trace.best_t);
     var material = materials[hit.material];
-    material.diffuse = shading_albedo(material, hit.position, hit.normal);
+    material.diffuse = shading_albedo(material, hit.position, hit.normal, hit.uv);
     let entering = dot(ray.direction, hit.normal) < 0.0;
     // Shading happens on the side the ray came from.
-    let n = select(-hit.normal, hit.normal, entering);
+    let ng = select(-hit.normal, hit.normal, entering);
     let medium = MediumStack((*path).medium_iors, (*path).medium_depth);
     //#if REFRACTION
     let outside_ior = medium_outside_ior(medium, entering);
@@ -199,18 +223,26 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
     // Without dielectrics every ray travels in air.
     let outside_ior = 1.0;
     //#endif
+    //#if MESH_ATTRIBUTES
+    let ns = select(-hit.shading_normal, hit.shading_normal, entering);
+    let n = shading_frame_normal(material, ray.direction, ng, ns, entering, outside_ior);
+    let lifted = shadow_terminator_point(hit, ng);
+    //#else
+    let n = ng;
+    let lifted = hit.position;
+    //#endif
     let response = surface_response(material, ray.direction, n, entering, outside_ior);
     if (*path).depth < frame.max_depth {
         // Refraction is pushed first so that reflection is traced first.
         //#if REFRACTION
         let inside = medium_after_refraction(medium, entering, material.ior);
         push_branch(slot, path, StackEntry(
-            offset_ray_origin(hit.position, -n, frame.offset_scale), (*path).depth + 1u,
+            offset_ray_origin(hit.position, -ng, frame.offset_scale), (*path).depth + 1u,
             response.transmit_direction, inside.depth,
             (*path).weight * response.transmit, 0u, inside.iors));
         //#endif
         push_branch(slot, path, StackEntry(
-            offset_ray_origin(hit.position, n, frame.offset_scale), (*path).depth + 1u,
+            offset_ray_origin(hit.position, ng, frame.offset_scale), (*path).depth + 1u,
             normalize(reflect_direction(ray.direction, n)), medium.depth,
             (*path).weight * response.reflect, 0u, medium.iors));
     }
@@ -219,8 +251,9 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
         (*path).albedo = material.diffuse;
         (*path).material = hit.material;
         (*path).normal = n;
+        (*path).geometric_normal = ng;
         (*path).base = response.base;
-        (*path).shadow_origin = offset_ray_origin(hit.position, n, frame.offset_scale);
+        (*path).shadow_origin = offset_ray_origin(lifted, ng, frame.offset_scale);
         (*path).light = 0u;
         (*path).phase = PHASE_NEXT_LIGHT;
     } else {
@@ -233,7 +266,8 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
 // moves on to the next light.
 fn consume_shadow_ray(path: ptr<function, PathState>, trace: TraceRay) {
     if trace.best_prim == NO_PRIM {
-        let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal);
+        let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal,
+                                  (*path).geometric_normal);
         var material = materials[(*path).material];
         material.diffuse = (*path).albedo;
         (*path).direct += eval_brdf(material, (*path).normal, sample.wi, -(*path).direction)
@@ -253,7 +287,8 @@ fn next_light(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) ->
         (*path).phase = PHASE_POP;
         return false;
     }
-    let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal);
+    let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal,
+                              (*path).geometric_normal);
     if !sample.lit {
         (*path).light += 1u;
         return false;

@@ -74,9 +74,25 @@ struct Triangle {
     v0: vec3<f32>,
     material: u32,
     v1: vec3<f32>,
-    _pad1: u32,
+    // Index into triangle_attributes, or NO_ATTRIBUTES.
+    attributes: u32,
     v2: vec3<f32>,
     _pad2: u32,
+}
+
+const NO_ATTRIBUTES: u32 = 0xffffffffu;
+
+// Vertex normals and texture coordinates of a mesh triangle, corner by corner.
+struct TriangleAttributes {
+    n0: vec3<f32>,
+    has_normals: u32,
+    n1: vec3<f32>,
+    has_uvs: u32,
+    n2: vec3<f32>,
+    _pad0: u32,
+    uv01: vec4<f32>,
+    uv2: vec2<f32>,
+    _pad1: vec2<u32>,
 }
 
 const MATERIAL_LAMBERT: u32 = 0u;
@@ -94,6 +110,10 @@ const FRESNEL_EXACT: u32 = 0u;
 const FRESNEL_SCHLICK: u32 = 1u;
 const MAPPING_PLANAR: u32 = 0u;
 const MAPPING_SPHERICAL: u32 = 1u;
+const MAPPING_UV: u32 = 2u;
+const WRAP_REPEAT: u32 = 0u;
+const WRAP_MIRRORED_REPEAT: u32 = 1u;
+const WRAP_CLAMP_TO_EDGE: u32 = 2u;
 const NO_IMAGE: u32 = 0xffffffffu;
 
 struct Material {
@@ -121,9 +141,10 @@ struct Material {
     texture_scale: f32,
     brdf_map_layer: u32,
     brdf_map_size: u32,
-    // Scalars, not vec2<u32>/vec3<u32>, so the padding never changes the alignment.
-    _pad0: u32,
-    _pad1: u32,
+    // WRAP_* modes of the albedo texture; scalars, not a vec2<u32>, whose 8-byte
+    // alignment would move them.
+    texture_wrap_u: u32,
+    texture_wrap_v: u32,
 }
 
 const LIGHT_POINT: u32 = 0u;
@@ -217,6 +238,10 @@ struct PathState {
     _pad1: u32,
     direct: vec3<f32>,
     _pad2: u32,
+    // Geometric normal of the hit being lit, facing the incoming ray: lights below it
+    // are not lit even where the shading normal would face them.
+    geometric_normal: vec3<f32>,
+    _pad3: u32,
 }
 
 // One pending reflected or refracted ray on a slot's bounce stack.

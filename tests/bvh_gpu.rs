@@ -35,6 +35,8 @@ const KERNELS: &str = r"
 @group(0) @binding(17) var<storage, read_write> traversal_stack: array<u32>;
 @group(0) @binding(18) var<storage, read> test_rays: array<vec4<f32>>;
 @group(0) @binding(19) var<storage, read_write> results: array<vec2<u32>>;
+// Declared for the shared intersection code; neither entry point reads it.
+@group(0) @binding(20) var<storage, read> triangle_attributes: array<TriangleAttributes>;
 
 fn test_trace(slot: u32) -> TraceRay {
     let a = test_rays[2u * slot];
@@ -106,6 +108,7 @@ fn scene_of(shapes: Vec<Shape>) -> Scene {
         material_names: vec!["grey".into()],
         lights: vec![],
         shapes,
+        meshes: vec![],
         images: vec![],
     }
 }

@@ -123,6 +123,7 @@ fn scaled_scene(s: f64) -> Scene {
                 ..Material::blank(MaterialKind::BlinnPhong)
             },
         ],
+        meshes: vec![],
         images: Vec::new(),
         material_names: ["floor", "red", "mirror", "glass", "coated"]
             .map(String::from)
@@ -255,6 +256,7 @@ fn floor_scene(huge_sphere: bool) -> Scene {
             Material::lambert(DVec3::splat(0.7)),
             Material::lambert(DVec3::new(0.8, 0.1, 0.1)),
         ],
+        meshes: vec![],
         images: Vec::new(),
         material_names: vec!["floor".into(), "ball".into()],
         lights: vec![Light::Point {
@@ -328,6 +330,7 @@ fn grazing_and_tangent_rays_are_finite_and_acne_free() {
         },
         environment: Environment::default(),
         materials: vec![Material::lambert(DVec3::splat(0.7))],
+        meshes: vec![],
         images: Vec::new(),
         material_names: vec!["floor".into()],
         lights: vec![Light::Point {
@@ -353,6 +356,7 @@ fn grazing_and_tangent_rays_are_finite_and_acne_free() {
             ambient: DVec3::ZERO,
         },
         materials: vec![Material::lambert(DVec3::splat(0.7)), dielectric(1.5)],
+        meshes: vec![],
         images: Vec::new(),
         material_names: vec!["matte".into(), "glass".into()],
         lights: vec![Light::Point {
@@ -517,6 +521,7 @@ fn mesh_scene(mesh: &[[DVec3; 3]], eye: DVec3, look_at: DVec3, fov_y_degrees: f6
         },
         environment: Environment::default(),
         materials: vec![emissive(1.0)],
+        meshes: vec![],
         images: Vec::new(),
         material_names: vec!["glow".into()],
         lights: Vec::new(),
@@ -590,6 +595,7 @@ fn camera_inside_glass_sees_the_background() {
             ambient: DVec3::ZERO,
         },
         materials: vec![dielectric(1.5)],
+        meshes: vec![],
         images: Vec::new(),
         material_names: vec!["glass".into()],
         lights: Vec::new(),
@@ -672,6 +678,7 @@ fn glass_scene(outer_ior: f64, inner_ior: Option<f64>) -> Scene {
             dielectric(outer_ior),
             dielectric(inner_ior.unwrap_or(1.0)),
         ],
+        meshes: vec![],
         images: Vec::new(),
         material_names: ["white", "stripe", "outer", "inner"]
             .map(String::from)
@@ -945,6 +952,7 @@ fn camera_inside_nested_dielectrics_starts_in_the_innermost() {
             ambient: DVec3::ZERO,
         },
         materials: vec![dielectric(1.5), dielectric(1.33)],
+        meshes: vec![],
         images: Vec::new(),
         material_names: vec!["glass".into(), "water".into()],
         lights: Vec::new(),

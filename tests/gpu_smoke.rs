@@ -59,6 +59,7 @@ fn scene(samples_per_pixel: u32) -> Scene {
                 material: 0,
             },
         ],
+        meshes: vec![],
         images: vec![],
     }
 }

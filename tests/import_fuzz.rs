@@ -176,6 +176,7 @@ fn render_small(model: &ImportedModel) {
         material_names: model.materials.iter().map(|m| m.name.clone()).collect(),
         lights: model.lights_or_default(),
         shapes,
+        meshes: vec![],
         images: Vec::new(),
     };
     let rendered = gpu_render::cpu::render(&scene, None);

@@ -96,7 +96,7 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 v0,
                 material,
                 v1,
-                _pad1,
+                attributes,
                 v2,
                 _pad2
             }),
@@ -128,8 +128,8 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 texture_scale,
                 brdf_map_layer,
                 brdf_map_size,
-                _pad0,
-                _pad1,
+                texture_wrap_u,
+                texture_wrap_v,
             }),
         ),
         (
@@ -196,7 +196,23 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 albedo,
                 _pad1,
                 direct,
-                _pad2
+                _pad2,
+                geometric_normal,
+                _pad3
+            }),
+        ),
+        (
+            "TriangleAttributes",
+            twin!(GpuTriangleAttributes {
+                n0,
+                has_normals,
+                n1,
+                has_uvs,
+                n2,
+                _pad0,
+                uv01,
+                uv2,
+                _pad1
             }),
         ),
         (
@@ -300,6 +316,11 @@ fn constants_match() {
         ("FRESNEL_SCHLICK", FRESNEL_SCHLICK),
         ("MAPPING_PLANAR", MAPPING_PLANAR),
         ("MAPPING_SPHERICAL", MAPPING_SPHERICAL),
+        ("MAPPING_UV", MAPPING_UV),
+        ("WRAP_REPEAT", WRAP_REPEAT),
+        ("WRAP_MIRRORED_REPEAT", WRAP_MIRRORED_REPEAT),
+        ("WRAP_CLAMP_TO_EDGE", WRAP_CLAMP_TO_EDGE),
+        ("NO_ATTRIBUTES", NO_ATTRIBUTES),
         ("NO_IMAGE", NO_IMAGE),
         ("LIGHT_POINT", LIGHT_POINT),
         ("LIGHT_DIRECTIONAL", LIGHT_DIRECTIONAL),

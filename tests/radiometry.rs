@@ -38,6 +38,7 @@ fn furnace_scene(albedo: f64, radius: f64, intensity: f64) -> Scene {
             radius,
             material: 0,
         }],
+        meshes: vec![],
         images: vec![],
     }
 }

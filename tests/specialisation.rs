@@ -79,9 +79,10 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         tabulated: false,
         pbr: false,
         textures: false,
+        mesh_attributes: false,
     };
     type Toggle = fn(&mut ShaderFeatures, bool);
-    let toggles: [Toggle; 11] = [
+    let toggles: [Toggle; 12] = [
         |f, v| f.spheres = v,
         |f, v| f.planes = v,
         |f, v| f.polygons = v,
@@ -93,6 +94,7 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         |f, v| f.tabulated = v,
         |f, v| f.pbr = v,
         |f, v| f.textures = v,
+        |f, v| f.mesh_attributes = v,
     ];
     let all = function_names(&ShaderFeatures::ALL).len();
     let bare = function_names(&none).len();

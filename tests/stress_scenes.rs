@@ -62,6 +62,7 @@ fn scene(
         material_names: names,
         lights,
         shapes,
+        meshes: vec![],
         images: vec![],
     }
 }

@@ -1,10 +1,10 @@
 //! The primitive lists both tracers intersect, and [`SceneGeometry`], which holds them
 //! with the BVH over them.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use super::bvh::{Aabb32, BuildMethod, Bvh};
-use crate::scene::{PolygonPlane, Scene, Shape, polygon_plane, project_to_plane};
+use crate::scene::{Mesh, PolygonPlane, Scene, Shape, polygon_plane, project_to_plane};
 
 /// Polygons with more vertices than this are triangulated when the geometry is built
 /// (with earcut), so that no single primitive test runs more than this many loop
@@ -109,6 +109,19 @@ pub struct TriangleShape {
     pub vertices: [DVec3; 3],
     /// Material index.
     pub material: u32,
+    /// Index into [`SceneGeometry::triangle_attributes`] for a mesh triangle with
+    /// vertex normals or texture coordinates.
+    pub attributes: Option<u32>,
+}
+
+/// The per-vertex shading attributes of a mesh triangle, in world space and in the
+/// order of its [`TriangleShape::vertices`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TriangleAttributes {
+    /// Unit vertex normals (smooth shading), if the mesh has them.
+    pub normals: Option<[DVec3; 3]>,
+    /// Vertex texture coordinates, if the mesh has them.
+    pub uvs: Option<[DVec2; 3]>,
 }
 
 /// A scene's primitives by kind and the BVH over the bounded ones: what both tracers
@@ -122,8 +135,13 @@ pub struct SceneGeometry {
     /// Polygons of at most [`MAX_POLYGON_VERTICES`] vertices, in scene order.
     pub polygons: Vec<PolygonShape>,
     /// Triangles: the scene's own in scene order, then those of the polygons that had
-    /// more than [`MAX_POLYGON_VERTICES`] vertices.
+    /// more than [`MAX_POLYGON_VERTICES`] vertices, then the meshes' (every instance,
+    /// in world space).
     pub triangles: Vec<TriangleShape>,
+    /// Shading attributes of the mesh triangles that have any.
+    pub triangle_attributes: Vec<TriangleAttributes>,
+    /// Mesh triangles left out because they have no area in world space.
+    pub degenerate_triangles: usize,
     /// How many of the scene's polygons were triangulated.
     pub triangulated_polygons: usize,
     /// Length scale of the self-intersection offset's near-origin branch
@@ -141,19 +159,27 @@ impl SceneGeometry {
 
     /// The geometry of `scene` with a BVH built by `method`.
     pub fn with_method(scene: &Scene, method: BuildMethod) -> Self {
-        Self::from_shapes(&scene.shapes, method)
+        Self::from_parts(&scene.shapes, &scene.meshes, method)
     }
 
     /// The geometry of `shapes` (validated, as in a [`Scene`]) with a BVH built by
     /// `method`.
     pub fn from_shapes(shapes: &[Shape], method: BuildMethod) -> Self {
+        Self::from_parts(shapes, &[], method)
+    }
+
+    /// The geometry of `shapes` and `meshes` (validated, as in a [`Scene`]) with a BVH
+    /// built by `method`.
+    pub fn from_parts(shapes: &[Shape], meshes: &[Mesh], method: BuildMethod) -> Self {
         let mut geometry = Self {
             spheres: Vec::new(),
             planes: Vec::new(),
             polygons: Vec::new(),
             triangles: Vec::new(),
+            triangle_attributes: Vec::new(),
+            degenerate_triangles: 0,
             triangulated_polygons: 0,
-            offset_scale: ray_offset_scale(shapes),
+            offset_scale: 1.0,
             bvh: Bvh::default(),
         };
         let mut large_polygons = Vec::new();
@@ -198,6 +224,7 @@ impl SceneGeometry {
                 Shape::Triangle { vertices, material } => geometry.triangles.push(TriangleShape {
                     vertices: *vertices,
                     material: *material,
+                    attributes: None,
                 }),
             }
         }
@@ -205,6 +232,10 @@ impl SceneGeometry {
         for (plane, vertices, material) in large_polygons {
             triangulate_polygon(&plane, vertices, material, &mut geometry.triangles);
         }
+        for mesh in meshes {
+            geometry.add_mesh(mesh);
+        }
+        geometry.offset_scale = geometry.ray_offset_scale();
         let bounds = geometry.bounded_primitives();
         geometry.bvh = Bvh::build(&bounds, method);
         geometry
@@ -241,6 +272,69 @@ impl SceneGeometry {
         spheres.chain(polygons).chain(triangles).collect()
     }
 
+    /// Adds every instance of `mesh` as world-space triangles. A transform that
+    /// mirrors (negative determinant) would reverse the winding, and with it the
+    /// geometric normal: two corners are swapped back. Normals go through the inverse
+    /// transpose. Triangles without area in world space are left out and counted.
+    fn add_mesh(&mut self, mesh: &Mesh) {
+        for transform in &mesh.instances {
+            let linear = glam::DMat3::from_mat4(*transform);
+            let normal_matrix = linear.inverse().transpose();
+            let mirrored = linear.determinant() < 0.0;
+            for corners in &mesh.triangles {
+                let mut order = corners.map(|i| i as usize);
+                if mirrored {
+                    order.swap(1, 2);
+                }
+                let vertices = order.map(|i| transform.transform_point3(mesh.positions[i]));
+                let area = (vertices[1] - vertices[0]).cross(vertices[2] - vertices[0]);
+                if !(area.length_squared() > 0.0 && area.is_finite()) {
+                    self.degenerate_triangles += 1;
+                    continue;
+                }
+                let facing = area.normalize();
+                let normals = mesh.normals.as_ref().map(|normals| {
+                    order.map(|i| (normal_matrix * normals[i]).normalize_or(facing))
+                });
+                let uvs = mesh.uvs.as_ref().map(|uvs| order.map(|i| uvs[i]));
+                let attributes = (normals.is_some() || uvs.is_some()).then(|| {
+                    self.triangle_attributes
+                        .push(TriangleAttributes { normals, uvs });
+                    (self.triangle_attributes.len() - 1) as u32
+                });
+                self.triangles.push(TriangleShape {
+                    vertices,
+                    material: mesh.material,
+                    attributes,
+                });
+            }
+        }
+    }
+
+    /// The length scale of the ray offset's near-origin branch ([`ray_offset_scale`])
+    /// over every primitive of this geometry.
+    fn ray_offset_scale(&self) -> f64 {
+        let mut extent = 0.0f64;
+        let mut include = |v: DVec3| extent = extent.max(v.abs().max_element());
+        self.spheres
+            .iter()
+            .for_each(|s| include(s.center.abs() + DVec3::splat(s.radius)));
+        self.planes
+            .iter()
+            .for_each(|p| include(DVec3::splat(p.offset)));
+        self.polygons
+            .iter()
+            .for_each(|p| p.vertices.iter().copied().for_each(&mut include));
+        self.triangles
+            .iter()
+            .for_each(|t| t.vertices.iter().copied().for_each(&mut include));
+        if extent > 0.0 && extent < 1.0 {
+            extent
+        } else {
+            1.0
+        }
+    }
+
     /// The material of primitive `prim`.
     pub fn material(&self, prim: PrimRef) -> u32 {
         match prim.kind() {
@@ -257,10 +351,10 @@ impl SceneGeometry {
     }
 }
 
-/// The length scale of the ray offset's near-origin branch for a scene of `shapes`
+/// The length scale of the ray offset's near-origin branch for `scene`
 /// (`offset_ray_origin` in `src/cpu/intersect.rs` and `shaders/intersect.wgsl`): the
 /// largest absolute coordinate of its geometry (sphere centres ± radii, plane offsets,
-/// vertices), capped at 1.
+/// vertices, mesh triangles where they stand), capped at 1.
 ///
 /// Wächter and Binder's constants (`1/32` for "near the origin", `1/65536` for the
 /// absolute offset there) assume a scene of about unit size. In a scene 10^-4 across
@@ -268,23 +362,10 @@ impl SceneGeometry {
 /// this scale, which makes the offset, like every other length, scale with the scene.
 /// Larger scenes keep the published constants (scale 1): there the ulp branch covers
 /// every coordinate beyond 1/32, and a larger near-origin offset would lift rays off a
-/// small object lying near the origin of a large world.
-pub fn ray_offset_scale(shapes: &[Shape]) -> f64 {
-    let mut extent = 0.0f64;
-    let mut include = |v: DVec3| extent = extent.max(v.abs().max_element());
-    for shape in shapes {
-        match shape {
-            Shape::Sphere { center, radius, .. } => include(center.abs() + DVec3::splat(*radius)),
-            Shape::Plane { offset, .. } => include(DVec3::splat(*offset)),
-            Shape::Polygon { vertices, .. } => vertices.iter().copied().for_each(&mut include),
-            Shape::Triangle { vertices, .. } => vertices.iter().copied().for_each(&mut include),
-        }
-    }
-    if extent > 0.0 && extent < 1.0 {
-        extent
-    } else {
-        1.0
-    }
+/// small object lying near the origin of a large world. [`SceneGeometry::offset_scale`]
+/// holds it for a built geometry.
+pub fn ray_offset_scale(scene: &Scene) -> f64 {
+    SceneGeometry::new(scene).offset_scale
 }
 
 /// Triangulates a planar polygon (ear clipping, mapbox's earcut, in the projection that
@@ -318,6 +399,7 @@ fn triangulate_polygon(
         out.push(TriangleShape {
             vertices: tri,
             material,
+            attributes: None,
         });
     }
 }

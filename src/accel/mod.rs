@@ -23,5 +23,5 @@ pub mod geometry;
 pub use bvh::{BuildMethod, Bvh, BvhNode, BvhStats, MAX_BVH_DEPTH, MAX_LEAF_PRIMITIVES};
 pub use geometry::{
     MAX_PLANES, MAX_POLYGON_VERTICES, PlaneShape, PolygonShape, PrimKind, PrimRef, SceneGeometry,
-    SphereShape, TriangleShape, ray_offset_scale,
+    SphereShape, TriangleAttributes, TriangleShape, ray_offset_scale,
 };

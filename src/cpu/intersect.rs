@@ -3,7 +3,7 @@
 //! self-intersection offset. The scene-level queries (`intersect_scene`, `occluded`)
 //! traverse the BVH in [`super::traverse`].
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use crate::accel::{PrimKind, PrimRef, SceneGeometry};
 use crate::scene::PolygonPlane;
@@ -40,6 +40,15 @@ pub struct Hit {
     pub position: DVec3,
     /// The primitive that was hit.
     pub prim: PrimRef,
+    /// Unit shading normal, on the same side as `normal`: a mesh triangle's vertex
+    /// normals interpolated at the hit (smooth shading), else `normal`.
+    pub shading_normal: DVec3,
+    /// Texture coordinates: a mesh triangle's vertex coordinates interpolated at the
+    /// hit, else `(0, 0)`.
+    pub uv: DVec2,
+    /// Barycentric coordinates of the hit in a triangle (weights of its three
+    /// corners), else `(1, 0, 0)`.
+    pub barycentrics: DVec3,
 }
 
 /// The ray parameter of `prim`'s nearest hit along `ray` in (0, `t_max`); `sheared`
@@ -110,13 +119,90 @@ pub fn hit_record(geometry: &SceneGeometry, prim: PrimRef, ray: &Ray, t: f64) ->
             (p.normal, project_onto_plane(point, p.normal, p.offset))
         }
     };
-    Hit {
+    let mut hit = Hit {
         t,
         normal,
         material: geometry.material(prim),
         position,
         prim,
+        shading_normal: normal,
+        uv: DVec2::ZERO,
+        barycentrics: DVec3::X,
+    };
+    if prim.kind() == PrimKind::Triangle {
+        let triangle = &geometry.triangles[i];
+        hit.barycentrics = triangle_barycentrics(position, &triangle.vertices);
+        if let Some(attributes) = triangle.attributes {
+            let attributes = &geometry.triangle_attributes[attributes as usize];
+            let b = hit.barycentrics;
+            if let Some(n) = attributes.normals {
+                let interpolated = n[0] * b.x + n[1] * b.y + n[2] * b.z;
+                // Degenerate interpolations and normals facing away from the surface
+                // fall back to the geometric normal.
+                let shading = interpolated.normalize_or(normal);
+                if shading.dot(normal) > 0.0 {
+                    hit.shading_normal = shading;
+                }
+            }
+            if let Some(uv) = attributes.uvs {
+                hit.uv = uv[0] * b.x + uv[1] * b.y + uv[2] * b.z;
+            }
+        }
     }
+    hit
+}
+
+/// The barycentric coordinates of `point` (on the triangle's plane) in the triangle
+/// `vertices`, clamped to the triangle and summing to 1 (Ericson, "Real-Time Collision
+/// Detection", §3.4): the weights of the corners for interpolating their attributes.
+pub fn triangle_barycentrics(point: DVec3, vertices: &[DVec3; 3]) -> DVec3 {
+    let e1 = vertices[1] - vertices[0];
+    let e2 = vertices[2] - vertices[0];
+    let p = point - vertices[0];
+    let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (d20, d21) = (p.dot(e1), p.dot(e2));
+    let denominator = d00 * d11 - d01 * d01;
+    if denominator.is_nan() || denominator <= 0.0 {
+        return DVec3::X;
+    }
+    let v = (d11 * d20 - d01 * d21) / denominator;
+    let w = (d00 * d21 - d01 * d20) / denominator;
+    // A hit found on an edge may lie a rounding error outside: clamp, renormalise.
+    let b = DVec3::new(1.0 - v - w, v, w).max(DVec3::ZERO);
+    let sum = b.x + b.y + b.z;
+    if sum > 0.0 { b / sum } else { DVec3::X }
+}
+
+/// Where the shadow rays of a smooth-shaded mesh hit start: the hit point lifted off
+/// its flat triangle towards the curved surface the vertex normals describe, `P' = P -
+/// Σ bᵢ·min(0, (P - Vᵢ)·nᵢ)·nᵢ` with the normals `nᵢ` turned to the side `facing` is on
+/// (Hanika, "Hacking the Shadow Terminator", Ray Tracing Gems II, ch. 4, 2021). Without
+/// it the neighbouring flat facets shadow a point that its smooth normal says is lit:
+/// black, faceted terminators on low-poly meshes. Other shapes keep the hit point.
+pub fn shadow_terminator_point(geometry: &SceneGeometry, hit: &Hit, facing: DVec3) -> DVec3 {
+    if hit.prim.kind() != PrimKind::Triangle {
+        return hit.position;
+    }
+    let triangle = &geometry.triangles[hit.prim.index()];
+    let Some(normals) = triangle
+        .attributes
+        .and_then(|a| geometry.triangle_attributes[a as usize].normals)
+    else {
+        return hit.position;
+    };
+    let sign = if facing.dot(hit.normal) < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    let p = hit.position;
+    let b = hit.barycentrics.to_array();
+    let mut lifted = p;
+    for k in 0..3 {
+        let n = normals[k] * sign;
+        lifted -= n * ((p - triangle.vertices[k]).dot(n).min(0.0) * b[k]);
+    }
+    lifted
 }
 
 /// The unit normal `(v1 - v0) × (v2 - v0)` of a triangle, normalized.

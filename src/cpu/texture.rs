@@ -9,9 +9,9 @@
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
-use crate::scene::{Image, Material, TextureMapping};
+use crate::scene::{Image, Material, TextureMapping, TextureWrap};
 
 /// Texture coordinates of a hit at `position` with unit geometric normal `normal`
 /// (as the shape defines it, not flipped towards the ray).
@@ -22,8 +22,15 @@ use crate::scene::{Image, Material, TextureMapping};
 /// - Planar: the position projected on the tangent frame of the normal
 ///   ([`tangent_frame`]): `u = p·t / scale`, `v = p·b / scale`; on a floor with
 ///   `n = +y` that is `u = x / scale`, `v = z / scale`.
-pub fn texture_coordinates(material: &Material, position: DVec3, normal: DVec3) -> (f64, f64) {
+/// - UV: the hit's interpolated mesh texture coordinates `uv` (`(0, 0)` off a mesh).
+pub fn texture_coordinates(
+    material: &Material,
+    position: DVec3,
+    normal: DVec3,
+    uv: DVec2,
+) -> (f64, f64) {
     match material.texture_mapping {
+        TextureMapping::Uv => (uv.x, uv.y),
         TextureMapping::Spherical => {
             let y = normal.y.clamp(-1.0, 1.0);
             (0.5 - normal.z.atan2(normal.x) / (2.0 * PI), y.acos() / PI)
@@ -50,21 +57,41 @@ pub fn tangent_frame(n: DVec3) -> (DVec3, DVec3) {
     (t, t.cross(n))
 }
 
-/// Bilinear lookup with repeat wrapping at texture coordinates `(u, v)`.
-pub fn sample_texture(image: &Image, u: f64, v: f64) -> DVec3 {
+/// The texel index for the integer-valued texel coordinate `i` of an axis of `n`
+/// texels under `wrap` (glTF 2.0, §3.8.4.4 "Samplers"): repeat takes `i mod n`,
+/// mirrored repeat reflects every other period (`i mod 2n`, folded back), clamp holds
+/// the edge texel. The modulo is taken in floating point, as the WGSL twin
+/// `wrap_index` does (an integer conversion would saturate for huge coordinates); the
+/// final clamp catches rounding up to the period.
+pub fn wrap_index(i: f64, n: u32, wrap: TextureWrap) -> u32 {
+    let m = f64::from(n);
+    match wrap {
+        TextureWrap::Repeat => ((i - m * (i / m).floor()) as u32).min(n - 1),
+        TextureWrap::MirroredRepeat => {
+            let period = 2.0 * m;
+            let j = ((i - period * (i / period).floor()) as u32).min(2 * n - 1);
+            if j >= n { 2 * n - 1 - j } else { j }
+        }
+        TextureWrap::ClampToEdge => i.clamp(0.0, m - 1.0) as u32,
+    }
+}
+
+/// Bilinear lookup at texture coordinates `(u, v)` with the wrap modes `wrap` of the
+/// two axes.
+pub fn sample_texture(image: &Image, u: f64, v: f64, wrap: [TextureWrap; 2]) -> DVec3 {
     let (w, h) = (f64::from(image.width), f64::from(image.height));
     let x = u * w - 0.5;
     let y = v * h - 0.5;
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = (x - x0, y - y0);
-    // i mod n in floating point, as the WGSL twin `wrap_index` computes it (an integer
-    // conversion would saturate for huge coordinates); the clamp catches rounding up.
-    let wrap = |i: f64, n: u32| -> u32 {
-        let m = f64::from(n);
-        ((i - m * (i / m).floor()) as u32).min(n - 1)
-    };
-    let (xa, xb) = (wrap(x0, image.width), wrap(x0 + 1.0, image.width));
-    let (ya, yb) = (wrap(y0, image.height), wrap(y0 + 1.0, image.height));
+    let (xa, xb) = (
+        wrap_index(x0, image.width, wrap[0]),
+        wrap_index(x0 + 1.0, image.width, wrap[0]),
+    );
+    let (ya, yb) = (
+        wrap_index(y0, image.height, wrap[1]),
+        wrap_index(y0 + 1.0, image.height, wrap[1]),
+    );
     bilinear(image, [xa, xb], [ya, yb], fx, fy)
 }
 
@@ -92,18 +119,20 @@ fn bilinear(image: &Image, xs: [u32; 2], ys: [u32; 2], fx: f64, fy: f64) -> DVec
     top * (1.0 - fy) + bottom * fy
 }
 
-/// The albedo at a hit: `material.diffuse`, times the albedo texture where there is
-/// one.
+/// The albedo at a hit at `position` with geometric normal `normal` and mesh texture
+/// coordinates `uv`: `material.diffuse`, times the albedo texture where there is one.
 pub fn shading_albedo(
     material: &Material,
     images: &[Image],
     position: DVec3,
     normal: DVec3,
+    uv: DVec2,
 ) -> DVec3 {
     match material.albedo_texture {
         Some(index) => {
-            let (u, v) = texture_coordinates(material, position, normal);
-            material.diffuse * sample_texture(&images[index as usize], u, v)
+            let (u, v) = texture_coordinates(material, position, normal, uv);
+            let image = &images[index as usize];
+            material.diffuse * sample_texture(image, u, v, material.texture_wrap)
         }
         None => material.diffuse,
     }

@@ -5,7 +5,7 @@
 use glam::DVec3;
 
 use super::bxdf::{eval_brdf, has_base_brdf, reflect_direction, surface_response};
-use super::intersect::{Hit, Ray, offset_ray_origin};
+use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
 use super::texture::shading_albedo;
 use super::traverse::{intersect_scene, occluded};
 use crate::accel::SceneGeometry;
@@ -216,30 +216,67 @@ pub struct ShadedHit {
     pub transmitted_medium: MediumStack,
 }
 
+/// The normal a hit is shaded with, on the side the ray came from: the interpolated
+/// shading normal `ns` of a smooth mesh when the ray, its mirror direction about `ns`
+/// and its refracted direction all stay on the sides of the geometric surface `ng` they
+/// belong to; otherwise `ng` itself. The fallback keeps every secondary ray on the
+/// correct side of the real surface, where the interpolated normal of a coarse mesh
+/// would send it through (Veach's thesis, 1997, §5.3, on the asymmetry of shading
+/// normals; the same test as PBRT v4's `BSDF` shading-frame checks, §10.1.1).
+pub fn shading_frame_normal(
+    material: &Material,
+    direction: DVec3,
+    ng: DVec3,
+    ns: DVec3,
+    entering: bool,
+    outside_ior: f64,
+) -> DVec3 {
+    if ns == ng || -direction.dot(ns) <= 0.0 {
+        return ng;
+    }
+    if reflect_direction(direction, ns).dot(ng) <= 0.0 {
+        return ng;
+    }
+    let response = surface_response(material, direction, ns, entering, outside_ior);
+    if response.transmit.max_element() > 0.0 && response.transmit_direction.dot(ng) >= 0.0 {
+        return ng;
+    }
+    ns
+}
+
 /// Shades `hit` for a ray travelling along `ray.direction`: emission, ambient and
 /// direct light with one shadow ray per light, and the secondary rays, for a ray
 /// travelling inside the dielectrics of `medium`. Every new ray starts at the
 /// re-projected hit point moved off the surface by [`offset_ray_origin`], to the side
-/// the ray leaves on.
+/// the ray leaves on (shadow rays of smooth meshes from [`shadow_terminator_point`]).
+/// Which side the ray enters is decided by the geometric normal; the BRDF, the mirror
+/// direction and refraction use [`shading_frame_normal`].
 pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumStack) -> ShadedHit {
     let position = hit.position;
     let mut material = scene.materials[hit.material as usize];
-    material.diffuse = shading_albedo(&material, &scene.images, position, hit.normal);
+    material.diffuse = shading_albedo(&material, &scene.images, position, hit.normal, hit.uv);
     let material = &material;
     let entering = ray.direction.dot(hit.normal) < 0.0;
     // Shading happens on the side the ray came from.
-    let n = if entering { hit.normal } else { -hit.normal };
-    let wo = -ray.direction;
+    let ng = if entering { hit.normal } else { -hit.normal };
     let outside_ior = medium.medium_outside_ior(entering);
+    let ns = if entering {
+        hit.shading_normal
+    } else {
+        -hit.shading_normal
+    };
+    let n = shading_frame_normal(material, ray.direction, ng, ns, entering, outside_ior);
+    let wo = -ray.direction;
     let response = surface_response(material, ray.direction, n, entering, outside_ior);
 
     let mut radiance = material.emission;
     let mut shadow_rays = 0;
     if has_base_brdf(material.kind) && response.base > 0.0 {
         let mut direct = material.diffuse * scene.ambient;
-        let shadow_origin = offset_ray_origin(position, n, scene.geometry.offset_scale);
+        let lifted = shadow_terminator_point(&scene.geometry, hit, ng);
+        let shadow_origin = offset_ray_origin(lifted, ng, scene.geometry.offset_scale);
         for light in &scene.lights {
-            let (lit, traced) = direct_light(scene, light, material, shadow_origin, n, wo);
+            let (lit, traced) = direct_light(scene, light, material, shadow_origin, ng, n, wo);
             direct += lit;
             shadow_rays += traced;
         }
@@ -247,11 +284,11 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumSta
     }
 
     let reflected = Ray {
-        origin: offset_ray_origin(position, n, scene.geometry.offset_scale),
+        origin: offset_ray_origin(position, ng, scene.geometry.offset_scale),
         direction: reflect_direction(ray.direction, n).normalize(),
     };
     let transmitted = Ray {
-        origin: offset_ray_origin(position, -n, scene.geometry.offset_scale),
+        origin: offset_ray_origin(position, -ng, scene.geometry.offset_scale),
         direction: response.transmit_direction,
     };
     ShadedHit {
@@ -263,14 +300,17 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumSta
     }
 }
 
-/// Reflected radiance due to one light: `f(wi, wo) · E · cos θ_i` when the shadow ray
-/// from `origin` towards the light is unblocked. Returns it and the number of shadow
-/// rays traced (0 when the light is behind the surface).
+/// Reflected radiance due to one light: `f(wi, wo) · E · cos θ_i` (the BRDF and the
+/// cosine taken about the shading normal `n`) when the shadow ray from `origin` towards
+/// the light is unblocked. Returns it and the number of shadow rays traced (0 when the
+/// light is behind the geometric surface `ng` or below the shading normal).
+#[allow(clippy::too_many_arguments)]
 pub fn direct_light(
     scene: &PreparedScene,
     light: &Light,
     material: &Material,
     origin: DVec3,
+    ng: DVec3,
     n: DVec3,
     wo: DVec3,
 ) -> (DVec3, u64) {
@@ -295,7 +335,7 @@ pub fn direct_light(
         } => (-direction, f64::INFINITY, irradiance),
     };
     let cos_i = n.dot(wi).clamp(-1.0, 1.0);
-    if cos_i <= 0.0 {
+    if cos_i <= 0.0 || ng.dot(wi) <= 0.0 {
         return (DVec3::ZERO, 0);
     }
     let shadow = Ray {

@@ -37,6 +37,9 @@ pub struct ShaderFeatures {
     pub pbr: bool,
     /// Albedo textures (`TEXTURES`).
     pub textures: bool,
+    /// Mesh vertex normals and texture coordinates: smooth shading, the shadow
+    /// terminator fix and UV lookups (`MESH_ATTRIBUTES`).
+    pub mesh_attributes: bool,
 }
 
 impl ShaderFeatures {
@@ -53,6 +56,7 @@ impl ShaderFeatures {
         tabulated: true,
         pbr: true,
         textures: true,
+        mesh_attributes: true,
     };
 
     /// Exactly the features `scene` uses.
@@ -67,10 +71,11 @@ impl ShaderFeatures {
             polygons: has_shape(
                 |s| matches!(s, Shape::Polygon { vertices, .. } if vertices.len() <= MAX_POLYGON_VERTICES),
             ),
-            triangles: has_shape(|s| {
-                matches!(s, Shape::Triangle { .. })
-                    || matches!(s, Shape::Polygon { vertices, .. } if vertices.len() > MAX_POLYGON_VERTICES)
-            }),
+            triangles: !scene.meshes.is_empty()
+                || has_shape(|s| {
+                    matches!(s, Shape::Triangle { .. })
+                        || matches!(s, Shape::Polygon { vertices, .. } if vertices.len() > MAX_POLYGON_VERTICES)
+                }),
             refraction: has_kind(MaterialKind::Dielectric),
             blinn_phong: has_kind(MaterialKind::BlinnPhong),
             cook_torrance: has_kind(MaterialKind::CookTorrance),
@@ -78,6 +83,10 @@ impl ShaderFeatures {
             tabulated: has_kind(MaterialKind::Tabulated),
             pbr: has_kind(MaterialKind::Pbr),
             textures: scene.materials.iter().any(|m| m.albedo_texture.is_some()),
+            mesh_attributes: scene
+                .meshes
+                .iter()
+                .any(|m| m.normals.is_some() || m.uvs.is_some()),
         }
     }
 
@@ -108,7 +117,7 @@ impl ShaderFeatures {
 type FeatureFlag = fn(&ShaderFeatures) -> bool;
 
 /// The name of each feature in the WGSL directives, with the flag it reads.
-const FEATURE_NAMES: [(&str, FeatureFlag); 11] = [
+const FEATURE_NAMES: [(&str, FeatureFlag); 12] = [
     ("SPHERES", |f| f.spheres),
     ("PLANES", |f| f.planes),
     ("POLYGONS", |f| f.polygons),
@@ -120,6 +129,7 @@ const FEATURE_NAMES: [(&str, FeatureFlag); 11] = [
     ("TABULATED", |f| f.tabulated),
     ("PBR", |f| f.pbr),
     ("TEXTURES", |f| f.textures),
+    ("MESH_ATTRIBUTES", |f| f.mesh_attributes),
 ];
 
 /// Keeps the lines of `source` whose enclosing `//#if` directives hold for `features`

@@ -172,6 +172,10 @@ pub struct GpuPathState {
     pub direct: [f32; 3],
     /// Padding.
     pub _pad2: u32,
+    /// Geometric normal of the hit being lit (facing the incoming ray).
+    pub geometric_normal: [f32; 3],
+    /// Padding.
+    pub _pad3: u32,
 }
 
 /// One pending ray on a slot's bounce stack (`StackEntry` in WGSL).
@@ -281,8 +285,9 @@ pub struct GpuTriangle {
     pub material: u32,
     /// Second corner.
     pub v1: [f32; 3],
-    /// Padding.
-    pub _pad1: u32,
+    /// Index of its vertex normals and texture coordinates in the triangle attribute
+    /// buffer, or [`NO_ATTRIBUTES`].
+    pub attributes: u32,
     /// Third corner.
     pub v2: [f32; 3],
     /// Padding.
@@ -341,10 +346,37 @@ pub struct GpuMaterial {
     pub brdf_map_layer: u32,
     /// Side of the (square) BRDF map in texels.
     pub brdf_map_size: u32,
-    /// Padding (scalars: a `vec3<u32>` would be 16-byte aligned in WGSL).
-    pub _pad0: u32,
+    /// How the albedo texture wraps along `u`: one of the `WRAP_*` constants.
+    pub texture_wrap_u: u32,
+    /// How the albedo texture wraps along `v`: one of the `WRAP_*` constants.
+    pub texture_wrap_v: u32,
+}
+
+/// The shading attributes of one mesh triangle (`TriangleAttributes` in WGSL): vertex
+/// normals and texture coordinates in the order of the triangle's corners; see
+/// [`crate::accel::TriangleAttributes`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuTriangleAttributes {
+    /// Unit normal at the first corner.
+    pub n0: [f32; 3],
+    /// 1 when the normals are given (smooth shading), else 0 (the shader then uses the
+    /// geometric normal).
+    pub has_normals: u32,
+    /// Unit normal at the second corner.
+    pub n1: [f32; 3],
+    /// 1 when the texture coordinates are given, else 0 (`(0, 0)` is used).
+    pub has_uvs: u32,
+    /// Unit normal at the third corner.
+    pub n2: [f32; 3],
     /// Padding.
-    pub _pad1: u32,
+    pub _pad0: u32,
+    /// Texture coordinates of the first and second corners.
+    pub uv01: [f32; 4],
+    /// Texture coordinates of the third corner.
+    pub uv2: [f32; 2],
+    /// Padding.
+    pub _pad1: [u32; 2],
 }
 
 /// A light (`Light` in WGSL).
@@ -401,6 +433,16 @@ pub const FRESNEL_SCHLICK: u32 = 1;
 pub const MAPPING_PLANAR: u32 = 0;
 /// `Material.texture_mapping` value for the spherical mapping.
 pub const MAPPING_SPHERICAL: u32 = 1;
+/// `texture_mapping`: the mesh's interpolated texture coordinates.
+pub const MAPPING_UV: u32 = 2;
+/// `texture_wrap_u`/`_v`: the image repeats.
+pub const WRAP_REPEAT: u32 = 0;
+/// `texture_wrap_u`/`_v`: the image repeats, mirrored every other time.
+pub const WRAP_MIRRORED_REPEAT: u32 = 1;
+/// `texture_wrap_u`/`_v`: the edge texels extend.
+pub const WRAP_CLAMP_TO_EDGE: u32 = 2;
+/// [`GpuTriangle::attributes`] of a triangle without vertex attributes.
+pub const NO_ATTRIBUTES: u32 = u32::MAX;
 /// `texture_layer` / `brdf_map_layer` value meaning "no image".
 pub const NO_IMAGE: u32 = u32::MAX;
 /// `Light.kind` value for a point light.

@@ -21,7 +21,8 @@ pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// Bindings of the trace module (`shaders/trace.wgsl`): 0 uniforms; 1–7 spheres,
 /// planes, polygons, polygon points, triangles, materials, lights; 8 the linear
 /// output; 9 counters; 10 accumulation; 11 images; 12–13 BVH nodes and primitives;
-/// 14–17 path states, bounce stacks, traces, traversal stacks.
+/// 14–17 path states, bounce stacks, traces, traversal stacks; 18 mesh triangles'
+/// vertex normals and texture coordinates.
 pub(crate) mod binding {
     pub const FRAME: u32 = 0;
     pub const SPHERES: u32 = 1;
@@ -41,10 +42,11 @@ pub(crate) mod binding {
     pub const RAY_STACK: u32 = 15;
     pub const TRACES: u32 = 16;
     pub const TRAVERSAL_STACK: u32 = 17;
+    pub const TRIANGLE_ATTRIBUTES: u32 = 18;
 }
 
 /// Storage buffers the trace kernels bind in one stage.
-pub const TRACE_STORAGE_BUFFERS: u32 = 15;
+pub const TRACE_STORAGE_BUFFERS: u32 = 16;
 
 /// The kernels of one trace module.
 #[derive(Debug, Clone)]
@@ -155,6 +157,7 @@ impl Pipelines {
                         storage_entry(RAY_STACK, false),
                         storage_entry(TRACES, false),
                         storage_entry(TRAVERSAL_STACK, false),
+                        storage_entry(TRIANGLE_ATTRIBUTES, true),
                     ],
                 })
             })?;

@@ -21,6 +21,7 @@ pub(crate) struct SceneBuffers {
     pub lights: wgpu::Buffer,
     pub bvh_nodes: wgpu::Buffer,
     pub bvh_prims: wgpu::Buffer,
+    pub triangle_attributes: wgpu::Buffer,
 }
 
 /// A scene uploaded to one device, ready to trace with
@@ -150,6 +151,10 @@ pub(crate) fn upload_scene(
         lights: upload("light", bytemuck::cast_slice(&padded.lights))?,
         bvh_nodes: upload("BVH node", bytemuck::cast_slice(&padded.bvh_nodes))?,
         bvh_prims: upload("BVH primitive", bytemuck::cast_slice(&padded.bvh_prims))?,
+        triangle_attributes: upload(
+            "triangle attribute",
+            bytemuck::cast_slice(&padded.triangle_attributes),
+        )?,
     };
     let images = upload_images(device, queue, &shaded, &limits)?;
     Ok(PreparedScene {

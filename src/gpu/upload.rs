@@ -7,16 +7,17 @@ use glam::DVec3;
 
 use super::layout::{
     DISTRIBUTION_BECKMANN, DISTRIBUTION_GGX, FRESNEL_EXACT, FRESNEL_SCHLICK, FrameUniforms,
-    GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle, LIGHT_DIRECTIONAL,
-    LIGHT_POINT, MAPPING_PLANAR, MAPPING_SPHERICAL, MATERIAL_BLINN_PHONG, MATERIAL_COOK_TORRANCE,
-    MATERIAL_DIELECTRIC, MATERIAL_EMISSIVE, MATERIAL_LAMBERT, MATERIAL_MIRROR, MATERIAL_OREN_NAYAR,
-    MATERIAL_PBR, MATERIAL_TABULATED, NO_IMAGE,
+    GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle, GpuTriangleAttributes,
+    LIGHT_DIRECTIONAL, LIGHT_POINT, MAPPING_PLANAR, MAPPING_SPHERICAL, MAPPING_UV,
+    MATERIAL_BLINN_PHONG, MATERIAL_COOK_TORRANCE, MATERIAL_DIELECTRIC, MATERIAL_EMISSIVE,
+    MATERIAL_LAMBERT, MATERIAL_MIRROR, MATERIAL_OREN_NAYAR, MATERIAL_PBR, MATERIAL_TABULATED,
+    NO_ATTRIBUTES, NO_IMAGE, WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT, WRAP_REPEAT,
 };
-use crate::accel::{BvhNode, PolygonShape, SceneGeometry};
+use crate::accel::{BvhNode, PolygonShape, SceneGeometry, TriangleAttributes};
 use crate::camera::CameraFrame;
 use crate::scene::{
     FresnelModel, Image, Light, Material, MaterialKind, MediumStack, MicrofacetDistribution, Scene,
-    TextureMapping, project_to_plane,
+    TextureMapping, TextureWrap, project_to_plane,
 };
 
 /// Every record list of a scene, ready for upload. The lists hold exactly the scene's
@@ -36,6 +37,9 @@ pub struct SceneRecords {
     pub polygon_points: Vec<[f32; 2]>,
     /// Triangles, in [`SceneGeometry::triangles`] order.
     pub triangles: Vec<GpuTriangle>,
+    /// Mesh triangles' vertex normals and texture coordinates, in
+    /// [`SceneGeometry::triangle_attributes`] order.
+    pub triangle_attributes: Vec<GpuTriangleAttributes>,
     /// Materials, indexed by the shapes' `material`.
     pub materials: Vec<GpuMaterial>,
     /// Lights, in scene order.
@@ -78,10 +82,15 @@ impl SceneRecords {
                     v0: vec3(t.vertices[0]),
                     material: t.material,
                     v1: vec3(t.vertices[1]),
-                    _pad1: 0,
+                    attributes: t.attributes.unwrap_or(NO_ATTRIBUTES),
                     v2: vec3(t.vertices[2]),
                     _pad2: 0,
                 })
+                .collect(),
+            triangle_attributes: geometry
+                .triangle_attributes
+                .iter()
+                .map(triangle_attributes_record)
                 .collect(),
             bvh_nodes: geometry.bvh.nodes.clone(),
             bvh_prims: geometry.bvh.prims.iter().map(|p| p.0).collect(),
@@ -116,6 +125,7 @@ impl SceneRecords {
             polygons: pad(&self.polygons),
             polygon_points: pad(&self.polygon_points),
             triangles: pad(&self.triangles),
+            triangle_attributes: pad(&self.triangle_attributes),
             materials: pad(&self.materials),
             lights: pad(&self.lights),
             bvh_nodes: pad(&self.bvh_nodes),
@@ -202,6 +212,7 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
         texture_mapping: match material.texture_mapping {
             TextureMapping::Planar => MAPPING_PLANAR,
             TextureMapping::Spherical => MAPPING_SPHERICAL,
+            TextureMapping::Uv => MAPPING_UV,
         },
         texture_layer,
         texture_width,
@@ -209,8 +220,39 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
         texture_scale: material.texture_scale as f32,
         brdf_map_layer,
         brdf_map_size,
+        texture_wrap_u: wrap_code(material.texture_wrap[0]),
+        texture_wrap_v: wrap_code(material.texture_wrap[1]),
+    }
+}
+
+/// The `WRAP_*` code of a wrap mode.
+fn wrap_code(wrap: TextureWrap) -> u32 {
+    match wrap {
+        TextureWrap::Repeat => WRAP_REPEAT,
+        TextureWrap::MirroredRepeat => WRAP_MIRRORED_REPEAT,
+        TextureWrap::ClampToEdge => WRAP_CLAMP_TO_EDGE,
+    }
+}
+
+/// The record of one mesh triangle's shading attributes (zeros where absent).
+pub fn triangle_attributes_record(attributes: &TriangleAttributes) -> GpuTriangleAttributes {
+    let normals = attributes.normals.unwrap_or([DVec3::ZERO; 3]);
+    let uvs = attributes.uvs.unwrap_or_default();
+    GpuTriangleAttributes {
+        n0: vec3(normals[0]),
+        has_normals: u32::from(attributes.normals.is_some()),
+        n1: vec3(normals[1]),
+        has_uvs: u32::from(attributes.uvs.is_some()),
+        n2: vec3(normals[2]),
         _pad0: 0,
-        _pad1: 0,
+        uv01: [
+            uvs[0].x as f32,
+            uvs[0].y as f32,
+            uvs[1].x as f32,
+            uvs[1].y as f32,
+        ],
+        uv2: [uvs[2].x as f32, uvs[2].y as f32],
+        _pad1: [0; 2],
     }
 }
 
@@ -332,6 +374,7 @@ mod tests {
             material_names: vec!["grey".into()],
             lights,
             shapes,
+            meshes: vec![],
             images: vec![],
         }
     }

@@ -277,6 +277,7 @@ impl SlotBuffers {
                     buffer(binding::RAY_STACK, &self.ray_stack),
                     buffer(binding::TRACES, &self.traces),
                     buffer(binding::TRAVERSAL_STACK, &self.traversal_stack),
+                    buffer(binding::TRIANGLE_ATTRIBUTES, &s.triangle_attributes),
                 ],
             })
         })

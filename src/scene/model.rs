@@ -8,7 +8,7 @@
 
 use std::path::PathBuf;
 
-use glam::DVec3;
+use glam::{DMat4, DVec2, DVec3};
 
 /// A complete scene: image settings, camera, environment, materials, lights and shapes.
 #[derive(Debug, Clone, PartialEq)]
@@ -27,9 +27,31 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Geometry.
     pub shapes: Vec<Shape>,
+    /// Triangle meshes with per-vertex normals and texture coordinates, each placed
+    /// one or more times (models from OBJ or glTF files).
+    pub meshes: Vec<Mesh>,
     /// Images (albedo textures and tabulated BRDF maps), indexed by
     /// [`Material::albedo_texture`] and [`Material::brdf_map`].
     pub images: Vec<Image>,
+}
+
+/// An indexed triangle mesh and the places it stands in the scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mesh {
+    /// Where it came from (a model file's mesh or primitive), for messages.
+    pub name: String,
+    /// Vertex positions in the mesh's own space.
+    pub positions: Vec<DVec3>,
+    /// Unit vertex normals, parallel to `positions`, for smooth shading.
+    pub normals: Option<Vec<DVec3>>,
+    /// Texture coordinates, parallel to `positions` (`v` down, as image rows run).
+    pub uvs: Option<Vec<DVec2>>,
+    /// Triangles as three vertex indices, counter-clockwise seen from the front.
+    pub triangles: Vec<[u32; 3]>,
+    /// Index into [`Scene::materials`].
+    pub material: u32,
+    /// Mesh-to-world transforms, one per placement (finite and invertible).
+    pub instances: Vec<DMat4>,
 }
 
 /// An image loaded from a file, in linear RGBA `f32` (8-bit sRGB files are linearised
@@ -191,6 +213,21 @@ pub enum TextureMapping {
     Planar,
     /// Longitude/latitude of the geometric normal (for spheres).
     Spherical,
+    /// The texture coordinates of a mesh's vertices, interpolated across each triangle
+    /// (shapes without them read `(0, 0)`).
+    Uv,
+}
+
+/// What a texture lookup does outside [0, 1] on one axis (glTF's sampler wrap modes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TextureWrap {
+    /// Repeat the image.
+    #[default]
+    Repeat,
+    /// Repeat it mirrored every other time.
+    MirroredRepeat,
+    /// Extend the edge texels.
+    ClampToEdge,
 }
 
 /// A material. One flat record for all kinds (fields a kind does not use are zero),
@@ -241,6 +278,8 @@ pub struct Material {
     pub texture_mapping: TextureMapping,
     /// Scene units per texture repeat of the planar mapping (> 0).
     pub texture_scale: f64,
+    /// Wrap modes of the albedo texture along `u` and `v`.
+    pub texture_wrap: [TextureWrap; 2],
     /// Index into [`Scene::images`] of the tabulated BRDF (Tabulated).
     pub brdf_map: Option<u32>,
 }
@@ -270,6 +309,7 @@ impl Material {
             albedo_texture: None,
             texture_mapping: TextureMapping::Planar,
             texture_scale: 1.0,
+            texture_wrap: [TextureWrap::Repeat; 2],
             brdf_map: None,
         }
     }

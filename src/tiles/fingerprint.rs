@@ -3,7 +3,7 @@
 //!
 //! The scene hash covers everything a pixel depends on apart from the render
 //! settings: the camera (of the frame, for an animation), the environment, the
-//! materials, the lights, the shapes and the texels of every image, but not the paths
+//! materials, the lights, the shapes, the meshes and the texels of every image, but not the paths
 //! the files were read from (a farm mounts them in other places). The settings hash
 //! covers the image size, samples per pixel, depth, stack size, lighting space and
 //! ray-weight cutoff. Settings that only change how the work is scheduled (the GPU's
@@ -22,7 +22,7 @@ use crate::scene::{RenderSettings, Scene};
 
 /// Changes whenever what the hashes cover changes, so that tiles hashed differently
 /// never agree.
-pub const FINGERPRINT_VERSION: u32 = 1;
+pub const FINGERPRINT_VERSION: u32 = 2;
 
 /// The hashes a tile records of its render.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -39,13 +39,14 @@ impl Fingerprint {
     pub fn of(scene: &Scene) -> Self {
         let mut hash = Fnv1a::new("scene");
         // `Debug` of the parts by name, so the image paths stay out.
-        let parts: [(&str, &dyn fmt::Debug); 6] = [
+        let parts: [(&str, &dyn fmt::Debug); 7] = [
             ("camera", &scene.camera),
             ("environment", &scene.environment),
             ("materials", &scene.materials),
             ("material_names", &scene.material_names),
             ("lights", &scene.lights),
             ("shapes", &scene.shapes),
+            ("meshes", &scene.meshes),
         ];
         for (name, value) in parts {
             hash.debug(name, value);

@@ -257,7 +257,7 @@ fn parse_crop(text: &str) -> Result<PixelWindow, String> {
 /// The arguments of a render.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// The scene file (TOML).
+    /// The scene file (TOML), or a model file (.obj, .gltf, .glb) to render on its own.
     #[arg(value_name = "SCENE", required_unless_present = "adapter")]
     pub scene: Option<PathBuf>,
 

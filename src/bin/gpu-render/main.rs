@@ -1,4 +1,5 @@
-//! `gpu-render SCENE -o OUT`: renders a scene file to an image.
+//! `gpu-render SCENE -o OUT`: renders a scene file, or a model file (OBJ, glTF, GLB)
+//! on its own, to an image.
 //!
 //! Cheap checks (output format and directory, command-line settings, the scene file)
 //! all happen before a device is opened or a ray traced. Errors are printed as
@@ -159,13 +160,19 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
     // Values out of range whatever the scene says (`--width 0`) fail before loading it.
     apply_overrides(&args.settings, minimal_settings(), None)?;
 
-    let file = load(scene_path, args.sandbox, args.quiet)?;
-    let mut scene = file.scene;
+    let (mut scene, camera_path) = if scene::import::is_model_path(scene_path) {
+        let render = apply_overrides(&args.settings, RenderSettings::default(), Some(scene_path))?;
+        let scene = load_model(scene_path, render, args.sandbox, args.quiet)?;
+        (scene, None)
+    } else {
+        let file = load(scene_path, args.sandbox, args.quiet)?;
+        (file.scene, file.camera_path)
+    };
     scene.render = apply_overrides(&args.settings, scene.render, Some(scene_path))?;
     let frame = match args.frame {
         None => None,
         Some(frame) => {
-            let Some(path) = &file.camera_path else {
+            let Some(path) = &camera_path else {
                 bail!(
                     "{}: --frame {frame}: the scene has no [animation] camera path",
                     scene_path.display()
@@ -317,6 +324,40 @@ pub fn load(scene_path: &Path, sandbox: bool, quiet: bool) -> Result<SceneFile> 
         };
         scene::load_scene_file(scene_path, &options)
     })?;
+    Ok(scene)
+}
+
+/// Imports a model file and frames it as a scene of its own
+/// ([`gpu_render::scene::import::ImportedModel::into_scene`]) with `render`'s settings;
+/// warnings on stderr unless `quiet`. A model's own references (material libraries,
+/// buffers, images) cannot be confined, so `sandbox` refuses model files.
+fn load_model(path: &Path, render: RenderSettings, sandbox: bool, quiet: bool) -> Result<Scene> {
+    if sandbox {
+        bail!(
+            "{}: --sandbox cannot render model files: the files a model names itself \
+             (material libraries, buffers, textures) are not confined",
+            path.display()
+        );
+    }
+    let model = scene::import::import_model(path)?;
+    let (scene, warnings) = model.into_scene(render);
+    if !quiet {
+        for warning in model.warnings.iter().chain(&warnings) {
+            eprintln!("warning: {warning}");
+        }
+        if model.camera.is_none() {
+            eprintln!(
+                "note: {} has no camera; framing its bounds from the front, above right",
+                path.display()
+            );
+        }
+        if model.lights.is_empty() {
+            eprintln!(
+                "note: {} has no lights; using the default three directional lights",
+                path.display()
+            );
+        }
+    }
     Ok(scene)
 }
 

@@ -121,8 +121,9 @@ impl fmt::Display for Estimate {
     }
 }
 
-/// Bytes of the scene the render holds: shapes, polygon vertices and image texels, in
-/// the model and (for the GPU) once more in upload form.
+/// Bytes of the scene the render holds: shapes, polygon vertices, image texels and
+/// mesh triangles (each instance in world space with its attributes, as the geometry
+/// holds them), in the model and (for the GPU) once more in upload form.
 fn scene_bytes(scene: &Scene) -> u64 {
     use gpu_render::scene::Shape;
     let vertices: usize = scene
@@ -134,7 +135,17 @@ fn scene_bytes(scene: &Scene) -> u64 {
         })
         .sum();
     let texels: usize = scene.images.iter().map(|image| image.texels.len()).sum();
-    let bytes = scene.shapes.len() * std::mem::size_of::<Shape>() + vertices * 24 + texels * 16;
+    // A world-space mesh triangle: 3 f64 corners plus a material and attribute index
+    // (80 B), its attributes (3 normals and 3 UVs, 128 B) and its BVH share (~40 B).
+    let mesh_triangles: usize = scene
+        .meshes
+        .iter()
+        .map(|m| m.triangles.len() * m.instances.len())
+        .sum();
+    let bytes = scene.shapes.len() * std::mem::size_of::<Shape>()
+        + vertices * 24
+        + texels * 16
+        + mesh_triangles * 248;
     2 * bytes as u64
 }
 

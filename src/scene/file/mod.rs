@@ -340,16 +340,18 @@ fn build_scene(
         })
         .collect::<Result<_, _>>()?;
     let table = MaterialTable::new(&material_names);
-    let shapes = raw
-        .objects
-        .into_iter()
-        .enumerate()
-        .map(|(i, object)| {
-            checked();
-            objects::object(source, &table, i, object)
-        })
-        .collect::<Result<_, _>>()?;
-    let scene = Scene {
+    let base = source.path.parent().unwrap_or(std::path::Path::new(""));
+    let mut shapes = Vec::with_capacity(raw.objects.len());
+    let mut models = Vec::new();
+    for (i, object) in raw.objects.into_iter().enumerate() {
+        checked();
+        if object.get_ref().kind.as_deref() == Some("model") {
+            models.push(objects::model(source, &table, i, object, base, options)?);
+        } else {
+            shapes.push(objects::object(source, &table, i, object)?);
+        }
+    }
+    let mut scene = Scene {
         render,
         camera,
         environment,
@@ -357,8 +359,18 @@ fn build_scene(
         material_names,
         lights,
         shapes,
+        meshes: vec![],
         images: images.into_images(),
     };
+    for placed in models {
+        let warnings = placed.model.add_to_scene(&mut scene, &placed.placement);
+        if let Some(warn) = options.warning {
+            let item = source.item(placed.name, Some(placed.span));
+            for message in warnings {
+                warn(&item.warning(message));
+            }
+        }
+    }
     Ok(SceneFile { scene, camera_path })
 }
 

@@ -5,14 +5,17 @@ use std::collections::HashMap;
 use glam::DVec3;
 use toml::Spanned;
 
+use super::LoadOptions;
 use super::check::{Item, Source};
-use super::raw::{RawObject, RawVec3};
+use super::raw::{RawColor, RawObject, RawVec3};
+use crate::scene::import::{ImportedModel, ModelPlacement, import_model};
 use crate::scene::{SceneError, Shape};
 
 const SPHERE_FIELDS: &[&str] = &["center", "radius", "material"];
 const PLANE_FIELDS: &[&str] = &["point", "normal", "material"];
 const POLYGON_FIELDS: &[&str] = &["vertices", "material"];
 const TRIANGLE_FIELDS: &[&str] = &["vertices", "material"];
+const MODEL_FIELDS: &[&str] = &["file", "material", "translate", "rotate", "scale"];
 /// A vertex farther than this fraction of the bounding-box diagonal from the polygon's
 /// plane makes it non-planar.
 const PLANARITY_TOLERANCE: f64 = 1e-6;
@@ -70,7 +73,8 @@ pub fn object(
         "triangle" => TRIANGLE_FIELDS,
         other => {
             return Err(untyped.fail(format_args!(
-                "unknown object type `{other}` (expected one of: sphere, plane, polygon, triangle)"
+                "unknown object type `{other}` (expected one of: sphere, plane, polygon, \
+                 triangle, model)"
             )));
         }
     };
@@ -83,6 +87,84 @@ pub fn object(
         "polygon" => polygon(&item, &raw, material),
         _ => triangle(&item, &raw, material),
     }
+}
+
+/// A `type = "model"` object, read and placed but not yet added to the scene.
+pub struct PlacedModel {
+    /// The model as imported.
+    pub model: ImportedModel,
+    /// Where it stands, and the material that replaces its own, if any.
+    pub placement: ModelPlacement,
+    /// The object's name and place in the scene file, for warnings.
+    pub name: String,
+    /// Byte range of the object in the scene file.
+    pub span: std::ops::Range<usize>,
+}
+
+/// Model object `index` (0-based, in file order): its file imported (relative to the
+/// scene file's folder `base`), its transform checked.
+pub fn model(
+    source: &Source<'_>,
+    materials: &MaterialTable<'_>,
+    index: usize,
+    raw: Spanned<RawObject>,
+    base: &std::path::Path,
+    options: &LoadOptions<'_>,
+) -> Result<PlacedModel, SceneError> {
+    let span = raw.span();
+    let raw = raw.into_inner();
+    let name = format!("objects[{index}] (model)");
+    let item = source.item(name.clone(), Some(span.clone()));
+    item.only_fields("model", MODEL_FIELDS, &raw.given_fields())?;
+    let file = item.require("file", raw.file.as_deref())?;
+    if options.sandbox {
+        // The importers follow the model's own references (material libraries, glTF
+        // buffers and images) without confinement, so a sandboxed scene may not load
+        // models at all rather than let them name files outside its folder.
+        return Err(item.fail(format_args!(
+            "file `{file}`: model objects are not accepted in sandboxed scenes (the files a \
+             model names itself are not confined to the scene's folder)"
+        )));
+    }
+    let material = raw
+        .material
+        .as_deref()
+        .map(|name| materials.resolve(&item, name))
+        .transpose()?;
+    let translate = match raw.translate {
+        Some(v) => item.vector("translate", v)?,
+        None => DVec3::ZERO,
+    };
+    let rotate = match raw.rotate {
+        Some(v) => item.vector("rotate", v)?,
+        None => DVec3::ZERO,
+    };
+    let scale = match raw.scale {
+        None => DVec3::ONE,
+        Some(RawColor::Grey(s)) => DVec3::splat(item.number("scale", s)?),
+        Some(RawColor::Rgb(v)) => item.vector("scale", v)?,
+    };
+    if scale.cmpeq(DVec3::ZERO).any() {
+        return Err(item.fail(format_args!(
+            "scale must not be 0 on any axis (it would flatten the model), got {scale}"
+        )));
+    }
+    let transform = ModelPlacement::trs(translate, rotate, scale);
+    let model = import_model(&base.join(file))?;
+    if let Some(warn) = options.warning {
+        for message in &model.warnings {
+            warn(&item.warning(message));
+        }
+    }
+    Ok(PlacedModel {
+        model,
+        placement: ModelPlacement {
+            transform,
+            material,
+        },
+        name,
+        span,
+    })
 }
 
 fn sphere(item: &Item<'_>, raw: &RawObject, material: u32) -> Result<Shape, SceneError> {

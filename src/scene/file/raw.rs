@@ -197,6 +197,14 @@ pub struct RawObject {
     pub normal: Option<RawVec3>,
     pub vertices: Option<Vec<RawVec3>>,
     pub material: Option<String>,
+    /// A model object's file (OBJ, glTF or GLB), relative to the scene file.
+    pub file: Option<String>,
+    /// A model's translation.
+    pub translate: Option<RawVec3>,
+    /// A model's rotation in degrees about x, y, z.
+    pub rotate: Option<RawVec3>,
+    /// A model's scale: one number (uniform) or one per axis (the colour syntax).
+    pub scale: Option<RawColor>,
 }
 
 impl RawObject {
@@ -209,6 +217,10 @@ impl RawObject {
             ("normal", self.normal.is_some()),
             ("vertices", self.vertices.is_some()),
             ("material", self.material.is_some()),
+            ("file", self.file.is_some()),
+            ("translate", self.translate.is_some()),
+            ("rotate", self.rotate.is_some()),
+            ("scale", self.scale.is_some()),
         ])
     }
 }

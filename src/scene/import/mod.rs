@@ -37,6 +37,7 @@ mod framing;
 mod gltf;
 mod mesh;
 mod obj;
+mod place;
 mod texture;
 
 use std::io::Read;
@@ -47,6 +48,7 @@ use glam::{DMat4, DVec2, DVec3};
 pub use self::framing::{DEFAULT_FOV_Y_DEGREES, default_camera, default_lights};
 pub use self::gltf::{LUMENS_PER_WATT, import_gltf, parse_gltf};
 pub use self::obj::{DEFAULT_OBJ_ALBEDO, import_obj, parse_obj};
+pub use self::place::{MODEL_BACKGROUND, ModelPlacement, is_model_path};
 use super::{Camera, Image, Light, Material, SceneError};
 
 /// Largest model file (OBJ, MTL, glTF, GLB or external glTF buffer) accepted, in bytes
