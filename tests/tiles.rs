@@ -134,8 +134,8 @@ fn tiles_merge_into_the_whole_render(backend: &str, scene: &str, extra: &[&str])
     let tiles: Vec<PathBuf> = (0..4)
         .map(|i| dir.path().join(format!("tile-{i}.exr")))
         .collect();
-    for i in 0..4 {
-        assert_same_bytes(&tiles[i], &dir.path().join(format!("again-{i}.exr")));
+    for (i, tile) in tiles.iter().enumerate() {
+        assert_same_bytes(tile, &dir.path().join(format!("again-{i}.exr")));
     }
     for format in ["exr", "png", "hdr"] {
         let merged = dir.path().join(format!("merged.{format}"));
