@@ -518,6 +518,41 @@ fn estimate_prints_a_line_per_tile_and_the_whole() {
     ] {
         assert!(out.contains(needle), "stdout lacks {needle:?}:\n{out}");
     }
+    // The longest tile is the setup plus the slowest row of the table.
+    let seconds = |text: &str| -> f64 {
+        let mut words = text.split_whitespace();
+        let value: f64 = words.next().and_then(|v| v.parse().ok()).expect("a number");
+        match words.next() {
+            Some("ms") => value / 1e3,
+            Some("s") => value,
+            other => panic!("unit {other:?} in {text:?}"),
+        }
+    };
+    let after = |marker: &str| -> f64 {
+        let line = out.lines().find(|l| l.contains(marker)).expect(marker);
+        let rest = &line[line.find(marker).expect(marker) + marker.len()..];
+        seconds(
+            rest.trim_start_matches([' ', '('])
+                .split([',', ')'])
+                .next()
+                .expect("value"),
+        )
+    };
+    let slowest_row = out
+        .lines()
+        .filter(|l| l.starts_with("-      "))
+        .map(|l| {
+            let words: Vec<&str> = l.split_whitespace().collect();
+            seconds(&words[words.len() - 2..].join(" "))
+        })
+        .fold(0.0, f64::max);
+    let setup = after("setup per process:");
+    let longest = after("the longest");
+    assert!(
+        (longest - (setup + slowest_row)).abs() <= 1e-4 + 0.02 * longest,
+        "the longest tile {longest} s is not the setup {setup} s plus the slowest row \
+         {slowest_row} s:\n{out}"
+    );
     let animated = succeeds(gpu_render(&[
         "estimate",
         shipped("animation/orbit.toml").as_str(),

@@ -110,6 +110,7 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
     );
     println!("frame  tile     window                                  expected");
     let mut frame_totals = Vec::new();
+    let mut longest_tile = 0.0_f64;
     for frame in &frames {
         let mut frame_scene = calibration.clone();
         if let (Some(frame), Some(path)) = (frame, &file.camera_path) {
@@ -122,6 +123,7 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
             let measured = time(|| backend.render_region(&frame_scene, &band, &no_progress))?;
             let expected = expected_seconds(measured, call_cost, band.pixels(), full.pixels());
             total += expected;
+            longest_tile = longest_tile.max(expected);
             println!(
                 "{:<6} {:<8} {:<39} {}",
                 frame.map_or("-".to_owned(), |f| f.to_string()),
@@ -159,7 +161,7 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
             seconds(setup),
             processes,
             seconds_f64(mean + processes as f64 * setup.as_secs_f64()),
-            seconds_f64(setup.as_secs_f64() + longest_tile(&frame_totals, mean, args.tiles))
+            seconds_f64(setup.as_secs_f64() + longest_tile)
         ),
     }
     println!(
@@ -203,15 +205,6 @@ fn expected_seconds(
     call_cost.as_secs_f64() + per_pixel * full_pixels as f64
 }
 
-/// The longest tile's expected seconds: from the mean frame when one frame was
-/// calibrated per tile (an upper bound of a tile is the frame's time when tiles = 1).
-fn longest_tile(frame_totals: &[f64], mean: f64, tiles: u32) -> f64 {
-    if tiles == 1 {
-        return mean;
-    }
-    frame_totals.iter().copied().fold(0.0, f64::max) / f64::from(tiles)
-}
-
 /// Runs `render` and returns its wall time.
 fn time<T>(render: impl FnOnce() -> Result<T>) -> Result<Duration> {
     let started = Instant::now();
@@ -224,7 +217,9 @@ fn seconds(duration: Duration) -> String {
 }
 
 fn seconds_f64(seconds: f64) -> String {
-    if seconds < 10.0 {
+    if seconds < 0.1 {
+        format!("{:.1} ms", seconds * 1e3)
+    } else if seconds < 10.0 {
         format!("{seconds:.2} s")
     } else {
         format!("{seconds:.1} s")
