@@ -48,6 +48,9 @@
 // Squared point-light distances below the smallest normal f32 (2^-126) contribute
 // nothing: I / r² would be infinite or NaN. Twin of MIN_LIGHT_DISTANCE_SQUARED.
 const MIN_LIGHT_DISTANCE_SQUARED: f32 = 1.17549435e-38;
+// The least cosine to the geometric surface a bent secondary ray keeps. Twin of
+// MIN_SECONDARY_COSINE (src/cpu/trace.rs).
+const MIN_SECONDARY_COSINE: f32 = 1e-3;
 
 // Branches whose weight is not above the smallest normal f32 are not traced, whatever
 // the cutoff. Twin of MIN_BRANCH_WEIGHT.
@@ -155,9 +158,10 @@ struct LightSample {
     lit: bool,
 }
 
-// `n` is the shading normal, `ng` the geometric one (both facing the incoming ray): a
-// light lights the point only when it is above both.
-fn sample_light(light: Light, origin: vec3<f32>, n: vec3<f32>, ng: vec3<f32>) -> LightSample {
+// `n` is the shading normal (facing the incoming ray): a light lights the point when it
+// is above `n` and its shadow ray, from the lifted point, reaches it. CPU twin:
+// direct_light.
+fn sample_light(light: Light, origin: vec3<f32>, n: vec3<f32>) -> LightSample {
     var sample = LightSample(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, false);
     if light.kind == LIGHT_POINT {
         let to_light = light.position_or_direction - origin;
@@ -175,27 +179,37 @@ fn sample_light(light: Light, origin: vec3<f32>, n: vec3<f32>, ng: vec3<f32>) ->
         sample.irradiance = light.power;
     }
     sample.cos_i = clamp(dot(n, sample.wi), -1.0, 1.0);
-    sample.lit = sample.cos_i > 0.0 && dot(ng, sample.wi) > 0.0;
+    sample.lit = sample.cos_i > 0.0;
     return sample;
 }
 
 //#if MESH_ATTRIBUTES
-// The normal a hit is shaded with (facing the ray): the shading normal `ns` when the
-// ray, its mirror direction about `ns` and its refracted direction stay on the sides of
-// the geometric surface `ng` they belong to, else `ng` (Veach's thesis, 1997, §5.3;
-// PBRT v4 §10.1.1). CPU twin: shading_frame_normal.
-fn shading_frame_normal(material: Material, direction: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>, entering: bool, outside_ior: f32) -> vec3<f32> {
-    if all(ns == ng) || -dot(direction, ns) <= 0.0 {
+// The normal a hit is shaded with: the shading normal `ns`, tilted towards the viewer
+// where the ray would arrive behind it, normalize(ns + (c_min - wo·ns)·wo) (continuous,
+// so no facet edge shows; Veach's thesis, 1997, §5.3, on shading normals). CPU twin:
+// shading_frame_normal.
+fn shading_frame_normal(direction: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>) -> vec3<f32> {
+    if all(ns == ng) {
         return ng;
     }
-    if dot(reflect_direction(direction, ns), ng) <= 0.0 {
-        return ng;
+    let wo = -direction;
+    let cosine = dot(wo, ns);
+    if cosine >= MIN_SECONDARY_COSINE {
+        return ns;
     }
-    let response = surface_response(material, direction, ns, entering, outside_ior);
-    if max_component(response.transmit) > 0.0 && dot(response.transmit_direction, ng) >= 0.0 {
-        return ng;
+    return normalize(ns + wo * (MIN_SECONDARY_COSINE - cosine));
+}
+
+// A secondary direction computed about a shading normal, kept on the side of the
+// geometric surface `side` points to, at a cosine of at least MIN_SECONDARY_COSINE: the
+// bent reflection of Keller et al., "The Iray Light Transport Simulation and Rendering
+// System" (2017). CPU twin: keep_on_side.
+fn keep_on_side(d: vec3<f32>, side: vec3<f32>) -> vec3<f32> {
+    let cosine = dot(d, side);
+    if cosine >= MIN_SECONDARY_COSINE {
+        return d;
     }
-    return ns;
+    return normalize(d + side * (MIN_SECONDARY_COSINE - cosine));
 }
 //#endif
 
@@ -225,13 +239,20 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
     //#endif
     //#if MESH_ATTRIBUTES
     let ns = select(-hit.shading_normal, hit.shading_normal, entering);
-    let n = shading_frame_normal(material, ray.direction, ng, ns, entering, outside_ior);
+    let n = shading_frame_normal(ray.direction, ng, ns);
     let lifted = shadow_terminator_point(hit, ng);
     //#else
     let n = ng;
     let lifted = hit.position;
     //#endif
-    let response = surface_response(material, ray.direction, n, entering, outside_ior);
+    var response = surface_response(material, ray.direction, n, entering, outside_ior);
+    var reflected = normalize(reflect_direction(ray.direction, n));
+    //#if MESH_ATTRIBUTES
+    if any(n != ng) {
+        reflected = keep_on_side(reflected, ng);
+        response.transmit_direction = keep_on_side(response.transmit_direction, -ng);
+    }
+    //#endif
     if (*path).depth < frame.max_depth {
         // Refraction is pushed first so that reflection is traced first.
         //#if REFRACTION
@@ -243,7 +264,7 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
         //#endif
         push_branch(slot, path, StackEntry(
             offset_ray_origin(hit.position, ng, frame.offset_scale), (*path).depth + 1u,
-            normalize(reflect_direction(ray.direction, n)), medium.depth,
+            reflected, medium.depth,
             (*path).weight * response.reflect, 0u, medium.iors));
     }
     if has_base_brdf(material.kind) && response.base > 0.0 {
@@ -251,7 +272,6 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
         (*path).albedo = material.diffuse;
         (*path).material = hit.material;
         (*path).normal = n;
-        (*path).geometric_normal = ng;
         (*path).base = response.base;
         (*path).shadow_origin = offset_ray_origin(lifted, ng, frame.offset_scale);
         (*path).light = 0u;
@@ -266,8 +286,7 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
 // moves on to the next light.
 fn consume_shadow_ray(path: ptr<function, PathState>, trace: TraceRay) {
     if trace.best_prim == NO_PRIM {
-        let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal,
-                                  (*path).geometric_normal);
+        let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal);
         var material = materials[(*path).material];
         material.diffuse = (*path).albedo;
         (*path).direct += eval_brdf(material, (*path).normal, sample.wi, -(*path).direction)
@@ -287,8 +306,7 @@ fn next_light(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) ->
         (*path).phase = PHASE_POP;
         return false;
     }
-    let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal,
-                              (*path).geometric_normal);
+    let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal);
     if !sample.lit {
         (*path).light += 1u;
         return false;

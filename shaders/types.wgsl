@@ -238,10 +238,6 @@ struct PathState {
     _pad1: u32,
     direct: vec3<f32>,
     _pad2: u32,
-    // Geometric normal of the hit being lit, facing the incoming ray: lights below it
-    // are not lit even where the shading normal would face them.
-    geometric_normal: vec3<f32>,
-    _pad3: u32,
 }
 
 // One pending reflected or refracted ray on a slot's bounce stack.

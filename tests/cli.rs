@@ -746,3 +746,58 @@ fn sigint_during_a_render_stops_it_and_keeps_the_old_output() {
     assert!(rest.contains("interrupted"), "{rest}");
     ws.assert_old_output_kept();
 }
+
+// ---------------------------------------------------------------- model files
+
+#[test]
+fn a_model_file_renders_directly_with_a_framing_camera_and_default_lights() {
+    let ws = Workspace::new(TINY_SCENE);
+    let vase = shipped_path("scenes/models/vase.gltf");
+    let run = gpu_render(&[
+        &vase,
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+        "--width",
+        "40",
+        "--height",
+        "30",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    for needle in ["has no camera", "has no lights", "40x30"] {
+        assert!(
+            run.stderr.contains(needle),
+            "stderr lacks {needle:?}:\n{}",
+            run.stderr
+        );
+    }
+    let image = image::open(ws.path("out.png")).expect("open").to_rgb8();
+    assert_eq!(image.dimensions(), (40, 30));
+    // The framed model fills the middle of the image and differs from the background.
+    let corner = *image.get_pixel(0, 0);
+    let centre = *image.get_pixel(20, 15);
+    assert_ne!(
+        corner, centre,
+        "the model is not in the middle of the frame"
+    );
+}
+
+#[test]
+fn a_broken_model_file_is_an_error_naming_it_and_keeps_the_old_output() {
+    let ws = Workspace::new(TINY_SCENE);
+    std::fs::write(ws.path("broken.glb"), b"glTF\x02\x00\x00\x00trunc").expect("write");
+    let run = gpu_render(&[&ws.arg("broken.glb"), "-o", &ws.arg("out.png"), "-q"]);
+    assert_fails_with(&run, &["broken.glb"]);
+    std::fs::remove_file(ws.path("broken.glb")).expect("remove");
+    ws.assert_old_output_kept();
+}
+
+#[test]
+fn the_sandbox_refuses_model_files() {
+    let ws = Workspace::new(TINY_SCENE);
+    let vase = shipped_path("scenes/models/vase.gltf");
+    let run = gpu_render(&[&vase, "-o", &ws.arg("out.png"), "--sandbox", "-q"]);
+    assert_fails_with(&run, &["vase.gltf", "--sandbox"]);
+    ws.assert_old_output_kept();
+}

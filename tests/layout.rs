@@ -196,9 +196,7 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 albedo,
                 _pad1,
                 direct,
-                _pad2,
-                geometric_normal,
-                _pad3
+                _pad2
             }),
         ),
         (
@@ -400,4 +398,35 @@ fn composed_display_shader_validates() {
 #[test]
 fn composed_bxdf_eval_shader_validates() {
     validate("bxdf eval shader", &bxdf_eval_shader_source());
+}
+
+/// The value of `const NAME: f32 = VALUE;` in a WGSL source.
+fn wgsl_f32_const(source: &str, name: &str) -> f32 {
+    let prefix = format!("const {name}: f32 = ");
+    let line = source
+        .lines()
+        .find(|l| l.starts_with(&prefix))
+        .unwrap_or_else(|| panic!("no `{prefix}` in the shader"));
+    line[prefix.len()..]
+        .trim_end_matches(';')
+        .parse()
+        .unwrap_or_else(|e| panic!("{line}: {e}"))
+}
+
+/// Numeric constants written in the WGSL by hand equal their Rust twins in f32.
+#[test]
+fn wgsl_constants_equal_their_rust_twins() {
+    let trace = gpu_render::gpu::shaders::TRACE_WGSL;
+    for (name, rust) in [
+        (
+            "MIN_LIGHT_DISTANCE_SQUARED",
+            gpu_render::cpu::trace::MIN_LIGHT_DISTANCE_SQUARED,
+        ),
+        (
+            "MIN_SECONDARY_COSINE",
+            gpu_render::cpu::trace::MIN_SECONDARY_COSINE,
+        ),
+    ] {
+        assert_eq!(wgsl_f32_const(trace, name), rust as f32, "{name}");
+    }
 }

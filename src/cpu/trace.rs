@@ -217,31 +217,43 @@ pub struct ShadedHit {
 }
 
 /// The normal a hit is shaded with, on the side the ray came from: the interpolated
-/// shading normal `ns` of a smooth mesh when the ray, its mirror direction about `ns`
-/// and its refracted direction all stay on the sides of the geometric surface `ng` they
-/// belong to; otherwise `ng` itself. The fallback keeps every secondary ray on the
-/// correct side of the real surface, where the interpolated normal of a coarse mesh
-/// would send it through (Veach's thesis, 1997, §5.3, on the asymmetry of shading
-/// normals; the same test as PBRT v4's `BSDF` shading-frame checks, §10.1.1).
-pub fn shading_frame_normal(
-    material: &Material,
-    direction: DVec3,
-    ng: DVec3,
-    ns: DVec3,
-    entering: bool,
-    outside_ior: f64,
-) -> DVec3 {
-    if ns == ng || -direction.dot(ns) <= 0.0 {
+/// shading normal `ns` of a smooth mesh, tilted towards the viewer where the ray would
+/// arrive behind it (near a coarse mesh's silhouette, where `ns` turns away while the
+/// real surface `ng` still faces the ray): `normalize(ns + (c_min - wo·ns)·wo)` with
+/// `wo = -direction` and `c_min` = [`MIN_SECONDARY_COSINE`], so that `wo` is just
+/// above it. Both steps are continuous, so no facet edge shows where a hard switch to
+/// `ng` would draw one; shading normals are not physical (Veach's thesis, 1997, §5.3),
+/// and this keeps them plausible. Secondary rays that the result would send through the
+/// real surface are bent back by [`keep_on_side`].
+pub fn shading_frame_normal(direction: DVec3, ng: DVec3, ns: DVec3) -> DVec3 {
+    if ns == ng {
         return ng;
     }
-    if reflect_direction(direction, ns).dot(ng) <= 0.0 {
-        return ng;
+    let wo = -direction;
+    let cosine = wo.dot(ns);
+    if cosine >= MIN_SECONDARY_COSINE {
+        return ns;
     }
-    let response = surface_response(material, direction, ns, entering, outside_ior);
-    if response.transmit.max_element() > 0.0 && response.transmit_direction.dot(ng) >= 0.0 {
-        return ng;
+    (ns + wo * (MIN_SECONDARY_COSINE - cosine)).normalize()
+}
+
+/// The least cosine to the geometric surface that a bent secondary ray keeps
+/// ([`keep_on_side`]): about 0.06 degrees off the surface.
+pub const MIN_SECONDARY_COSINE: f64 = 1e-3;
+
+/// A secondary ray's unit direction `d`, computed about a shading normal, kept on the
+/// side of the geometric surface that `side` (a unit normal) points to: unchanged when
+/// it leaves that side at a cosine of at least [`MIN_SECONDARY_COSINE`], otherwise
+/// pulled towards `side` until it does, `normalize(d + (c_min - d·side)·side)`. This is
+/// the bent reflection of Keller et al., "The Iray Light Transport Simulation and
+/// Rendering System" (2017), on shading normals: continuous in `d`, so a smooth-shaded
+/// mirror or glass mesh shows no seam where `ns` would have sent the ray inside.
+pub fn keep_on_side(d: DVec3, side: DVec3) -> DVec3 {
+    let cosine = d.dot(side);
+    if cosine >= MIN_SECONDARY_COSINE {
+        return d;
     }
-    ns
+    (d + side * (MIN_SECONDARY_COSINE - cosine)).normalize()
 }
 
 /// Shades `hit` for a ray travelling along `ray.direction`: emission, ambient and
@@ -265,9 +277,14 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumSta
     } else {
         -hit.shading_normal
     };
-    let n = shading_frame_normal(material, ray.direction, ng, ns, entering, outside_ior);
+    let n = shading_frame_normal(ray.direction, ng, ns);
     let wo = -ray.direction;
-    let response = surface_response(material, ray.direction, n, entering, outside_ior);
+    let mut response = surface_response(material, ray.direction, n, entering, outside_ior);
+    let mut reflect = reflect_direction(ray.direction, n).normalize();
+    if n != ng {
+        reflect = keep_on_side(reflect, ng);
+        response.transmit_direction = keep_on_side(response.transmit_direction, -ng);
+    }
 
     let mut radiance = material.emission;
     let mut shadow_rays = 0;
@@ -276,7 +293,7 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumSta
         let lifted = shadow_terminator_point(&scene.geometry, hit, ng);
         let shadow_origin = offset_ray_origin(lifted, ng, scene.geometry.offset_scale);
         for light in &scene.lights {
-            let (lit, traced) = direct_light(scene, light, material, shadow_origin, ng, n, wo);
+            let (lit, traced) = direct_light(scene, light, material, shadow_origin, n, wo);
             direct += lit;
             shadow_rays += traced;
         }
@@ -285,7 +302,7 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumSta
 
     let reflected = Ray {
         origin: offset_ray_origin(position, ng, scene.geometry.offset_scale),
-        direction: reflect_direction(ray.direction, n).normalize(),
+        direction: reflect,
     };
     let transmitted = Ray {
         origin: offset_ray_origin(position, -ng, scene.geometry.offset_scale),
@@ -303,14 +320,17 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumSta
 /// Reflected radiance due to one light: `f(wi, wo) · E · cos θ_i` (the BRDF and the
 /// cosine taken about the shading normal `n`) when the shadow ray from `origin` towards
 /// the light is unblocked. Returns it and the number of shadow rays traced (0 when the
-/// light is behind the geometric surface `ng` or below the shading normal).
-#[allow(clippy::too_many_arguments)]
+/// light is below the shading normal). A light below a smooth mesh's flat triangle but
+/// above its shading normal (`ng·wi < 0 < n·wi`, near the shadow terminator) is lit
+/// when its shadow ray, which starts at the lifted point of [`shadow_terminator_point`],
+/// reaches it: the mesh itself decides, so the terminator follows the smooth surface
+/// instead of the facets (Hanika 2021). It can pass at most as far below `ng` as `n`
+/// leans from it.
 pub fn direct_light(
     scene: &PreparedScene,
     light: &Light,
     material: &Material,
     origin: DVec3,
-    ng: DVec3,
     n: DVec3,
     wo: DVec3,
 ) -> (DVec3, u64) {
@@ -335,7 +355,7 @@ pub fn direct_light(
         } => (-direction, f64::INFINITY, irradiance),
     };
     let cos_i = n.dot(wi).clamp(-1.0, 1.0);
-    if cos_i <= 0.0 || ng.dot(wi) <= 0.0 {
+    if cos_i <= 0.0 {
         return (DVec3::ZERO, 0);
     }
     let shadow = Ray {

@@ -172,10 +172,6 @@ pub struct GpuPathState {
     pub direct: [f32; 3],
     /// Padding.
     pub _pad2: u32,
-    /// Geometric normal of the hit being lit (facing the incoming ray).
-    pub geometric_normal: [f32; 3],
-    /// Padding.
-    pub _pad3: u32,
 }
 
 /// One pending ray on a slot's bounce stack (`StackEntry` in WGSL).

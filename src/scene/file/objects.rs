@@ -15,7 +15,7 @@ const SPHERE_FIELDS: &[&str] = &["center", "radius", "material"];
 const PLANE_FIELDS: &[&str] = &["point", "normal", "material"];
 const POLYGON_FIELDS: &[&str] = &["vertices", "material"];
 const TRIANGLE_FIELDS: &[&str] = &["vertices", "material"];
-const MODEL_FIELDS: &[&str] = &["file", "material", "translate", "rotate", "scale"];
+const MODEL_FIELDS: &[&str] = &["file", "material", "translate", "rotate", "scale", "smooth"];
 /// A vertex farther than this fraction of the bounding-box diagonal from the polygon's
 /// plane makes it non-planar.
 const PLANARITY_TOLERANCE: f64 = 1e-6;
@@ -150,7 +150,10 @@ pub fn model(
         )));
     }
     let transform = ModelPlacement::trs(translate, rotate, scale);
-    let model = import_model(&base.join(file))?;
+    // The importer's error names the model file and its element; this names the scene
+    // object that asked for it.
+    let model = import_model(&base.join(file))
+        .map_err(|err| item.fail(format_args!("file `{file}`: {err}")))?;
     if let Some(warn) = options.warning {
         for message in &model.warnings {
             warn(&item.warning(message));
@@ -161,6 +164,7 @@ pub fn model(
         placement: ModelPlacement {
             transform,
             material,
+            smooth: raw.smooth.unwrap_or(true),
         },
         name,
         span,

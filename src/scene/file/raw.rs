@@ -205,6 +205,8 @@ pub struct RawObject {
     pub rotate: Option<RawVec3>,
     /// A model's scale: one number (uniform) or one per axis (the colour syntax).
     pub scale: Option<RawColor>,
+    /// Whether a model shades with its vertex normals (default true).
+    pub smooth: Option<bool>,
 }
 
 impl RawObject {
@@ -221,6 +223,7 @@ impl RawObject {
             ("translate", self.translate.is_some()),
             ("rotate", self.rotate.is_some()),
             ("scale", self.scale.is_some()),
+            ("smooth", self.smooth.is_some()),
         ])
     }
 }

@@ -20,6 +20,9 @@ pub struct ModelPlacement {
     /// A scene material (an index into [`Scene::materials`]) that replaces every
     /// material of the model, or `None` to keep the model's own.
     pub material: Option<u32>,
+    /// Whether the meshes keep their vertex normals (smooth shading); `false` shades
+    /// every triangle flat with its geometric normal, as if the file had none.
+    pub smooth: bool,
 }
 
 impl ModelPlacement {
@@ -27,6 +30,7 @@ impl ModelPlacement {
     pub const IDENTITY: Self = Self {
         transform: DMat4::IDENTITY,
         material: None,
+        smooth: true,
     };
 
     /// The transform `T · R · S` of a scene file's `translate`, `rotate` (degrees about
@@ -105,7 +109,11 @@ impl ImportedModel {
             scene.meshes.push(Mesh {
                 name: format!("{stem}/{}", mesh.name),
                 positions: mesh.positions.clone(),
-                normals: mesh.normals.clone(),
+                normals: if placement.smooth {
+                    mesh.normals.clone()
+                } else {
+                    None
+                },
                 uvs: mesh.uvs.clone(),
                 triangles: mesh.triangles.clone(),
                 material: placement.material.unwrap_or(material_base + mesh.material),
