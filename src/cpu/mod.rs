@@ -7,6 +7,7 @@
 
 pub mod bxdf;
 pub mod intersect;
+pub mod sample;
 pub mod texture;
 pub mod trace;
 pub mod traverse;
