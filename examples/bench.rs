@@ -144,6 +144,7 @@ fn million_triangle_scene() -> gpu_render::scene::Scene {
             stack_size: 5,
             lighting_space: LightingSpace::Linear,
             min_ray_weight: 0.0,
+            integrator: gpu_render::scene::Integrator::Whitted,
         },
         camera: Camera {
             eye: DVec3::new(0.0, 2.5, 7.0),

@@ -801,3 +801,55 @@ fn the_sandbox_refuses_model_files() {
     assert_fails_with(&run, &["vase.gltf", "--sandbox"]);
     ws.assert_old_output_kept();
 }
+
+// ---------------------------------------------------------------- integrators
+
+#[test]
+fn the_path_integrator_renders_on_the_cpu_and_auto_says_why() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--integrator",
+        "path",
+        "--spp",
+        "2",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(
+        run.stderr.contains("CPU reference") && run.stderr.contains("path integrator"),
+        "stderr:\n{}",
+        run.stderr
+    );
+    assert_eq!(read_png_size(&ws.path("out.png")), (32, 24));
+}
+
+#[test]
+fn the_path_integrator_on_the_gpu_is_refused_before_rendering() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--integrator",
+        "path",
+        "--backend",
+        "gpu",
+    ]);
+    assert_fails_with(&run, &["path integrator", "--backend cpu"]);
+    ws.assert_old_output_kept();
+}
+
+#[test]
+fn a_scene_may_choose_its_integrator_and_a_bad_one_is_named() {
+    let path_scene = TINY_SCENE.replace("[render]\n", "[render]\nintegrator = \"path\"\n");
+    let ws = Workspace::new(&path_scene);
+    let run = gpu_render(&[&ws.arg("scene.toml"), "-o", &ws.arg("out.png"), "-q"]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    let bad = TINY_SCENE.replace("[render]\n", "[render]\nintegrator = \"photon\"\n");
+    let ws = Workspace::new(&bad);
+    let run = gpu_render(&[&ws.arg("scene.toml"), "-o", &ws.arg("out.png"), "-q"]);
+    assert_fails_with(&run, &["scene.toml:3", "photon", "whitted", "path"]);
+    ws.assert_old_output_kept();
+}

@@ -34,6 +34,7 @@ fn settings(width: u32, height: u32, samples: u32, depth: u32) -> RenderSettings
         stack_size: RenderSettings::sufficient_stack_size(depth),
         lighting_space: LightingSpace::Linear,
         min_ray_weight: 0.0,
+        integrator: gpu_render::scene::Integrator::Whitted,
     }
 }
 

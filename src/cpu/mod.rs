@@ -7,6 +7,7 @@
 
 pub mod bxdf;
 pub mod intersect;
+pub mod path;
 pub mod sample;
 pub mod texture;
 pub mod trace;

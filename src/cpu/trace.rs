@@ -6,12 +6,13 @@ use glam::DVec3;
 
 use super::bxdf::{eval_brdf, has_base_brdf, reflect_direction, surface_response};
 use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
+use super::path::{AreaLights, path_radiance};
 use super::texture::shading_albedo;
 use super::traverse::{intersect_scene, occluded};
 use crate::accel::SceneGeometry;
 use crate::camera::{CameraFrame, SamplePattern};
 pub use crate::scene::MediumStack;
-use crate::scene::{Image, Light, Material, RenderSettings, Scene};
+use crate::scene::{Image, Integrator, Light, Material, RenderSettings, Scene};
 
 /// The scene in the form the tracer reads: colours in the lighting space, the geometry
 /// with its BVH, the camera basis.
@@ -37,6 +38,8 @@ pub struct PreparedScene {
     pub camera_medium: MediumStack,
     /// Albedo textures and BRDF maps.
     pub images: Vec<Image>,
+    /// The emissive shapes the path integrator samples.
+    pub area_lights: AreaLights,
 }
 
 impl PreparedScene {
@@ -49,6 +52,10 @@ impl PreparedScene {
     /// the one the GPU backend uploaded, so both trace the same tree).
     pub fn with_geometry(scene: &Scene, geometry: SceneGeometry) -> Self {
         let scene = scene.in_lighting_space();
+        let area_lights = match scene.render.integrator {
+            Integrator::Path => AreaLights::new(&geometry, &scene.materials),
+            Integrator::Whitted => AreaLights::default(),
+        };
         Self {
             settings: scene.render,
             camera: CameraFrame::new(&scene.camera, scene.render.width, scene.render.height),
@@ -60,6 +67,7 @@ impl PreparedScene {
             geometry,
             camera_medium: MediumStack::from_outermost_first(&scene.camera_medium()),
             images: scene.images,
+            area_lights,
         }
     }
 }
@@ -127,7 +135,10 @@ pub fn trace_pixel(scene: &PreparedScene, x: u32, y: u32) -> PixelResult {
             origin: scene.camera.eye,
             direction,
         };
-        let (radiance, sample_rays) = trace_radiance(scene, primary);
+        let (radiance, sample_rays) = match settings.integrator {
+            Integrator::Whitted => trace_radiance(scene, primary),
+            Integrator::Path => path_radiance(scene, primary, y * settings.width + x, index),
+        };
         sum += radiance;
         rays += sample_rays;
     }

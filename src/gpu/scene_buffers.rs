@@ -99,6 +99,13 @@ pub(crate) fn upload_scene(
     specialise: bool,
 ) -> Result<PreparedScene, GpuError> {
     scene.render.check().map_err(GpuError::Validation)?;
+    if scene.render.integrator == crate::scene::Integrator::Path {
+        return Err(GpuError::Validation(
+            "the path integrator runs on the CPU reference only; its GPU twin is not \
+             written yet"
+                .into(),
+        ));
+    }
     if geometry.planes.len() > MAX_PLANES {
         return Err(GpuError::DeviceLimit {
             what: "infinite planes (every ray tests every plane; use polygons)".into(),

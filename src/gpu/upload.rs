@@ -359,6 +359,7 @@ mod tests {
                 stack_size: 4,
                 lighting_space: LightingSpace::Linear,
                 min_ray_weight: 0.0,
+                integrator: crate::scene::Integrator::Whitted,
             },
             camera: Camera {
                 eye: DVec3::new(0.0, 0.0, 5.0),

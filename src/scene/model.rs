@@ -98,6 +98,8 @@ pub struct RenderSettings {
     /// weight (largest channel) is not above it is not traced. 0 traces every branch
     /// that carries any light; larger values trade accuracy for speed.
     pub min_ray_weight: f64,
+    /// The light-transport algorithm.
+    pub integrator: Integrator,
 }
 
 impl Default for RenderSettings {
@@ -112,6 +114,7 @@ impl Default for RenderSettings {
             stack_size: Self::sufficient_stack_size(5),
             lighting_space: LightingSpace::Linear,
             min_ray_weight: 0.0,
+            integrator: Integrator::Whitted,
         }
     }
 }
@@ -122,6 +125,19 @@ impl RenderSettings {
         // Saturating: an absurd depth is reported by `check`, not by an overflow panic.
         max_depth.saturating_add(1)
     }
+}
+
+/// How radiance along a camera ray is computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Integrator {
+    /// Whitted's recursive ray tracing: direct light by one shadow ray per light,
+    /// perfect mirror and refraction branches, a flat ambient term.
+    #[default]
+    Whitted,
+    /// Unbiased Monte Carlo path tracing: emissive shapes are lights, next-event
+    /// estimation with multiple importance sampling, importance-sampled BRDFs, Russian
+    /// roulette (docs/path-tracing.md). CPU reference only, for now.
+    Path,
 }
 
 /// Where shading arithmetic happens (see the lecture's "Gamma space vs linear space").
@@ -421,6 +437,8 @@ pub struct RenderOverrides {
     pub lighting_space: Option<LightingSpace>,
     /// Ray-weight cutoff.
     pub min_ray_weight: Option<f64>,
+    /// Light-transport algorithm.
+    pub integrator: Option<Integrator>,
 }
 
 impl RenderSettings {
@@ -450,6 +468,9 @@ impl RenderSettings {
         }
         if let Some(cutoff) = overrides.min_ray_weight {
             self.min_ray_weight = cutoff;
+        }
+        if let Some(integrator) = overrides.integrator {
+            self.integrator = integrator;
         }
         self.check()?;
         Ok(self)

@@ -5,7 +5,8 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use gpu_render::quality::QualityPreset;
 use gpu_render::scene::{
-    LightingSpace, MAX_DEPTH_LIMIT, MAX_IMAGE_DIMENSION, MAX_SAMPLES_PER_PIXEL, RenderOverrides,
+    Integrator, LightingSpace, MAX_DEPTH_LIMIT, MAX_IMAGE_DIMENSION, MAX_SAMPLES_PER_PIXEL,
+    RenderOverrides,
 };
 use gpu_render::tiles::PixelWindow;
 
@@ -412,6 +413,15 @@ pub struct SettingsArgs {
         help_heading = "Render settings"
     )]
     pub lighting: Option<LightingArg>,
+    /// Light transport: Whitted ray tracing or Monte Carlo path tracing (CPU
+    /// reference only for now) [default: the scene's, else whitted].
+    #[arg(
+        long,
+        value_enum,
+        value_name = "INTEGRATOR",
+        help_heading = "Render settings"
+    )]
+    pub integrator: Option<IntegratorArg>,
 }
 
 /// Where and how to trace.
@@ -466,6 +476,7 @@ impl SettingsArgs {
             stack_size: self.stack_size.or(preset_stack),
             lighting_space: self.lighting.map(LightingSpace::from),
             min_ray_weight: self.min_ray_weight.or(preset.min_ray_weight),
+            integrator: self.integrator.map(Integrator::from),
         }
     }
 
@@ -525,6 +536,24 @@ pub enum LightingArg {
     Linear,
     /// The classic mistake: light on sRGB-encoded colours, no final encode.
     NaiveGamma,
+}
+
+/// `--integrator` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum IntegratorArg {
+    /// Whitted ray tracing: shadow rays, mirror and refraction branches, ambient.
+    Whitted,
+    /// Path tracing: area lights, indirect light, caustics (CPU reference only).
+    Path,
+}
+
+impl From<IntegratorArg> for Integrator {
+    fn from(arg: IntegratorArg) -> Self {
+        match arg {
+            IntegratorArg::Whitted => Integrator::Whitted,
+            IntegratorArg::Path => Integrator::Path,
+        }
+    }
 }
 
 impl From<LightingArg> for LightingSpace {

@@ -459,6 +459,7 @@ pub fn minimal_settings() -> RenderSettings {
         stack_size: 1,
         lighting_space: LightingSpace::Linear,
         min_ray_weight: 0.0,
+        integrator: gpu_render::scene::Integrator::Whitted,
     }
 }
 

@@ -103,6 +103,7 @@ mod tests {
             stack_size: 6,
             lighting_space: LightingSpace::Linear,
             min_ray_weight: 0.0,
+            integrator: gpu_render::scene::Integrator::Whitted,
         };
         let summary = Summary {
             settings: &settings,

@@ -112,10 +112,17 @@ impl Item<'_> {
         given: &[&str],
     ) -> Result<(), SceneError> {
         match given.iter().find(|field| !allowed.contains(field)) {
-            Some(field) => Err(self.fail(format_args!(
-                "a {kind} has no field `{field}` (it takes: {})",
-                allowed.join(", ")
-            ))),
+            Some(field) => {
+                let article = if kind.starts_with(['a', 'e', 'i', 'o', 'u']) {
+                    "an"
+                } else {
+                    "a"
+                };
+                Err(self.fail(format_args!(
+                    "{article} {kind} has no field `{field}` (it takes: {})",
+                    allowed.join(", ")
+                )))
+            }
             None => Ok(()),
         }
     }

@@ -69,6 +69,15 @@ pub struct RawRender {
     pub stack_size: Option<u32>,
     pub lighting: Option<RawLighting>,
     pub min_ray_weight: Option<f64>,
+    pub integrator: Option<RawIntegrator>,
+}
+
+/// `render.integrator`.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RawIntegrator {
+    Whitted,
+    Path,
 }
 
 /// `render.lighting`.

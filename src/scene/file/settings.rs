@@ -4,8 +4,8 @@ use glam::DVec3;
 use toml::Spanned;
 
 use super::check::{ColourRange, Source};
-use super::raw::{RawCamera, RawEnvironment, RawLighting, RawRender};
-use crate::scene::{Camera, Environment, LightingSpace, RenderSettings, SceneError};
+use super::raw::{RawCamera, RawEnvironment, RawIntegrator, RawLighting, RawRender};
+use crate::scene::{Camera, Environment, Integrator, LightingSpace, RenderSettings, SceneError};
 
 /// Default image width in pixels.
 const DEFAULT_WIDTH: u32 = 640;
@@ -39,6 +39,10 @@ pub fn render(
             Some(RawLighting::NaiveGamma) => LightingSpace::NaiveGamma,
         },
         min_ray_weight: raw.min_ray_weight.unwrap_or(0.0),
+        integrator: match raw.integrator {
+            None | Some(RawIntegrator::Whitted) => Integrator::Whitted,
+            Some(RawIntegrator::Path) => Integrator::Path,
+        },
     };
     let item = source.item("render".into(), span);
     settings.check().map_err(|message| item.fail(message))?;

@@ -29,6 +29,7 @@ fn defaults_are_applied() {
             stack_size: 6,
             lighting_space: LightingSpace::Linear,
             min_ray_weight: 0.0,
+            integrator: crate::scene::Integrator::Whitted,
         }
     );
     assert_eq!(scene.camera.up, DVec3::Y);

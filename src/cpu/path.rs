@@ -1,0 +1,538 @@
+//! The path-tracing integrator (`integrator = "path"`) of the CPU reference: unbiased
+//! Monte Carlo estimation of the rendering equation over the same scenes, materials
+//! and numerics as the Whitted tracer of `trace.rs` (docs/path-tracing.md).
+//!
+//! At each hit a path picks one of the material's events (its base BRDF, the perfect
+//! mirror or coat reflection, the refraction) with probability in proportion to its
+//! weight. For the base BRDF it gathers direct light by next-event estimation: every
+//! point and directional light with a shadow ray, and one emissive shape chosen by
+//! power and sampled (spheres by the cone they subtend, polygons and triangles by area),
+//! combined with the BRDF-sampled hits of emitters by multiple importance sampling
+//! (the power heuristic; Veach's thesis, 1997, ch. 9). Then it continues in a
+//! direction drawn from the BRDF's importance sampler (`sample.rs`), and Russian
+//! roulette ends it in proportion to its throughput after [`ROULETTE_DEPTH`] bounces.
+//! Random numbers come from the counter-based generator [`random_number`] of the
+//! pixel, the sample and the dimension, so the GPU twin can draw the same ones.
+
+use glam::{DVec2, DVec3};
+
+use super::bxdf::{
+    eval_brdf, has_base_brdf, microfacet_alpha, reflect_direction, surface_response,
+};
+use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
+use super::sample::{
+    ShadingFrame, area_to_solid_angle_pdf, pdf_beckmann_normal, pdf_blinn_phong_half,
+    pdf_cosine_hemisphere, pdf_ggx_visible_normal, pdf_sphere_cone, power_heuristic, random_number,
+    reflect_about, reflected_pdf, sample_beckmann_normal, sample_blinn_phong_half,
+    sample_cosine_hemisphere, sample_ggx_visible_normal, sample_sphere_cone,
+    sample_triangle_barycentrics,
+};
+use super::texture::shading_albedo;
+use super::trace::{
+    PreparedScene, direct_light, finite_radiance, keep_on_side, shading_frame_normal,
+};
+use super::traverse::intersect_scene;
+use crate::accel::{PrimKind, PrimRef, SceneGeometry};
+use crate::scene::{Material, MaterialKind, MediumStack, MicrofacetDistribution, project_to_plane};
+
+/// Bounces after which Russian roulette may end a path.
+pub const ROULETTE_DEPTH: u32 = 3;
+
+/// The least survival probability of Russian roulette: paths of tiny throughput
+/// still survive sometimes, so that the estimate stays unbiased and bounded.
+pub const MIN_SURVIVAL: f64 = 0.05;
+
+/// Random dimensions a path uses per bounce: the event (0), the BRDF lobe (1), the
+/// BRDF direction (2, 3), the emitter (4), the point on it (5, 6) and roulette (7).
+/// Dimensions 0 and 1 of a pixel's sample are its position in the pixel.
+const DIMENSIONS_PER_BOUNCE: u32 = 8;
+
+/// Relative luminance of a linear Rec. 709 colour (ITU-R BT.709 weights).
+pub fn luminance(c: DVec3) -> f64 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+/// An emissive shape that next-event estimation samples.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum EmitterShape {
+    /// A sphere, sampled by the cone of directions it subtends.
+    Sphere { center: DVec3, radius: f64 },
+    /// A triangle (of a triangle, a mesh or a polygon), sampled uniformly by area; it
+    /// emits on the side its unit `normal` points to.
+    Triangle { vertices: [DVec3; 3], normal: DVec3 },
+}
+
+/// One emitter: its shape, the primitive a ray hits on it, and its radiance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Emitter {
+    shape: EmitterShape,
+    prim: PrimRef,
+    radiance: DVec3,
+}
+
+/// The emissive spheres, polygons and triangles of a scene and the distribution by
+/// which next-event estimation picks one: in proportion to luminance times area (its
+/// power, up to π), so that every point of the flat emitters has the same density per
+/// unit area. Infinite planes are never sampled: their emission is found by BRDF
+/// sampling alone.
+#[derive(Debug, Clone, Default)]
+pub struct AreaLights {
+    emitters: Vec<Emitter>,
+    /// The first emitter of each primitive.
+    first_of: std::collections::HashMap<PrimRef, usize>,
+    /// Cumulative selection weights.
+    cdf: Vec<f64>,
+    total: f64,
+}
+
+impl AreaLights {
+    /// The emitters of `geometry` with `materials` (in the lighting space).
+    pub fn new(geometry: &SceneGeometry, materials: &[Material]) -> Self {
+        let mut lights = Self::default();
+        let emission = |material: u32| materials[material as usize].emission;
+        for (i, s) in geometry.spheres.iter().enumerate() {
+            let radiance = emission(s.material);
+            if radiance.max_element() > 0.0 {
+                let area = 4.0 * std::f64::consts::PI * s.radius * s.radius;
+                lights.push(
+                    Emitter {
+                        shape: EmitterShape::Sphere {
+                            center: s.center,
+                            radius: s.radius,
+                        },
+                        prim: PrimRef::new(PrimKind::Sphere, i as u32),
+                        radiance,
+                    },
+                    area,
+                );
+            }
+        }
+        for (i, p) in geometry.polygons.iter().enumerate() {
+            let radiance = emission(p.material);
+            if radiance.max_element() <= 0.0 || p.plane.normal == DVec3::ZERO {
+                continue;
+            }
+            let prim = PrimRef::new(PrimKind::Polygon, i as u32);
+            for vertices in polygon_triangles(&p.vertices, p.plane.dropped_axis) {
+                lights.push_triangle(vertices, p.plane.normal, prim, radiance);
+            }
+        }
+        for (i, t) in geometry.triangles.iter().enumerate() {
+            let radiance = emission(t.material);
+            if radiance.max_element() <= 0.0 {
+                continue;
+            }
+            let [a, b, c] = t.vertices;
+            let normal = (b - a).cross(c - a).normalize_or_zero();
+            if normal != DVec3::ZERO {
+                let prim = PrimRef::new(PrimKind::Triangle, i as u32);
+                lights.push_triangle(t.vertices, normal, prim, radiance);
+            }
+        }
+        lights
+    }
+
+    fn push_triangle(
+        &mut self,
+        vertices: [DVec3; 3],
+        normal: DVec3,
+        prim: PrimRef,
+        radiance: DVec3,
+    ) {
+        let [a, b, c] = vertices;
+        let area = 0.5 * (b - a).cross(c - a).length();
+        if area > 0.0 {
+            self.push(
+                Emitter {
+                    shape: EmitterShape::Triangle { vertices, normal },
+                    prim,
+                    radiance,
+                },
+                area,
+            );
+        }
+    }
+
+    fn push(&mut self, emitter: Emitter, area: f64) {
+        let weight = luminance(emitter.radiance).max(1e-12 * emitter.radiance.max_element()) * area;
+        if !(weight > 0.0 && weight.is_finite()) {
+            return;
+        }
+        self.total += weight;
+        self.cdf.push(self.total);
+        self.first_of
+            .entry(emitter.prim)
+            .or_insert(self.emitters.len());
+        self.emitters.push(emitter);
+    }
+
+    /// Whether the scene has any emitter to sample.
+    pub fn is_empty(&self) -> bool {
+        self.emitters.is_empty()
+    }
+
+    /// The emitter chosen by `u ∈ [0, 1)` and its selection probability.
+    fn choose(&self, u: f64) -> Option<(&Emitter, f64)> {
+        let target = u * self.total;
+        let index = self
+            .cdf
+            .partition_point(|&c| c <= target)
+            .min(self.emitters.len().checked_sub(1)?);
+        let below = if index == 0 { 0.0 } else { self.cdf[index - 1] };
+        Some((
+            &self.emitters[index],
+            (self.cdf[index] - below) / self.total,
+        ))
+    }
+
+    /// The density per steradian with which next-event estimation from `point` samples
+    /// the direction towards `hit` on an emitter (0 if `hit` is on no sampled emitter).
+    fn pdf(&self, point: DVec3, hit: &Hit) -> f64 {
+        // Every flat emitter piece of a primitive has the density luminance / total per
+        // unit area; a sphere has its cone density times its selection probability.
+        let Some(&index) = self.first_of.get(&hit.prim) else {
+            return 0.0;
+        };
+        let below = if index == 0 { 0.0 } else { self.cdf[index - 1] };
+        let selection = (self.cdf[index] - below) / self.total;
+        match self.emitters[index].shape {
+            EmitterShape::Sphere { center, radius } => {
+                let w = (hit.position - point).normalize_or_zero();
+                selection * pdf_sphere_cone(point, center, radius, w)
+            }
+            EmitterShape::Triangle { vertices, normal } => {
+                let [a, b, c] = vertices;
+                let area = 0.5 * (b - a).cross(c - a).length();
+                area_to_solid_angle_pdf(selection / area, point, hit.position, normal)
+            }
+        }
+    }
+}
+
+/// The triangles of a polygon of at most `MAX_POLYGON_VERTICES` vertices (earcut in
+/// the projection dropping `dropped_axis`), for sampling it by area.
+fn polygon_triangles(vertices: &[DVec3], dropped_axis: u32) -> Vec<[DVec3; 3]> {
+    let projected: Vec<[f64; 2]> = vertices
+        .iter()
+        .map(|v| {
+            let (u, w) = project_to_plane(*v, dropped_axis);
+            [u, w]
+        })
+        .collect();
+    let mut indices: Vec<u32> = Vec::new();
+    earcut::Earcut::new().earcut(projected.iter().copied(), &[] as &[u32], &mut indices);
+    indices
+        .chunks_exact(3)
+        .map(|c| c.iter().map(|&i| vertices[i as usize]).collect::<Vec<_>>())
+        .map(|t| [t[0], t[1], t[2]])
+        .collect()
+}
+
+/// Whether emission of the shape hit is seen from the side the ray arrives on: flat
+/// shapes (polygons, triangles, planes) emit on the side of their normal, spheres on
+/// both (outside and, for a camera inside, inside).
+fn emits_towards(hit: &Hit, direction: DVec3) -> bool {
+    hit.prim.kind() == PrimKind::Sphere || direction.dot(hit.normal) < 0.0
+}
+
+/// The base BRDF's importance sampler: the lobes of `material` mixed in proportion to
+/// their weights. Returns the probability of the specular lobe.
+fn specular_lobe_probability(material: &Material) -> f64 {
+    match material.kind {
+        MaterialKind::BlinnPhong => {
+            let (d, s) = (luminance(material.diffuse), luminance(material.specular));
+            if d + s > 0.0 { s / (d + s) } else { 0.0 }
+        }
+        MaterialKind::CookTorrance => {
+            if material.diffuse.max_element() > 0.0 {
+                0.5
+            } else {
+                1.0
+            }
+        }
+        MaterialKind::Pbr => 0.5 + 0.5 * material.metallic,
+        _ => 0.0,
+    }
+}
+
+/// A half vector of `material`'s specular lobe in the local frame (`wo` local).
+fn sample_half_vector(material: &Material, wo: DVec3, u: DVec2) -> DVec3 {
+    let alpha = microfacet_alpha(material.roughness);
+    match material.kind {
+        MaterialKind::BlinnPhong => sample_blinn_phong_half(material.shininess, u),
+        MaterialKind::CookTorrance if material.distribution == MicrofacetDistribution::Beckmann => {
+            sample_beckmann_normal(alpha, u)
+        }
+        _ => sample_ggx_visible_normal(wo, alpha, u),
+    }
+}
+
+/// The density of [`sample_half_vector`] at `h`.
+fn pdf_half_vector(material: &Material, wo: DVec3, h: DVec3) -> f64 {
+    let alpha = microfacet_alpha(material.roughness);
+    match material.kind {
+        MaterialKind::BlinnPhong => pdf_blinn_phong_half(h, material.shininess),
+        MaterialKind::CookTorrance if material.distribution == MicrofacetDistribution::Beckmann => {
+            pdf_beckmann_normal(h, alpha)
+        }
+        _ => pdf_ggx_visible_normal(wo, h, alpha),
+    }
+}
+
+/// A direction for the base BRDF of `material` at a point with shading normal `n`,
+/// seen from `wo` (world), from the uniform numbers `u_lobe` and `u`.
+fn sample_brdf(material: &Material, n: DVec3, wo: DVec3, u_lobe: f64, u: DVec2) -> DVec3 {
+    let frame = ShadingFrame::new(n);
+    let wo_local = frame.to_local(wo);
+    let local = if u_lobe < specular_lobe_probability(material) {
+        reflect_about(wo_local, sample_half_vector(material, wo_local, u))
+    } else {
+        sample_cosine_hemisphere(u)
+    };
+    frame.to_world(local)
+}
+
+/// The density per steradian of [`sample_brdf`] producing `wi`.
+fn pdf_brdf(material: &Material, n: DVec3, wo: DVec3, wi: DVec3) -> f64 {
+    let frame = ShadingFrame::new(n);
+    let (wo_local, wi_local) = (frame.to_local(wo), frame.to_local(wi));
+    let p_specular = specular_lobe_probability(material);
+    let mut pdf = (1.0 - p_specular) * pdf_cosine_hemisphere(wi_local);
+    if p_specular > 0.0 {
+        let h = (wo_local + wi_local).normalize_or_zero();
+        if h.z > 0.0 {
+            pdf +=
+                p_specular * reflected_pdf(pdf_half_vector(material, wo_local, h), wo_local.dot(h));
+        }
+    }
+    pdf
+}
+
+/// Radiance along `primary` for sample `sample` of pixel `pixel`, by path tracing.
+/// Returns it and the number of rays traced.
+pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u32) -> (DVec3, u64) {
+    let geometry = &scene.geometry;
+    let max_depth = scene.settings.max_depth;
+    let mut radiance = DVec3::ZERO;
+    let mut rays = 0u64;
+    let mut throughput = DVec3::ONE;
+    let mut ray = primary;
+    let mut medium: MediumStack = scene.camera_medium;
+    // The density of the BRDF sample that made `ray`, for MIS at an emitter it hits;
+    // None after a camera ray or a perfectly specular event.
+    let mut brdf_pdf: Option<f64> = None;
+    let mut previous_point = ray.origin;
+    let mut depth = 0u32;
+    loop {
+        let first_dimension = 2 + depth * DIMENSIONS_PER_BOUNCE;
+        let random = move |k: u32| random_number(pixel, sample, first_dimension + k);
+        rays += 1;
+        let Some(hit) = intersect_scene(geometry, &ray, f64::INFINITY) else {
+            add(&mut radiance, throughput * scene.background);
+            break;
+        };
+        let mut material = scene.materials[hit.material as usize];
+        material.diffuse =
+            shading_albedo(&material, &scene.images, hit.position, hit.normal, hit.uv);
+        // Emission, weighted against next-event estimation where that could have
+        // found it.
+        if material.emission.max_element() > 0.0 && emits_towards(&hit, ray.direction) {
+            let weight = match brdf_pdf {
+                Some(pdf) => power_heuristic(pdf, scene.area_lights.pdf(previous_point, &hit)),
+                None => 1.0,
+            };
+            add(&mut radiance, throughput * material.emission * weight);
+        }
+        let entering = ray.direction.dot(hit.normal) < 0.0;
+        let ng = if entering { hit.normal } else { -hit.normal };
+        let ns = if entering {
+            hit.shading_normal
+        } else {
+            -hit.shading_normal
+        };
+        let n = shading_frame_normal(ray.direction, ng, ns);
+        let wo = -ray.direction;
+        let outside_ior = medium.medium_outside_ior(entering);
+        let response = surface_response(&material, ray.direction, n, entering, outside_ior);
+        // The events and their weights.
+        let base = if has_base_brdf(material.kind) {
+            response.base
+        } else {
+            0.0
+        };
+        let weights = [
+            base,
+            luminance(response.reflect),
+            luminance(response.transmit),
+        ];
+        let total: f64 = weights.iter().sum();
+        // Also ends a path whose weights are NaN.
+        if total.is_nan() || total <= 0.0 {
+            break;
+        }
+        let u_event = random(0) * total;
+        let continues = depth < max_depth;
+        if u_event < weights[0] {
+            let p_event = weights[0] / total;
+            let event_weight = throughput * (response.base / p_event);
+            let lifted = shadow_terminator_point(geometry, &hit, ng);
+            let shadow_origin = offset_ray_origin(lifted, ng, geometry.offset_scale);
+            // Point and directional lights: one shadow ray each (delta lights, no MIS).
+            for light in &scene.lights {
+                let (lit, traced) = direct_light(scene, light, &material, shadow_origin, n, wo);
+                rays += traced;
+                add(&mut radiance, event_weight * lit);
+            }
+            // One emitter, chosen by power.
+            if let Some((emitter, selection)) = scene.area_lights.choose(random(4)) {
+                let (lit, traced) = sample_emitter(
+                    scene,
+                    emitter,
+                    selection,
+                    &material,
+                    shadow_origin,
+                    n,
+                    wo,
+                    DVec2::new(random(5), random(6)),
+                    continues,
+                );
+                rays += traced;
+                add(&mut radiance, event_weight * lit);
+            }
+            if !continues {
+                break;
+            }
+            let wi = sample_brdf(
+                &material,
+                n,
+                wo,
+                random(1),
+                DVec2::new(random(2), random(3)),
+            );
+            let pdf = pdf_brdf(&material, n, wo, wi);
+            let cos_i = n.dot(wi);
+            if pdf.is_nan() || pdf <= 0.0 || cos_i <= 0.0 || ng.dot(wi) <= 0.0 {
+                break;
+            }
+            let f = eval_brdf(&material, &scene.images, n, wi, wo);
+            throughput = event_weight * f * (cos_i / pdf);
+            brdf_pdf = Some(pdf);
+            // Where next-event estimation sampled from, so that both strategies' MIS
+            // weights use the same densities.
+            previous_point = shadow_origin;
+            ray = Ray {
+                origin: offset_ray_origin(hit.position, ng, geometry.offset_scale),
+                direction: wi,
+            };
+        } else {
+            if !continues {
+                break;
+            }
+            let reflect = u_event < weights[0] + weights[1];
+            let (weight, direction, side) = if reflect {
+                let direction = reflect_direction(ray.direction, n).normalize();
+                (response.reflect / (weights[1] / total), direction, ng)
+            } else {
+                medium = medium.medium_after_refraction(entering, material.ior);
+                (
+                    response.transmit / (weights[2] / total),
+                    response.transmit_direction,
+                    -ng,
+                )
+            };
+            let direction = if n == ng {
+                direction
+            } else {
+                keep_on_side(direction, side)
+            };
+            throughput *= weight;
+            brdf_pdf = None;
+            previous_point = hit.position;
+            ray = Ray {
+                origin: offset_ray_origin(hit.position, side, geometry.offset_scale),
+                direction,
+            };
+        }
+        depth += 1;
+        // Russian roulette on the throughput's largest channel.
+        if depth >= ROULETTE_DEPTH {
+            let survival = throughput.max_element().clamp(MIN_SURVIVAL, 1.0);
+            if random(7) >= survival {
+                break;
+            }
+            throughput /= survival;
+        }
+        if !finite_radiance(throughput) {
+            break;
+        }
+    }
+    (radiance, rays)
+}
+
+/// Adds a contribution to `radiance` when it is finite (as the Whitted tracer does).
+fn add(radiance: &mut DVec3, contribution: DVec3) {
+    if finite_radiance(contribution) {
+        *radiance += contribution;
+    }
+}
+
+/// Next-event estimation of one emitter (chosen with probability `selection`) from
+/// `origin`: a sample on it, `f · L · cos θ / pdf` if nothing blocks it, weighted by
+/// the power heuristic against the BRDF's sampler when `mis` (the path goes on, so
+/// that a BRDF sample could find the same light). Returns it and the rays traced.
+#[allow(clippy::too_many_arguments)]
+fn sample_emitter(
+    scene: &PreparedScene,
+    emitter: &Emitter,
+    selection: f64,
+    material: &Material,
+    origin: DVec3,
+    n: DVec3,
+    wo: DVec3,
+    u: DVec2,
+    mis: bool,
+) -> (DVec3, u64) {
+    let (wi, pdf) = match emitter.shape {
+        EmitterShape::Sphere { center, radius } => {
+            match sample_sphere_cone(origin, center, radius, u) {
+                Some((wi, pdf)) => (wi, pdf * selection),
+                None => return (DVec3::ZERO, 0),
+            }
+        }
+        EmitterShape::Triangle { vertices, normal } => {
+            let b = sample_triangle_barycentrics(u);
+            let point = vertices[0] * b.x + vertices[1] * b.y + vertices[2] * b.z;
+            let to_light = point - origin;
+            if to_light.dot(normal) >= 0.0 {
+                // The back of a one-sided emitter.
+                return (DVec3::ZERO, 0);
+            }
+            let [a, bv, c] = vertices;
+            let area = 0.5 * (bv - a).cross(c - a).length();
+            let pdf = area_to_solid_angle_pdf(selection / area, origin, point, normal);
+            (to_light.normalize_or_zero(), pdf)
+        }
+    };
+    let cos_i = n.dot(wi);
+    if pdf.is_nan() || pdf <= 0.0 || cos_i <= 0.0 || wi == DVec3::ZERO {
+        return (DVec3::ZERO, 0);
+    }
+    let shadow = Ray {
+        origin,
+        direction: wi,
+    };
+    // Visible when the first thing the ray meets is the emitter itself, on its
+    // emitting side.
+    let visible = intersect_scene(&scene.geometry, &shadow, f64::INFINITY)
+        .is_some_and(|hit| hit.prim == emitter.prim && emits_towards(&hit, wi));
+    if !visible {
+        return (DVec3::ZERO, 1);
+    }
+    let f = eval_brdf(material, &scene.images, n, wi, wo);
+    let weight = if mis {
+        power_heuristic(pdf, pdf_brdf(material, n, wo, wi))
+    } else {
+        1.0
+    };
+    (f * emitter.radiance * (cos_i * weight / pdf), 1)
+}
