@@ -325,7 +325,7 @@ impl GpuRenderer {
         let pipelines = self.trace_pipelines(device, &prepared.features)?;
         let slot_count =
             SlotBuffers::slot_count(device, self.slot_count, pixels, prepared.stack_size);
-        let slots = SlotBuffers::new(device, slot_count, prepared.stack_size)?;
+        let slots = SlotBuffers::new(device, slot_count, prepared.stack_size, 0)?;
         let bind_group = slots.bind_group(
             device,
             &self.pipelines.trace_bind_group_layout,
