@@ -15,6 +15,7 @@ use std::sync::Mutex;
 
 use common::compare::{Tolerance, assert_images_match};
 use gpu_render::film::LinearImage;
+use gpu_render::gpu::layout::FrameUniforms;
 use gpu_render::gpu::{
     BufferWrites, Film, GpuScene, HeadlessGpu, RenderError, Renderer, RendererOptions,
 };
@@ -313,11 +314,12 @@ fn a_camera_move_uploads_only_the_trace_constants_and_equals_a_fresh_upload() {
         .writes
         .into_inner()
         .unwrap_or_else(std::sync::PoisonError::into_inner);
-    // One pass: one write of the 160-byte trace constants into a uniform buffer, and
+    // One pass: one write of the 192-byte trace constants into a uniform buffer, and
     // nothing into any storage buffer (the scene's buffers are all storage buffers).
     assert_eq!(writes.len(), 1, "writes after the camera move: {writes:?}");
     let (buffer, offset, bytes) = &writes[0];
-    assert_eq!((*offset, *bytes), (0, 160));
+    assert_eq!((*offset, *bytes), (0, size_of::<FrameUniforms>()));
+    assert_eq!(size_of::<FrameUniforms>(), 192);
     assert!(buffer.usage().contains(wgpu::BufferUsages::UNIFORM));
     assert!(!buffer.usage().contains(wgpu::BufferUsages::STORAGE));
     assert_eq!(film.passes(), 1);

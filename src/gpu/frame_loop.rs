@@ -206,7 +206,7 @@ impl Renderer {
     }
 
     /// Moves `scene`'s camera. Writes nothing to the device: the next trace pass of
-    /// each film writes the camera with the pass's other constants (one 160-byte
+    /// each film writes the camera with the pass's other constants (one 192-byte
     /// uniform record), and a film accumulating the old camera restarts at sample 0 in
     /// its next [`Renderer::encode_samples`]. No scene buffer is touched.
     ///
@@ -258,7 +258,7 @@ impl Renderer {
     /// host has seen it complete, calls record more rounds of it and queue their
     /// samples for the next pass ([`Film::samples`], [`Film::requested_samples`]).
     /// `samples = 0` only moves the pass in progress on. The only write through
-    /// `queue` is the film's 160-byte trace constants when a pass starts. Every
+    /// `queue` is the film's 192-byte trace constants when a pass starts. Every
     /// encoder given here must be submitted, in order.
     ///
     /// A film whose scene or camera changed since its last samples restarts at

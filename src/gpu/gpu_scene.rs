@@ -22,7 +22,7 @@ static NEXT_SCENE_ID: AtomicU64 = AtomicU64::new(1);
 ///
 /// The camera is not in any GPU buffer of the scene: [`super::Renderer::set_camera`]
 /// changes it on the host, and the next trace pass of each film writes it with the
-/// pass's other constants (one [`FrameUniforms`] record, 160 bytes).
+/// pass's other constants (one [`FrameUniforms`] record, 192 bytes).
 #[derive(Debug)]
 pub struct GpuScene {
     pub(crate) id: u64,
