@@ -151,7 +151,12 @@ fn progressive(
     wait_between: bool,
 ) -> (Film, LinearImage) {
     let mut film = renderer
-        .create_film(&gpu.device, gpu_scene, gpu_scene.width(), gpu_scene.height())
+        .create_film(
+            &gpu.device,
+            gpu_scene,
+            gpu_scene.width(),
+            gpu_scene.height(),
+        )
         .unwrap_or_else(|e| panic!("create_film: {e}"));
     for &n in splits {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
@@ -265,7 +270,12 @@ fn a_camera_move_uploads_only_the_trace_constants_and_equals_a_fresh_upload() {
         .upload(&gpu.device, &gpu.queue, &scene)
         .unwrap_or_else(|e| panic!("upload: {e}"));
     let mut film = renderer
-        .create_film(&gpu.device, &gpu_scene, gpu_scene.width(), gpu_scene.height())
+        .create_film(
+            &gpu.device,
+            &gpu_scene,
+            gpu_scene.width(),
+            gpu_scene.height(),
+        )
         .unwrap_or_else(|e| panic!("create_film: {e}"));
     let before = renderer
         .render_to_image(&gpu.device, &gpu.queue, &gpu_scene, &mut film)
@@ -436,7 +446,12 @@ fn draw_applies_the_scenes_srgb_rule_once_on_any_attachment() {
                 .upload(&gpu.device, &gpu.queue, &scene)
                 .unwrap_or_else(|e| panic!("upload: {e}"));
             let mut film = renderer
-                .create_film(&gpu.device, &gpu_scene, gpu_scene.width(), gpu_scene.height())
+                .create_film(
+                    &gpu.device,
+                    &gpu_scene,
+                    gpu_scene.width(),
+                    gpu_scene.height(),
+                )
                 .unwrap_or_else(|e| panic!("create_film: {e}"));
             let shown = renderer
                 .render_to_image(&gpu.device, &gpu.queue, &gpu_scene, &mut film)

@@ -16,12 +16,12 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 
-use super::{RenderError, Renderer};
 use super::gpu_scene::GpuScene;
 use super::layout::GpuCounters;
 use super::limits::{check_binding_bytes, check_film_size};
 use super::pipelines::LINEAR_FORMAT;
 use super::wavefront::{SlotBuffers, check_errors};
+use super::{RenderError, Renderer};
 
 /// Readback buffers a film keeps in flight at most; past that, a call records no
 /// counter copy (a later one will).
@@ -253,12 +253,8 @@ impl Film {
     /// Errors: [`RenderError::TraceIncomplete`] if the kernels flagged an error (the
     /// pass is dropped and the film reset).
     pub fn collect_progress(&mut self) -> Result<(), RenderError> {
-        let reports: Vec<Report> = std::mem::take(
-            &mut *self
-                .reports
-                .lock()
-                .unwrap_or_else(PoisonError::into_inner),
-        );
+        let reports: Vec<Report> =
+            std::mem::take(&mut *self.reports.lock().unwrap_or_else(PoisonError::into_inner));
         let pixels = u64::from(self.width) * u64::from(self.height);
         for report in reports {
             let Some(pass) = self.pass else { break };

@@ -52,9 +52,9 @@ pub use features::ShaderFeatures;
 pub use film::Film;
 pub use frame_loop::{BufferWrites, FilmImage, Renderer, RendererOptions};
 pub use gpu_scene::GpuScene;
-pub use render_error::RenderError;
 pub use pipelines::{DISPLAY_FORMAT, LINEAR_FORMAT, TRACE_STORAGE_BUFFERS, TracePipelines};
 pub use readback::read_texture;
+pub use render_error::RenderError;
 pub use renderer::{GpuRendered, GpuRenderer, TraceRegion, image_tiles};
 pub use scene_buffers::PreparedScene;
 pub use wavefront::{

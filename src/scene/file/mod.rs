@@ -22,8 +22,8 @@ use self::check::Source;
 pub use self::materials::CONDUCTOR_PRESETS;
 use self::objects::MaterialTable;
 pub use self::paths::confined_path;
-pub(crate) use self::settings::view_problem;
 use self::raw::RawScene;
+pub(crate) use self::settings::view_problem;
 use super::image::not_a_regular_file;
 use super::{CameraPath, Scene, SceneError, SceneWarning};
 
