@@ -1,0 +1,126 @@
+//! The cost of a camera move in the frame loop (`Renderer::set_camera`, then the next
+//! `encode_samples`, which starts a pass and writes its trace constants) against a
+//! full re-upload of the scene with the new camera (what moving the camera cost
+//! before: `GpuRenderer::prepare` builds the geometry and BVH and uploads every buffer
+//! and image), in alternating runs, medians printed. Bytes are counted as written:
+//! the frame loop's through a `BufferWrites` wrapper, the re-upload's as the scene's
+//! buffer and image bytes.
+//!
+//! ```sh
+//! cargo run --release --example embed_bench -- scenes/showcase.toml --runs 15
+//! ```
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use gpu_render::gpu::{
+    AdapterChoice, BufferWrites, GpuRenderer, HeadlessGpu, Renderer, RendererOptions,
+};
+use gpu_render::scene::{Camera, load_scene};
+
+/// Counts the bytes written through it and forwards them.
+struct CountingQueue<'a> {
+    queue: &'a wgpu::Queue,
+    bytes: AtomicU64,
+}
+
+impl BufferWrites for CountingQueue<'_> {
+    fn write_buffer(&self, buffer: &wgpu::Buffer, offset: u64, data: &[u8]) {
+        self.bytes.fetch_add(data.len() as u64, Ordering::Relaxed);
+        self.queue.write_buffer(buffer, offset, data);
+    }
+}
+
+fn median(mut values: Vec<Duration>) -> Duration {
+    values.sort();
+    values[values.len() / 2]
+}
+
+/// Blocks until the queue is idle.
+fn wait_idle(gpu: &HeadlessGpu) -> Result<()> {
+    gpu.device.poll(wgpu::PollType::Wait {
+        submission_index: None,
+        timeout: None,
+    })?;
+    Ok(())
+}
+
+fn main() -> Result<()> {
+    let mut args = std::env::args().skip(1);
+    let path = args.next().unwrap_or_else(|| "scenes/showcase.toml".into());
+    let mut runs = 15usize;
+    while let Some(arg) = args.next() {
+        if arg == "--runs" {
+            runs = args.next().context("--runs N")?.parse()?;
+        }
+    }
+    let scene = load_scene(path.as_ref())?;
+    let gpu = HeadlessGpu::new(&AdapterChoice::Default)?;
+    let renderer = Renderer::new(&gpu.device, RendererOptions::default())?;
+    let old = GpuRenderer::new(&gpu.device)?;
+    let mut gpu_scene = renderer.upload(&gpu.device, &gpu.queue, &scene)?;
+    // A small film: only the pass start's host cost and bytes are measured, not the
+    // tracing.
+    let mut film = renderer.create_film(&gpu.device, &gpu_scene, 64, 36)?;
+    let counting = CountingQueue {
+        queue: &gpu.queue,
+        bytes: AtomicU64::new(0),
+    };
+    let camera_at = |i: usize| Camera {
+        eye: scene.camera.eye + glam::DVec3::new(0.01 * (i % 7) as f64, 0.0, 0.0),
+        ..scene.camera
+    };
+
+    let (mut set_camera, mut frame_loop, mut reupload) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut frame_loop_bytes, mut reupload_bytes) = (0, 0);
+    for run in 0..runs {
+        // The frame loop: move the camera, record the next frame's samples, submit.
+        let moved = camera_at(run + 1);
+        counting.bytes.store(0, Ordering::Relaxed);
+        let start = Instant::now();
+        renderer.set_camera(&mut gpu_scene, &moved)?;
+        set_camera.push(start.elapsed());
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        renderer.encode_samples(
+            &gpu.device,
+            &counting,
+            &mut encoder,
+            &gpu_scene,
+            &mut film,
+            1,
+        )?;
+        gpu.queue.submit([encoder.finish()]);
+        frame_loop.push(start.elapsed());
+        frame_loop_bytes = counting.bytes.load(Ordering::Relaxed);
+        wait_idle(&gpu)?;
+
+        // The re-upload: the scene with the new camera, uploaded again, until the
+        // queue has taken every byte.
+        let moved_scene = gpu_render::scene::Scene {
+            camera: moved,
+            ..scene.clone()
+        };
+        let start = Instant::now();
+        let prepared = old.prepare(&gpu.device, &gpu.queue, &moved_scene)?;
+        gpu.queue.submit([]);
+        wait_idle(&gpu)?;
+        reupload.push(start.elapsed());
+        reupload_bytes = prepared.scene_bytes() + prepared.image_bytes();
+    }
+    let adapter = gpu.adapter_info();
+    println!("{path} on {} ({:?}), {runs} alternating runs", adapter.name, adapter.backend);
+    println!(
+        "set_camera alone:                           median {:>10.6} ms, 0 bytes written",
+        median(set_camera).as_secs_f64() * 1e3
+    );
+    println!(
+        "set_camera + next encode_samples + submit: median {:>10.3} ms, {frame_loop_bytes} bytes written",
+        median(frame_loop).as_secs_f64() * 1e3
+    );
+    println!(
+        "full re-upload (GpuRenderer::prepare):     median {:>10.3} ms, {reupload_bytes} bytes written",
+        median(reupload).as_secs_f64() * 1e3
+    );
+    Ok(())
+}
