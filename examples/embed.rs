@@ -83,7 +83,14 @@ fn main() -> Result<()> {
     while frames < gpu_scene.samples_per_pixel() || !film.is_complete() {
         let samples = u32::from(frames < gpu_scene.samples_per_pixel());
         let mut encoder = device.create_command_encoder(&Default::default());
-        renderer.encode_samples(&device, &queue, &mut encoder, &gpu_scene, &mut film, samples)?;
+        renderer.encode_samples(
+            &device,
+            &queue,
+            &mut encoder,
+            &gpu_scene,
+            &mut film,
+            samples,
+        )?;
         renderer.encode_display(&device, &mut encoder, &gpu_scene, &film, &display_view)?;
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {

@@ -109,7 +109,10 @@ fn main() -> Result<()> {
         reupload_bytes = prepared.scene_bytes() + prepared.image_bytes();
     }
     let adapter = gpu.adapter_info();
-    println!("{path} on {} ({:?}), {runs} alternating runs", adapter.name, adapter.backend);
+    println!(
+        "{path} on {} ({:?}), {runs} alternating runs",
+        adapter.name, adapter.backend
+    );
     println!(
         "set_camera alone:                           median {:>10.6} ms, 0 bytes written",
         median(set_camera).as_secs_f64() * 1e3

@@ -17,7 +17,7 @@ use common::compare::{Tolerance, assert_images_match};
 use gpu_render::film::LinearImage;
 use gpu_render::gpu::layout::FrameUniforms;
 use gpu_render::gpu::{
-    BufferWrites, Film, GpuScene, HeadlessGpu, RenderError, Renderer, RendererOptions,
+    BufferWrites, Film, GpuScene, HeadlessGpu, RenderError, Renderer, RendererOptions, Schedule,
 };
 use gpu_render::scene::{Camera, LightingSpace, RenderOverrides, Scene};
 
@@ -515,4 +515,48 @@ fn draw_applies_the_scenes_srgb_rule_once_on_any_attachment() {
         renderer.draw(&mut pass, &gpu_scene, &film),
         Err(RenderError::NoSurfaceFormat)
     ));
+}
+
+#[test]
+fn both_schedules_and_resized_films_equal_one_shot_renders() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let old = common::gpu::renderer(&gpu);
+    let scene = scene("glass.toml", 48, 4);
+    let one_shot = old
+        .render(&gpu.device, &gpu.queue, &scene, None)
+        .unwrap_or_else(|e| panic!("one-shot render: {e}"));
+    for schedule in [Schedule::Wavefront, Schedule::Fused] {
+        let renderer = renderer(
+            &gpu,
+            RendererOptions {
+                schedule: Some(schedule),
+                ..RendererOptions::default()
+            },
+        );
+        let gpu_scene = renderer
+            .upload(&gpu.device, &gpu.queue, &scene)
+            .unwrap_or_else(|e| panic!("upload: {e}"));
+        let (mut film, image) = progressive(&gpu, &renderer, &gpu_scene, &[1, 3], true);
+        assert_eq!(film.passes(), 2);
+        assert_identical(
+            &format!("frame-loop-{schedule:?}").to_lowercase(),
+            &one_shot.image,
+            &image,
+        );
+
+        // A resized film renders the image of the scene at that size.
+        let small = common::scenes::reduced(scene.clone(), 30, RenderOverrides::default());
+        film.resize(&gpu.device, &renderer, 30, small.render.height)
+            .unwrap_or_else(|e| panic!("resize: {e}"));
+        assert_eq!(film.samples(), 0);
+        let resized = renderer
+            .render_to_image(&gpu.device, &gpu.queue, &gpu_scene, &mut film)
+            .unwrap_or_else(|e| panic!("render_to_image: {e}"));
+        let expected = old
+            .render(&gpu.device, &gpu.queue, &small, None)
+            .unwrap_or_else(|e| panic!("one-shot render: {e}"));
+        assert_identical("frame-loop-resized", &expected.image, &resized.image);
+    }
 }
