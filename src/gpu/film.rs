@@ -20,11 +20,12 @@ use super::gpu_scene::GpuScene;
 use super::layout::GpuCounters;
 use super::limits::{check_binding_bytes, check_film_size};
 use super::pipelines::LINEAR_FORMAT;
+use super::readback::{Caught, capture};
 use super::wavefront::{SlotBuffers, check_errors};
 use super::{RenderError, Renderer};
 
-/// Readback buffers a film keeps in flight at most; past that, a call records no
-/// counter copy (a later one will).
+/// Readback buffers a film keeps (made with it); with all of them in flight, a call
+/// records no counter copy (a later one will).
 const MAX_READBACKS: usize = 8;
 
 /// The counters of one pass as a mapped readback found them.
@@ -42,6 +43,20 @@ struct Report {
 struct Readback {
     buffer: wgpu::Buffer,
     busy: Arc<AtomicBool>,
+}
+
+impl Readback {
+    fn new(device: &wgpu::Device) -> Self {
+        Self {
+            buffer: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("gpu-render film counters"),
+                size: size_of::<GpuCounters>() as u64,
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                mapped_at_creation: false,
+            }),
+            busy: Arc::new(AtomicBool::new(false)),
+        }
+    }
 }
 
 /// The pass in progress, as far as the host knows.
@@ -101,22 +116,24 @@ impl Film {
         check_binding_bytes(&limits, pixels * 16)?;
         let slot_count = SlotBuffers::slot_count(device, requested_slots, pixels, stack_size);
         let slots = SlotBuffers::new(device, slot_count, stack_size, pixels)?;
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("gpu-render film"),
-            size: wgpu::Extent3d {
-                width: width.max(1),
-                height: height.max(1),
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: LINEAR_FORMAT,
-            usage: wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let texture = capture(device, "film texture", Caught::Resource, || {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("gpu-render film"),
+                size: wgpu::Extent3d {
+                    width: width.max(1),
+                    height: height.max(1),
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: LINEAR_FORMAT,
+                usage: wgpu::TextureUsages::STORAGE_BINDING
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            })
+        })?;
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
         let draw_binding = draw_layout.map(|layout| {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -148,7 +165,9 @@ impl Film {
             rounds_per_sample: None,
             rays: 0,
             passes: 0,
-            readbacks: Vec::new(),
+            readbacks: capture(device, "film readbacks", Caught::Resource, || {
+                (0..MAX_READBACKS).map(|_| Readback::new(device)).collect()
+            })?,
             reports: Arc::new(Mutex::new(Vec::new())),
         })
     }
@@ -328,33 +347,16 @@ impl Film {
 
     /// Records a copy of the counters into a free readback buffer, mapped when the
     /// encoder's command buffer has run; the callback files a report. Records nothing
-    /// if [`MAX_READBACKS`] are in flight.
-    pub(crate) fn record_readback(
-        &mut self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-    ) {
+    /// if all [`MAX_READBACKS`] are in flight.
+    pub(crate) fn record_readback(&mut self, encoder: &mut wgpu::CommandEncoder) {
         let Some(pass) = self.pass else { return };
         let size = size_of::<GpuCounters>() as u64;
-        let free = self
+        let Some(index) = self
             .readbacks
             .iter()
-            .position(|r| !r.busy.load(Ordering::Acquire));
-        let index = match free {
-            Some(index) => index,
-            None if self.readbacks.len() < MAX_READBACKS => {
-                self.readbacks.push(Readback {
-                    buffer: device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("gpu-render film counters"),
-                        size,
-                        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                        mapped_at_creation: false,
-                    }),
-                    busy: Arc::new(AtomicBool::new(false)),
-                });
-                self.readbacks.len() - 1
-            }
-            None => return,
+            .position(|r| !r.busy.load(Ordering::Acquire))
+        else {
+            return;
         };
         let readback = &self.readbacks[index];
         readback.busy.store(true, Ordering::Release);

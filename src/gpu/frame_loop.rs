@@ -236,14 +236,25 @@ impl Renderer {
         width: u32,
         height: u32,
     ) -> Result<Film, RenderError> {
-        Film::new(
+        let mut film = Film::new(
             device,
             self.draw_layout(),
             self.options.slot_count,
             scene.prepared.stack_size,
             width,
             height,
-        )
+        )?;
+        let bind_group = film
+            .slots
+            .bind_group(
+                device,
+                &self.pipelines.trace_bind_group_layout,
+                &scene.prepared,
+                &film.view,
+            )
+            .map_err(RenderError::Wgpu)?;
+        film.binding = Some((scene.id, bind_group));
+        Ok(film)
     }
 
     /// Adds `samples` samples per pixel to `film`'s running mean of `scene` (sample
@@ -329,7 +340,7 @@ impl Renderer {
             );
         }
         film.add_rounds(rounds);
-        film.record_readback(device, encoder);
+        film.record_readback(encoder);
         Ok(())
     }
 
