@@ -49,10 +49,12 @@ fn wait_idle(gpu: &HeadlessGpu) -> Result<()> {
 fn main() -> Result<()> {
     let mut args = std::env::args().skip(1);
     let path = args.next().unwrap_or_else(|| "scenes/showcase.toml".into());
-    let mut runs = 15usize;
+    let (mut runs, mut frames) = (15usize, 0u32);
     while let Some(arg) = args.next() {
-        if arg == "--runs" {
-            runs = args.next().context("--runs N")?.parse()?;
+        match arg.as_str() {
+            "--runs" => runs = args.next().context("--runs N")?.parse()?,
+            "--frames" => frames = args.next().context("--frames N")?.parse()?,
+            other => anyhow::bail!("unknown argument {other}"),
         }
     }
     let scene = load_scene(path.as_ref())?;
@@ -124,6 +126,55 @@ fn main() -> Result<()> {
     println!(
         "full re-upload (GpuRenderer::prepare):     median {:>10.3} ms, {reupload_bytes} bytes written",
         median(reupload).as_secs_f64() * 1e3
+    );
+    if frames > 0 {
+        frame_loop_rate(&gpu, &renderer, &gpu_scene, frames)?;
+    }
+    Ok(())
+}
+
+/// Runs `frames` frames of the frame loop on a film of the scene's size, one sample
+/// per pixel asked per frame, each frame waited for (as a swapchain would pace it),
+/// and prints the median frame time and the samples per pixel completed per second.
+fn frame_loop_rate(
+    gpu: &HeadlessGpu,
+    renderer: &Renderer,
+    gpu_scene: &gpu_render::gpu::GpuScene,
+    frames: u32,
+) -> Result<()> {
+    let (width, height) = (gpu_scene.width(), gpu_scene.height());
+    let mut film = renderer.create_film(&gpu.device, gpu_scene, width, height)?;
+    // Warm-up: lavapipe compiles the pipeline at its first dispatch.
+    renderer.render_to_image(&gpu.device, &gpu.queue, gpu_scene, &mut film)?;
+    film.reset();
+    let mut times = Vec::new();
+    let start = Instant::now();
+    for _ in 0..frames {
+        let frame = Instant::now();
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        renderer.encode_samples(
+            &gpu.device,
+            &gpu.queue,
+            &mut encoder,
+            gpu_scene,
+            &mut film,
+            1,
+        )?;
+        gpu.queue.submit([encoder.finish()]);
+        wait_idle(gpu)?;
+        times.push(frame.elapsed());
+    }
+    let elapsed = start.elapsed();
+    film.collect_progress()?;
+    println!(
+        "frame loop at {width}x{height}, 1 sample per frame asked: median frame {:.1} ms \
+         ({:.2} frames/s), {} samples per pixel completed in {:.2} s ({:.2} spp/s, {} passes)",
+        median(times).as_secs_f64() * 1e3,
+        f64::from(frames) / elapsed.as_secs_f64(),
+        film.samples(),
+        elapsed.as_secs_f64(),
+        f64::from(film.samples()) / elapsed.as_secs_f64(),
+        film.passes()
     );
     Ok(())
 }
