@@ -401,3 +401,29 @@ fn composed_display_shader_validates() {
 fn composed_bxdf_eval_shader_validates() {
     validate("bxdf eval shader", &bxdf_eval_shader_source());
 }
+
+#[test]
+fn composed_draw_shader_validates() {
+    let source = gpu_render::gpu::shaders::draw_shader_source();
+    validate("draw shader", &source);
+    let module = naga::front::wgsl::parse_str(&source).expect("parsed above");
+    for (name, stage) in [
+        ("fullscreen_triangle", naga::ShaderStage::Vertex),
+        ("draw_film", naga::ShaderStage::Fragment),
+    ] {
+        let entry = module
+            .entry_points
+            .iter()
+            .find(|e| e.name == name)
+            .unwrap_or_else(|| panic!("entry point {name}"));
+        assert_eq!(entry.stage, stage, "{name}");
+    }
+    // The mode the host sets (src/gpu/draw.rs) is an override constant of that name.
+    assert!(
+        module
+            .overrides
+            .iter()
+            .any(|(_, o)| o.name.as_deref() == Some("DRAW_MODE")),
+        "DRAW_MODE override"
+    );
+}
