@@ -112,8 +112,8 @@ fn main() -> Result<()> {
     }
     let adapter = gpu.adapter_info();
     println!(
-        "{path} on {} ({:?}), {runs} alternating runs",
-        adapter.name, adapter.backend
+        "{path} on {} ({:?}, {}), {runs} alternating runs",
+        adapter.name, adapter.backend, adapter.driver_info
     );
     println!(
         "set_camera alone:                           median {:>10.6} ms, 0 bytes written",
