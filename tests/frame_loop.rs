@@ -560,3 +560,98 @@ fn both_schedules_and_resized_films_equal_one_shot_renders() {
         assert_identical("frame-loop-resized", &expected.image, &resized.image);
     }
 }
+
+#[test]
+fn unsuitable_targets_and_films_get_typed_errors() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let renderer = renderer(&gpu, RendererOptions::default());
+    let scene = scene("minimal.toml", 16, 1);
+    let gpu_scene = renderer
+        .upload(&gpu.device, &gpu.queue, &scene)
+        .unwrap_or_else(|e| panic!("upload: {e}"));
+    let film = renderer
+        .create_film(&gpu.device, &gpu_scene, 16, 12)
+        .unwrap_or_else(|e| panic!("create_film: {e}"));
+    let target = |format, usage, width| {
+        gpu.device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: None,
+                size: wgpu::Extent3d {
+                    width,
+                    height: 12,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+            .create_view(&Default::default())
+    };
+    use wgpu::TextureFormat as F;
+    use wgpu::TextureUsages as U;
+    let display = |view: &wgpu::TextureView| {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        renderer.encode_display(&gpu.device, &mut encoder, &gpu_scene, &film, view)
+    };
+    assert!(matches!(
+        display(&target(F::Rgba16Float, U::STORAGE_BINDING, 16)),
+        Err(RenderError::TargetFormat {
+            expected: F::Rgba8Unorm,
+            found: F::Rgba16Float
+        })
+    ));
+    assert!(matches!(
+        display(&target(F::Rgba8Unorm, U::TEXTURE_BINDING, 16)),
+        Err(RenderError::TargetUsage { .. })
+    ));
+    assert!(matches!(
+        display(&target(F::Rgba8Unorm, U::STORAGE_BINDING, 20)),
+        Err(RenderError::TargetSize {
+            film: (16, 12),
+            target: (20, 12)
+        })
+    ));
+    assert!(display(&target(F::Rgba8Unorm, U::STORAGE_BINDING, 16)).is_ok());
+
+    // A film sized past the device's textures names the limit.
+    let side = gpu.device.limits().max_texture_dimension_2d + 1;
+    assert!(matches!(
+        renderer.create_film(&gpu.device, &gpu_scene, side, 1),
+        Err(RenderError::Limit {
+            limit: "max_texture_dimension_2d",
+            ..
+        })
+    ));
+
+    // A film made for shallow bounce stacks refuses a scene with deeper ones.
+    let deep = Scene {
+        render: gpu_render::scene::RenderSettings {
+            stack_size: scene.render.stack_size + 4,
+            ..scene.render
+        },
+        ..scene.clone()
+    };
+    let deep_scene = renderer
+        .upload(&gpu.device, &gpu.queue, &deep)
+        .unwrap_or_else(|e| panic!("upload: {e}"));
+    let mut shallow = renderer
+        .create_film(&gpu.device, &gpu_scene, 16, 12)
+        .unwrap_or_else(|e| panic!("create_film: {e}"));
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    assert!(matches!(
+        renderer.encode_samples(
+            &gpu.device,
+            &gpu.queue,
+            &mut encoder,
+            &deep_scene,
+            &mut shallow,
+            1
+        ),
+        Err(RenderError::FilmStack { .. })
+    ));
+}
