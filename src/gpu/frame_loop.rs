@@ -273,7 +273,9 @@ impl Renderer {
     /// encoder given here must be submitted, in order.
     ///
     /// A film whose scene or camera changed since its last samples restarts at
-    /// sample 0.
+    /// sample 0. The film's trace bind group is made again (without an error scope)
+    /// only when the film is used with another scene than the last, or after
+    /// [`Film::resize`]; nothing else is created here.
     ///
     /// Errors: [`RenderError::FilmStack`] for a scene with deeper bounce stacks than
     /// the film's; [`RenderError::TraceIncomplete`] when an earlier pass's counters
