@@ -430,3 +430,29 @@ fn wgsl_constants_equal_their_rust_twins() {
         assert_eq!(wgsl_f32_const(trace, name), rust as f32, "{name}");
     }
 }
+
+#[test]
+fn composed_draw_shader_validates() {
+    let source = gpu_render::gpu::shaders::draw_shader_source();
+    validate("draw shader", &source);
+    let module = naga::front::wgsl::parse_str(&source).expect("parsed above");
+    for (name, stage) in [
+        ("fullscreen_triangle", naga::ShaderStage::Vertex),
+        ("draw_film", naga::ShaderStage::Fragment),
+    ] {
+        let entry = module
+            .entry_points
+            .iter()
+            .find(|e| e.name == name)
+            .unwrap_or_else(|| panic!("entry point {name}"));
+        assert_eq!(entry.stage, stage, "{name}");
+    }
+    // The mode the host sets (src/gpu/draw.rs) is an override constant of that name.
+    assert!(
+        module
+            .overrides
+            .iter()
+            .any(|(_, o)| o.name.as_deref() == Some("DRAW_MODE")),
+        "DRAW_MODE override"
+    );
+}

@@ -1,5 +1,9 @@
 //! The wgpu backend: tracing in WGSL compute shaders, driven from the host here.
 //!
+//! - The frame loop, for applications that own their device and frame
+//!   (`docs/embedding.md`): [`Renderer`] (`frame_loop`), [`GpuScene`] (`gpu_scene`),
+//!   [`Film`] (`film`), the draw pipeline (`draw`), the device [`limits`] it checks,
+//!   and its error type [`RenderError`] (`render_error`).
 //! - [`context`]: a headless instance/adapter/device/queue ([`HeadlessGpu`]) for apps
 //!   and tests that do not bring their own device.
 //! - [`renderer`]: [`GpuRenderer`], built from the caller's `Device`; a high-level
@@ -25,11 +29,17 @@
 
 pub mod context;
 mod display;
+mod draw;
 mod error;
 pub mod features;
+mod film;
+mod frame_loop;
+mod gpu_scene;
 pub mod layout;
+pub mod limits;
 mod pipelines;
 mod readback;
+mod render_error;
 pub mod renderer;
 mod scene_buffers;
 pub mod shaders;
@@ -39,8 +49,12 @@ mod wavefront;
 pub use context::{AdapterChoice, HeadlessGpu, list_adapters};
 pub use error::GpuError;
 pub use features::ShaderFeatures;
+pub use film::Film;
+pub use frame_loop::{BufferWrites, FilmImage, Renderer, RendererOptions};
+pub use gpu_scene::GpuScene;
 pub use pipelines::{DISPLAY_FORMAT, LINEAR_FORMAT, TRACE_STORAGE_BUFFERS, TracePipelines};
 pub use readback::read_texture;
+pub use render_error::RenderError;
 pub use renderer::{GpuRendered, GpuRenderer, TraceRegion, image_tiles};
 pub use scene_buffers::PreparedScene;
 pub use wavefront::{

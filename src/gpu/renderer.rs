@@ -156,15 +156,11 @@ impl GpuRenderer {
     }
 
     /// The limits a device needs for this renderer: `adapter_limits` (what the adapter
-    /// offers, so large scenes and images fit) with at least the storage buffers per
-    /// shader stage the trace kernels bind.
+    /// offers, so large scenes and images fit) raised to the minimums of
+    /// [`super::limits::required_limits`] (the storage buffers per shader stage the
+    /// trace kernels bind among them).
     pub fn required_limits(adapter_limits: &wgpu::Limits) -> wgpu::Limits {
-        wgpu::Limits {
-            max_storage_buffers_per_shader_stage: adapter_limits
-                .max_storage_buffers_per_shader_stage
-                .max(TRACE_STORAGE_BUFFERS),
-            ..adapter_limits.clone()
-        }
+        super::limits::required_limits(adapter_limits)
     }
 
     /// Bounds every wait for the GPU (one submission of trace rounds, the display
@@ -325,7 +321,7 @@ impl GpuRenderer {
         let pipelines = self.trace_pipelines(device, &prepared.features)?;
         let slot_count =
             SlotBuffers::slot_count(device, self.slot_count, pixels, prepared.stack_size);
-        let slots = SlotBuffers::new(device, slot_count, prepared.stack_size)?;
+        let slots = SlotBuffers::new(device, slot_count, prepared.stack_size, 0)?;
         let bind_group = slots.bind_group(
             device,
             &self.pipelines.trace_bind_group_layout,

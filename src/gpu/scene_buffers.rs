@@ -37,6 +37,7 @@ pub struct PreparedScene {
     pub(crate) images: wgpu::TextureView,
     bvh: BvhStats,
     scene_bytes: u64,
+    image_bytes: u64,
 }
 
 impl PreparedScene {
@@ -86,6 +87,12 @@ impl PreparedScene {
     /// materials, lights; not the images or the per-trace slots).
     pub fn scene_bytes(&self) -> u64 {
         self.scene_bytes
+    }
+
+    /// Bytes of the scene's image array on the device (albedo textures and BRDF
+    /// maps, `Rgba32Float`, at least one 1×1 layer).
+    pub fn image_bytes(&self) -> u64 {
+        self.image_bytes
     }
 }
 
@@ -163,7 +170,7 @@ pub(crate) fn upload_scene(
             bytemuck::cast_slice(&padded.triangle_attributes),
         )?,
     };
-    let images = upload_images(device, queue, &shaded, &limits)?;
+    let (images, image_bytes) = upload_images(device, queue, &shaded, &limits)?;
     Ok(PreparedScene {
         frame,
         stack_size: scene.render.stack_size,
@@ -177,17 +184,18 @@ pub(crate) fn upload_scene(
         images,
         bvh: geometry.bvh.stats,
         scene_bytes,
+        image_bytes,
     })
 }
 
 /// Uploads the scene's images as one `Rgba32Float` 2D array texture (one layer per
-/// image, see [`image_layers`]) and returns its view.
+/// image, see [`image_layers`]) and returns its view and its bytes.
 fn upload_images(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     scene: &Scene,
     limits: &wgpu::Limits,
-) -> Result<wgpu::TextureView, GpuError> {
+) -> Result<(wgpu::TextureView, u64), GpuError> {
     let (width, height, layers, texels) = image_layers(&scene.images);
     if layers > limits.max_texture_array_layers {
         return Err(GpuError::DeviceLimit {
@@ -223,8 +231,9 @@ fn upload_images(
         },
         size,
     );
-    Ok(texture.create_view(&wgpu::TextureViewDescriptor {
+    let view = texture.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2Array),
         ..Default::default()
-    }))
+    });
+    Ok((view, std::mem::size_of_val(texels.as_slice()) as u64))
 }

@@ -10,6 +10,8 @@ pub const TYPES_WGSL: &str = include_str!("../../shaders/types.wgsl");
 pub const COLOR_WGSL: &str = include_str!("../../shaders/color.wgsl");
 /// The display pass (`encode_display`).
 pub const DISPLAY_WGSL: &str = include_str!("../../shaders/display.wgsl");
+/// `shaders/draw.wgsl`: the fullscreen-triangle draw of a film into a colour attachment.
+pub const DRAW_WGSL: &str = include_str!("../../shaders/draw.wgsl");
 /// Camera rays and the sample pattern, twin of [`crate::camera`].
 pub const SAMPLING_WGSL: &str = include_str!("../../shaders/sampling.wgsl");
 /// Ray/shape intersection.
@@ -103,6 +105,18 @@ pub fn bxdf_eval_shader_source() -> String {
 pub fn display_shader_source() -> String {
     let mut source = String::new();
     for part in [TYPES_WGSL, COLOR_WGSL, DISPLAY_WGSL] {
+        source.push_str(part);
+        if !part.ends_with('\n') {
+            source.push('\n');
+        }
+    }
+    source
+}
+
+/// The draw shader (`shaders/draw.wgsl` after `shaders/color.wgsl`).
+pub fn draw_shader_source() -> String {
+    let mut source = String::new();
+    for part in [COLOR_WGSL, DRAW_WGSL] {
         source.push_str(part);
         if !part.ends_with('\n') {
             source.push('\n');

@@ -127,12 +127,12 @@ const READBACK_SIZE: u64 = 256 + 16;
 /// The buffers of a trace's path slots.
 #[derive(Debug)]
 pub(crate) struct SlotBuffers {
-    uniforms: wgpu::Buffer,
-    paths: wgpu::Buffer,
-    traces: wgpu::Buffer,
+    pub uniforms: wgpu::Buffer,
+    pub paths: wgpu::Buffer,
+    pub traces: wgpu::Buffer,
     ray_stack: wgpu::Buffer,
     traversal_stack: wgpu::Buffer,
-    counters: wgpu::Buffer,
+    pub counters: wgpu::Buffer,
     accumulation: wgpu::Buffer,
     readback: wgpu::Buffer,
     timestamps: Option<(wgpu::QuerySet, wgpu::Buffer)>,
@@ -163,8 +163,15 @@ impl SlotBuffers {
         wanted.min(pixels).min(fits).min(workgroups).max(1) as u32
     }
 
-    /// Creates the buffers for `slot_count` slots with bounce stacks of `stack_size`.
-    pub fn new(device: &wgpu::Device, slot_count: u32, stack_size: u32) -> Result<Self, GpuError> {
+    /// Creates the buffers for `slot_count` slots with bounce stacks of `stack_size`,
+    /// and an accumulation buffer of one sum per pixel for `accumulation_pixels`
+    /// pixels (0 for whole renders, which keep no sums).
+    pub fn new(
+        device: &wgpu::Device,
+        slot_count: u32,
+        stack_size: u32,
+        accumulation_pixels: u64,
+    ) -> Result<Self, GpuError> {
         let storage = |label: &str, bytes: u64, extra: wgpu::BufferUsages| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -207,8 +214,13 @@ impl SlotBuffers {
                 size_of::<GpuCounters>() as u64,
                 wgpu::BufferUsages::COPY_SRC,
             ),
-            // Progressive sums are not used by whole renders: one record.
-            accumulation: storage("gpu-render accumulation", 16, wgpu::BufferUsages::empty()),
+            // One vec4 sum per pixel (progressive rendering); whole renders keep none
+            // and get the 16-byte minimum.
+            accumulation: storage(
+                "gpu-render accumulation",
+                accumulation_pixels * 16,
+                wgpu::BufferUsages::empty(),
+            ),
             readback: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("gpu-render counter readback"),
                 size: READBACK_SIZE,
@@ -233,7 +245,8 @@ impl SlotBuffers {
         })
     }
 
-    /// The bind group of the trace kernels for `scene`, writing into `target`.
+    /// The bind group of the trace kernels for `scene`, writing into `target`, built
+    /// inside error scopes.
     pub fn bind_group(
         &self,
         device: &wgpu::Device,
@@ -241,6 +254,21 @@ impl SlotBuffers {
         scene: &PreparedScene,
         target: &wgpu::TextureView,
     ) -> Result<wgpu::BindGroup, GpuError> {
+        capture(device, "trace bind group", Caught::Resource, || {
+            self.bind_group_unchecked(device, layout, scene, target)
+        })
+    }
+
+    /// [`SlotBuffers::bind_group`] without error scopes (whose pops would block), for
+    /// the frame loop: `layout` must be the renderer's trace layout and `target` an
+    /// `Rgba32Float` storage texture.
+    pub fn bind_group_unchecked(
+        &self,
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        scene: &PreparedScene,
+        target: &wgpu::TextureView,
+    ) -> wgpu::BindGroup {
         fn buffer(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry {
                 binding,
@@ -248,38 +276,36 @@ impl SlotBuffers {
             }
         }
         let s = &scene.buffers;
-        capture(device, "trace bind group", Caught::Resource, || {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("gpu-render trace bind group"),
-                layout,
-                entries: &[
-                    buffer(binding::FRAME, &self.uniforms),
-                    buffer(binding::SPHERES, &s.spheres),
-                    buffer(binding::PLANES, &s.planes),
-                    buffer(binding::POLYGONS, &s.polygons),
-                    buffer(binding::POLYGON_POINTS, &s.polygon_points),
-                    buffer(binding::TRIANGLES, &s.triangles),
-                    buffer(binding::MATERIALS, &s.materials),
-                    buffer(binding::LIGHTS, &s.lights),
-                    wgpu::BindGroupEntry {
-                        binding: binding::LINEAR_OUTPUT,
-                        resource: wgpu::BindingResource::TextureView(target),
-                    },
-                    buffer(binding::COUNTERS, &self.counters),
-                    buffer(binding::ACCUMULATION, &self.accumulation),
-                    wgpu::BindGroupEntry {
-                        binding: binding::IMAGES,
-                        resource: wgpu::BindingResource::TextureView(&scene.images),
-                    },
-                    buffer(binding::BVH_NODES, &s.bvh_nodes),
-                    buffer(binding::BVH_PRIMS, &s.bvh_prims),
-                    buffer(binding::PATHS, &self.paths),
-                    buffer(binding::RAY_STACK, &self.ray_stack),
-                    buffer(binding::TRACES, &self.traces),
-                    buffer(binding::TRAVERSAL_STACK, &self.traversal_stack),
-                    buffer(binding::TRIANGLE_ATTRIBUTES, &s.triangle_attributes),
-                ],
-            })
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gpu-render trace bind group"),
+            layout,
+            entries: &[
+                buffer(binding::FRAME, &self.uniforms),
+                buffer(binding::SPHERES, &s.spheres),
+                buffer(binding::PLANES, &s.planes),
+                buffer(binding::POLYGONS, &s.polygons),
+                buffer(binding::POLYGON_POINTS, &s.polygon_points),
+                buffer(binding::TRIANGLES, &s.triangles),
+                buffer(binding::MATERIALS, &s.materials),
+                buffer(binding::LIGHTS, &s.lights),
+                wgpu::BindGroupEntry {
+                    binding: binding::LINEAR_OUTPUT,
+                    resource: wgpu::BindingResource::TextureView(target),
+                },
+                buffer(binding::COUNTERS, &self.counters),
+                buffer(binding::ACCUMULATION, &self.accumulation),
+                wgpu::BindGroupEntry {
+                    binding: binding::IMAGES,
+                    resource: wgpu::BindingResource::TextureView(&scene.images),
+                },
+                buffer(binding::BVH_NODES, &s.bvh_nodes),
+                buffer(binding::BVH_PRIMS, &s.bvh_prims),
+                buffer(binding::PATHS, &self.paths),
+                buffer(binding::RAY_STACK, &self.ray_stack),
+                buffer(binding::TRACES, &self.traces),
+                buffer(binding::TRAVERSAL_STACK, &self.traversal_stack),
+                buffer(binding::TRIANGLE_ATTRIBUTES, &s.triangle_attributes),
+            ],
         })
     }
 }
@@ -349,21 +375,7 @@ pub(crate) fn trace_region(
                     }
                 }),
             });
-            pass.set_bind_group(0, bind_group, &[]);
-            for _ in 0..rounds {
-                match schedule {
-                    Schedule::Wavefront => {
-                        pass.set_pipeline(&pipelines.shade);
-                        pass.dispatch_workgroups(groups, 1, 1);
-                        pass.set_pipeline(&pipelines.trace);
-                        pass.dispatch_workgroups(groups, 1, 1);
-                    }
-                    Schedule::Fused => {
-                        pass.set_pipeline(&pipelines.fused);
-                        pass.dispatch_workgroups(groups, 1, 1);
-                    }
-                }
-            }
+            encode_rounds(&mut pass, pipelines, schedule, bind_group, groups, rounds);
         }
         encoder.copy_buffer_to_buffer(
             &slots.counters,
@@ -408,9 +420,37 @@ pub(crate) fn trace_region(
     Ok(outcome)
 }
 
+/// Records `rounds` rounds of the trace kernels over `groups` workgroups of slots into
+/// `pass`: each round one dispatch of `shade_paths` and one of `trace_rays`
+/// (wavefront), or one of `trace_paths` (fused).
+pub(crate) fn encode_rounds(
+    pass: &mut wgpu::ComputePass<'_>,
+    pipelines: &TracePipelines,
+    schedule: Schedule,
+    bind_group: &wgpu::BindGroup,
+    groups: u32,
+    rounds: u32,
+) {
+    pass.set_bind_group(0, bind_group, &[]);
+    for _ in 0..rounds {
+        match schedule {
+            Schedule::Wavefront => {
+                pass.set_pipeline(&pipelines.shade);
+                pass.dispatch_workgroups(groups, 1, 1);
+                pass.set_pipeline(&pipelines.trace);
+                pass.dispatch_workgroups(groups, 1, 1);
+            }
+            Schedule::Fused => {
+                pass.set_pipeline(&pipelines.fused);
+                pass.dispatch_workgroups(groups, 1, 1);
+            }
+        }
+    }
+}
+
 /// Turns the kernels' error bits into an error: an image with a cut loop or an
 /// overflowing traversal stack would be silently wrong, so none is returned.
-fn check_errors(errors: u32) -> Result<(), GpuError> {
+pub(crate) fn check_errors(errors: u32) -> Result<(), GpuError> {
     if errors & ERROR_LOOP_CUT != 0 {
         return Err(GpuError::TraceIncomplete(
             "a shader loop was cut short by the driver before it finished (llvmpipe ends \

@@ -11,6 +11,7 @@ mod model;
 
 pub use animation::{CameraKey, CameraPath, Interpolation, MAX_FRAMES};
 pub use error::{SceneError, SceneWarning};
+pub(crate) use file::view_problem;
 pub use file::{
     CONDUCTOR_PRESETS, LoadOptions, LoadProgress, MAX_SCENE_FILE_BYTES, SceneFile, confined_path,
     load_scene, load_scene_file, load_scene_with, parse_scene, parse_scene_file, parse_scene_with,

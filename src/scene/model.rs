@@ -555,23 +555,30 @@ impl Scene {
     /// dielectric shapes (polygon or triangle meshes) around the camera are not
     /// detected; rays then start in air.
     pub fn camera_medium(&self) -> Vec<f64> {
-        let mut around: Vec<(f64, f64)> = self
-            .shapes
+        media_around(self.camera.eye, &self.dielectric_spheres())
+    }
+
+    /// The spheres of dielectric material: the only shapes that can contain the
+    /// camera ([`Scene::camera_medium`], [`media_around`]).
+    pub fn dielectric_spheres(&self) -> Vec<DielectricSphere> {
+        self.shapes
             .iter()
             .filter_map(|shape| match shape {
                 Shape::Sphere {
                     center,
                     radius,
                     material,
-                } if self.camera.eye.distance(*center) < *radius => {
+                } => {
                     let material = self.materials.get(*material as usize)?;
-                    (material.kind == MaterialKind::Dielectric).then_some((*radius, material.ior))
+                    (material.kind == MaterialKind::Dielectric).then_some(DielectricSphere {
+                        center: *center,
+                        radius: *radius,
+                        ior: material.ior,
+                    })
                 }
                 _ => None,
             })
-            .collect();
-        around.sort_by(|a, b| b.0.total_cmp(&a.0));
-        around.into_iter().map(|(_, ior)| ior).collect()
+            .collect()
     }
 
     /// Whether the display pass applies the sRGB curve (false in naive gamma mode,
@@ -579,6 +586,30 @@ impl Scene {
     pub fn display_encodes_srgb(&self) -> bool {
         self.render.lighting_space == LightingSpace::Linear
     }
+}
+
+/// A sphere of dielectric material, as far as the camera's medium is concerned.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DielectricSphere {
+    /// Centre.
+    pub center: DVec3,
+    /// Radius.
+    pub radius: f64,
+    /// Index of refraction of its material.
+    pub ior: f64,
+}
+
+/// The indices of refraction of the dielectric spheres that contain `eye`, outermost
+/// (largest) first: the medium stack camera rays start with. Nested spheres are
+/// assumed not to intersect.
+pub fn media_around(eye: DVec3, spheres: &[DielectricSphere]) -> Vec<f64> {
+    let mut around: Vec<(f64, f64)> = spheres
+        .iter()
+        .filter(|s| eye.distance(s.center) < s.radius)
+        .map(|s| (s.radius, s.ior))
+        .collect();
+    around.sort_by(|a, b| b.0.total_cmp(&a.0));
+    around.into_iter().map(|(_, ior)| ior).collect()
 }
 
 /// The plane of a polygon and the axis dropped to project it for the inside test.

@@ -23,6 +23,7 @@ pub use self::materials::CONDUCTOR_PRESETS;
 use self::objects::MaterialTable;
 pub use self::paths::confined_path;
 use self::raw::RawScene;
+pub(crate) use self::settings::view_problem;
 use super::image::not_a_regular_file;
 use super::{CameraPath, Scene, SceneError, SceneWarning};
 

@@ -1,0 +1,45 @@
+// Draws a film's mean radiance into the caller's colour attachment: one fullscreen
+// triangle, film pixel (x, y) at framebuffer pixel (x, y) (the caller's viewport
+// places it; pixels past the film's edge repeat the edge).
+// Composed as color.wgsl + draw.wgsl; DRAW_MODE is chosen on the host from the
+// scene's sRGB rule and the attachment's format (src/gpu/draw.rs, DrawMode):
+//   0: clamp only (linear radiance into an *Srgb attachment, which encodes it; or
+//      naive-gamma display values into a linear-unorm attachment);
+//   1: exact sRGB curve (linear radiance into a linear-unorm attachment);
+//   2: sRGB decode (naive-gamma display values into an *Srgb attachment, whose
+//      encoding then gives the values back: no double encoding).
+
+override DRAW_MODE: u32 = 0u;
+
+@group(0) @binding(0) var film_mean: texture_2d<f32>;
+
+// Inverse of srgb_encode (IEC 61966-2-1:1999, section 5.2), twin of `srgb_decode` in
+// src/color.rs; input in [0, 1].
+fn srgb_decode(encoded: f32) -> f32 {
+    if (encoded <= 0.04045) {
+        return encoded / 12.92;
+    }
+    return pow((encoded + 0.055) / 1.055, 2.4);
+}
+
+@vertex
+fn fullscreen_triangle(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
+    // Vertices (-1, -1), (3, -1), (-1, 3): one triangle that covers the viewport.
+    let x = f32(i32(index & 1u) * 4 - 1);
+    let y = f32(i32(index >> 1u) * 4 - 1);
+    return vec4<f32>(x, y, 0.0, 1.0);
+}
+
+@fragment
+fn draw_film(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
+    let size = textureDimensions(film_mean);
+    let xy = min(vec2<u32>(position.xy), size - vec2<u32>(1u));
+    let value = textureLoad(film_mean, xy, 0).rgb;
+    var c = vec3<f32>(clamp_unit(value.x), clamp_unit(value.y), clamp_unit(value.z));
+    if (DRAW_MODE == 1u) {
+        c = srgb_encode3(value);
+    } else if (DRAW_MODE == 2u) {
+        c = vec3<f32>(srgb_decode(c.x), srgb_decode(c.y), srgb_decode(c.z));
+    }
+    return vec4<f32>(c, 1.0);
+}

@@ -1,0 +1,142 @@
+//! [`GpuScene`]: a scene uploaded for the frame loop, with its trace pipelines built,
+//! and its camera kept on the host so that a camera move uploads nothing but the
+//! next trace pass's constants.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use wgpu::util::DeviceExt;
+
+use super::layout::{DisplayUniforms, FrameUniforms};
+use super::pipelines::TracePipelines;
+use super::scene_buffers::PreparedScene;
+use crate::camera::CameraFrame;
+use crate::scene::{Camera, DielectricSphere, MediumStack, media_around};
+
+/// Identities of uploaded scenes, so that a film knows which scene its bind group
+/// was built for.
+static NEXT_SCENE_ID: AtomicU64 = AtomicU64::new(1);
+
+/// A scene uploaded to one device by [`super::Renderer::upload`]: its storage
+/// buffers and images, the trace pipelines specialised to its features (built at
+/// upload, never while encoding), and its camera.
+///
+/// The camera is not in any GPU buffer of the scene: [`super::Renderer::set_camera`]
+/// changes it on the host, and the next trace pass of each film writes it with the
+/// pass's other constants (one [`FrameUniforms`] record, 192 bytes).
+#[derive(Debug)]
+pub struct GpuScene {
+    pub(crate) id: u64,
+    pub(crate) prepared: PreparedScene,
+    pub(crate) pipelines: TracePipelines,
+    /// The display pass's constants (the scene's sRGB rule), bound by
+    /// [`super::Renderer::encode_display`].
+    pub(crate) display_uniforms: wgpu::Buffer,
+    pub(crate) camera: Camera,
+    /// Increased by every camera change: films accumulating an older camera restart.
+    pub(crate) camera_version: u64,
+    dielectric_spheres: Vec<DielectricSphere>,
+}
+
+impl GpuScene {
+    pub(crate) fn new(
+        device: &wgpu::Device,
+        prepared: PreparedScene,
+        pipelines: TracePipelines,
+        camera: Camera,
+        dielectric_spheres: Vec<DielectricSphere>,
+    ) -> Self {
+        let uniforms = DisplayUniforms {
+            encode_srgb: u32::from(prepared.display_encodes_srgb()),
+            _pad: [0; 3],
+        };
+        let display_uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("gpu-render display uniforms"),
+            contents: bytemuck::bytes_of(&uniforms),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        Self {
+            id: NEXT_SCENE_ID.fetch_add(1, Ordering::Relaxed),
+            prepared,
+            pipelines,
+            display_uniforms,
+            camera,
+            camera_version: 0,
+            dielectric_spheres,
+        }
+    }
+
+    /// The scene's image width in pixels (its render settings'; a film may have
+    /// another size).
+    pub fn width(&self) -> u32 {
+        self.prepared.width()
+    }
+
+    /// The scene's image height in pixels.
+    pub fn height(&self) -> u32 {
+        self.prepared.height()
+    }
+
+    /// The scene's samples per pixel: the size of the stratified sample pattern
+    /// (`crate::camera::SamplePattern`). A film that has accumulated this many samples
+    /// holds exactly the image of a one-shot render; more samples continue the
+    /// sequence.
+    pub fn samples_per_pixel(&self) -> u32 {
+        self.prepared.samples_per_pixel()
+    }
+
+    /// The camera the next trace pass uses.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// Whether the scene's display values are sRGB-encoded linear radiance (`true`) or
+    /// already display values (naive gamma mode). [`super::Renderer::encode_display`]
+    /// and [`super::Renderer::draw`] apply this rule themselves.
+    pub fn display_encodes_srgb(&self) -> bool {
+        self.prepared.display_encodes_srgb()
+    }
+
+    /// Bytes of the scene's storage buffers on the device (primitives, BVH,
+    /// materials, lights; not the images): what a full re-upload writes besides the
+    /// images.
+    pub fn scene_bytes(&self) -> u64 {
+        self.prepared.scene_bytes()
+    }
+
+    /// The uploaded scene of the blocking layer (its buffers and constants).
+    pub fn prepared(&self) -> &PreparedScene {
+        &self.prepared
+    }
+
+    /// The trace constants of one pass over a `width × height` film: the scene's
+    /// settings, this camera (its basis, field of view and the dielectrics around
+    /// it), the film's size, and the sample pattern of the scene's samples per pixel.
+    /// The scheduler fills in the sample range, slots and budget.
+    pub(crate) fn frame_for(&self, width: u32, height: u32) -> FrameUniforms {
+        let camera = CameraFrame::new(&self.camera, width, height);
+        let medium = MediumStack::from_outermost_first(&media_around(
+            self.camera.eye,
+            &self.dielectric_spheres,
+        ));
+        let v = |d: glam::DVec3| d.as_vec3().to_array();
+        FrameUniforms {
+            eye: v(camera.eye),
+            tan_half_fov_y: camera.tan_half_fov_y as f32,
+            forward: v(camera.forward),
+            aspect: camera.aspect as f32,
+            right: v(camera.right),
+            width,
+            up: v(camera.up),
+            height,
+            camera_medium_iors: medium.iors.map(|ior| ior as f32),
+            camera_medium_depth: medium.depth,
+            region_x: 0,
+            region_y: 0,
+            region_width: width,
+            region_height: height,
+            target_x: 0,
+            target_y: 0,
+            ..self.prepared.frame
+        }
+    }
+}
