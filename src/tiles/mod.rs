@@ -6,7 +6,7 @@
 //!   image into `count` bands of rows;
 //! - [`fingerprint`]: the hashes of the scene and of the render settings that a tile
 //!   records, so that tiles of different renders are never merged;
-//! - [`file`]: the tile file ([`write_tile`], [`read_tile_header`], [`read_tile`]);
+//! - [`file`](mod@file): the tile file ([`write_tile`], [`read_tile_header`], [`read_tile`]);
 //! - [`merge`]: [`merge_tiles`], which checks that the tiles cover the image exactly
 //!   once and agree on what they render.
 //!
