@@ -1,0 +1,143 @@
+//! The path integrator against an independent renderer: the Cornell box
+//! (`scenes/cornell-box.toml`) at 32 × 32 pixels, rendered by Mitsuba 3's path tracer
+//! with 65,536 samples per pixel (`scripts/mitsuba/path_reference.py`, the reference
+//! committed as `tests/fixtures/mitsuba/cornell-box-32.exr`), and here with 1,024.
+//!
+//! The tolerance is statistical, per pixel and channel: the difference over its
+//! standard error, `z = (ours − reference) / sqrt(s²/n + s²/n_ref)` with `s²` the
+//! sample variance of our pixel's samples (the reference's error taken as that of the
+//! same variance at its sample count). A correct integrator gives z of about unit
+//! spread: at most 0.5% of the values may have |z| > 4 (a normal variable exceeds 4
+//! once in 16,000). Against bias, each channel's image mean must agree within 4 of its
+//! standard error (the pixels are independent, so the variances add) and within 0.5%.
+
+use std::path::Path;
+
+use glam::DVec3;
+use gpu_render::cpu::intersect::Ray;
+use gpu_render::cpu::path::path_radiance;
+use gpu_render::cpu::trace::PreparedScene;
+use gpu_render::scene::load_scene;
+
+const SIZE: u32 = 32;
+const SAMPLES: u32 = 1024;
+const REFERENCE_SAMPLES: f64 = 65_536.0;
+
+/// Per pixel: the mean and the sample variance of our samples.
+fn render_with_variance(scene: &PreparedScene) -> Vec<(DVec3, DVec3)> {
+    let pixels: Vec<u32> = (0..SIZE * SIZE).collect();
+    let threads = std::thread::available_parallelism().map_or(1, usize::from);
+    let chunk = pixels.len().div_ceil(threads);
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = pixels
+            .chunks(chunk)
+            .map(|part| {
+                scope.spawn(move || {
+                    part.iter()
+                        .map(|&p| {
+                            let (x, y) = (p % SIZE, p / SIZE);
+                            let (mut sum, mut squares) = (DVec3::ZERO, DVec3::ZERO);
+                            for s in 0..SAMPLES {
+                                let (dx, dy) = scene.samples.offset(x, y, s);
+                                let direction = scene.camera.ray_direction(
+                                    f64::from(x) + dx,
+                                    f64::from(y) + dy,
+                                    SIZE,
+                                    SIZE,
+                                );
+                                let ray = Ray {
+                                    origin: scene.camera.eye,
+                                    direction,
+                                };
+                                let (radiance, _) = path_radiance(scene, ray, p, s);
+                                sum += radiance;
+                                squares += radiance * radiance;
+                            }
+                            let n = f64::from(SAMPLES);
+                            let mean = sum / n;
+                            let variance = (squares / n - mean * mean) * (n / (n - 1.0));
+                            (mean, variance.max(DVec3::ZERO))
+                        })
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().expect("render thread"))
+            .collect()
+    })
+}
+
+#[test]
+fn the_cornell_box_agrees_with_mitsuba_within_its_statistical_error() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut scene = load_scene(&root.join("scenes/cornell-box.toml")).expect("scene");
+    scene.render.width = SIZE;
+    scene.render.height = SIZE;
+    scene.render.samples_per_pixel = SAMPLES;
+    let prepared = PreparedScene::new(&scene);
+    let ours = render_with_variance(&prepared);
+    let reference = image::open(root.join("tests/fixtures/mitsuba/cornell-box-32.exr"))
+        .expect("the Mitsuba reference")
+        .to_rgb32f();
+    assert_eq!(reference.dimensions(), (SIZE, SIZE));
+
+    let mut z_values = Vec::new();
+    let (mut our_total, mut reference_total) = (DVec3::ZERO, DVec3::ZERO);
+    let mut total_variance = DVec3::ZERO;
+    for (i, (mean, variance)) in ours.iter().enumerate() {
+        let r = reference.get_pixel(i as u32 % SIZE, i as u32 / SIZE);
+        for c in 0..3 {
+            let expected = f64::from(r[c]);
+            let error = (variance[c] / f64::from(SAMPLES) + variance[c] / REFERENCE_SAMPLES).sqrt();
+            our_total[c] += mean[c];
+            reference_total[c] += expected;
+            total_variance[c] += error * error;
+            if error > 0.0 {
+                z_values.push((mean[c] - expected) / error);
+            } else {
+                // A pixel without variance (the lamp seen directly) must agree exactly,
+                // to f32.
+                assert!(
+                    (mean[c] - expected).abs() <= 1e-5 * expected.max(1.0),
+                    "pixel {i} channel {c}: {} against {expected} with no variance",
+                    mean[c]
+                );
+            }
+        }
+    }
+    let n = z_values.len() as f64;
+    let outliers = z_values.iter().filter(|z| z.abs() > 4.0).count();
+    let difference = our_total - reference_total;
+    let standard_error = DVec3::new(
+        total_variance.x.sqrt(),
+        total_variance.y.sqrt(),
+        total_variance.z.sqrt(),
+    );
+    let relative = difference / reference_total;
+    eprintln!(
+        "{} values: {outliers} with |z| > 4; image means differ by {relative:.5} \
+         (relative), {:.2} standard errors",
+        z_values.len(),
+        (difference / standard_error).abs().max_element()
+    );
+    assert!(
+        outliers as f64 <= 0.005 * n,
+        "{outliers} of {n} pixel values differ from Mitsuba by more than 4 standard errors"
+    );
+    for c in 0..3 {
+        assert!(
+            difference[c].abs() <= 4.0 * standard_error[c],
+            "channel {c}: biased against Mitsuba: the image sums differ by {} with a \
+             standard error of {}",
+            difference[c],
+            standard_error[c]
+        );
+        assert!(
+            relative[c].abs() <= 0.005,
+            "channel {c}: the image mean differs from Mitsuba's by {:.3}%",
+            100.0 * relative[c]
+        );
+    }
+}
