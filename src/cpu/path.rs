@@ -536,3 +536,114 @@ fn sample_emitter(
     };
     (f * emitter.radiance * (cos_i * weight / pdf), 1)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::FresnelModel;
+
+    /// `∫ f(wi, wo) cos θi dωi` over the hemisphere (the directional albedo), by the
+    /// midpoint rule on a fine (θ, φ) grid.
+    fn albedo_by_quadrature(material: &Material, wo: DVec3) -> DVec3 {
+        let (nt, np) = (256, 512);
+        let (dt, dp) = (
+            std::f64::consts::FRAC_PI_2 / nt as f64,
+            2.0 * std::f64::consts::PI / np as f64,
+        );
+        let mut sum = DVec3::ZERO;
+        for i in 0..nt {
+            let theta = (i as f64 + 0.5) * dt;
+            for j in 0..np {
+                let phi = (j as f64 + 0.5) * dp;
+                let wi = DVec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                );
+                let f = eval_brdf(material, &[], DVec3::Z, wi, wo);
+                sum += f * (wi.z * theta.sin() * dt * dp);
+            }
+        }
+        sum
+    }
+
+    /// The estimator a path uses, `f cos θ / pdf` over `sample_brdf`'s directions, is
+    /// unbiased for every material: its mean is the directional albedo. This ties the
+    /// mixture sampler, its density and the BRDF together (a density that disagreed
+    /// with its sampler, or a lobe chosen with the wrong probability, would not be).
+    #[test]
+    fn brdf_sampling_estimates_the_directional_albedo_of_every_material() {
+        let blinn = Material {
+            diffuse: DVec3::splat(0.5),
+            specular: DVec3::splat(0.3),
+            shininess: 30.0,
+            ..Material::blank(MaterialKind::BlinnPhong)
+        };
+        let conductor = Material {
+            roughness: 0.4,
+            conductor: true,
+            eta: DVec3::new(0.2, 0.9, 1.1),
+            k: DVec3::new(3.9, 2.4, 2.2),
+            fresnel: FresnelModel::Exact,
+            ..Material::blank(MaterialKind::CookTorrance)
+        };
+        let beckmann = Material {
+            roughness: 0.5,
+            diffuse: DVec3::splat(0.4),
+            ior: 1.5,
+            distribution: MicrofacetDistribution::Beckmann,
+            ..Material::blank(MaterialKind::CookTorrance)
+        };
+        let pbr = Material {
+            diffuse: DVec3::new(0.8, 0.5, 0.3),
+            metallic: 0.5,
+            roughness: 0.3,
+            ..Material::blank(MaterialKind::Pbr)
+        };
+        let oren_nayar = Material {
+            diffuse: DVec3::splat(0.7),
+            sigma: 0.4,
+            ..Material::blank(MaterialKind::OrenNayar)
+        };
+        let materials = [
+            ("lambert", Material::lambert(DVec3::splat(0.6))),
+            ("blinn-phong", blinn),
+            ("cook-torrance conductor", conductor),
+            ("cook-torrance beckmann", beckmann),
+            ("pbr", pbr),
+            ("oren-nayar", oren_nayar),
+        ];
+        let theta_o = 40f64.to_radians();
+        let wo = DVec3::new(theta_o.sin(), 0.0, theta_o.cos());
+        let n = 200_000u32;
+        for (name, material) in materials {
+            let expected = albedo_by_quadrature(&material, wo);
+            let (mut sum, mut squares) = (DVec3::ZERO, DVec3::ZERO);
+            for i in 0..n {
+                let u = |d| random_number(i, 7, d);
+                let wi = sample_brdf(&material, DVec3::Z, wo, u(0), DVec2::new(u(1), u(2)));
+                if wi.z <= 0.0 {
+                    continue;
+                }
+                let pdf = pdf_brdf(&material, DVec3::Z, wo, wi);
+                assert!(pdf > 0.0, "{name}: a sampled direction has density 0");
+                let value = eval_brdf(&material, &[], DVec3::Z, wi, wo) * (wi.z / pdf);
+                sum += value;
+                squares += value * value;
+            }
+            let count = f64::from(n);
+            let mean = sum / count;
+            let error = ((squares / count - mean * mean) / count).max(DVec3::ZERO);
+            for c in 0..3 {
+                let tolerance = 4.0 * error[c].sqrt() + 2e-3 * expected[c];
+                assert!(
+                    (mean[c] - expected[c]).abs() <= tolerance,
+                    "{name}, channel {c}: the estimator's mean {} against the albedo {} \
+                     (tolerance {tolerance})",
+                    mean[c],
+                    expected[c]
+                );
+            }
+        }
+    }
+}
