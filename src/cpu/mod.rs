@@ -41,54 +41,7 @@ pub fn render(scene: &Scene, progress: Option<ProgressFn<'_>>) -> Rendered {
     let started = Instant::now();
     let prepared = PreparedScene::new(scene);
     let (width, height) = (scene.render.width, scene.render.height);
-    let mut image = LinearImage::new(width, height);
-    let rows: Vec<(u32, &mut [[f32; 4]])> = image
-        .pixels
-        .chunks_mut(width as usize)
-        .enumerate()
-        .map(|(y, row)| (y as u32, row))
-        .collect();
-    let queue = Mutex::new(rows);
-    let rays = AtomicU64::new(0);
-    let rows_done = AtomicU32::new(0);
-    let threads = std::thread::available_parallelism().map_or(1, usize::from);
-    std::thread::scope(|scope| {
-        for _ in 0..threads {
-            scope.spawn(|| {
-                loop {
-                    let next = queue
-                        .lock()
-                        .unwrap_or_else(std::sync::PoisonError::into_inner)
-                        .pop();
-                    let Some((y, row)) = next else { break };
-                    let mut row_rays = 0;
-                    for (x, pixel) in row.iter_mut().enumerate() {
-                        let result = trace_pixel(&prepared, x as u32, y);
-                        *pixel = [
-                            result.radiance.x as f32,
-                            result.radiance.y as f32,
-                            result.radiance.z as f32,
-                            1.0,
-                        ];
-                        row_rays += result.rays;
-                    }
-                    rays.fetch_add(row_rays, Ordering::Relaxed);
-                    let done = rows_done.fetch_add(1, Ordering::Relaxed) + 1;
-                    if let Some(report) = progress {
-                        report(done, height);
-                    }
-                }
-            });
-        }
-    });
-    Rendered {
-        image,
-        stats: RenderStats {
-            rays_traced: rays.into_inner(),
-            elapsed: started.elapsed(),
-            gpu_time: None,
-        },
-    }
+    trace_window(&prepared, 0..width, 0..height, progress, started)
 }
 
 /// A region handed to [`render_region`] that is empty or does not lie inside the image.
@@ -147,6 +100,18 @@ pub fn render_region(
     }
     let started = Instant::now();
     let prepared = PreparedScene::new(scene);
+    Ok(trace_window(&prepared, columns, rows, progress, started))
+}
+
+/// Traces the pixels in `columns × rows` on all CPU cores, rows handed out one at a
+/// time, into an image of the window's size; `progress` is told the finished rows.
+fn trace_window(
+    prepared: &PreparedScene,
+    columns: Range<u32>,
+    rows: Range<u32>,
+    progress: Option<ProgressFn<'_>>,
+    started: Instant,
+) -> Rendered {
     let region_width = columns.end - columns.start;
     let region_height = rows.end - rows.start;
     let mut image = LinearImage::new(region_width, region_height);
@@ -171,7 +136,7 @@ pub fn render_region(
                     let Some((y, row)) = next else { break };
                     let mut row_rays = 0;
                     for (x, pixel) in columns.clone().zip(row.iter_mut()) {
-                        let result = trace_pixel(&prepared, x, y);
+                        let result = trace_pixel(prepared, x, y);
                         *pixel = [
                             result.radiance.x as f32,
                             result.radiance.y as f32,
@@ -189,12 +154,12 @@ pub fn render_region(
             });
         }
     });
-    Ok(Rendered {
+    Rendered {
         image,
         stats: RenderStats {
             rays_traced: rays.into_inner(),
             elapsed: started.elapsed(),
             gpu_time: None,
         },
-    })
+    }
 }

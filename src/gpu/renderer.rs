@@ -415,7 +415,8 @@ impl GpuRenderer {
         self.render_prepared(device, queue, &prepared, progress)
     }
 
-    /// [`GpuRenderer::render`] for a scene already uploaded.
+    /// [`GpuRenderer::render`] for a scene already uploaded: the region of the whole
+    /// image ([`GpuRenderer::render_region`]).
     pub fn render_prepared(
         &self,
         device: &wgpu::Device,
@@ -423,105 +424,13 @@ impl GpuRenderer {
         prepared: &PreparedScene,
         progress: Option<ProgressFn<'_>>,
     ) -> Result<GpuRendered, GpuError> {
-        let (width, height) = (prepared.width(), prepared.height());
-        let limits = device.limits();
-        // A tile must fit one texture and one display dispatch's workgroup count.
-        let tile_limit = limits.max_texture_dimension_2d.min(
-            limits
-                .max_compute_workgroups_per_dimension
-                .saturating_mul(WORKGROUP_SIZE),
-        );
-        let tiles = image_tiles(width, height, tile_limit);
-        let mut pixels = vec![[0.0f32; 4]; width as usize * height as usize];
-        let mut display_rgba8 = vec![0u8; width as usize * height as usize * 4];
-        let finished = AtomicU64::new(0);
-        let report = |new: u64| {
-            let done = finished.fetch_add(new, Ordering::Relaxed) + new;
-            if let Some(progress) = progress {
-                progress((done / u64::from(width)) as u32, height);
-            }
-        };
-        let mut stats = RenderStats::default();
-        let mut gpu_time = Some(Duration::ZERO);
-        for tile in &tiles {
-            let (tile_width, tile_height) = tile.size();
-            let linear = create_texture(
-                device,
-                "gpu-render linear image",
-                tile_width,
-                tile_height,
-                LINEAR_FORMAT,
-                wgpu::TextureUsages::STORAGE_BINDING
-                    | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC,
-            )?;
-            let display = create_texture(
-                device,
-                "gpu-render display image",
-                tile_width,
-                tile_height,
-                DISPLAY_FORMAT,
-                wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
-            )?;
-            let linear_view = linear.create_view(&wgpu::TextureViewDescriptor::default());
-            let display_view = display.create_view(&wgpu::TextureViewDescriptor::default());
-            let last = AtomicU64::new(0);
-            let tile_progress = |done: u64, _: u64| {
-                let before = last.swap(done, Ordering::Relaxed);
-                report(done - before);
-            };
-            let traced = self.trace_into(
-                device,
-                queue,
-                prepared,
-                &linear_view,
-                tile,
-                Some(&tile_progress),
-            )?;
-            stats.rays_traced += traced.rays_traced;
-            stats.elapsed += traced.elapsed;
-            gpu_time = gpu_time.zip(traced.gpu_time).map(|(a, b)| a + b);
-
-            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("gpu-render display pass"),
-            });
-            self.encode_display(
-                device,
-                &mut encoder,
-                &linear_view,
-                &display_view,
-                prepared.display_encodes_srgb(),
-            )?;
-            submit_and_wait(device, queue, encoder, "display pass", self.poll_timeout)?;
-            let linear_bytes = read_texture(device, queue, &linear, 16, self.poll_timeout)?;
-            let display_bytes = read_texture(device, queue, &display, 4, self.poll_timeout)?;
-            // pod_collect_to_vec copies, so the byte vector's alignment does not matter.
-            let tile_pixels: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&linear_bytes);
-            let tile_width = tile_width as usize;
-            for (row, y) in tile.rows.clone().enumerate() {
-                let start = y as usize * width as usize + tile.columns.start as usize;
-                pixels[start..start + tile_width]
-                    .copy_from_slice(&tile_pixels[row * tile_width..(row + 1) * tile_width]);
-                display_rgba8[start * 4..(start + tile_width) * 4].copy_from_slice(
-                    &display_bytes[row * tile_width * 4..(row + 1) * tile_width * 4],
-                );
-            }
-        }
-        stats.gpu_time = gpu_time;
-        Ok(GpuRendered {
-            image: LinearImage {
-                width,
-                height,
-                pixels,
-            },
-            display_rgba8,
-            stats,
-        })
+        let whole = TraceRegion::whole(prepared.width(), prepared.height());
+        self.render_region(device, queue, prepared, &whole, progress)
     }
 
-    /// Renders only the pixels of `region` of a scene already uploaded: traces them
-    /// (in tiles of at most the device's limits, as [`GpuRenderer::render_prepared`]
-    /// does), runs the display pass and reads both images back. The result is the
+    /// Renders only the pixels of `region` of a scene already uploaded: traces them in
+    /// tiles of at most the device's limits (each into textures of its own), runs the
+    /// display pass and reads both images back. The result is the
     /// region's: `image` is `columns × rows` pixels whose (0, 0) is the region's first
     /// pixel, and `region.target_origin` is not used. Each pixel is bit-identical to
     /// the same pixel of a whole render (`docs/model.md`, "Bounded work"), so regions
@@ -547,7 +456,8 @@ impl GpuRenderer {
     /// ```
     ///
     /// Errors: [`GpuError::Validation`] for a region that is empty or lies outside
-    /// the image; otherwise as [`GpuRenderer::render_prepared`].
+    /// the image; see [`GpuRenderer::prepare`] and [`GpuRenderer::trace_into`];
+    /// [`GpuError::Readback`].
     pub fn render_region(
         &self,
         device: &wgpu::Device,

@@ -4,7 +4,7 @@ use std::io::Write;
 
 use anyhow::{Context, Result, bail};
 use gpu_render::cpu;
-use gpu_render::film::{LinearImage, ProgressFn, RenderStats};
+use gpu_render::film::{LinearImage, ProgressFn, RenderStats, Rendered};
 use gpu_render::gpu::{self, AdapterChoice, GpuRenderer, HeadlessGpu, TraceRegion};
 use gpu_render::scene::{Integrator, Scene};
 use gpu_render::tiles::PixelWindow;
@@ -19,6 +19,20 @@ pub struct Frame {
     pub display_rgba8: Vec<u8>,
     /// Ray count and tracing time.
     pub stats: RenderStats,
+}
+
+impl Frame {
+    /// A CPU render of `scene` with its display image encoded as the scene says.
+    fn from_cpu(rendered: Rendered, scene: &Scene) -> Self {
+        let display_rgba8 = rendered
+            .image
+            .to_display_rgba8(scene.display_encodes_srgb());
+        Self {
+            image: rendered.image,
+            display_rgba8,
+            stats: rendered.stats,
+        }
+    }
 }
 
 /// The GPU renderer's options from the command line.
@@ -198,14 +212,7 @@ impl Backend {
                     window.rows.clone(),
                     Some(progress),
                 )?;
-                let display_rgba8 = rendered
-                    .image
-                    .to_display_rgba8(scene.display_encodes_srgb());
-                Ok(Frame {
-                    image: rendered.image,
-                    display_rgba8,
-                    stats: rendered.stats,
-                })
+                Ok(Frame::from_cpu(rendered, scene))
             }
         }
     }
@@ -223,17 +230,7 @@ impl Backend {
                     stats: rendered.stats,
                 })
             }
-            Backend::Cpu { .. } => {
-                let rendered = cpu::render(scene, Some(progress));
-                let display_rgba8 = rendered
-                    .image
-                    .to_display_rgba8(scene.display_encodes_srgb());
-                Ok(Frame {
-                    image: rendered.image,
-                    display_rgba8,
-                    stats: rendered.stats,
-                })
-            }
+            Backend::Cpu { .. } => Ok(Frame::from_cpu(cpu::render(scene, Some(progress)), scene)),
         }
     }
 }
