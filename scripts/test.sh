@@ -22,6 +22,9 @@ cargo fmt --all -- --check
 section "cargo clippy (warnings are errors)"
 cargo clippy --all-targets -- -D warnings
 
+section "the library without the CLI's dependencies (cargo check --no-default-features)"
+cargo check --lib --no-default-features
+
 section "cargo test --all-targets"
 cargo test --all-targets
 

@@ -15,7 +15,8 @@
 //! - [`quality`]: the named presets chosen from the measured front.
 //! - [`tiles`]: windows of an image rendered apart, their EXR tile files and merging
 //!   them into the whole image.
-//! - [`tradeoff`]: measuring time against error for the speed/accuracy knobs.
+//! - `tradeoff` (with the default `cli` feature): measuring time against error for the
+//!   speed/accuracy knobs.
 
 #![warn(missing_docs)]
 
@@ -30,4 +31,5 @@ pub mod plausibility;
 pub mod quality;
 pub mod scene;
 pub mod tiles;
+#[cfg(feature = "cli")]
 pub mod tradeoff;
