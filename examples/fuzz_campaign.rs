@@ -112,7 +112,9 @@ fn main() {
         .map(|m| started + Duration::from_secs_f64(m * 60.0));
     let (mut run, mut finds) = (0u64, Vec::new());
     while run < args.cases && deadline.is_none_or(|d| Instant::now() < d) {
-        let tree = strategy.new_tree(&mut runner).expect("a scene is generated");
+        let tree = strategy
+            .new_tree(&mut runner)
+            .expect("a scene is generated");
         run += 1;
         if let Err(failed) = checker.check(&tree.current()) {
             let (text, reason) = shrink(&checker, tree, failed.reason);

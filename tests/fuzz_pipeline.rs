@@ -112,7 +112,11 @@ fn regression_corpus_renders_alike_on_both_backends() {
         .filter(|p| p.extension().is_some_and(|e| e == "toml"))
         .collect();
     paths.sort();
-    assert!(!paths.is_empty(), "the corpus in {} is empty", dir.display());
+    assert!(
+        !paths.is_empty(),
+        "the corpus in {} is empty",
+        dir.display()
+    );
     let Some(gpu) = common::gpu::headless_gpu() else {
         return;
     };

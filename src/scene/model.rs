@@ -542,7 +542,13 @@ impl Scene {
                     center,
                     radius,
                     material,
-                } if self.camera.eye.distance(*center) < *radius => {
+                } if {
+                    // Inside, decided relative to the anchor: a centre 1e20 away would
+                    // leave |eye - c| without the digits that say.
+                    let (anchor, normal) = super::sphere_anchor(*center, *radius);
+                    super::sphere_level(self.camera.eye, anchor, normal, *radius) < 0.0
+                } =>
+                {
                     let material = self.materials.get(*material as usize)?;
                     (material.kind == MaterialKind::Dielectric).then_some((*radius, material.ior))
                 }

@@ -51,27 +51,35 @@ pub fn scene_text() -> impl Strategy<Value = String> {
         lights(),
         prop::collection::vec(object(), 0..7),
     )
-        .prop_map(|(settings, camera, environment, materials, lights, objects)| {
-            let mut text = String::new();
-            text.push_str(&settings);
-            text.push_str(&camera.text(settings_scale(&settings)));
-            text.push_str(&environment);
-            let count = materials.len();
-            for (i, material) in materials.iter().enumerate() {
-                let _ = writeln!(text, "[materials.m{i}]\n{material}");
-            }
-            // Dielectric shells need a dielectric; every scene has one more material.
-            let _ = writeln!(text, "[materials.glass]\ntype = \"dielectric\"\nior = 1.5\n");
-            let _ = writeln!(text, "[materials.water]\ntype = \"dielectric\"\nior = 1.33\n");
-            let scale = settings_scale(&settings);
-            for light in &lights {
-                text.push_str(&light.text(scale));
-            }
-            for object in &objects {
-                text.push_str(&object.text(scale, count));
-            }
-            text
-        })
+        .prop_map(
+            |(settings, camera, environment, materials, lights, objects)| {
+                let mut text = String::new();
+                text.push_str(&settings);
+                text.push_str(&camera.text(settings_scale(&settings)));
+                text.push_str(&environment);
+                let count = materials.len();
+                for (i, material) in materials.iter().enumerate() {
+                    let _ = writeln!(text, "[materials.m{i}]\n{material}");
+                }
+                // Dielectric shells need a dielectric; every scene has one more material.
+                let _ = writeln!(
+                    text,
+                    "[materials.glass]\ntype = \"dielectric\"\nior = 1.5\n"
+                );
+                let _ = writeln!(
+                    text,
+                    "[materials.water]\ntype = \"dielectric\"\nior = 1.33\n"
+                );
+                let scale = settings_scale(&settings);
+                for light in &lights {
+                    text.push_str(&light.text(scale));
+                }
+                for object in &objects {
+                    text.push_str(&object.text(scale, count));
+                }
+                text
+            },
+        )
 }
 
 /// The scale recorded in the settings' first comment line.
@@ -107,7 +115,10 @@ fn settings() -> impl Strategy<Value = String> {
         // Whitted's tree doubles at every dielectric hit: a depth of 60 or more comes
         // with a weight cutoff of at least 0.05, which bounds it (see docs/fuzzing.md).
         prop_oneof![
-            (0u32..=6, prop::sample::select(vec![0.0, 0.0, 0.0, 0.01, 0.5, 1.0])),
+            (
+                0u32..=6,
+                prop::sample::select(vec![0.0, 0.0, 0.0, 0.01, 0.5, 1.0])
+            ),
             (60u32..=64, prop::sample::select(vec![0.05, 0.1, 0.5, 1.0])),
         ],
         prop::option::weighted(0.2, 1u32..=4),
@@ -201,14 +212,16 @@ fn radiance() -> impl Strategy<Value = String> {
 }
 
 fn environment() -> impl Strategy<Value = String> {
-    (radiance(), prop::sample::select(vec![0.0, 0.0, 0.0, 0.05, 0.5])).prop_map(
-        |(background, ambient)| {
+    (
+        radiance(),
+        prop::sample::select(vec![0.0, 0.0, 0.0, 0.05, 0.5]),
+    )
+        .prop_map(|(background, ambient)| {
             format!(
                 "[environment]\nbackground = {background}\nambient = {}\n\n",
                 num(ambient)
             )
-        },
-    )
+        })
 }
 
 fn emission_line() -> impl Strategy<Value = String> {
@@ -262,8 +275,11 @@ fn material() -> impl Strategy<Value = String> {
             prop_oneof![
                 prop::sample::select(vec!["gold", "silver", "copper", "aluminium"])
                     .prop_map(|c| format!("conductor = \"{c}\"\n")),
-                (ior(), fraction())
-                    .prop_map(|(ior, d)| format!("ior = {}\ndiffuse = {}\n", num(ior), num(d))),
+                (ior(), fraction()).prop_map(|(ior, d)| format!(
+                    "ior = {}\ndiffuse = {}\n",
+                    num(ior),
+                    num(d)
+                )),
             ],
         )
             .prop_map(|(roughness, distribution, fresnel, base)| format!(
@@ -287,8 +303,14 @@ fn material() -> impl Strategy<Value = String> {
 
 #[derive(Debug, Clone)]
 enum LightSpec {
-    Point { position: [f64; 3], intensity: f64 },
-    Directional { direction: [f64; 3], irradiance: f64 },
+    Point {
+        position: [f64; 3],
+        intensity: f64,
+    },
+    Directional {
+        direction: [f64; 3],
+        irradiance: f64,
+    },
 }
 
 impl LightSpec {
@@ -359,10 +381,7 @@ enum ObjectSpec {
         material: usize,
     },
     /// Concentric dielectric spheres, outermost first.
-    Shells {
-        center: [f64; 3],
-        radii: Vec<f64>,
-    },
+    Shells { center: [f64; 3], radii: Vec<f64> },
     Plane {
         point: [f64; 3],
         normal: [f64; 3],
@@ -620,8 +639,9 @@ impl PipelineChecker {
         };
         let scene = gpu_render::scene::parse_scene(text, std::path::Path::new("<fuzz>"))
             .map_err(|e| fail(format!("the generated scene does not parse: {e}")))?;
-        let cpu = std::panic::catch_unwind(AssertUnwindSafe(|| gpu_render::cpu::render(&scene, None)))
-            .map_err(|p| fail(format!("the CPU render panicked: {}", panic_message(&p))))?;
+        let cpu =
+            std::panic::catch_unwind(AssertUnwindSafe(|| gpu_render::cpu::render(&scene, None)))
+                .map_err(|p| fail(format!("the CPU render panicked: {}", panic_message(&p))))?;
         let gpu = std::panic::catch_unwind(AssertUnwindSafe(|| {
             self.renderer
                 .render(&self.gpu.device, &self.gpu.queue, &scene, None)
