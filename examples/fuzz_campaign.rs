@@ -1,9 +1,11 @@
 //! A long whole-pipeline fuzzing campaign: the generator and check of
 //! `tests/fuzz_pipeline.rs` (`tests/common/pipeline.rs`) run for `--cases N` scenes from
 //! `--seed S`, continuing past failures. Each failing scene is shrunk to a small one and
-//! written to `tests/fixtures/pipeline-regressions/campaign-S-K.toml` (the test replays
-//! that folder); a line with the date, seed, cases, time and finds is appended to the
-//! record in `docs/fuzzing.md`.
+//! written, with the failure as a comment, to
+//! `tests/fixtures/pipeline-open/campaign-S-K.toml` (open finds: triage them, see
+//! `docs/fuzzing.md`, and move the fixed ones to `tests/fixtures/pipeline-regressions/`,
+//! which the test replays); a line with the date, seed, cases, time and finds is
+//! appended to the record in `docs/fuzzing.md`.
 //!
 //! ```sh
 //! XDG_RUNTIME_DIR=/tmp/xdg WGPU_BACKEND=vulkan \
@@ -11,7 +13,8 @@
 //! ```
 //!
 //! `--no-record` leaves `docs/fuzzing.md` alone; `--minutes M` stops after M minutes
-//! (recording the cases actually run).
+//! (recording the cases actually run); `--keep N` writes at most N finds (default 25;
+//! the rest are counted, and most are more of the same).
 
 #[path = "../tests/common/mod.rs"]
 #[allow(dead_code)]
@@ -33,6 +36,7 @@ struct Args {
     seed: u64,
     minutes: Option<f64>,
     record: bool,
+    keep: u64,
 }
 
 fn parse_args() -> Args {
@@ -41,6 +45,7 @@ fn parse_args() -> Args {
         seed: 1,
         minutes: None,
         record: true,
+        keep: 25,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -55,8 +60,10 @@ fn parse_args() -> Args {
             "--seed" => args.seed = value("--seed") as u64,
             "--minutes" => args.minutes = Some(value("--minutes")),
             "--no-record" => args.record = false,
+            "--keep" => args.keep = value("--keep") as u64,
             other => panic!(
-                "unknown argument {other:?} (use --cases N, --seed S, --minutes M, --no-record)"
+                "unknown argument {other:?} (use --cases N, --seed S, --minutes M, --keep N, \
+                 --no-record)"
             ),
         }
     }
@@ -105,7 +112,8 @@ fn main() {
         TestRng::from_seed(RngAlgorithm::ChaCha, &bytes),
     );
     let strategy = pipeline::scene_text();
-    let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pipeline-regressions");
+    let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pipeline-open");
+    std::fs::create_dir_all(&corpus).expect("tests/fixtures/pipeline-open/ created");
     let started = Instant::now();
     let deadline = args
         .minutes
@@ -117,6 +125,10 @@ fn main() {
             .expect("a scene is generated");
         run += 1;
         if let Err(failed) = checker.check(&tree.current()) {
+            if finds.len() as u64 >= args.keep {
+                finds.push((run, failed.reason));
+                continue;
+            }
             let (text, reason) = shrink(&checker, tree, failed.reason);
             let path = corpus.join(format!("campaign-{}-{run}.toml", args.seed));
             let header: String = reason.lines().map(|l| format!("# {l}\n")).collect();
@@ -141,16 +153,12 @@ fn main() {
         if finds.is_empty() {
             "none".to_owned()
         } else {
-            finds
-                .iter()
-                .map(|(case, reason)| {
-                    format!(
-                        "case {case}: {}",
-                        reason.lines().next().unwrap_or("").replace('|', "/")
-                    )
-                })
-                .collect::<Vec<_>>()
-                .join("; ")
+            format!(
+                "{} failing cases ({} kept as `campaign-{}-CASE.toml` in tests/fixtures/pipeline-open/)",
+                finds.len(),
+                finds.len().min(args.keep as usize),
+                args.seed
+            )
         }
     );
     println!("{summary}");

@@ -51,6 +51,13 @@ pub fn scene_text() -> impl Strategy<Value = String> {
         lights(),
         prop::collection::vec(object(), 0..7),
     )
+        // A camera on a surface is ill-posed (which side it is on, and the first hit at
+        // t ≈ 0, depend on the last bit), and shrinking drives coordinates to 0, onto
+        // the ground spheres' tops: keep the eye 1e-3 (in units of the scale) off every
+        // sphere and plane.
+        .prop_filter("the eye lies on a surface", |(_, camera, _, _, _, objects)| {
+            objects.iter().all(|o| o.distance_from(camera.eye) > 1e-3)
+        })
         .prop_map(
             |(settings, camera, environment, materials, lights, objects)| {
                 let mut text = String::new();
@@ -432,6 +439,31 @@ fn normalized(v: [f64; 3]) -> [f64; 3] {
 }
 
 impl ObjectSpec {
+    /// The distance from `p` to the object's spheres and planes, in units of the scale
+    /// (infinite for polygons and triangles).
+    fn distance_from(&self, p: [f64; 3]) -> f64 {
+        let to_sphere = |c: [f64; 3], r: f64| {
+            let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+            ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() - r).abs()
+        };
+        match self {
+            ObjectSpec::Sphere { center, radius, .. } => to_sphere(*center, *radius),
+            ObjectSpec::Ground { at, radius, .. } => to_sphere([at[0], -radius, at[2]], *radius),
+            ObjectSpec::Tangent { center, radius, .. } => to_sphere(*center, *radius).min(
+                to_sphere([center[0] + 2.0 * radius, center[1], center[2]], *radius),
+            ),
+            ObjectSpec::Shells { center, radii } => radii
+                .iter()
+                .map(|r| to_sphere(*center, *r))
+                .fold(f64::INFINITY, f64::min),
+            ObjectSpec::Plane { point, normal, .. } => {
+                let n = normalized(*normal);
+                ((0..3).map(|a| n[a] * (p[a] - point[a])).sum::<f64>()).abs()
+            }
+            ObjectSpec::Polygon { .. } | ObjectSpec::Triangle { .. } => f64::INFINITY,
+        }
+    }
+
     fn text(&self, scale: f64, materials: usize) -> String {
         let s = |p: [f64; 3]| p.map(|c| c * scale);
         let m = |i: usize| format!("m{}", i % materials);
