@@ -11,7 +11,8 @@
 //! rounding, as deep paths in curved mirror and glass cavities are), and GPU-versus-CPU
 //! differences there say nothing about the GPU. With `--twin DIR` it compares each
 //! scene's CPU image with the CPU image of `DIR/` + the same file name (for example
-//! the scene with every coordinate moved by one f32 ulp).
+//! the scene with every coordinate moved by one f32 ulp). `--pixels` prints the pixels
+//! outside the tolerance.
 
 #[path = "../tests/common/mod.rs"]
 #[allow(dead_code)]
@@ -33,6 +34,10 @@ fn main() {
         args.drain(i..i + 2);
         value
     });
+    let pixels = args
+        .iter()
+        .position(|a| a == "--pixels")
+        .map(|i| args.remove(i));
     let twin = args.iter().position(|a| a == "--twin").map(|i| {
         let dir = args.get(i + 1).cloned().expect("--twin needs a folder");
         args.drain(i..i + 2);
@@ -40,19 +45,15 @@ fn main() {
     });
     let cpu_image = |path: &std::path::Path| {
         let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{e}"));
-        let scene =
-            gpu_render::scene::parse_scene(&text, path).unwrap_or_else(|e| panic!("{e}"));
+        let scene = gpu_render::scene::parse_scene(&text, path).unwrap_or_else(|e| panic!("{e}"));
         gpu_render::cpu::render(&scene, None).image
     };
     for path in args {
         if let Some(dir) = &twin {
             let own = std::path::Path::new(&path);
             let other = dir.join(own.file_name().expect("a file name"));
-            let c = common::compare::measure(
-                &cpu_image(own),
-                &cpu_image(&other),
-                pipeline::TOLERANCE,
-            );
+            let c =
+                common::compare::measure(&cpu_image(own), &cpu_image(&other), pipeline::TOLERANCE);
             println!(
                 "{path}: CPU against {}: {} of {} pixels outside tolerance, max |Δ| {:.2e}",
                 other.display(),
@@ -71,6 +72,19 @@ fn main() {
             Err(fail) => {
                 failed += 1;
                 println!("{path}: FAILS: {}", fail.reason);
+                if let (Some(_), Some((cpu, gpu))) = (&pixels, &fail.images) {
+                    for (i, (c, g)) in cpu.pixels.iter().zip(&gpu.pixels).enumerate() {
+                        if (0..3).any(|k| !pipeline::TOLERANCE.channel_passes(c[k], g[k])) {
+                            println!(
+                                "  ({}, {}): cpu {:?} gpu {:?}",
+                                i as u32 % cpu.width,
+                                i as u32 / cpu.width,
+                                &c[..3],
+                                &g[..3]
+                            );
+                        }
+                    }
+                }
             }
         }
         if let Some(relative) = perturb {

@@ -55,9 +55,12 @@ pub fn scene_text() -> impl Strategy<Value = String> {
         // t ≈ 0, depend on the last bit), and shrinking drives coordinates to 0, onto
         // the ground spheres' tops: keep the eye 1e-3 (in units of the scale) off every
         // sphere and plane.
-        .prop_filter("the eye lies on a surface", |(_, camera, _, _, _, objects)| {
-            objects.iter().all(|o| o.distance_from(camera.eye) > 1e-3)
-        })
+        .prop_filter(
+            "the eye lies on a surface",
+            |(_, camera, _, _, _, objects)| {
+                objects.iter().all(|o| o.distance_from(camera.eye) > 1e-3)
+            },
+        )
         .prop_map(
             |(settings, camera, environment, materials, lights, objects)| {
                 let mut text = String::new();
