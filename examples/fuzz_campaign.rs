@@ -17,7 +17,6 @@
 //! the rest are counted, and most are more of the same).
 
 #[path = "../tests/common/mod.rs"]
-#[allow(dead_code)]
 mod common;
 #[path = "../tests/common/pipeline.rs"]
 #[allow(dead_code)]

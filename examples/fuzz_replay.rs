@@ -15,7 +15,6 @@
 //! outside the tolerance.
 
 #[path = "../tests/common/mod.rs"]
-#[allow(dead_code)]
 mod common;
 #[path = "../tests/common/pipeline.rs"]
 #[allow(dead_code)]

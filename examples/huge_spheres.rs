@@ -120,7 +120,7 @@ fn main() {
             for k in 0..3 {
                 let d = (c[k] - g[k]).abs();
                 max_abs = max_abs.max(if d.is_nan() { f32::INFINITY } else { d });
-                outlier |= !(d <= 1e-3 + 5e-3 * c[k].abs());
+                outlier |= d.is_nan() || d > 1e-3 + 5e-3 * c[k].abs();
             }
             outliers += usize::from(outlier);
         }

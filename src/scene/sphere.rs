@@ -67,13 +67,18 @@ impl SpherePrecision {
 
     /// Whether the CPU reference cannot place the sphere to [`SPHERE_PRECISION_LIMIT`].
     pub fn cpu_hopeless(&self) -> bool {
-        !(self.cpu_relative() <= SPHERE_PRECISION_LIMIT)
+        beyond_the_limit(self.cpu_relative())
     }
 
     /// Whether the GPU cannot place the sphere to [`SPHERE_PRECISION_LIMIT`].
     pub fn gpu_hopeless(&self) -> bool {
-        !(self.gpu_relative() <= SPHERE_PRECISION_LIMIT)
+        beyond_the_limit(self.gpu_relative())
     }
+}
+
+/// Whether a relative error exceeds [`SPHERE_PRECISION_LIMIT`] (NaN counts as exceeding).
+fn beyond_the_limit(relative: f64) -> bool {
+    relative.is_nan() || relative > SPHERE_PRECISION_LIMIT
 }
 
 /// How precisely the CPU reference and the GPU place the surface of the sphere

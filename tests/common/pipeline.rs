@@ -13,7 +13,8 @@
 //!   roughness 0 and 1, indices of refraction from 1 to 10, 1.0001, metallic 0 and 1,
 //!   Oren-Nayar σ 90°);
 //! - up to 40 lights, point and directional, some with intensities of 1e30;
-//! - spheres (including "ground" spheres of radius up to 1e4 times the scale, tangent
+//! - spheres (including "ground" spheres of radius up to 1e4 times the scale
+//!   (and 1e8, since spheres are intersected relative to their anchor), tangent
 //!   pairs and up to 7 concentric dielectric shells, more than the medium stack's 4),
 //!   planes, polygons of up to 300 vertices (regular, star-shaped and so concave) in any
 //!   orientation, and triangles, some of them slivers.
@@ -546,10 +547,11 @@ impl ObjectSpec {
                 if *sliver {
                     // The third corner 1e-3 of the way from the first edge's midpoint
                     // towards itself: thin, but far from the loader's 1e-12 limit.
-                    for a in 0..3 {
-                        let mid = 0.5 * (v[0][a] + v[1][a]);
-                        v[2][a] = mid + 1e-3 * (v[2][a] - mid);
-                    }
+                    let (a, b, c) = (v[0], v[1], v[2]);
+                    v[2] = [0, 1, 2].map(|k| {
+                        let mid = 0.5 * (a[k] + b[k]);
+                        mid + 1e-3 * (c[k] - mid)
+                    });
                 }
                 format!(
                     "[[objects]]\ntype = \"triangle\"\nvertices = [{}, {}, {}]\nmaterial = \"{}\"\n\n",
@@ -578,7 +580,7 @@ fn object() -> impl Strategy<Value = ObjectSpec> {
         4 => (point(3.0), radius.clone(), material.clone()).prop_map(|(center, radius, material)| {
             ObjectSpec::Sphere { center, radius, material }
         }),
-        1 => (point(2.0), prop::sample::select(vec![10.0, 1e3, 1e4]), material.clone())
+        1 => (point(2.0), prop::sample::select(vec![10.0, 1e3, 1e4, 1e8]), material.clone())
             .prop_map(|(at, radius, material)| ObjectSpec::Ground { at, radius, material }),
         1 => (point(2.0), radius.clone(), material.clone()).prop_map(|(center, radius, material)| {
             ObjectSpec::Tangent { center, radius, material }
