@@ -53,13 +53,25 @@ pub fn scene_text() -> impl Strategy<Value = String> {
         prop::collection::vec(object(), 0..7),
     )
         // A camera on a surface is ill-posed (which side it is on, and the first hit at
-        // t ≈ 0, depend on the last bit), and shrinking drives coordinates to 0, onto
-        // the ground spheres' tops: keep the eye 1e-3 (in units of the scale) off every
-        // sphere and plane.
+        // t ≈ 0, depend on the last bit), and so is a point light on one (the surface
+        // around it is lit at cos θ ≈ 0, whose sign and relative size are rounding);
+        // shrinking drives coordinates to 0, onto the ground spheres' tops. Keep the
+        // eye and the point lights 1e-3 (in units of the scale) off every sphere and
+        // plane.
         .prop_filter(
-            "the eye lies on a surface",
-            |(_, camera, _, _, _, objects)| {
-                objects.iter().all(|o| o.distance_from(camera.eye) > 1e-3)
+            "the eye or a point light lies on a surface",
+            |(_, camera, _, _, lights, objects)| {
+                let points = lights
+                    .iter()
+                    .filter_map(|l| match l {
+                        LightSpec::Point { position, .. } => Some(*position),
+                        LightSpec::Directional { .. } => None,
+                    })
+                    .chain(std::iter::once(camera.eye))
+                    .collect::<Vec<_>>();
+                objects
+                    .iter()
+                    .all(|o| points.iter().all(|&p| o.distance_from(p) > 1e-3))
             },
         )
         .prop_map(
