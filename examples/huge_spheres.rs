@@ -9,7 +9,7 @@
 //! the table.
 //!
 //! ```sh
-//! XDG_RUNTIME_DIR=/tmp/xdg WGPU_BACKEND=vulkan cargo run --release --example huge_spheres
+//! XDG_RUNTIME_DIR=/tmp/xdg WGPU_BACKEND=vulkan cargo run --example huge_spheres
 //! ```
 
 use std::path::Path;
