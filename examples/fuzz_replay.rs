@@ -11,8 +11,10 @@
 //! rounding, as deep paths in curved mirror and glass cavities are), and GPU-versus-CPU
 //! differences there say nothing about the GPU. With `--twin DIR` it compares each
 //! scene's CPU image with the CPU image of `DIR/` + the same file name (for example
-//! the scene with every coordinate moved by one f32 ulp). `--pixels` prints the pixels
-//! outside the tolerance.
+//! the scene with every coordinate moved by one f32 ulp). `--f32-inputs` compares each
+//! scene's CPU image with the CPU image of the same scene with its camera, lights and
+//! shapes rounded to `f32`, the GPU's inputs: where they differ, input rounding alone
+//! explains a GPU difference. `--pixels` prints the pixels outside the tolerance.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -37,6 +39,10 @@ fn main() {
         .iter()
         .position(|a| a == "--pixels")
         .map(|i| args.remove(i));
+    let f32_inputs = args
+        .iter()
+        .position(|a| a == "--f32-inputs")
+        .map(|i| args.remove(i));
     let twin = args.iter().position(|a| a == "--twin").map(|i| {
         let dir = args.get(i + 1).cloned().expect("--twin needs a folder");
         args.drain(i..i + 2);
@@ -48,6 +54,24 @@ fn main() {
         gpu_render::cpu::render(&scene, None).image
     };
     for path in args {
+        if f32_inputs.is_some() {
+            let own = std::path::Path::new(&path);
+            let text = std::fs::read_to_string(own).unwrap_or_else(|e| panic!("{e}"));
+            let scene =
+                gpu_render::scene::parse_scene(&text, own).unwrap_or_else(|e| panic!("{e}"));
+            let rounded = rounded_to_f32(&scene);
+            let c = common::compare::measure(
+                &gpu_render::cpu::render(&scene, None).image,
+                &gpu_render::cpu::render(&rounded, None).image,
+                pipeline::TOLERANCE,
+            );
+            println!(
+                "{path}: CPU against CPU on f32 inputs: {} of {} pixels outside tolerance, \
+                 max |Δ| {:.2e}",
+                c.outliers, c.pixels, c.max_abs_error
+            );
+            continue;
+        }
         if let Some(dir) = &twin {
             let own = std::path::Path::new(&path);
             let other = dir.join(own.file_name().expect("a file name"));
@@ -102,4 +126,48 @@ fn main() {
         }
     }
     std::process::exit(i32::from(failed > 0));
+}
+
+/// `scene` with its camera, lights and shapes rounded to `f32`, as the GPU receives them.
+fn rounded_to_f32(scene: &gpu_render::scene::Scene) -> gpu_render::scene::Scene {
+    use gpu_render::scene::{Light, Shape};
+    let v = |v: glam::DVec3| v.as_vec3().as_dvec3();
+    let x = |x: f64| f64::from(x as f32);
+    let mut rounded = scene.clone();
+    rounded.camera.eye = v(scene.camera.eye);
+    rounded.camera.look_at = v(scene.camera.look_at);
+    rounded.camera.up = v(scene.camera.up);
+    for light in &mut rounded.lights {
+        match light {
+            Light::Point {
+                position,
+                intensity,
+            } => {
+                *position = v(*position);
+                *intensity = v(*intensity);
+            }
+            Light::Directional {
+                direction,
+                irradiance,
+            } => {
+                *direction = v(*direction);
+                *irradiance = v(*irradiance);
+            }
+        }
+    }
+    for shape in &mut rounded.shapes {
+        match shape {
+            Shape::Sphere { center, radius, .. } => {
+                *center = v(*center);
+                *radius = x(*radius);
+            }
+            Shape::Plane { normal, offset, .. } => {
+                *normal = v(*normal);
+                *offset = x(*offset);
+            }
+            Shape::Polygon { vertices, .. } => vertices.iter_mut().for_each(|p| *p = v(*p)),
+            Shape::Triangle { vertices, .. } => vertices.iter_mut().for_each(|p| *p = v(*p)),
+        }
+    }
+    rounded
 }
