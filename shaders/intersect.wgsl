@@ -123,14 +123,23 @@ fn triangle_normal(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> vec3<f32> {
 //#endif
 
 //#if SPHERES
+// The unit outward normal at p of the sphere of radius `radius` through `anchor`, whose
+// outward normal there is `normal`: (p - c)/r = (p - anchor)/r + normal, normalized.
+fn sphere_normal(p: vec3<f32>, anchor: vec3<f32>, normal: vec3<f32>, radius: f32) -> vec3<f32> {
+    return normalize((p - anchor) / radius + normal);
+}
+
 // A point moved radially onto the sphere, c + r·normalize(p - c) (Wächter and Binder,
 // Ray Tracing Gems, ch. 6, §6.2.1): its error is then relative to its own magnitude,
 // not to the length of the ray that found it, as the ulp-scaled offset assumes.
-fn project_onto_sphere(p: vec3<f32>, center: vec3<f32>, radius: f32) -> vec3<f32> {
-    let from_center = p - center;
-    let length_squared = dot(from_center, from_center);
-    if length_squared > 0.0 {
-        return center + from_center * (radius / sqrt(length_squared));
+// Relative to the anchor: with y = (p - anchor)/r and m = y + n, p - r·(|m| - 1)·m/|m|,
+// where |m| - 1 = y·(y + 2n)/(|m| + 1) cancels nothing.
+fn project_onto_sphere(p: vec3<f32>, anchor: vec3<f32>, normal: vec3<f32>, radius: f32) -> vec3<f32> {
+    let y = (p - anchor) / radius;
+    let m = y + normal;
+    let len = length(m);
+    if len > 0.0 {
+        return p - m * (dot(y, y + 2.0 * normal) / (len * (len + 1.0)) * radius);
     }
     return p;
 }
@@ -157,24 +166,32 @@ fn nearest_root(t0: f32, t1: f32, t_max: f32) -> f32 {
 //#if SPHERES
 // Ray/sphere in the stable form of Haines, Günther and Akenine-Möller, "Precision
 // Improvements for Ray/Sphere Intersection" (Ray Tracing Gems, ch. 7): the lecture's
-// s = -u·ΔP ± sqrt((u·ΔP)² - |ΔP|² + r²), with the discriminant taken from the distance
-// between the centre and the ray's closest point, and the smaller root as c/q.
-fn intersect_sphere(ray: Ray, center: vec3<f32>, radius: f32, t_max: f32) -> f32 {
-    let f = ray.origin - center;
-    let b = -dot(f, ray.direction);
-    let closest = f + ray.direction * b;
-    let discriminant = radius * radius - dot(closest, closest);
+// s = -u·ΔP ± sqrt((u·ΔP)² - |ΔP|² + r²), with the discriminant taken from the ray's
+// closest approach and the smaller root as c/q, solved relative to the sphere's anchor
+// (its point nearest the origin, outward normal n there) in units of its radius, so that
+// no term is the square of the distance to a centre that may be 1e10 away: with
+// g = (o - anchor)/r, b = -(g·u + n·u), discriminant (n·u)² - g⊥·(g⊥ + 2n) with
+// g⊥ = g - (g·u)u, and c = g·(g + 2n).
+fn intersect_sphere(ray: Ray, anchor: vec3<f32>, normal: vec3<f32>, radius: f32, t_max: f32) -> f32 {
+    let u = ray.direction;
+    let g = (ray.origin - anchor) / radius;
+    let g_along = dot(g, u);
+    let n_along = dot(normal, u);
+    let b = -(g_along + n_along);
+    let g_perp = g - u * g_along;
+    let discriminant = n_along * n_along - dot(g_perp, g_perp + 2.0 * normal);
     if !(discriminant >= 0.0) {
         return NO_HIT;
     }
-    let c = dot(f, f) - radius * radius;
+    let c = dot(g, g + 2.0 * normal);
     let sign_b = select(-1.0, 1.0, b >= 0.0);
     let q = b + sign_b * sqrt(discriminant);
     if q == 0.0 {
         return NO_HIT;
     }
-    let r0 = c / q;
-    return nearest_root(min(r0, q), max(r0, q), t_max);
+    let r0 = c / q * radius;
+    let r1 = q * radius;
+    return nearest_root(min(r0, r1), max(r0, r1), t_max);
 }
 //#endif
 
@@ -341,7 +358,7 @@ fn intersect_prim(prim: u32, ray: Ray, sheared: ShearedRay, t_max: f32) -> f32 {
         //#if SPHERES
         case PRIM_SPHERE: {
             let sphere = spheres[i];
-            return intersect_sphere(ray, sphere.center, sphere.radius, t_max);
+            return intersect_sphere(ray, sphere.anchor, sphere.normal, sphere.radius, t_max);
         }
         //#endif
         //#if PLANES
@@ -377,8 +394,9 @@ fn hit_record(prim: u32, ray: Ray, t: f32) -> Hit {
         //#if SPHERES
         case PRIM_SPHERE: {
             let sphere = spheres[i];
-            return flat_hit(prim, t, normalize(p - sphere.center), sphere.material,
-                            project_onto_sphere(p, sphere.center, sphere.radius));
+            return flat_hit(prim, t, sphere_normal(p, sphere.anchor, sphere.normal, sphere.radius),
+                            sphere.material,
+                            project_onto_sphere(p, sphere.anchor, sphere.normal, sphere.radius));
         }
         //#endif
         //#if PLANES

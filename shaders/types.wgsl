@@ -44,12 +44,13 @@ const FLAG_STORE_SUM: u32 = 1u;
 // an exit, as a driver that cuts loops makes them do.
 const FLAG_SIMULATE_LOOP_CUT: u32 = 2u;
 
+// A sphere through its anchor (its point nearest the origin) with the outward normal
+// there: see src/scene/sphere.rs.
 struct Sphere {
-    center: vec3<f32>,
+    anchor: vec3<f32>,
     radius: f32,
+    normal: vec3<f32>,
     material: u32,
-    // Not vec3<u32>: that is 16-byte aligned and would grow the struct to 48 bytes.
-    _pad: array<u32, 3>,
 }
 
 // The plane normal · p = offset.

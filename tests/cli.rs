@@ -853,3 +853,60 @@ fn a_scene_may_choose_its_integrator_and_a_bad_one_is_named() {
     assert_fails_with(&run, &["scene.toml:3", "photon", "whitted", "path"]);
     ws.assert_old_output_kept();
 }
+
+/// A sphere only the CPU reference's f64 can place (a unit sphere a million units out,
+/// seen from 5 units): the load warning names it and its precision on both backends,
+/// and `--backend auto` renders on the CPU and says why (or, with no GPU at all, says
+/// that). A ground sphere of radius 1000 loads without a warning.
+#[test]
+fn a_sphere_beyond_the_gpus_precision_is_warned_about_and_auto_renders_on_the_cpu() {
+    let far = TINY_SCENE
+        .replace("eye = [0.0, 0.0, 3.0]", "eye = [1000000.0, 0.0, 6.0]")
+        .replace(
+            "look_at = [0.0, 0.0, 0.0]",
+            "look_at = [1000000.0, 0.0, 0.0]",
+        )
+        .replace(
+            "position = [0.0, 2.0, 3.0]",
+            "position = [1000000.0, 2.0, 3.0]",
+        )
+        .replace("center = [0.0, 0.0, 0.0]", "center = [1000000.0, 0.0, 0.0]");
+    let ws = Workspace::new(&far);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "auto",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(
+        run.stderr.contains("warning: ")
+            && run.stderr.contains("objects[0] (sphere): radius 1e0")
+            && run.stderr.contains("on the CPU reference (f64")
+            && run.stderr.contains("the GPU cannot place it"),
+        "{}",
+        run.stderr
+    );
+    assert!(
+        run.stderr
+            .contains("CPU reference (auto: a sphere of radius 1e0")
+            || run.stderr.contains("CPU reference (auto: no GPU adapter"),
+        "{}",
+        run.stderr
+    );
+
+    let ground = TINY_SCENE
+        .replace("center = [0.0, 0.0, 0.0]", "center = [0.0, -1001.0, 0.0]")
+        .replace("radius = 1.0", "radius = 1000.0");
+    let ws = Workspace::new(&ground);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(!run.stderr.contains("warning"), "{}", run.stderr);
+}

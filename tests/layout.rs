@@ -64,10 +64,10 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
         (
             "Sphere",
             twin!(GpuSphere {
-                center,
+                anchor,
                 radius,
-                material,
-                _pad
+                normal,
+                material
             }),
         ),
         (

@@ -69,13 +69,18 @@ impl PrimRef {
     }
 }
 
-/// A sphere.
+/// A sphere, with the anchor both tracers intersect it relative to
+/// ([`crate::scene::sphere_anchor`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SphereShape {
     /// Centre.
     pub center: DVec3,
     /// Radius (> 0).
     pub radius: f64,
+    /// The sphere's point nearest the world origin.
+    pub anchor: DVec3,
+    /// The unit outward normal at `anchor`.
+    pub anchor_normal: DVec3,
     /// Material index.
     pub material: u32,
 }
@@ -189,11 +194,16 @@ impl SceneGeometry {
                     center,
                     radius,
                     material,
-                } => geometry.spheres.push(SphereShape {
-                    center: *center,
-                    radius: *radius,
-                    material: *material,
-                }),
+                } => {
+                    let (anchor, anchor_normal) = crate::scene::sphere_anchor(*center, *radius);
+                    geometry.spheres.push(SphereShape {
+                        center: *center,
+                        radius: *radius,
+                        anchor,
+                        anchor_normal,
+                        material: *material,
+                    });
+                }
                 Shape::Plane {
                     normal,
                     offset,
@@ -247,9 +257,11 @@ impl SceneGeometry {
         let index = |i: usize| u32::try_from(i).unwrap_or(PrimRef::MAX_INDEX);
         let spheres = self.spheres.iter().enumerate().map(|(i, s)| {
             let r = DVec3::splat(s.radius);
-            // The f32 sphere the GPU intersects, widened by both roundings.
-            let c32 = s.center.as_vec3().as_dvec3();
-            let r32 = DVec3::splat(f64::from(s.radius as f32));
+            // The f32 sphere the GPU intersects (through its f32 anchor, with its f32
+            // normal and radius), widened by both roundings.
+            let r32 = f64::from(s.radius as f32);
+            let c32 = s.anchor.as_vec3().as_dvec3() - s.anchor_normal.as_vec3().as_dvec3() * r32;
+            let r32 = DVec3::splat(r32 * (1.0 + 4.0 * f64::from(f32::EPSILON)));
             let lo = (s.center - r).min(c32 - r32);
             let hi = (s.center + r).max(c32 + r32);
             (

@@ -64,7 +64,7 @@ pub fn intersect_prim(
     match prim.kind() {
         PrimKind::Sphere => {
             let s = &geometry.spheres[i];
-            intersect_sphere(ray, s.center, s.radius, t_max)
+            intersect_sphere(ray, s.anchor, s.anchor_normal, s.radius, t_max)
         }
         PrimKind::Polygon => {
             let p = &geometry.polygons[i];
@@ -95,8 +95,8 @@ pub fn hit_record(geometry: &SceneGeometry, prim: PrimRef, ray: &Ray, t: f64) ->
         PrimKind::Sphere => {
             let s = &geometry.spheres[i];
             (
-                (point - s.center).normalize(),
-                project_onto_sphere(point, s.center, s.radius),
+                sphere_normal(point, s.anchor, s.anchor_normal, s.radius),
+                project_onto_sphere(point, s.anchor, s.anchor_normal, s.radius),
             )
         }
         PrimKind::Polygon => {
@@ -212,13 +212,25 @@ pub fn triangle_normal(vertices: &[DVec3; 3]) -> DVec3 {
         .normalize()
 }
 
+/// The unit outward normal at `point` of the sphere of radius `radius` through
+/// `anchor`, whose outward normal there is `normal` (see [`crate::scene::sphere_anchor`]):
+/// `(p - c)/r = (p - anchor)/r + normal`, normalized, without forming the centre.
+pub fn sphere_normal(point: DVec3, anchor: DVec3, normal: DVec3, radius: f64) -> DVec3 {
+    ((point - anchor) / radius + normal).normalize()
+}
+
 /// `point` moved radially onto the sphere: `c + r·normalize(p - c)` (Ray Tracing
-/// Gems, ch. 6, §6.2.1). A point at the centre (never a hit) is returned unchanged.
-pub fn project_onto_sphere(point: DVec3, center: DVec3, radius: f64) -> DVec3 {
-    let from_center = point - center;
-    let length_squared = from_center.dot(from_center);
-    if length_squared > 0.0 {
-        center + from_center * (radius / length_squared.sqrt())
+/// Gems, ch. 6, §6.2.1), relative to the anchor: with `m = (p - c)/r = y + n` and
+/// `y = (p - anchor)/r`, the point is `p - r·(|m| - 1)·m/|m|`, and `|m| - 1 =
+/// y·(y + 2n) / (|m| + 1)` cancels nothing, where `c + r·m/|m|` would round the
+/// surface to the precision of a centre far away. A point at the centre (never a hit)
+/// is returned unchanged.
+pub fn project_onto_sphere(point: DVec3, anchor: DVec3, normal: DVec3, radius: f64) -> DVec3 {
+    let y = (point - anchor) / radius;
+    let m = y + normal;
+    let length = m.length();
+    if length > 0.0 {
+        point - m * (y.dot(y + 2.0 * normal) / (length * (length + 1.0)) * radius)
     } else {
         point
     }
@@ -232,27 +244,47 @@ pub fn project_onto_plane(point: DVec3, normal: DVec3, offset: f64) -> DVec3 {
 
 /// Ray/sphere intersection in the numerically stable form of Haines, Günther and
 /// Akenine-Möller, "Precision Improvements for Ray/Sphere Intersection" (Ray Tracing
-/// Gems, ch. 7). It solves the lecture's `s = -u·ΔP ± sqrt((u·ΔP)² - |ΔP|² + r²)`, but
-/// takes the discriminant from the distance between the centre and the ray's closest
-/// point, `r² - |ΔP - (u·ΔP)u|²`, and the smaller root as `c/q`, which avoids the
-/// cancellations that make the textbook form fail for small or distant spheres.
-pub fn intersect_sphere(ray: &Ray, center: DVec3, radius: f64, t_max: f64) -> Option<f64> {
-    let f = ray.origin - center;
-    let b = -f.dot(ray.direction);
-    let closest = f + ray.direction * b;
-    let discriminant = radius * radius - closest.dot(closest);
+/// Gems, ch. 7): the lecture's `s = -u·ΔP ± sqrt((u·ΔP)² - |ΔP|² + r²)` with the
+/// discriminant taken from the ray's closest approach and the smaller root as `c/q`,
+/// solved relative to the sphere's anchor (its point nearest the origin, with outward
+/// normal `normal`; [`crate::scene::sphere_anchor`]) in units of its radius. With
+/// `g = (o - anchor)/r`, `ΔP/r = g + n`, and
+///
+/// - `b = -(g·u + n·u)`,
+/// - the discriminant `1 - |(g + n)⊥|² = (n·u)² - g⊥·(g⊥ + 2n)`, `g⊥ = g - (g·u)u`,
+/// - `c = |g + n|² - 1 = g·(g + 2n)`,
+///
+/// none of which is the square of the distance to the centre: a sphere of radius 1e10
+/// resting on the origin keeps the precision of the scene around its anchor, where
+/// `|ΔP|² - r²` would keep that of a point 1e10 away (ulp 1024 in f32) and lose the
+/// surface entirely (`docs/numerics.md`). For a ray that can hit, `|g⊥| <= 2`, so the
+/// discriminant's terms are at most 8 and lose at most 3 bits more than Haines's.
+pub fn intersect_sphere(
+    ray: &Ray,
+    anchor: DVec3,
+    normal: DVec3,
+    radius: f64,
+    t_max: f64,
+) -> Option<f64> {
+    let u = ray.direction;
+    let g = (ray.origin - anchor) / radius;
+    let g_along = g.dot(u);
+    let n_along = normal.dot(u);
+    let b = -(g_along + n_along);
+    let g_perp = g - u * g_along;
+    let discriminant = n_along * n_along - g_perp.dot(g_perp + 2.0 * normal);
     // NaN (from an overflowing square) is a miss, like a negative discriminant.
     if discriminant.is_nan() || discriminant < 0.0 {
         return None;
     }
-    let c = f.dot(f) - radius * radius;
+    let c = g.dot(g + 2.0 * normal);
     // sign(b) with sign(0) = +1, as the WGSL twin computes it.
     let sign_b = if b >= 0.0 { 1.0 } else { -1.0 };
     let q = b + sign_b * discriminant.sqrt();
     let (t0, t1) = if q == 0.0 {
         (0.0, 0.0)
     } else {
-        let (a, b) = (c / q, q);
+        let (a, b) = (c / q * radius, q * radius);
         (a.min(b), a.max(b))
     };
     if t0 > 0.0 && t0 < t_max {
@@ -433,29 +465,50 @@ mod tests {
         }
     }
 
+    /// [`intersect_sphere`] of the sphere (`center`, `radius`) through its anchor.
+    fn sphere_at(ray: &Ray, center: DVec3, radius: f64, t_max: f64) -> Option<f64> {
+        let (anchor, normal) = crate::scene::sphere_anchor(center, radius);
+        intersect_sphere(ray, anchor, normal, radius, t_max)
+    }
+
     #[test]
     fn sphere_hit_from_outside_and_inside() {
         let r = ray(DVec3::new(0.0, 0.0, 5.0), DVec3::NEG_Z);
-        let t = intersect_sphere(&r, DVec3::ZERO, 1.0, f64::INFINITY).expect("hit");
+        let t = sphere_at(&r, DVec3::ZERO, 1.0, f64::INFINITY).expect("hit");
         assert!((t - 4.0).abs() < 1e-12);
         let inside = ray(DVec3::ZERO, DVec3::X);
-        let t = intersect_sphere(&inside, DVec3::ZERO, 2.0, f64::INFINITY).expect("hit");
+        let t = sphere_at(&inside, DVec3::ZERO, 2.0, f64::INFINITY).expect("hit");
         assert!((t - 2.0).abs() < 1e-12);
         let miss = ray(DVec3::new(0.0, 1.5, 5.0), DVec3::NEG_Z);
-        assert!(intersect_sphere(&miss, DVec3::ZERO, 1.0, f64::INFINITY).is_none());
+        assert!(sphere_at(&miss, DVec3::ZERO, 1.0, f64::INFINITY).is_none());
         // Behind the origin: no hit.
         let away = ray(DVec3::new(0.0, 0.0, 5.0), DVec3::Z);
-        assert!(intersect_sphere(&away, DVec3::ZERO, 1.0, f64::INFINITY).is_none());
+        assert!(sphere_at(&away, DVec3::ZERO, 1.0, f64::INFINITY).is_none());
         // t_max excludes the hit.
-        assert!(intersect_sphere(&r, DVec3::ZERO, 1.0, 3.9).is_none());
+        assert!(sphere_at(&r, DVec3::ZERO, 1.0, 3.9).is_none());
     }
 
     #[test]
     fn sphere_far_away_keeps_precision() {
         // A unit sphere 1e6 units away: the textbook form loses most digits here.
         let r = ray(DVec3::new(0.0, 0.0, 1e6), DVec3::NEG_Z);
-        let t = intersect_sphere(&r, DVec3::ZERO, 1.0, f64::INFINITY).expect("hit");
+        let t = sphere_at(&r, DVec3::ZERO, 1.0, f64::INFINITY).expect("hit");
         assert!((t - (1e6 - 1.0)).abs() < 1e-8, "t = {t}");
+    }
+
+    #[test]
+    fn huge_sphere_resting_on_the_origin_keeps_precision() {
+        // Radius 1e20, centre (0, -1e20, 0): |ΔP|² - r² would be 1e40 ± 1e24 in f64.
+        // From (0, 3, 4) towards the origin the hit is the origin itself, t = 5.
+        let r = ray(DVec3::new(0.0, 3.0, 4.0), DVec3::new(0.0, -3.0, -4.0));
+        let t = sphere_at(&r, DVec3::new(0.0, -1e20, 0.0), 1e20, f64::INFINITY).expect("hit");
+        assert!((t - 5.0).abs() < 1e-12, "t = {t}");
+        let (anchor, normal) = crate::scene::sphere_anchor(DVec3::new(0.0, -1e20, 0.0), 1e20);
+        let n = sphere_normal(r.at(t), anchor, normal, 1e20);
+        assert!((n - DVec3::Y).length() < 1e-12, "{n}");
+        // A point 1 unit above the surface is projected onto it, not 1e4 away.
+        let p = project_onto_sphere(DVec3::new(2.0, 1.0, 0.0), anchor, normal, 1e20);
+        assert!((p - DVec3::new(2.0, 0.0, 0.0)).length() < 1e-12, "{p}");
     }
 
     #[test]

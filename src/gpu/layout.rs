@@ -229,14 +229,14 @@ pub const ERROR_TRAVERSAL_STACK: u32 = 2;
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuSphere {
-    /// Centre.
-    pub center: [f32; 3],
+    /// The sphere's point nearest the world origin (`crate::scene::sphere_anchor`).
+    pub anchor: [f32; 3],
     /// Radius.
     pub radius: f32,
+    /// The unit outward normal at `anchor`.
+    pub normal: [f32; 3],
     /// Material index.
     pub material: u32,
-    /// Padding.
-    pub _pad: [u32; 3],
 }
 
 /// An infinite plane `normal · p = offset` (`Plane` in WGSL).

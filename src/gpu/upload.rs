@@ -59,10 +59,10 @@ impl SceneRecords {
                 .spheres
                 .iter()
                 .map(|s| GpuSphere {
-                    center: vec3(s.center),
+                    anchor: vec3(s.anchor),
                     radius: s.radius as f32,
+                    normal: vec3(s.anchor_normal),
                     material: s.material,
-                    _pad: [0; 3],
                 })
                 .collect(),
             planes: geometry
@@ -528,7 +528,11 @@ mod tests {
         );
         let geometry = SceneGeometry::new(&s);
         let r = SceneRecords::new(&s, &geometry);
-        assert_eq!(r.spheres[0].center, [1.0, 2.0, 3.0]);
+        // The anchor: the sphere's point nearest the origin, 0.5 from (1, 2, 3) towards it.
+        let towards_origin = -DVec3::new(1.0, 2.0, 3.0).normalize();
+        let anchor = DVec3::new(1.0, 2.0, 3.0) + towards_origin * 0.5;
+        assert_eq!(r.spheres[0].anchor, anchor.as_vec3().to_array());
+        assert_eq!(r.spheres[0].normal, towards_origin.as_vec3().to_array());
         assert_eq!(r.spheres[0].radius, 0.5);
         assert_eq!(r.planes[0].offset, -1.0);
         assert_eq!(r.polygons.len(), 2);

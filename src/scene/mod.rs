@@ -8,6 +8,7 @@ mod image;
 pub mod import;
 mod medium;
 mod model;
+mod sphere;
 
 pub use animation::{CameraKey, CameraPath, Interpolation, MAX_FRAMES};
 pub use error::{SceneError, SceneWarning};
@@ -19,3 +20,6 @@ pub use file::{
 pub use image::{MAX_IMAGE_SIDE, load_image};
 pub use medium::{MEDIUM_STACK_SIZE, MediumStack};
 pub use model::*;
+pub use sphere::{
+    SPHERE_PRECISION_LIMIT, SpherePrecision, sphere_anchor, sphere_level, sphere_precision,
+};

@@ -605,7 +605,12 @@ pub struct DielectricSphere {
 pub fn media_around(eye: DVec3, spheres: &[DielectricSphere]) -> Vec<f64> {
     let mut around: Vec<(f64, f64)> = spheres
         .iter()
-        .filter(|s| eye.distance(s.center) < s.radius)
+        .filter(|s| {
+            // Inside, decided relative to the anchor: a centre 1e20 away would leave
+            // |eye - c| without the digits that say.
+            let (anchor, normal) = super::sphere_anchor(s.center, s.radius);
+            super::sphere_level(eye, anchor, normal, s.radius) < 0.0
+        })
         .map(|s| (s.radius, s.ior))
         .collect();
     around.sort_by(|a, b| b.0.total_cmp(&a.0));

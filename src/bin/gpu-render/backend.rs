@@ -242,9 +242,17 @@ impl Backend {
 /// (whose loops have no limit, `gpu::driver_loop_limit`) on scenes without polygons
 /// and without glass (2.7x on the direct-light scene, 1.2x on spheres and planes);
 /// polygons and refraction make it slower (0.45x on `glass.toml`, 0.5x on the
-/// showcase), and so is every scene on older Mesa. Returns why the CPU reference is
-/// chosen instead, if it is.
+/// showcase), and so is every scene on older Mesa. On any device, a scene with a sphere
+/// that only the CPU reference's f64 places precisely enough (`scene::sphere_precision`:
+/// a small sphere far from the origin seen from close by) renders on the CPU. Returns
+/// why the CPU reference is chosen instead, if it is.
 pub fn auto_rule(adapter: &wgpu::AdapterInfo, scene: &Scene) -> Option<String> {
+    if let Some(radius) = sphere_only_the_cpu_places(scene) {
+        return Some(format!(
+            "a sphere of radius {radius:e} is beyond the GPU's f32 precision here but not \
+             the CPU reference's f64 (see the load warning); --backend gpu uses the GPU anyway"
+        ));
+    }
     if adapter.device_type != wgpu::DeviceType::Cpu {
         return None;
     }
@@ -262,6 +270,18 @@ pub fn auto_rule(adapter: &wgpu::AdapterInfo, scene: &Scene) -> Option<String> {
          uses it anyway",
         adapter.name
     ))
+}
+
+/// The radius of the first sphere that the GPU cannot place precisely enough seen from
+/// the camera while the CPU reference can ([`gpu_render::scene::sphere_precision`]).
+fn sphere_only_the_cpu_places(scene: &Scene) -> Option<f64> {
+    scene.shapes.iter().find_map(|shape| match shape {
+        gpu_render::scene::Shape::Sphere { center, radius, .. } => {
+            let precision = gpu_render::scene::sphere_precision(*center, *radius, scene.camera.eye);
+            (precision.gpu_hopeless() && !precision.cpu_hopeless()).then_some(*radius)
+        }
+        _ => None,
+    })
 }
 
 /// Prints the GPU adapters wgpu can see, one a line, on stdout.
@@ -304,6 +324,30 @@ mod tests {
 
     fn scene(text: &str) -> gpu_render::scene::Scene {
         gpu_render::scene::parse_scene(text, std::path::Path::new("<test>")).expect("scene")
+    }
+
+    #[test]
+    fn auto_prefers_the_cpu_where_only_it_can_place_a_sphere() {
+        let materials = "[materials.m]\ntype = \"lambert\"\nalbedo = 0.5\n";
+        // A unit sphere a million units out seen from 5 units: f32 places it to 0.12.
+        let far = scene(&format!(
+            "[camera]\neye = [1000000, 0, 6]\nlook_at = [1000000, 0, 0]\n{materials}\
+             [[objects]]\ntype = \"sphere\"\ncenter = [1000000, 0, 0]\nradius = 1\nmaterial = \"m\"\n"
+        ));
+        let h200 = adapter("NVIDIA H200", wgpu::DeviceType::DiscreteGpu);
+        let reason = auto_rule(&h200, &far).expect("the CPU places it");
+        assert!(
+            reason.contains("radius 1e0") && reason.contains("f32"),
+            "{reason}"
+        );
+        // A ground sphere of radius 1000 and a hopeless one (both backends) stay on the GPU.
+        for (centre, radius) in [("-1000", "1000"), ("-1e20", "1e20")] {
+            let ground = scene(&format!(
+                "[camera]\neye = [0, 3, 4]\nlook_at = [0, 0, 0]\n{materials}\
+                 [[objects]]\ntype = \"sphere\"\ncenter = [0, {centre}, 0]\nradius = {radius}\nmaterial = \"m\"\n"
+            ));
+            assert_eq!(auto_rule(&h200, &ground), None, "radius {radius}");
+        }
     }
 
     #[test]

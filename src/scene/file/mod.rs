@@ -349,7 +349,18 @@ fn build_scene(
         if object.get_ref().kind.as_deref() == Some("model") {
             models.push(objects::model(source, &table, i, object, base, options)?);
         } else {
-            shapes.push(objects::object(source, &table, i, object)?);
+            let span = object.span();
+            let shape = objects::object(source, &table, i, object)?;
+            if let Some(warn) = options.warning
+                && let Some(message) = objects::sphere_precision_warning(&shape, camera.eye)
+            {
+                warn(
+                    &source
+                        .item(format!("objects[{i}] (sphere)"), Some(span))
+                        .warning(message),
+                );
+            }
+            shapes.push(shape);
         }
     }
     let mut scene = Scene {

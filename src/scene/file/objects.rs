@@ -9,7 +9,7 @@ use super::LoadOptions;
 use super::check::{Item, Source};
 use super::raw::{RawColor, RawObject, RawVec3};
 use crate::scene::import::{ImportedModel, ModelPlacement, import_model};
-use crate::scene::{SceneError, Shape};
+use crate::scene::{SPHERE_PRECISION_LIMIT, SceneError, Shape, sphere_precision};
 
 const SPHERE_FIELDS: &[&str] = &["center", "radius", "material"];
 const PLANE_FIELDS: &[&str] = &["point", "normal", "material"];
@@ -182,6 +182,34 @@ fn sphere(item: &Item<'_>, raw: &RawObject, material: u32) -> Result<Shape, Scen
         radius,
         material,
     })
+}
+
+/// The warning for a sphere that a backend cannot place precisely enough, relative to
+/// its distance from the camera at `eye` (see [`crate::scene::sphere_precision`]), or
+/// `None` for any other shape and for a sphere both backends place well.
+pub fn sphere_precision_warning(shape: &Shape, eye: DVec3) -> Option<String> {
+    let Shape::Sphere { center, radius, .. } = shape else {
+        return None;
+    };
+    let precision = sphere_precision(*center, *radius, eye);
+    let consequence = match (precision.cpu_hopeless(), precision.gpu_hopeless()) {
+        (false, false) => return None,
+        (true, _) => "neither backend can place it precisely: use a plane for a floor",
+        (false, true) => {
+            "the GPU cannot place it precisely (the CPU reference can: --backend auto \
+             renders this scene on the CPU); move the scene nearer the origin"
+        }
+    };
+    Some(format!(
+        "radius {radius:e} at {:.3e} from the camera: its surface is placed to about {:.1e} \
+         units on the CPU reference (f64, {:.1e} of that distance) and {:.1e} on the GPU \
+         (f32, {:.1e}), more than {SPHERE_PRECISION_LIMIT:e}; {consequence}",
+        precision.distance,
+        precision.cpu,
+        precision.cpu_relative(),
+        precision.gpu,
+        precision.gpu_relative(),
+    ))
 }
 
 fn plane(item: &Item<'_>, raw: &RawObject, material: u32) -> Result<Shape, SceneError> {

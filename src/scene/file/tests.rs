@@ -4,8 +4,10 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::parse_scene;
-use crate::scene::{Light, LightingSpace, Material, MaterialKind, RenderSettings, Scene, Shape};
+use super::{LoadOptions, parse_scene, parse_scene_with};
+use crate::scene::{
+    Light, LightingSpace, Material, MaterialKind, RenderSettings, Scene, SceneWarning, Shape,
+};
 
 const CAMERA: &str = "[camera]\neye = [0, 1, 5]\nlook_at = [0, 0.5, 0]\n";
 
@@ -261,4 +263,72 @@ fn animation_errors_are_located() {
     );
     let message = fail(&ANIMATION.replace("time = 1.5\n", "time = 1.5\nfov = 3\n"));
     assert!(message.contains("unknown field `fov`"), "{message}");
+}
+
+/// The warnings `text` loads with.
+fn warnings(text: &str) -> Vec<SceneWarning> {
+    let collected = std::sync::Mutex::new(Vec::new());
+    let hook = |w: &SceneWarning| collected.lock().expect("lock").push(w.clone());
+    let options = LoadOptions {
+        warning: Some(&hook),
+        ..LoadOptions::default()
+    };
+    parse_scene_with(text, Path::new("s.toml"), &options).expect("the scene loads");
+    collected.into_inner().expect("lock")
+}
+
+fn sphere_scene(center: &str, radius: &str) -> String {
+    format!(
+        "[camera]\neye = [0, 3, 4]\nlook_at = [0, 0, 0]\n\
+         [materials.m]\ntype = \"lambert\"\nalbedo = 0.5\n\
+         [[objects]]\ntype = \"plane\"\npoint = [0, -1, 0]\nnormal = [0, 1, 0]\nmaterial = \"m\"\n\
+         [[objects]]\ntype = \"sphere\"\ncenter = {center}\nradius = {radius}\nmaterial = \"m\"\n"
+    )
+}
+
+#[test]
+fn a_sphere_beyond_both_precisions_is_warned_about_with_its_figures() {
+    let found = warnings(&sphere_scene("[0, -1e20, 0]", "1e20"));
+    assert_eq!(found.len(), 1, "{found:?}");
+    let warning = &found[0];
+    assert_eq!(warning.location, Some((12, 1)), "{warning}");
+    let message = &warning.message;
+    for part in [
+        "objects[1] (sphere)",
+        "radius 1e20",
+        "at 3.000e0 from the camera",
+        "2.2e4 units on the CPU reference",
+        "neither backend",
+    ] {
+        assert!(message.contains(part), "{part:?} missing from: {message}");
+    }
+}
+
+#[test]
+fn a_sphere_only_f64_places_is_warned_about_for_the_gpu() {
+    let text = sphere_scene("[1000000, 0, 0]", "1").replace(
+        "eye = [0, 3, 4]\nlook_at = [0, 0, 0]",
+        "eye = [1000000, 0, 6]\nlook_at = [1000000, 0, 0]",
+    );
+    let found = warnings(&text);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!(
+        found[0].message.contains("the GPU cannot place it")
+            && found[0].message.contains("--backend auto"),
+        "{}",
+        found[0]
+    );
+}
+
+#[test]
+fn ordinary_and_ground_spheres_load_without_a_warning() {
+    for (center, radius) in [
+        ("[0, 0.5, 0]", "0.5"),
+        ("[0, -1000, 0]", "1000"),
+        ("[3, -1e10, 2]", "1e10"),
+        ("[0, 0, -1e4]", "1"),
+    ] {
+        let found = warnings(&sphere_scene(center, radius));
+        assert!(found.is_empty(), "{center} {radius}: {found:?}");
+    }
 }

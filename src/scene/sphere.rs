@@ -1,0 +1,146 @@
+//! Spheres relative to their anchor, and how precisely each backend can place one.
+//!
+//! A sphere far larger than the scene, such as a "ground" sphere of radius 1e10 resting
+//! on the origin, cannot be intersected relative to its centre: the centre is 1e10 away,
+//! where an `f32` has a spacing of 1024 units (and an `f64` one of 2e-6), so
+//! `|o - c|² - r²` loses every digit that says where the surface near the camera is.
+//! Both tracers therefore intersect a sphere relative to its **anchor**, its point
+//! nearest the world origin, with the outward normal there, in units of its radius
+//! (Haines, Günther and Akenine-Möller, "Precision Improvements for Ray/Sphere
+//! Intersection", Ray Tracing Gems, ch. 7, §7.3 and 7.4, carried to a better-conditioned
+//! point): with `y = (p - a)/r`, the sphere is `|y + n|² = 1`, that is
+//! `y·(y + 2n) = 0`, a form whose terms are as small as the distance from the anchor.
+//! The anchor is computed once, in `f64`, from the centre and the radius.
+//!
+//! What still limits a sphere is how precisely its anchor is known: the anchor is
+//! `c + r·n`, rounded in `f64` to about `2.2e-16·max(|c|, r)` (exact when the centre and
+//! radius are, as `(0, -1e20, 0)` and `1e20` are), and the GPU then rounds it to `f32`,
+//! about `1.2e-7·|a|`. [`sphere_precision`] gives both, relative to the distance from the
+//! camera, and the loader warns when either exceeds [`SPHERE_PRECISION_LIMIT`].
+
+use glam::DVec3;
+
+/// A sphere's anchor: its point nearest the world origin and the unit outward normal
+/// there (`normalize(-c)`; `+y` for a sphere centred on the origin).
+pub fn sphere_anchor(center: DVec3, radius: f64) -> (DVec3, DVec3) {
+    let normal = (-center).try_normalize().unwrap_or(DVec3::Y);
+    (center + normal * radius, normal)
+}
+
+/// `(|p - c|² - r²) / r²` for the sphere of radius `radius` through `anchor` with outward
+/// normal `normal` there, computed as `y·(y + 2n)` with `y = (p - anchor)/r`: negative
+/// inside the sphere, zero on it, positive outside, and as precise as `p - anchor`.
+pub fn sphere_level(point: DVec3, anchor: DVec3, normal: DVec3, radius: f64) -> f64 {
+    let y = (point - anchor) / radius;
+    y.dot(y + 2.0 * normal)
+}
+
+/// Relative precision above which the loader warns about a sphere: the error of its
+/// surface on a backend as a fraction of its distance from the camera. A pixel of a
+/// 1000-pixel-high image with a 45° field of view is 8e-4 of the distance.
+pub const SPHERE_PRECISION_LIMIT: f64 = 1e-4;
+
+/// How precisely each backend places a sphere's surface, as seen from a camera.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpherePrecision {
+    /// Distance from the camera to the sphere's surface (scene units).
+    pub distance: f64,
+    /// About how far the CPU reference (`f64`) may misplace the surface near its
+    /// anchor: the rounding of the anchor, `2.2e-16·max(|c|∞, r)`.
+    pub cpu: f64,
+    /// The same for the GPU (`f32`): the CPU's error plus the `f32` rounding of the
+    /// anchor, `1.2e-7·|a|∞`.
+    pub gpu: f64,
+}
+
+impl SpherePrecision {
+    /// The CPU's error as a fraction of the distance (infinite for a camera on the
+    /// surface).
+    pub fn cpu_relative(&self) -> f64 {
+        self.cpu / self.distance
+    }
+
+    /// The GPU's error as a fraction of the distance.
+    pub fn gpu_relative(&self) -> f64 {
+        self.gpu / self.distance
+    }
+
+    /// Whether the CPU reference cannot place the sphere to [`SPHERE_PRECISION_LIMIT`].
+    pub fn cpu_hopeless(&self) -> bool {
+        beyond_the_limit(self.cpu_relative())
+    }
+
+    /// Whether the GPU cannot place the sphere to [`SPHERE_PRECISION_LIMIT`].
+    pub fn gpu_hopeless(&self) -> bool {
+        beyond_the_limit(self.gpu_relative())
+    }
+}
+
+/// Whether a relative error exceeds [`SPHERE_PRECISION_LIMIT`] (NaN counts as exceeding).
+fn beyond_the_limit(relative: f64) -> bool {
+    relative.is_nan() || relative > SPHERE_PRECISION_LIMIT
+}
+
+/// How precisely the CPU reference and the GPU place the surface of the sphere
+/// (`center`, `radius`) seen from `eye`; see the module documentation.
+pub fn sphere_precision(center: DVec3, radius: f64, eye: DVec3) -> SpherePrecision {
+    let (anchor, normal) = sphere_anchor(center, radius);
+    // | |e - c| - r | = |level|·r / (|y + n| + 1), without cancellation.
+    let y = (eye - anchor) / radius;
+    let distance =
+        sphere_level(eye, anchor, normal, radius).abs() * radius / ((y + normal).length() + 1.0);
+    let cpu = f64::EPSILON * center.abs().max_element().max(radius);
+    let gpu = cpu + f64::from(f32::EPSILON) * anchor.abs().max_element();
+    SpherePrecision { distance, cpu, gpu }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_anchor_is_the_point_nearest_the_origin() {
+        let (anchor, normal) = sphere_anchor(DVec3::new(0.0, -1e10, 0.0), 1e10);
+        assert_eq!(anchor, DVec3::ZERO);
+        assert_eq!(normal, DVec3::Y);
+        let (anchor, normal) = sphere_anchor(DVec3::new(3.0, 0.0, 4.0), 1.0);
+        assert!((anchor - DVec3::new(2.4, 0.0, 3.2)).length() < 1e-15);
+        assert!((normal - DVec3::new(-0.6, 0.0, -0.8)).length() < 1e-15);
+        // Centred on the origin: any direction will do; +y.
+        assert_eq!(
+            sphere_anchor(DVec3::ZERO, 2.0),
+            (DVec3::new(0.0, 2.0, 0.0), DVec3::Y)
+        );
+    }
+
+    #[test]
+    fn the_level_is_exact_far_from_the_centre() {
+        let (anchor, normal) = sphere_anchor(DVec3::new(0.0, -1e20, 0.0), 1e20);
+        // 3 units above the top of a sphere of radius 1e20: (|p - c|² - r²)/r² =
+        // (2·3·r + 9)/r² ≈ 6e-20, which |p - c|² - r² in f64 cannot give at all.
+        let level = sphere_level(DVec3::new(0.0, 3.0, 0.0), anchor, normal, 1e20);
+        assert!((level - 6e-20).abs() < 1e-33, "{level}");
+        assert!(sphere_level(DVec3::new(0.0, -1.0, 0.0), anchor, normal, 1e20) < 0.0);
+    }
+
+    #[test]
+    fn precision_of_a_ground_sphere_and_a_hopeless_one() {
+        let eye = DVec3::new(0.0, 3.0, 4.0);
+        let ground = sphere_precision(DVec3::new(0.0, -1000.0, 0.0), 1000.0, eye);
+        assert!((ground.distance - 3.0).abs() < 0.01, "{ground:?}");
+        assert!(
+            !ground.cpu_hopeless() && !ground.gpu_hopeless(),
+            "{ground:?}"
+        );
+        let huge = sphere_precision(DVec3::new(0.0, -1e20, 0.0), 1e20, eye);
+        assert!((huge.distance - 3.0).abs() < 1e-9, "{huge:?}");
+        assert!(huge.cpu_hopeless() && huge.gpu_hopeless(), "{huge:?}");
+        // A unit sphere a million units out, seen from 4 units: f64 is fine, f32 is not.
+        let far = sphere_precision(
+            DVec3::new(1e6, 0.0, 0.0),
+            1.0,
+            DVec3::new(1e6 - 5.0, 0.0, 0.0),
+        );
+        assert!(!far.cpu_hopeless() && far.gpu_hopeless(), "{far:?}");
+    }
+}
