@@ -139,43 +139,6 @@ fn regression_corpus_renders_alike_on_both_backends() {
     }
 }
 
-/// The open finds (`tests/fixtures/pipeline-open/`, written by `examples/fuzz_campaign.rs`
-/// and triaged in `docs/fuzzing.md`): scenes on which the GPU and the CPU still differ.
-/// Ignored, since they fail; run it with `--ignored` to see whether a change fixed any
-/// (then move that file to `pipeline-regressions/`).
-#[test]
-#[ignore = "open finds: these scenes still differ between the backends (docs/fuzzing.md)"]
-fn open_finds_render_alike_on_both_backends() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pipeline-open");
-    let Ok(entries) = std::fs::read_dir(&dir) else {
-        return;
-    };
-    let mut paths: Vec<_> = entries
-        .map(|e| e.expect("entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    paths.sort();
-    let Some(gpu) = common::gpu::headless_gpu() else {
-        return;
-    };
-    let checker = PipelineChecker::new(gpu);
-    let still_failing: Vec<String> = paths
-        .iter()
-        .filter_map(|path| {
-            let text = std::fs::read_to_string(path).expect("readable");
-            let failed = checker.check(&text).err()?;
-            Some(format!("{}: {}", path.display(), failed.reason))
-        })
-        .collect();
-    assert!(
-        still_failing.is_empty(),
-        "{} of {} open finds still fail:\n{}",
-        still_failing.len(),
-        paths.len(),
-        still_failing.join("\n")
-    );
-}
-
 /// The generator makes what `tests/common/pipeline.rs` says, and every scene it makes
 /// is accepted by the loader: otherwise the fuzzer would test less than it claims.
 #[test]
