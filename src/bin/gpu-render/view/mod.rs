@@ -35,6 +35,8 @@ use watch::SceneWatcher;
 
 /// Pixels of wheel scrolling that count as one line (touchpads report pixels).
 const PIXELS_PER_LINE: f64 = 40.0;
+/// How many times in a row the last `--frames` frame may find no surface texture.
+const MAX_SKIPPED_FRAMES: u32 = 100;
 /// How often the title is rewritten, at most.
 const TITLE_INTERVAL: Duration = Duration::from_millis(250);
 /// The span over which the title's Mrays/s is measured, at least (passes complete
@@ -290,7 +292,7 @@ impl Viewer {
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             compatible_surface: Some(&surface),
-            force_fallback_adapter: false,
+            ..Default::default()
         }))
         .context("no GPU adapter can present to this window")?;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
@@ -397,7 +399,13 @@ impl Viewer {
         // Every sample asked for is traced; one more frame shows the finished film.
         self.renderer
             .finish(&self.device, &self.queue, &self.scene, &mut self.film)?;
-        while !self.frame(0)? {}
+        let mut tries = 0;
+        while !self.frame(0)? {
+            tries += 1;
+            if tries == MAX_SKIPPED_FRAMES {
+                bail!("the window's surface gave no texture to show the finished image in");
+            }
+        }
         self.wait_in_flight()?;
         let seconds = elapsed.as_secs_f64();
         eprintln!(
@@ -684,7 +692,7 @@ impl Viewer {
             .renderer
             .upload(&self.device, &self.queue, &scene)
             .map_err(|e| anyhow!(e))?;
-        if gpu_scene.prepared().stack_size > self.scene.prepared().stack_size {
+        if gpu_scene.prepared().stack_size() > self.scene.prepared().stack_size() {
             self.film = self.renderer.create_film(
                 &self.device,
                 &gpu_scene,
