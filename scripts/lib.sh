@@ -4,6 +4,7 @@
 #                     (on Debian 12 from bookworm-backports: Mesa 25)
 #   ensure_rust_components  rustfmt and clippy (rustup component add) if missing
 #   ensure_parallel   install GNU parallel (the recipe test runs it) if it is missing
+#   ensure_xvfb       install Xvfb (the viewer's window tests start it) if it is missing
 #   setup_gpu_env     XDG_RUNTIME_DIR and WGPU_BACKEND defaults for headless wgpu
 #   section TITLE     print a section header
 
@@ -98,6 +99,28 @@ ensure_parallel() {
         as_root env DEBIAN_FRONTEND=noninteractive \
             apt-get install -y -qq --no-install-recommends parallel; }; then
         echo "warning: could not install GNU parallel; its recipe test will skip" >&2
+    fi
+}
+
+# Xvfb, the virtual X server that tests/viewer.rs starts to open the viewer's window
+# (and wgpu's surface on it) without a display, and the X11 client libraries winit
+# loads at run time (Xlib with its XCB bridge, xkbcommon's X11 keymaps, the cursor,
+# RandR and input extensions). Without apt (or root) it warns and carries on: those
+# tests then skip, except in CI, where they fail.
+VIEWER_X11_PACKAGES=(xvfb libx11-6 libx11-xcb1 libxkbcommon-x11-0 libxcursor1 libxrandr2 libxi6)
+ensure_xvfb() {
+    local installed
+    installed=$(dpkg-query -W -f='${Status}\n' "${VIEWER_X11_PACKAGES[@]}" 2>/dev/null |
+        grep -c 'install ok installed' || true)
+    if command -v Xvfb >/dev/null 2>&1 && [ "${installed:-0}" -eq "${#VIEWER_X11_PACKAGES[@]}" ]; then
+        return 0
+    fi
+    echo "installing Xvfb and the X11 libraries of the viewer: ${VIEWER_X11_PACKAGES[*]}"
+    if ! { command -v apt-get >/dev/null 2>&1 &&
+        as_root apt-get update -qq &&
+        as_root env DEBIAN_FRONTEND=noninteractive \
+            apt-get install -y -qq --no-install-recommends "${VIEWER_X11_PACKAGES[@]}"; }; then
+        echo "warning: could not install Xvfb; the viewer's window tests will skip" >&2
     fi
 }
 

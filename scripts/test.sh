@@ -11,6 +11,7 @@ source scripts/lib.sh
 section "Environment"
 ensure_lavapipe
 ensure_parallel
+ensure_xvfb
 ensure_rust_components
 setup_gpu_env
 cargo --version
@@ -30,5 +31,8 @@ cargo test --all-targets
 
 section "cargo test --doc"
 cargo test --doc
+
+section "the library and program without the viewer (--no-default-features --features cli,vulkan)"
+cargo clippy --all-targets --no-default-features --features cli,vulkan -- -D warnings
 
 section "All checks passed"

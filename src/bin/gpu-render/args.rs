@@ -29,6 +29,7 @@ Examples:
   gpu-render estimate scene.toml --tiles 4
   gpu-render tradeoff scenes/showcase.toml --out-dir tradeoff
   gpu-render brdf-check scenes/brdf/plausible.png
+  gpu-render view scenes/showcase.toml
   gpu-render --adapter list
 
 Tiles, frames and the recipes for Slurm, Kubernetes and GNU parallel:
@@ -43,7 +44,7 @@ docs/distributed.md";
     long_about = "Renders a TOML scene file with a Whitted-style, physically based ray \
                   tracer that runs in WGSL compute shaders through wgpu, or with the CPU \
                   reference tracer.",
-    override_usage = "gpu-render [OPTIONS] SCENE --output <PATH>\n       gpu-render merge TILE.exr... --output <PATH>\n       gpu-render estimate SCENE [OPTIONS]\n       gpu-render tradeoff SCENE [OPTIONS]\n       gpu-render brdf-check FILE\n       gpu-render --adapter list",
+    override_usage = "gpu-render [OPTIONS] SCENE --output <PATH>\n       gpu-render merge TILE.exr... --output <PATH>\n       gpu-render estimate SCENE [OPTIONS]\n       gpu-render tradeoff SCENE [OPTIONS]\n       gpu-render brdf-check FILE\n       gpu-render view SCENE [OPTIONS]\n       gpu-render --adapter list",
     after_help = AFTER_HELP,
     args_conflicts_with_subcommands = true,
     subcommand_negates_reqs = true
@@ -77,6 +78,12 @@ pub enum Command {
     /// Print the expected time of each tile (and frame) on the chosen backend, from a
     /// short calibration render at a fraction of the pixels.
     Estimate(EstimateArgs),
+
+    /// Open a window showing the scene rendered progressively on the GPU: orbit
+    /// (left drag), pan (right or middle drag), zoom (wheel), S saves the image,
+    /// Esc or Q quits; the scene file is reloaded when it changes. See docs/viewer.md.
+    #[cfg(feature = "viewer")]
+    View(ViewArgs),
 
     /// Reports whether a tabulated BRDF map (a square image, θi across, θr down,
     /// texels holding π·f) is physically plausible: positivity, energy conservation
@@ -197,6 +204,57 @@ pub struct EstimateArgs {
     /// Confine the files the scene names to its folder (see the render options).
     #[arg(long)]
     pub sandbox: bool,
+}
+
+/// The arguments of `gpu-render view`.
+#[cfg(feature = "viewer")]
+#[derive(Debug, Args)]
+pub struct ViewArgs {
+    /// The scene file (TOML), or a model file (.obj, .gltf, .glb).
+    #[arg(value_name = "SCENE")]
+    pub scene: PathBuf,
+
+    /// Samples per pixel added each frame.
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 1,
+        value_parser = parse_in_range::<1, MAX_SAMPLES_PER_PIXEL>
+    )]
+    pub samples_per_frame: u32,
+
+    /// Stop adding samples once a pixel has this many (the window then only redraws
+    /// on a change).
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 4096,
+        value_parser = parse_in_range::<1, MAX_SAMPLES_PER_PIXEL>
+    )]
+    pub max_samples: u32,
+
+    /// Render this many frames, finish their samples, show the result and exit (with
+    /// the frame rate on stderr).
+    #[arg(long, value_name = "N", value_parser = parse_in_range::<1, 1_000_000>)]
+    pub frames: Option<u32>,
+
+    /// With --frames: write what the window shows at the end to this PNG.
+    #[arg(long, value_name = "PATH", requires = "frames")]
+    pub screenshot: Option<PathBuf>,
+
+    /// Image size (the window's first size), samples, depth and lighting, over the
+    /// scene's. The scene's samples per pixel sets the stratified pattern: after that
+    /// many samples the window shows exactly the one-shot render.
+    #[command(flatten)]
+    pub settings: SettingsArgs,
+
+    /// Confine the files the scene names to its folder (see the render options).
+    #[arg(long)]
+    pub sandbox: bool,
+
+    /// Print nothing but errors and the --frames summary.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 /// `--tile I/N`: tile `index` of `count`.
@@ -330,7 +388,7 @@ fn parse_seconds(text: &str) -> Result<std::time::Duration, String> {
 }
 
 /// The render settings that override the scene's.
-#[derive(Debug, Args)]
+#[derive(Debug, Clone, Args)]
 pub struct SettingsArgs {
     /// Image width in pixels [default: the scene's].
     #[arg(

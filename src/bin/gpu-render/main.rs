@@ -18,6 +18,8 @@ mod progress;
 mod signals;
 mod summary;
 mod tradeoff;
+#[cfg(feature = "viewer")]
+mod view;
 
 use std::borrow::Cow;
 use std::path::Path;
@@ -60,6 +62,8 @@ fn run(cli: Cli) -> Result<()> {
             args::Command::Merge(args) => merge::run(&args),
             args::Command::Estimate(args) => estimate::run(&args),
             args::Command::BrdfCheck { file } => brdf_check(&file),
+            #[cfg(feature = "viewer")]
+            args::Command::View(args) => view::run(&args),
         };
     }
     let args = cli.render;
@@ -331,7 +335,12 @@ pub fn load(scene_path: &Path, sandbox: bool, quiet: bool) -> Result<SceneFile> 
 /// ([`gpu_render::scene::import::ImportedModel::into_scene`]) with `render`'s settings;
 /// warnings on stderr unless `quiet`. A model's own references (material libraries,
 /// buffers, images) cannot be confined, so `sandbox` refuses model files.
-fn load_model(path: &Path, render: RenderSettings, sandbox: bool, quiet: bool) -> Result<Scene> {
+pub fn load_model(
+    path: &Path,
+    render: RenderSettings,
+    sandbox: bool,
+    quiet: bool,
+) -> Result<Scene> {
     if sandbox {
         bail!(
             "{}: --sandbox cannot render model files: the files a model names itself \
