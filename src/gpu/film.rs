@@ -21,6 +21,7 @@ use super::layout::GpuCounters;
 use super::limits::{check_binding_bytes, check_film_size};
 use super::pipelines::LINEAR_FORMAT;
 use super::readback::{Caught, capture};
+use super::renderer::create_texture;
 use super::wavefront::{SlotBuffers, check_errors};
 use super::{RenderError, Renderer};
 
@@ -116,24 +117,16 @@ impl Film {
         check_binding_bytes(&limits, pixels * 16)?;
         let slot_count = SlotBuffers::slot_count(device, requested_slots, pixels, stack_size);
         let slots = SlotBuffers::new(device, slot_count, stack_size, pixels)?;
-        let texture = capture(device, "film texture", Caught::Resource, || {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("gpu-render film"),
-                size: wgpu::Extent3d {
-                    width: width.max(1),
-                    height: height.max(1),
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: LINEAR_FORMAT,
-                usage: wgpu::TextureUsages::STORAGE_BINDING
-                    | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
-        })?;
+        let texture = create_texture(
+            device,
+            "gpu-render film",
+            width.max(1),
+            height.max(1),
+            LINEAR_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+        )?;
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
         let draw_binding = draw_layout.map(|layout| {
             device.create_bind_group(&wgpu::BindGroupDescriptor {

@@ -14,6 +14,7 @@ use super::layout::FLAG_STORE_SUM;
 use super::limits::{check_limits, required_limits};
 use super::pipelines::{DISPLAY_FORMAT, Pipelines};
 use super::readback::{read_texture, wait};
+use super::renderer::create_texture;
 use super::scene_buffers::upload_scene;
 use super::shaders::{SLOT_WORKGROUP_SIZE, WORKGROUP_SIZE};
 use super::wavefront::{Schedule, default_schedule, encode_rounds, iteration_budget_for};
@@ -507,20 +508,14 @@ impl Renderer {
         film: &Film,
     ) -> Result<FilmImage, RenderError> {
         let (width, height) = (film.width(), film.height());
-        let display = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("gpu-render film display image"),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: DISPLAY_FORMAT,
-            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let display = create_texture(
+            device,
+            "gpu-render film display image",
+            width,
+            height,
+            DISPLAY_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        )?;
         let view = display.create_view(&wgpu::TextureViewDescriptor::default());
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("gpu-render film display"),

@@ -653,7 +653,7 @@ impl GpuRenderer {
 
 /// Creates a 2D texture inside error scopes (allocation failure becomes
 /// [`GpuError::OutOfMemory`]).
-fn create_texture(
+pub(crate) fn create_texture(
     device: &wgpu::Device,
     label: &str,
     width: u32,
