@@ -14,6 +14,10 @@ ensure_parallel
 ensure_xvfb
 ensure_rust_components
 setup_gpu_env
+# A clean clone gains nothing from incremental artefacts, and they cost gigabytes of disk.
+if [[ -n "${CI:-}" ]]; then
+    export CARGO_INCREMENTAL=0
+fi
 cargo --version
 rustc --version
 
