@@ -417,8 +417,10 @@ impl Renderer {
     }
 
     /// Draws `film` into the caller's render pass (whose colour attachment has the
-    /// [`RendererOptions::surface_format`]): one fullscreen triangle, film pixel
-    /// (x, y) at framebuffer pixel (x, y) of the pass's viewport. The sRGB curve is
+    /// [`RendererOptions::surface_format`]): one triangle over the pass's viewport,
+    /// which the film fills, each pixel showing the film texel under its centre (a
+    /// viewport of the film's size shows film pixel (x, y) at viewport pixel (x, y);
+    /// a larger one scales the film up by nearest texel). The sRGB curve is
     /// applied exactly once: by the shader for a linear-unorm attachment, by the
     /// attachment for an `*Srgb` one (naive-gamma scenes are decoded first, so that
     /// their display values come out unchanged). Records only; binds the film's bind
