@@ -1,7 +1,10 @@
 //! Triage aid for the pipeline fuzzer's finds: prints one pixel of a scene file on both
 //! backends at every depth from 0 to the scene's, and the CPU reference's ray tree of
 //! that pixel (every ray, its hit, its weight and what it added), so that the bounce
-//! where the backends part can be found.
+//! where the backends part can be found. The tree is traced with the tracer's own
+//! `shade_hit` and weight cutoff, in its order (reflection before refraction), but
+//! without the bounce stack's capacity: a scene whose `stack_size` drops branches
+//! shows them here.
 //!
 //! ```sh
 //! cargo run --example fuzz_probe -- FILE X Y [SAMPLE]
