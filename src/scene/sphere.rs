@@ -143,7 +143,8 @@ pub fn far_wall_precision(
     extent: f64,
 ) -> Option<FarWallPrecision> {
     let (anchor, normal) = sphere_anchor(center, radius);
-    if !(sphere_level(eye, anchor, normal, radius) < 0.0) {
+    let level = sphere_level(eye, anchor, normal, radius);
+    if level.is_nan() || level >= 0.0 {
         return None;
     }
     let gpu = f64::from(f32::EPSILON) * (anchor.abs().max_element() + 2.0 * radius);
@@ -190,7 +191,7 @@ pub fn coincident_spheres(
     let y = (eye - a1) / first.1;
     let m = y + n1;
     let length = m.length();
-    if !(length > 0.0) {
+    if length.is_nan() || length <= 0.0 {
         return None;
     }
     let p = eye - m * (y.dot(y + 2.0 * n1) / (length * (length + 1.0)) * first.1);

@@ -255,7 +255,8 @@ pub fn far_wall_warning(shape: &Shape, eye: DVec3, extent: f64) -> Option<String
     let Shape::Sphere { center, radius, .. } = shape else {
         return None;
     };
-    if !(extent > 0.0) {
+    // Zero (nothing but the eye) or NaN: nothing to judge against.
+    if extent.is_nan() || extent <= 0.0 {
         return None;
     }
     let far = far_wall_precision(*center, *radius, eye, extent)?;
