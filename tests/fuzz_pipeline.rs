@@ -7,8 +7,10 @@
 //!
 //! CI runs a bounded number of cases from a fixed seed; `FUZZ_PIPELINE_CASES` and
 //! `FUZZ_PIPELINE_SEED` change both, and `examples/fuzz_campaign.rs` runs long
-//! campaigns and records them in `docs/fuzzing.md`. Every case that ever failed is kept
-//! in `tests/fixtures/pipeline-regressions/` and replayed here.
+//! campaigns and records them in `docs/fuzzing.md`. Every fixed find is kept in
+//! `tests/fixtures/pipeline-regressions/` and replayed here; the finds that are limits
+//! of `f32` are kept in `tests/fixtures/pipeline-f32-limits/`, checked to get their load
+//! warning.
 
 mod common;
 #[path = "common/pipeline.rs"]
@@ -23,7 +25,8 @@ use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRu
 
 /// Cases a plain `cargo test` runs (a few milliseconds each in the test profile on
 /// lavapipe: the images are tiny). From this seed the first 200 pass; later ones hit
-/// the open finds of `docs/fuzzing.md` (the 250th did).
+/// the finds of `docs/fuzzing.md` (the 250th, `ci-seed12-ground-sphere-far-wall`, is an
+/// `f32` limit the loader warns about).
 const CI_CASES: u32 = 200;
 /// The seed a plain `cargo test` uses, so that CI is reproducible.
 const CI_SEED: u64 = 12;
