@@ -79,24 +79,6 @@ impl Backend {
             Some(AdapterArg::Name(name)) => AdapterChoice::NameContains(name.clone()),
             Some(AdapterArg::List) => bail!("--adapter list does not select an adapter"),
         };
-        if scene.render.integrator == Integrator::Path {
-            match choice {
-                BackendArg::Cpu => return Ok(Backend::Cpu { reason: None }),
-                BackendArg::Auto if adapter.is_none() => {
-                    return Ok(Backend::Cpu {
-                        reason: Some(
-                            "the path integrator runs on the CPU reference only (its GPU \
-                             twin is not written yet)"
-                                .into(),
-                        ),
-                    });
-                }
-                _ => bail!(
-                    "the path integrator runs on the CPU reference only (its GPU twin is not \
-                     written yet): use --backend cpu or auto, or --integrator whitted"
-                ),
-            }
-        }
         match choice {
             BackendArg::Cpu => Ok(Backend::Cpu { reason: None }),
             BackendArg::Gpu => Self::open_gpu(&adapter_choice, options),

@@ -1,0 +1,101 @@
+//! The path integrator's emitters on the device: the CPU reference's [`AreaLights`]
+//! distribution (emitters chosen by power, spheres sampled by cone, triangles by area)
+//! as a storage buffer of [`GpuEmitter`] records that `shaders/path.wgsl` samples, and
+//! the constants it shares with `shaders/path_types.wgsl` (checked by
+//! `tests/layout.rs`).
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::accel::SceneGeometry;
+use crate::cpu::path::{AreaLights, EmitterEntry, EmitterEntryShape};
+use crate::scene::Material;
+
+/// `FrameUniforms.flags`: trace with the path integrator (`FLAG_PATH` in WGSL).
+pub const FLAG_PATH: u32 = 4;
+/// `PathState.phase` of the path integrator's emitter shadow ray (`PHASE_EMITTER`).
+pub const PHASE_EMITTER: u32 = 8;
+/// [`GpuEmitter::kind`] of a sphere.
+pub const EMITTER_SPHERE: u32 = 0;
+/// [`GpuEmitter::kind`] of a triangle.
+pub const EMITTER_TRIANGLE: u32 = 1;
+/// [`GpuEmitter::kind`] of the padding record of a scene without emitters.
+pub const EMITTER_NONE: u32 = 2;
+
+/// One emitter (`Emitter` in WGSL), in the CPU's selection order, which is ascending
+/// [`crate::accel::PrimRef`] order.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuEmitter {
+    /// Sphere: its centre; triangle: its first vertex.
+    pub v0: [f32; 3],
+    /// `EMITTER_*`.
+    pub kind: u32,
+    /// Sphere: `(radius, 0, 0)`; triangle: its second vertex.
+    pub v1: [f32; 3],
+    /// The primitive a ray hits on it (a `PrimRef`).
+    pub prim: u32,
+    /// Triangle: its third vertex.
+    pub v2: [f32; 3],
+    /// Cumulative selection probability up to and including it.
+    pub cdf: f32,
+    /// Triangle: the unit normal of its emitting side.
+    pub normal: [f32; 3],
+    /// Its selection probability.
+    pub selection: f32,
+    /// Its radiance.
+    pub radiance: [f32; 3],
+    /// Triangle: selection probability over area (its density per unit area).
+    pub area_density: f32,
+}
+
+fn vec3(v: glam::DVec3) -> [f32; 3] {
+    v.as_vec3().to_array()
+}
+
+/// The record of one emitter of [`AreaLights::entries`].
+pub fn emitter_record(entry: &EmitterEntry) -> GpuEmitter {
+    let mut record = GpuEmitter {
+        prim: entry.prim.0,
+        cdf: entry.cdf as f32,
+        selection: entry.selection as f32,
+        radiance: vec3(entry.radiance),
+        ..GpuEmitter::zeroed()
+    };
+    match entry.shape {
+        EmitterEntryShape::Sphere { center, radius } => {
+            record.kind = EMITTER_SPHERE;
+            record.v0 = vec3(center);
+            record.v1 = [radius as f32, 0.0, 0.0];
+        }
+        EmitterEntryShape::Triangle { vertices, normal } => {
+            record.kind = EMITTER_TRIANGLE;
+            record.v0 = vec3(vertices[0]);
+            record.v1 = vec3(vertices[1]);
+            record.v2 = vec3(vertices[2]);
+            record.normal = vec3(normal);
+            record.area_density = (entry.selection / entry.area) as f32;
+        }
+    }
+    record
+}
+
+/// The emitter records of `geometry` with `materials` (in the lighting space), as the
+/// CPU's [`AreaLights::new`] finds them; one [`EMITTER_NONE`] record when there are
+/// none (a storage binding cannot be empty).
+pub fn emitter_records(geometry: &SceneGeometry, materials: &[Material]) -> Vec<GpuEmitter> {
+    let mut records: Vec<GpuEmitter> = AreaLights::new(geometry, materials)
+        .entries()
+        .iter()
+        .map(emitter_record)
+        .collect();
+    if let Some(last) = records.last_mut() {
+        // The last cumulative probability is 1 exactly, whatever the rounding.
+        last.cdf = 1.0;
+    } else {
+        records.push(GpuEmitter {
+            kind: EMITTER_NONE,
+            ..GpuEmitter::zeroed()
+        });
+    }
+    records
+}
