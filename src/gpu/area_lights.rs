@@ -48,6 +48,23 @@ pub struct GpuEmitter {
     pub area_density: f32,
 }
 
+impl GpuEmitter {
+    /// The padding record of a scene without emitters (a storage binding cannot be
+    /// empty).
+    pub const NONE: Self = Self {
+        v0: [0.0; 3],
+        kind: EMITTER_NONE,
+        v1: [0.0; 3],
+        prim: 0,
+        v2: [0.0; 3],
+        cdf: 0.0,
+        normal: [0.0; 3],
+        selection: 0.0,
+        radiance: [0.0; 3],
+        area_density: 0.0,
+    };
+}
+
 fn vec3(v: glam::DVec3) -> [f32; 3] {
     v.as_vec3().to_array()
 }
@@ -80,8 +97,8 @@ pub fn emitter_record(entry: &EmitterEntry) -> GpuEmitter {
 }
 
 /// The emitter records of `geometry` with `materials` (in the lighting space), as the
-/// CPU's [`AreaLights::new`] finds them; one [`EMITTER_NONE`] record when there are
-/// none (a storage binding cannot be empty).
+/// CPU's [`AreaLights::new`] finds them; [`GpuEmitter::NONE`] alone when there are
+/// none.
 pub fn emitter_records(geometry: &SceneGeometry, materials: &[Material]) -> Vec<GpuEmitter> {
     let mut records: Vec<GpuEmitter> = AreaLights::new(geometry, materials)
         .entries()
@@ -92,10 +109,7 @@ pub fn emitter_records(geometry: &SceneGeometry, materials: &[Material]) -> Vec<
         // The last cumulative probability is 1 exactly, whatever the rounding.
         last.cdf = 1.0;
     } else {
-        records.push(GpuEmitter {
-            kind: EMITTER_NONE,
-            ..GpuEmitter::zeroed()
-        });
+        records.push(GpuEmitter::NONE);
     }
     records
 }

@@ -7,7 +7,7 @@ use super::layout::FrameUniforms;
 use super::readback::{Caught, capture};
 use super::upload::{SceneRecords, frame_uniforms, image_layers};
 use crate::accel::{BvhStats, MAX_PLANES, SceneGeometry};
-use super::area_lights::{FLAG_PATH, emitter_records};
+use super::area_lights::{FLAG_PATH, GpuEmitter, emitter_records};
 use crate::scene::{Integrator, Scene};
 
 /// The storage buffers of an uploaded scene.
@@ -126,7 +126,7 @@ pub(crate) fn upload_scene(
         frame.stack_size = frame.stack_size.max(1);
         emitter_records(geometry, &shaded.materials)
     } else {
-        emitter_records(geometry, &[])
+        vec![GpuEmitter::NONE]
     };
     let limits = device.limits();
     let max_binding = limits
