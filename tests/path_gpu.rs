@@ -7,7 +7,9 @@
 //! `tests/gpu_vs_cpu.rs`. A pixel may still fail where one of its paths takes another
 //! branch in f32 than in f64 (a ray grazing an edge, an event or roulette number within
 //! rounding of its threshold), and from then on draws other numbers: at most
-//! [`OUTLIERS`] of the pixels may. On failure both images and their difference are
+//! [`OUTLIERS`] of the pixels may (measured on lavapipe, 2026-12-01: none does on any
+//! of these scenes; the largest difference is 2.1e-3 on a Cornell box pixel of value
+//! above 1, RMSE at most 2.7e-5). On failure both images and their difference are
 //! written under `target/test-output/`.
 //!
 //! Also: the ray counts agree, a tiny iteration budget (many resumed dispatches) gives
@@ -25,7 +27,7 @@ use gpu_render::scene::{
 };
 
 /// The largest fraction of pixels allowed outside the per-channel tolerance.
-const OUTLIERS: f64 = 0.02;
+const OUTLIERS: f64 = 0.005;
 
 const TOLERANCE: Tolerance = Tolerance {
     absolute: 1e-3,

@@ -126,8 +126,8 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
 fn reduced(scene: Scene) -> Scene {
     let overrides = RenderOverrides {
         samples_per_pixel: Some(2),
-        // The path integrator has no GPU twin yet: path-traced scenes are compared
-        // as Whitted renders.
+        // Path-traced scenes are compared as Whitted renders here; the path
+        // integrator's twin has tests/path_gpu.rs.
         integrator: Some(gpu_render::scene::Integrator::Whitted),
         ..RenderOverrides::default()
     };
