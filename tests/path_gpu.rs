@@ -20,7 +20,7 @@ mod common;
 use common::compare::{Tolerance, assert_images_match};
 use glam::DVec3;
 use gpu_render::film::RenderStats;
-use gpu_render::gpu::{GpuError, GpuRenderer, Schedule};
+use gpu_render::gpu::{GpuError, GpuRenderer, Renderer, RendererOptions, Schedule};
 use gpu_render::scene::{
     Camera, Environment, Integrator, Material, MaterialKind, RenderOverrides, RenderSettings,
     Scene, Shape,
@@ -212,4 +212,57 @@ fn the_budget_bounds_path_tracing_and_a_cut_loop_is_an_error() {
             other => panic!("{schedule:?}: expected TraceIncomplete, got {other:?}"),
         }
     }
+}
+
+/// The frame loop (the viewer's engine) accumulates path-traced samples in passes
+/// whose sample indices continue, drawing the same numbers: three passes of 1, 3 and 4
+/// samples give the bit-identical image and ray count of a one-shot render.
+#[test]
+fn progressive_path_tracing_equals_a_one_shot_render() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let scene = shipped("cornell-box.toml", 32, 8);
+    let one_shot = common::gpu::renderer(&gpu)
+        .render(&gpu.device, &gpu.queue, &scene, None)
+        .expect("one-shot render");
+    let renderer = Renderer::new(&gpu.device, RendererOptions::default()).expect("renderer");
+    let gpu_scene = renderer
+        .upload(&gpu.device, &gpu.queue, &scene)
+        .expect("upload");
+    let mut film = renderer
+        .create_film(&gpu.device, &gpu_scene, gpu_scene.width(), gpu_scene.height())
+        .expect("film");
+    for samples in [1, 3, 4] {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        renderer
+            .encode_samples(
+                &gpu.device,
+                &gpu.queue,
+                &mut encoder,
+                &gpu_scene,
+                &mut film,
+                samples,
+            )
+            .expect("encode_samples");
+        let index = gpu.queue.submit([encoder.finish()]);
+        gpu.device
+            .poll(wgpu::PollType::Wait {
+                submission_index: Some(index),
+                timeout: None,
+            })
+            .expect("poll");
+        renderer
+            .finish(&gpu.device, &gpu.queue, &gpu_scene, &mut film)
+            .expect("finish");
+    }
+    assert_eq!(film.samples(), 8);
+    let image = renderer
+        .read_film(&gpu.device, &gpu.queue, &gpu_scene, &film)
+        .expect("read_film");
+    assert_eq!(
+        image.image.pixels, one_shot.image.pixels,
+        "progressive passes must give the one-shot image"
+    );
+    assert_eq!(film.rays_traced(), one_shot.stats.rays_traced);
 }
