@@ -145,6 +145,18 @@ fn gpu_path_tracing_matches_the_cpu_on_the_showcase_materials() {
     compare(&gpu, &renderer, "path-showcase", &shipped("showcase.toml", 64, 4));
 }
 
+/// Smooth and textured meshes (shading normals, the shadow terminator, bent
+/// continuations) and every material model, tabulated BRDFs included.
+#[test]
+fn gpu_path_tracing_matches_the_cpu_on_meshes_and_every_material() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let renderer = common::gpu::renderer(&gpu);
+    compare(&gpu, &renderer, "path-models", &shipped("models.toml", 48, 2));
+    compare(&gpu, &renderer, "path-materials", &shipped("materials.toml", 48, 2));
+}
+
 #[test]
 fn gpu_path_tracing_matches_the_cpu_in_furnaces() {
     let Some(gpu) = common::gpu::headless_gpu() else {
