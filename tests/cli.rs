@@ -807,7 +807,7 @@ fn the_sandbox_refuses_model_files() {
 // ---------------------------------------------------------------- integrators
 
 #[test]
-fn the_path_integrator_renders_on_the_cpu_and_auto_says_why() {
+fn the_path_integrator_renders_with_auto_which_says_why_it_chose_the_cpu() {
     let ws = Workspace::new(TINY_SCENE);
     let run = gpu_render(&[
         &ws.arg("scene.toml"),
@@ -819,11 +819,15 @@ fn the_path_integrator_renders_on_the_cpu_and_auto_says_why() {
         "2",
     ]);
     assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
-    assert!(
-        run.stderr.contains("CPU reference") && run.stderr.contains("path integrator"),
-        "stderr:\n{}",
-        run.stderr
-    );
+    // On a CPU device (lavapipe) auto measured the CPU reference faster for path
+    // tracing and says so; a real GPU renders it.
+    if run.stderr.contains("is a CPU device") {
+        assert!(
+            run.stderr.contains("CPU reference") && run.stderr.contains("path-traced"),
+            "stderr:\n{}",
+            run.stderr
+        );
+    }
     assert_eq!(read_png_size(&ws.path("out.png")), (32, 24));
 }
 

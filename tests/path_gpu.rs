@@ -122,7 +122,12 @@ fn gpu_path_tracing_matches_the_cpu_on_the_cornell_box() {
         return;
     };
     let renderer = common::gpu::renderer(&gpu);
-    compare(&gpu, &renderer, "path-cornell-box", &shipped("cornell-box.toml", 48, 8));
+    compare(
+        &gpu,
+        &renderer,
+        "path-cornell-box",
+        &shipped("cornell-box.toml", 48, 8),
+    );
 }
 
 #[test]
@@ -131,7 +136,12 @@ fn gpu_path_tracing_matches_the_cpu_on_the_caustic() {
         return;
     };
     let renderer = common::gpu::renderer(&gpu);
-    compare(&gpu, &renderer, "path-caustic", &shipped("caustic.toml", 64, 8));
+    compare(
+        &gpu,
+        &renderer,
+        "path-caustic",
+        &shipped("caustic.toml", 64, 8),
+    );
 }
 
 /// The showcase's glossy models (Blinn-Phong, Cook-Torrance, glTF PBR, Oren-Nayar)
@@ -142,7 +152,12 @@ fn gpu_path_tracing_matches_the_cpu_on_the_showcase_materials() {
         return;
     };
     let renderer = common::gpu::renderer(&gpu);
-    compare(&gpu, &renderer, "path-showcase", &shipped("showcase.toml", 64, 4));
+    compare(
+        &gpu,
+        &renderer,
+        "path-showcase",
+        &shipped("showcase.toml", 64, 4),
+    );
 }
 
 /// Smooth and textured meshes (shading normals, the shadow terminator, bent
@@ -153,8 +168,18 @@ fn gpu_path_tracing_matches_the_cpu_on_meshes_and_every_material() {
         return;
     };
     let renderer = common::gpu::renderer(&gpu);
-    compare(&gpu, &renderer, "path-models", &shipped("models.toml", 48, 2));
-    compare(&gpu, &renderer, "path-materials", &shipped("materials.toml", 48, 2));
+    compare(
+        &gpu,
+        &renderer,
+        "path-models",
+        &shipped("models.toml", 48, 2),
+    );
+    compare(
+        &gpu,
+        &renderer,
+        "path-materials",
+        &shipped("materials.toml", 48, 2),
+    );
 }
 
 #[test]
@@ -243,7 +268,12 @@ fn progressive_path_tracing_equals_a_one_shot_render() {
         .upload(&gpu.device, &gpu.queue, &scene)
         .expect("upload");
     let mut film = renderer
-        .create_film(&gpu.device, &gpu_scene, gpu_scene.width(), gpu_scene.height())
+        .create_film(
+            &gpu.device,
+            &gpu_scene,
+            gpu_scene.width(),
+            gpu_scene.height(),
+        )
         .expect("film");
     for samples in [1, 3, 4] {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());

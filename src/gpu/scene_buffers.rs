@@ -2,12 +2,12 @@
 //! lights), its image array and its trace constants.
 
 use super::GpuError;
+use super::area_lights::{FLAG_PATH, GpuEmitter, emitter_records};
 use super::features::ShaderFeatures;
 use super::layout::FrameUniforms;
 use super::readback::{Caught, capture};
 use super::upload::{SceneRecords, frame_uniforms, image_layers};
 use crate::accel::{BvhStats, MAX_PLANES, SceneGeometry};
-use super::area_lights::{FLAG_PATH, GpuEmitter, emitter_records};
 use crate::scene::{Integrator, Scene};
 
 /// The storage buffers of an uploaded scene.
