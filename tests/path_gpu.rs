@@ -8,8 +8,8 @@
 //! branch in f32 than in f64 (a ray grazing an edge, an event or roulette number within
 //! rounding of its threshold), and from then on draws other numbers: at most
 //! [`OUTLIERS`] of the pixels may (measured on lavapipe, 2026-12-01: none does on any
-//! of these scenes; the largest difference is 2.1e-3 on a Cornell box pixel of value
-//! above 1, RMSE at most 2.7e-5). On failure both images and their difference are
+//! of these scenes; the largest difference is 2.1e-3, on a bright Cornell box pixel,
+//! RMSE at most 2.7e-5). On failure both images and their difference are
 //! written under `target/test-output/`.
 //!
 //! Also: the ray counts agree, a tiny iteration budget (many resumed dispatches) gives
