@@ -113,3 +113,64 @@ pub fn emitter_records(geometry: &SceneGeometry, materials: &[Material]) -> Vec<
     }
     records
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::DVec3;
+
+    use super::*;
+    use crate::accel::{BuildMethod, PrimKind, PrimRef};
+    use crate::scene::{MaterialKind, Shape};
+
+    #[test]
+    fn records_are_in_ascending_prim_order_with_a_cumulative_distribution() {
+        let lamp = Material {
+            emission: DVec3::splat(4.0),
+            ..Material::blank(MaterialKind::Emissive)
+        };
+        let materials = [Material::lambert(DVec3::splat(0.5)), lamp];
+        let square = [
+            DVec3::new(-1.0, 2.0, -1.0),
+            DVec3::new(1.0, 2.0, -1.0),
+            DVec3::new(1.0, 2.0, 1.0),
+            DVec3::new(-1.0, 2.0, 1.0),
+        ];
+        let shapes = [
+            Shape::Triangle {
+                vertices: [DVec3::ZERO, DVec3::X, DVec3::Z],
+                material: 1,
+            },
+            Shape::Polygon {
+                vertices: square.to_vec(),
+                material: 1,
+            },
+            Shape::Sphere {
+                center: DVec3::new(0.0, 3.0, 0.0),
+                radius: 0.5,
+                material: 1,
+            },
+            Shape::Sphere {
+                center: DVec3::ZERO,
+                radius: 1.0,
+                material: 0,
+            },
+        ];
+        let geometry = SceneGeometry::from_shapes(&shapes, BuildMethod::Sah);
+        let records = emitter_records(&geometry, &materials);
+        // The lamp sphere, the square's two triangles, the triangle.
+        assert_eq!(records.len(), 4, "{records:?}");
+        assert!(records.windows(2).all(|w| w[0].prim <= w[1].prim));
+        assert!(records.windows(2).all(|w| w[0].cdf <= w[1].cdf));
+        assert_eq!(records[0].kind, EMITTER_SPHERE);
+        assert_eq!(PrimRef(records[1].prim).kind(), PrimKind::Polygon);
+        assert_eq!(records[1].prim, records[2].prim);
+        assert_eq!(records[3].kind, EMITTER_TRIANGLE);
+        assert_eq!(records[3].cdf, 1.0);
+        let total: f32 = records.iter().map(|r| r.selection).sum();
+        assert!((total - 1.0).abs() < 1e-6, "{total}");
+        // Every piece of a flat emitter has the same density per unit area.
+        assert!((records[1].area_density - records[3].area_density).abs() < 1e-6);
+        let dark = [materials[0], materials[0]];
+        assert_eq!(emitter_records(&geometry, &dark), vec![GpuEmitter::NONE]);
+    }
+}
