@@ -40,6 +40,9 @@ pub struct ShaderFeatures {
     /// Mesh vertex normals and texture coordinates: smooth shading, the shadow
     /// terminator fix and UV lookups (`MESH_ATTRIBUTES`).
     pub mesh_attributes: bool,
+    /// The path-tracing integrator (`PATH`, `shaders/path.wgsl`); a module with it
+    /// traces with it only when the trace's flags ask for it.
+    pub path: bool,
 }
 
 impl ShaderFeatures {
@@ -57,6 +60,7 @@ impl ShaderFeatures {
         pbr: true,
         textures: true,
         mesh_attributes: true,
+        path: true,
     };
 
     /// Exactly the features `scene` uses.
@@ -87,6 +91,7 @@ impl ShaderFeatures {
                 .meshes
                 .iter()
                 .any(|m| m.normals.is_some() || m.uvs.is_some()),
+            path: scene.render.integrator == crate::scene::Integrator::Path,
         }
     }
 
@@ -117,7 +122,7 @@ impl ShaderFeatures {
 type FeatureFlag = fn(&ShaderFeatures) -> bool;
 
 /// The name of each feature in the WGSL directives, with the flag it reads.
-const FEATURE_NAMES: [(&str, FeatureFlag); 12] = [
+const FEATURE_NAMES: [(&str, FeatureFlag); 13] = [
     ("SPHERES", |f| f.spheres),
     ("PLANES", |f| f.planes),
     ("POLYGONS", |f| f.polygons),
@@ -130,6 +135,7 @@ const FEATURE_NAMES: [(&str, FeatureFlag); 12] = [
     ("PBR", |f| f.pbr),
     ("TEXTURES", |f| f.textures),
     ("MESH_ATTRIBUTES", |f| f.mesh_attributes),
+    ("PATH", |f| f.path),
 ];
 
 /// Keeps the lines of `source` whose enclosing `//#if` directives hold for `features`

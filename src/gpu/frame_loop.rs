@@ -315,7 +315,8 @@ impl Renderer {
                 end_sample: pass.end,
                 slot_count: film.slot_count,
                 iteration_budget: self.iteration_budget,
-                flags: FLAG_STORE_SUM,
+                // The scene's own flags (its integrator) kept.
+                flags: FLAG_STORE_SUM | scene.prepared.frame.flags,
                 ..scene.frame_for(film.width(), film.height())
             };
             queue.write_buffer(&film.slots.uniforms, 0, bytemuck::bytes_of(&frame));

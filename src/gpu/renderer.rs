@@ -339,11 +339,13 @@ impl GpuRenderer {
             end_sample: prepared.samples_per_pixel(),
             slot_count,
             iteration_budget: self.iteration_budget(device),
-            flags: if self.simulate_loop_cut {
-                super::layout::FLAG_SIMULATE_LOOP_CUT
-            } else {
-                0
-            },
+            // The scene's own flags (its integrator) and the test switch.
+            flags: prepared.frame.flags
+                | if self.simulate_loop_cut {
+                    super::layout::FLAG_SIMULATE_LOOP_CUT
+                } else {
+                    0
+                },
             ..prepared.frame
         };
         let done = AtomicU64::new(0);

@@ -635,7 +635,7 @@ pub enum LightingArg {
 pub enum IntegratorArg {
     /// Whitted ray tracing: shadow rays, mirror and refraction branches, ambient.
     Whitted,
-    /// Path tracing: area lights, indirect light, caustics (CPU reference only).
+    /// Path tracing: area lights, indirect light, caustics.
     Path,
 }
 

@@ -22,7 +22,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, anyhow, bail};
 use gpu_render::gpu::{Film, GpuScene, Renderer, RendererOptions, read_texture};
 use gpu_render::output;
-use gpu_render::scene::{self, Camera, Integrator, RenderSettings, Scene};
+use gpu_render::scene::{self, Camera, RenderSettings, Scene};
 use winit::application::ApplicationHandler;
 use winit::dpi::{PhysicalPosition, PhysicalSize};
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -77,8 +77,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     }
 }
 
-/// Loads the scene file (or model file) with the command-line overrides, refusing
-/// what the GPU frame loop cannot show.
+/// Loads the scene file (or model file) with the command-line overrides.
 fn load_view_scene(args: &ViewArgs) -> Result<Scene> {
     let path = args.scene.as_path();
     let mut scene = if scene::import::is_model_path(path) {
@@ -88,13 +87,6 @@ fn load_view_scene(args: &ViewArgs) -> Result<Scene> {
         crate::load(path, args.sandbox, args.quiet)?.scene
     };
     scene.render = crate::apply_overrides(&args.settings, scene.render, Some(path))?;
-    if scene.render.integrator == Integrator::Path {
-        bail!(
-            "{}: the viewer traces on the GPU, and the path integrator runs on the CPU \
-             reference only: use --integrator whitted",
-            path.display()
-        );
-    }
     Ok(scene)
 }
 
@@ -687,9 +679,6 @@ impl Viewer {
             crate::load(path, args.sandbox, args.quiet)?.scene
         };
         scene.render = crate::apply_overrides(&args.settings, scene.render, Some(path))?;
-        if scene.render.integrator == Integrator::Path {
-            bail!("the path integrator runs on the CPU reference only: the viewer cannot show it");
-        }
         let file_camera = scene.camera;
         // The interactive camera stays unless the file's camera changed.
         if file_camera == self.file_camera {
