@@ -24,6 +24,18 @@ fn strata_grid(samples_per_pixel: u32) -> vec2<u32> {
     return vec2<u32>(n, n);
 }
 
+// The hash that jitters sample `index` inside its cell: the pattern's samples hash
+// pixel_index * spp + index; later rounds through the same strata (index >= spp)
+// hash that seed again mixed with the round. Twin of jitter_seed (src/camera.rs).
+fn jitter_seed(pixel_index: u32, spp: u32, index: u32) -> u32 {
+    let round = index / spp;
+    let first = pcg_hash(pixel_index * spp + index % spp);
+    if round == 0u {
+        return first;
+    }
+    return pcg_hash(first ^ pcg_hash(round));
+}
+
 // Offset in [0, 1)^2 of sample `index` inside pixel (px, py): the pixel centre for one
 // sample; otherwise column `index` and row (index * g + shift) mod n of the n x n strata
 // (one sample per column and per row, on a Fibonacci lattice of generator g =
@@ -39,7 +51,7 @@ fn sample_offset(px: u32, py: u32, index: u32) -> vec2<f32> {
     let column = index % grid.x;
     // column * g + shift < 65535 * 65535 + 65536 < 2^32: no overflow for n <= 65536.
     let row = (column * frame.lattice_generator + shift) % grid.y;
-    let seed = pcg_hash(pixel_index * spp + index);
+    let seed = jitter_seed(pixel_index, spp, index);
     let jitter = vec2<f32>(unit_from_hash(seed), unit_from_hash(pcg_hash(seed)));
     let cell = vec2<f32>(f32(column), f32(row));
     return (cell + jitter) / vec2<f32>(grid);

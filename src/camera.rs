@@ -155,13 +155,29 @@ impl SamplePattern {
         // In u64 for safety; the WGSL twin's u32 cannot overflow either for n <= 65536.
         let row = ((u64::from(column) * u64::from(self.lattice_generator) + u64::from(shift))
             % u64::from(rows)) as u32;
-        let seed = pcg_hash(pixel_index.wrapping_mul(spp).wrapping_add(index));
+        let seed = jitter_seed(pixel_index, spp, index);
         let jitter_x = unit_from_hash(seed);
         let jitter_y = unit_from_hash(pcg_hash(seed));
         (
             (f64::from(column) + jitter_x) / f64::from(columns),
             (f64::from(row) + jitter_y) / f64::from(rows),
         )
+    }
+}
+
+/// The hash that jitters sample `index` of pixel `pixel_index` inside its cell. The
+/// samples of the pattern (`index < spp`) hash `pixel_index · spp + index`, one number
+/// per sample of the image. A progressive render's later rounds through the same
+/// strata (`index ≥ spp`, round `r = index / spp`) hash that first-round seed again
+/// mixed with the round, so that they repeat neither their own first round's jitter
+/// nor a neighbour's (`pixel_index · spp + index` would be the next pixel's).
+pub fn jitter_seed(pixel_index: u32, spp: u32, index: u32) -> u32 {
+    let round = index / spp;
+    let first = pcg_hash(pixel_index.wrapping_mul(spp).wrapping_add(index % spp));
+    if round == 0 {
+        first
+    } else {
+        pcg_hash(first ^ pcg_hash(round))
     }
 }
 
@@ -284,6 +300,28 @@ mod tests {
         // The right edge spans aspect * tan(45°) = 2.
         let right = frame.ray_direction(200.0, 50.0, 200, 100);
         assert!((right.x / -right.z - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn later_rounds_jitter_afresh_and_never_as_the_next_pixel() {
+        // The position inside its cell of each sample: with n samples the cell is 1/n
+        // wide, so the jitter is the fractional part of offset × n.
+        let jitter = |px: u32, index: u32, n: u32| {
+            let (x, y) = sample_offset(px, 0, index, &settings(64, n));
+            ((x * f64::from(n)).fract(), (y * f64::from(n)).fract())
+        };
+        for n in [2, 3, 16] {
+            for px in 0..8 {
+                for index in 0..n {
+                    let later = jitter(px, n + index, n);
+                    assert_ne!(later, jitter(px + 1, index, n), "n={n} pixel {px} {index}");
+                    assert_ne!(later, jitter(px, index, n), "n={n} pixel {px} {index}");
+                    assert_ne!(later, jitter(px, 2 * n + index, n), "n={n} pixel {px}");
+                }
+            }
+        }
+        // The first round is the pattern as it always was.
+        assert_eq!(jitter_seed(7, 16, 3), pcg_hash(7 * 16 + 3));
     }
 
     #[test]

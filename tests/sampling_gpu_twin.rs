@@ -1,5 +1,6 @@
 //! The WGSL sample pattern (`shaders/sampling.wgsl`) against its CPU twin
-//! (`src/camera.rs`): a test kernel calls `sample_offset` for every sample of a few
+//! (`src/camera.rs`): a test kernel calls `sample_offset` for two rounds of every sample
+//! (the pattern and the progressive samples past it) of a few
 //! pixels at every sample count 1..=300 and at the largest counts (where the u32
 //! arithmetic of the lattice is closest to overflowing), and each offset must equal the
 //! CPU's within f32 rounding. That the CPU pattern covers the pixel uniformly (one sample
@@ -21,7 +22,8 @@ const KERNEL: &str = r"
 
 @compute @workgroup_size(64)
 fn sample_offsets(@builtin(global_invocation_id) id: vec3<u32>) {
-    let n = frame.samples_per_pixel;
+    // Two rounds of the pattern: the progressive samples past it too.
+    let n = frame.samples_per_pixel * 2u;
     if id.x >= arrayLength(&pixels) * n {
         return;
     }
@@ -30,6 +32,8 @@ fn sample_offsets(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 ";
 
+/// Rounds of each pattern compared: the kernel's `* 2u`.
+const ROUNDS: u32 = 2;
 /// Image width the pixel index is computed with.
 const WIDTH: u32 = 1920;
 /// Pixels whose samples are compared.
@@ -71,7 +75,7 @@ fn gpu_sample_offsets_match_the_cpu() {
     let counts = sample_counts();
     let total: u64 = counts
         .iter()
-        .map(|&n| u64::from(n) * PIXELS.len() as u64)
+        .map(|&n| u64::from(ROUNDS * n) * PIXELS.len() as u64)
         .sum();
     let readback = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback"),
@@ -83,7 +87,7 @@ fn gpu_sample_offsets_match_the_cpu() {
     let mut keep_alive = Vec::new();
     let mut offset = 0;
     for &n in &counts {
-        let invocations = n * PIXELS.len() as u32;
+        let invocations = ROUNDS * n * PIXELS.len() as u32;
         let uniforms = FrameUniforms {
             width: WIDTH,
             height: 1080,
@@ -151,7 +155,7 @@ fn gpu_sample_offsets_match_the_cpu() {
             ..RenderSettings::default()
         };
         for [px, py] in PIXELS {
-            for index in 0..n {
+            for index in 0..ROUNDS * n {
                 let Some(&[gx, gy]) = results.next() else {
                     panic!("the GPU returned too few offsets");
                 };
