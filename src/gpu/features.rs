@@ -40,6 +40,9 @@ pub struct ShaderFeatures {
     /// Mesh vertex normals and texture coordinates: smooth shading, the shadow
     /// terminator fix and UV lookups (`MESH_ATTRIBUTES`).
     pub mesh_attributes: bool,
+    /// Instanced meshes: entering their trees with transformed rays, and their hit
+    /// records (`INSTANCES`; see `crate::accel::instance`).
+    pub instances: bool,
 }
 
 impl ShaderFeatures {
@@ -57,6 +60,7 @@ impl ShaderFeatures {
         pbr: true,
         textures: true,
         mesh_attributes: true,
+        instances: true,
     };
 
     /// Exactly the features `scene` uses.
@@ -87,6 +91,7 @@ impl ShaderFeatures {
                 .meshes
                 .iter()
                 .any(|m| m.normals.is_some() || m.uvs.is_some()),
+            instances: crate::accel::instance::has_instances(&scene.meshes),
         }
     }
 
@@ -117,7 +122,7 @@ impl ShaderFeatures {
 type FeatureFlag = fn(&ShaderFeatures) -> bool;
 
 /// The name of each feature in the WGSL directives, with the flag it reads.
-const FEATURE_NAMES: [(&str, FeatureFlag); 12] = [
+const FEATURE_NAMES: [(&str, FeatureFlag); 13] = [
     ("SPHERES", |f| f.spheres),
     ("PLANES", |f| f.planes),
     ("POLYGONS", |f| f.polygons),
@@ -130,6 +135,7 @@ const FEATURE_NAMES: [(&str, FeatureFlag); 12] = [
     ("PBR", |f| f.pbr),
     ("TEXTURES", |f| f.textures),
     ("MESH_ATTRIBUTES", |f| f.mesh_attributes),
+    ("INSTANCES", |f| f.instances),
 ];
 
 /// Keeps the lines of `source` whose enclosing `//#if` directives hold for `features`
