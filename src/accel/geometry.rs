@@ -293,9 +293,11 @@ impl SceneGeometry {
                 Aabb32::around_points(&t.vertices),
             )
         });
-        let instances = self.instances.iter().enumerate().map(|(i, instance)| {
-            (PrimRef::new(PrimKind::Instance, index(i)), instance.bounds)
-        });
+        let instances = self
+            .instances
+            .iter()
+            .enumerate()
+            .map(|(i, instance)| (PrimRef::new(PrimKind::Instance, index(i)), instance.bounds));
         spheres
             .chain(polygons)
             .chain(triangles)
@@ -314,7 +316,8 @@ impl SceneGeometry {
                 group.iter().for_each(|&i| self.add_mesh(&meshes[i]));
                 continue;
             }
-            let stored = InstancedMesh::new(&meshes[group[0]], method, &mut self.degenerate_triangles);
+            let stored =
+                InstancedMesh::new(&meshes[group[0]], method, &mut self.degenerate_triangles);
             let Some(root) = stored.bvh.root_bounds() else {
                 // Every triangle degenerate: nothing to place.
                 continue;
@@ -322,8 +325,12 @@ impl SceneGeometry {
             let mesh_index = self.instanced_meshes.len() as u32;
             for &i in &group {
                 for transform in &meshes[i].instances {
-                    self.instances
-                        .push(Instance::new(mesh_index, transform, meshes[i].material, root));
+                    self.instances.push(Instance::new(
+                        mesh_index,
+                        transform,
+                        meshes[i].material,
+                        root,
+                    ));
                 }
             }
             self.instanced_meshes.push(stored);

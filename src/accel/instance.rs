@@ -270,9 +270,13 @@ pub fn mesh_groups(meshes: &[Mesh]) -> Vec<Vec<usize>> {
 /// Whether `meshes` place some geometry more than once, so that the geometry built
 /// from them has instances.
 pub fn has_instances(meshes: &[Mesh]) -> bool {
-    mesh_groups(meshes)
-        .iter()
-        .any(|group| group.iter().map(|&i| meshes[i].instances.len()).sum::<usize>() > 1)
+    mesh_groups(meshes).iter().any(|group| {
+        group
+            .iter()
+            .map(|&i| meshes[i].instances.len())
+            .sum::<usize>()
+            > 1
+    })
 }
 
 #[cfg(test)]
@@ -282,12 +286,7 @@ mod tests {
     fn quad(instances: Vec<DMat4>) -> Mesh {
         Mesh {
             name: "quad".into(),
-            positions: vec![
-                DVec3::ZERO,
-                DVec3::X,
-                DVec3::new(1.0, 1.0, 0.0),
-                DVec3::Y,
-            ],
+            positions: vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y],
             normals: Some(vec![DVec3::Z; 4]),
             uvs: None,
             triangles: vec![[0, 1, 2], [0, 2, 3]],
@@ -337,7 +336,10 @@ mod tests {
         let (triangle, attributes) = instance.world_triangle(&mesh, 0);
         assert_eq!(triangle.material, 5);
         let [a, b, c] = triangle.vertices;
-        assert_eq!([a, b, c], [DVec3::ZERO, DVec3::new(-2.0, 1.0, 0.0), -2.0 * DVec3::X]);
+        assert_eq!(
+            [a, b, c],
+            [DVec3::ZERO, DVec3::new(-2.0, 1.0, 0.0), -2.0 * DVec3::X]
+        );
         let normal = (b - a).cross(c - a).normalize();
         assert!((normal - DVec3::Z).length() < 1e-15, "{normal}");
         let normals = attributes.and_then(|a| a.normals).expect("normals");

@@ -260,10 +260,13 @@ pub fn triangle_barycentrics(point: DVec3, vertices: &[DVec3; 3]) -> DVec3 {
 /// it the neighbouring flat facets shadow a point that its smooth normal says is lit:
 /// black, faceted terminators on low-poly meshes. Other shapes keep the hit point.
 pub fn shadow_terminator_point(geometry: &SceneGeometry, hit: &Hit, facing: DVec3) -> DVec3 {
-    let Some((triangle, Some(TriangleAttributes {
-        normals: Some(normals),
-        ..
-    }))) = world_triangle(geometry, hit.key())
+    let Some((
+        triangle,
+        Some(TriangleAttributes {
+            normals: Some(normals),
+            ..
+        }),
+    )) = world_triangle(geometry, hit.key())
     else {
         return hit.position;
     };

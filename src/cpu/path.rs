@@ -154,13 +154,7 @@ impl AreaLights {
         lights
     }
 
-    fn push_triangle(
-        &mut self,
-        vertices: [DVec3; 3],
-        normal: DVec3,
-        key: HitKey,
-        radiance: DVec3,
-    ) {
+    fn push_triangle(&mut self, vertices: [DVec3; 3], normal: DVec3, key: HitKey, radiance: DVec3) {
         let [a, b, c] = vertices;
         let area = 0.5 * (b - a).cross(c - a).length();
         if area > 0.0 {

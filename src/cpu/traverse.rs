@@ -129,13 +129,9 @@ impl Query<'_> {
         let sheared = shear_ray(&local);
         let id = Some(index as u32);
         self.walk(&mesh.bvh, &local, |query, prim| {
-            query.consider(
-                HitKey {
-                    prim,
-                    instance: id,
-                },
-                |limit| intersect_triangle(&sheared, &mesh.triangles[prim.index()].vertices, limit),
-            );
+            query.consider(HitKey { prim, instance: id }, |limit| {
+                intersect_triangle(&sheared, &mesh.triangles[prim.index()].vertices, limit)
+            });
         });
     }
 
@@ -312,7 +308,9 @@ pub fn closest_hit_brute_force(
                 prim: PrimRef::new(PrimKind::Triangle, j as u32),
                 instance: Some(i as u32),
             };
-            consider(key, &|limit| intersect_triangle(&sheared, &triangle.vertices, limit));
+            consider(key, &|limit| {
+                intersect_triangle(&sheared, &triangle.vertices, limit)
+            });
         }
     }
     best.map(|key| (best_t, key))

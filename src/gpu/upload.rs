@@ -142,13 +142,17 @@ impl SceneRecords {
             let first_node = index(self.bvh_nodes.len());
             let first_prim = index(self.bvh_prims.len());
             roots.push(first_node);
-            self.bvh_nodes.extend(mesh.bvh.nodes.iter().map(|n| BvhNode {
-                first: n.first + if n.is_leaf() { first_prim } else { first_node },
-                ..*n
-            }));
-            self.bvh_prims.extend(mesh.bvh.prims.iter().map(|p| {
-                PrimRef::new(PrimKind::Triangle, first_triangle + p.index() as u32).0
-            }));
+            self.bvh_nodes
+                .extend(mesh.bvh.nodes.iter().map(|n| BvhNode {
+                    first: n.first + if n.is_leaf() { first_prim } else { first_node },
+                    ..*n
+                }));
+            self.bvh_prims.extend(
+                mesh.bvh
+                    .prims
+                    .iter()
+                    .map(|p| PrimRef::new(PrimKind::Triangle, first_triangle + p.index() as u32).0),
+            );
         }
         let first_record = self.bvh_nodes.len();
         for instance in &geometry.instances {
@@ -203,8 +207,18 @@ pub fn instance_records(instance: &Instance, root: u32) -> [BvhNode; INSTANCE_RE
         count,
     };
     [
-        node(o2w.matrix3.x_axis, root, o2w.matrix3.y_axis, instance.material),
-        node(o2w.matrix3.z_axis, u32::from(instance.mirrored), o2w.translation, 0),
+        node(
+            o2w.matrix3.x_axis,
+            root,
+            o2w.matrix3.y_axis,
+            instance.material,
+        ),
+        node(
+            o2w.matrix3.z_axis,
+            u32::from(instance.mirrored),
+            o2w.translation,
+            0,
+        ),
         node(w2o.matrix3.x_axis, 0, w2o.matrix3.y_axis, 0),
         node(w2o.matrix3.z_axis, 0, w2o.translation, 0),
     ]
@@ -216,9 +230,7 @@ fn triangle_record(t: &TriangleShape, first_attributes: u32) -> GpuTriangle {
         v0: vec3(t.vertices[0]),
         material: t.material,
         v1: vec3(t.vertices[1]),
-        attributes: t
-            .attributes
-            .map_or(NO_ATTRIBUTES, |a| a + first_attributes),
+        attributes: t.attributes.map_or(NO_ATTRIBUTES, |a| a + first_attributes),
         v2: vec3(t.vertices[2]),
         _pad2: 0,
     }
