@@ -280,16 +280,30 @@ fn instancing_figures(scene: &gpu_render::scene::Scene) {
         .iter()
         .map(|m| m.triangles.len())
         .sum();
-    let records = gpu_render::gpu::upload::SceneRecords::new(scene, &geometry);
-    let triangle_bytes = std::mem::size_of_val(records.triangles.as_slice())
-        + std::mem::size_of_val(records.triangle_attributes.as_slice());
+    // What the instanced meshes' triangles take on the GPU (records, attributes, their
+    // trees' nodes and references), and what flattening every placement would take.
+    let mesh_bytes: usize = geometry
+        .instanced_meshes
+        .iter()
+        .map(|m| {
+            m.triangles.len() * std::mem::size_of::<gpu_render::gpu::layout::GpuTriangle>()
+                + m.triangle_attributes.len()
+                    * std::mem::size_of::<gpu_render::gpu::layout::GpuTriangleAttributes>()
+                + m.bvh.nodes.len() * std::mem::size_of::<gpu_render::accel::BvhNode>()
+                + m.bvh.prims.len() * 4
+        })
+        .sum();
+    let flattened =
+        mesh_bytes as f64 / stored.max(1) as f64 * geometry.instanced_triangle_count() as f64;
     println!(
-        "instancing: {} instances of {} mesh(es), {stored} triangles stored for {} placed;          geometry (every BVH) built in {:.0} ms; triangle and attribute records {} bytes",
+        "instancing: {} instances of {} mesh(es), {stored} triangles stored for {} placed; \
+         geometry (every BVH) built in {:.0} ms; the stored meshes take {mesh_bytes} bytes \
+         on the GPU, flattened they would take about {:.2} GB",
         geometry.instances.len(),
         geometry.instanced_meshes.len(),
         geometry.instanced_triangle_count(),
         built * 1e3,
-        triangle_bytes
+        flattened / 1e9
     );
 }
 

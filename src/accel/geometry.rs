@@ -494,6 +494,7 @@ mod tests {
             PrimKind::Polygon,
             PrimKind::Triangle,
             PrimKind::Plane,
+            PrimKind::Instance,
         ] {
             for index in [0, 1, 12345, PrimRef::MAX_INDEX] {
                 let prim = PrimRef::new(kind, index);

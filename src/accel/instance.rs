@@ -109,7 +109,7 @@ impl Instance {
         let mut hi = DVec3::NEG_INFINITY;
         for corner in 0..8 {
             let pick = |axis: usize| {
-                let bit = corner >> axis & 1 == 1;
+                let bit = (corner >> axis) & 1 == 1;
                 f64::from(if bit {
                     object_bounds.max[axis]
                 } else {

@@ -689,4 +689,56 @@ mod tests {
             assert_eq!(rec.transmittance, [1.0; 3]);
         }
     }
+
+    #[test]
+    fn instances_become_node_records_and_shifted_trees() {
+        let mut s = scene(vec![], vec![]);
+        s.materials.push(Material::lambert(DVec3::splat(0.9)));
+        let mesh = crate::scene::Mesh {
+            name: "tri".into(),
+            positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
+            normals: Some(vec![DVec3::Z; 3]),
+            uvs: None,
+            triangles: vec![[0, 1, 2]],
+            material: 1,
+            instances: vec![
+                glam::DMat4::from_translation(DVec3::new(3.0, 0.0, 0.0)),
+                glam::DMat4::from_scale(DVec3::new(-1.0, 2.0, 1.0)),
+            ],
+        };
+        s.meshes.push(mesh);
+        let geometry = SceneGeometry::new(&s);
+        assert_eq!(geometry.instances.len(), 2);
+        let r = SceneRecords::new(&s, &geometry);
+        // The mesh's one triangle and its attributes, once.
+        assert_eq!((r.triangles.len(), r.triangle_attributes.len()), (1, 1));
+        assert_eq!(r.triangles[0].attributes, 0);
+        let world_nodes = geometry.bvh.nodes.len();
+        let mesh_nodes = geometry.instanced_meshes[0].bvh.nodes.len();
+        assert_eq!(
+            r.bvh_nodes.len(),
+            world_nodes + mesh_nodes + 2 * INSTANCE_RECORD_NODES
+        );
+        // The mesh's leaf names the triangle at its place in the triangle list.
+        let leaf = r.bvh_nodes[world_nodes];
+        assert!(leaf.is_leaf());
+        let prim = PrimRef(r.bvh_prims[leaf.first as usize]);
+        assert_eq!((prim.kind(), prim.index()), (PrimKind::Triangle, 0));
+        // The scene's tree names each instance by its records' node index.
+        let mut records: Vec<usize> = r.bvh_prims[..geometry.bvh.prims.len()]
+            .iter()
+            .map(|&p| PrimRef(p))
+            .filter(|p| p.kind() == PrimKind::Instance)
+            .map(PrimRef::index)
+            .collect();
+        records.sort_unstable();
+        let first = world_nodes + mesh_nodes;
+        assert_eq!(records, [first, first + INSTANCE_RECORD_NODES]);
+        let second = &r.bvh_nodes[first + INSTANCE_RECORD_NODES..];
+        assert_eq!(second[0].first as usize, world_nodes, "the mesh tree's root");
+        assert_eq!(second[0].count, 1, "the material");
+        assert_eq!(second[1].first, 1, "mirrored");
+        assert_eq!(second[0].min, [-1.0, 0.0, 0.0], "object_to_world's x column");
+        assert_eq!(second[2].max, [0.0, 0.5, 0.0], "world_to_object's y column");
+    }
 }
