@@ -139,10 +139,10 @@ pub fn hit_record(geometry: &SceneGeometry, prim: PrimRef, ray: &Ray, t: f64) ->
 /// record is then made from the triangle moved to world space
 /// ([`world_triangle`]), at the world point `ray.at(t)`.
 pub fn hit_record_keyed(geometry: &SceneGeometry, key: HitKey, ray: &Ray, t: f64) -> Hit {
-    if key.instance.is_some() {
-        if let Some((triangle, attributes)) = world_triangle(geometry, key) {
-            return triangle_hit(&triangle, attributes.as_ref(), key, ray.at(t), t);
-        }
+    if key.instance.is_some()
+        && let Some((triangle, attributes)) = world_triangle(geometry, key)
+    {
+        return triangle_hit(&triangle, attributes.as_ref(), key, ray.at(t), t);
     }
     let prim = key.prim;
     let point = ray.at(t);

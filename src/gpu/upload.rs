@@ -735,10 +735,17 @@ mod tests {
         let first = world_nodes + mesh_nodes;
         assert_eq!(records, [first, first + INSTANCE_RECORD_NODES]);
         let second = &r.bvh_nodes[first + INSTANCE_RECORD_NODES..];
-        assert_eq!(second[0].first as usize, world_nodes, "the mesh tree's root");
+        assert_eq!(
+            second[0].first as usize, world_nodes,
+            "the mesh tree's root"
+        );
         assert_eq!(second[0].count, 1, "the material");
         assert_eq!(second[1].first, 1, "mirrored");
-        assert_eq!(second[0].min, [-1.0, 0.0, 0.0], "object_to_world's x column");
+        assert_eq!(
+            second[0].min,
+            [-1.0, 0.0, 0.0],
+            "object_to_world's x column"
+        );
         assert_eq!(second[2].max, [0.0, 0.5, 0.0], "world_to_object's y column");
     }
 }
