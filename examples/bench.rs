@@ -62,6 +62,13 @@ struct Args {
     /// at one ray per pixel.
     #[arg(long)]
     traversal: bool,
+    /// Placements in `generated:instances`.
+    #[arg(long, default_value_t = 100)]
+    copies: usize,
+    /// Flatten `generated:instances` by hand (every placement a world-space mesh of
+    /// its own, placed once), to compare with instancing.
+    #[arg(long)]
+    flatten: bool,
 }
 
 fn median(mut values: Vec<f64>) -> f64 {
@@ -193,8 +200,8 @@ fn million_triangle_scene() -> gpu_render::scene::Scene {
 /// quads (1,001,112 triangles, vertex normals) placed 100 times on a 10 x 10 grid,
 /// each rotated and scaled differently (every seventh mirrored), in four materials,
 /// over a ground plane under a sun and a point light; 1920x1080, 1 spp, depth 4.
-fn instanced_million_scene() -> gpu_render::scene::Scene {
-    use glam::{DMat4, DVec3};
+fn instanced_million_scene(copies: usize, flatten: bool) -> gpu_render::scene::Scene {
+    use glam::{DMat3, DMat4, DVec3};
     use gpu_render::scene::{Mesh, Shape};
     let mut scene = million_triangle_scene();
     let n = 708;
@@ -233,7 +240,7 @@ fn instanced_million_scene() -> gpu_render::scene::Scene {
         }
     }
     let mut meshes: Vec<Mesh> = Vec::new();
-    for k in 0..100 {
+    for k in 0..copies {
         let (i, j) = ((k % 10) as f64, (k / 10) as f64);
         let mirror = if k % 7 == 3 { -1.0 } else { 1.0 };
         let scale = DVec3::new(mirror * (0.8 + 0.04 * i), 0.7 + 0.05 * j, 0.9);
@@ -243,6 +250,32 @@ fn instanced_million_scene() -> gpu_render::scene::Scene {
             DVec3::new(1.4 * i - 6.3, -0.4, -1.4 * j + 1.0),
         );
         let material = (k % 4) as u32 + 1;
+        if flatten {
+            let linear = DMat3::from_mat4(transform);
+            let normal_matrix = linear.inverse().transpose();
+            let mirrored = linear.determinant() < 0.0;
+            meshes.push(Mesh {
+                name: format!("bumpy sphere {k}"),
+                positions: positions
+                    .iter()
+                    .map(|p| transform.transform_point3(*p))
+                    .collect(),
+                normals: Some(
+                    normals
+                        .iter()
+                        .map(|n| (normal_matrix * *n).normalize())
+                        .collect(),
+                ),
+                uvs: None,
+                triangles: triangles
+                    .iter()
+                    .map(|&[a, b, c]| if mirrored { [a, c, b] } else { [a, b, c] })
+                    .collect(),
+                material,
+                instances: vec![DMat4::IDENTITY],
+            });
+            continue;
+        }
         match meshes.iter_mut().find(|m| m.material == material) {
             Some(mesh) => mesh.instances.push(transform),
             None => meshes.push(Mesh {
@@ -312,7 +345,7 @@ fn main() -> Result<()> {
     let mut scene = if args.scene.as_os_str() == "generated:million" {
         million_triangle_scene()
     } else if args.scene.as_os_str() == "generated:instances" {
-        instanced_million_scene()
+        instanced_million_scene(args.copies, args.flatten)
     } else {
         load_scene(&args.scene)?
     };
