@@ -69,6 +69,9 @@ struct Args {
     /// its own, placed once), to compare with instancing.
     #[arg(long)]
     flatten: bool,
+    /// Quads per side of the mesh of `generated:instances` (708: 1,001,112 triangles).
+    #[arg(long, default_value_t = 708)]
+    mesh_quads: usize,
 }
 
 fn median(mut values: Vec<f64>) -> f64 {
@@ -200,11 +203,15 @@ fn million_triangle_scene() -> gpu_render::scene::Scene {
 /// quads (1,001,112 triangles, vertex normals) placed 100 times on a 10 x 10 grid,
 /// each rotated and scaled differently (every seventh mirrored), in four materials,
 /// over a ground plane under a sun and a point light; 1920x1080, 1 spp, depth 4.
-fn instanced_million_scene(copies: usize, flatten: bool) -> gpu_render::scene::Scene {
+fn instanced_million_scene(
+    copies: usize,
+    flatten: bool,
+    mesh_quads: usize,
+) -> gpu_render::scene::Scene {
     use glam::{DMat3, DMat4, DVec3};
     use gpu_render::scene::{Mesh, Shape};
     let mut scene = million_triangle_scene();
-    let n = 708;
+    let n = mesh_quads.max(2);
     let mut positions = Vec::with_capacity((n + 1) * (n + 1));
     let mut normals = Vec::with_capacity((n + 1) * (n + 1));
     for r in 0..=n {
@@ -345,7 +352,7 @@ fn main() -> Result<()> {
     let mut scene = if args.scene.as_os_str() == "generated:million" {
         million_triangle_scene()
     } else if args.scene.as_os_str() == "generated:instances" {
-        instanced_million_scene(args.copies, args.flatten)
+        instanced_million_scene(args.copies, args.flatten, args.mesh_quads)
     } else {
         load_scene(&args.scene)?
     };
