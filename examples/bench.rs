@@ -427,12 +427,17 @@ fn main() -> Result<()> {
             cpu_rays = rendered.stats.rays_traced;
         }
     }
+    let samples = f64::from(scene.render.width)
+        * f64::from(scene.render.height)
+        * f64::from(scene.render.samples_per_pixel);
     let report = |name: &str, trace: f64, total: Option<f64>, rays: u64| {
         let total = total.map_or(String::new(), |t| format!(", total {:.3} s", t));
         println!(
-            "{name}: trace {:.3} s (wall clock){total}; {rays} rays; {:.1} Mrays/s",
+            "{name}: trace {:.3} s (wall clock){total}; {rays} rays; {:.1} Mrays/s; {:.2} M \
+             samples/s",
             trace,
-            rays as f64 / trace / 1e6
+            rays as f64 / trace / 1e6,
+            samples / trace / 1e6
         );
     };
     report(

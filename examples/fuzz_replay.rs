@@ -14,7 +14,8 @@
 //! the scene with every coordinate moved by one f32 ulp). `--f32-inputs` compares each
 //! scene's CPU image with the CPU image of the same scene with its camera, lights and
 //! shapes rounded to `f32`, the GPU's inputs: where they differ, input rounding alone
-//! explains a GPU difference. `--pixels` prints the pixels outside the tolerance.
+//! explains a GPU difference. `--pixels` prints the pixels outside the tolerance. The
+//! loader's warnings about each scene are printed before its result.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -87,6 +88,13 @@ fn main() {
             continue;
         }
         let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+        // The loader's warnings (f32 limits it can see) come before the verdict.
+        let warn = |w: &gpu_render::scene::SceneWarning| println!("  warning: {w}");
+        let options = gpu_render::scene::LoadOptions {
+            warning: Some(&warn),
+            ..Default::default()
+        };
+        let _ = gpu_render::scene::parse_scene_with(&text, std::path::Path::new(&path), &options);
         match checker.check(&text) {
             Ok(passed) => println!(
                 "{path}: passes ({} of {} pixels outside tolerance, max |Δ| {:.2e})",

@@ -218,6 +218,12 @@ fn keep_on_side(d: vec3<f32>, side: vec3<f32>) -> vec3<f32> {
 // reflected branch, and either adds its emission at once or, for a surface with a base
 // BRDF, starts gathering its lights (PHASE_NEXT_LIGHT), the ambient term first.
 fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) {
+    //#if PATH
+    if path_mode() {
+        path_closest_hit(slot, path, trace);
+        return;
+    }
+    //#endif
     let ray = Ray((*path).origin, (*path).direction);
     if trace.best_prim == NO_PRIM {
         add_contribution(path, (*path).weight * frame.background);
@@ -285,6 +291,12 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
 // Adds the current light's f(wi, wo)·E·cos θi if its shadow ray was unblocked, and
 // moves on to the next light.
 fn consume_shadow_ray(path: ptr<function, PathState>, trace: TraceRay) {
+    //#if PATH
+    if path_mode() {
+        path_consume_shadow_ray(path, trace);
+        return;
+    }
+    //#endif
     if trace.best_prim == NO_PRIM {
         let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal);
         var material = materials[(*path).material];
@@ -301,6 +313,12 @@ fn consume_shadow_ray(path: ptr<function, PathState>, trace: TraceRay) {
 // base weight and moves on to the bounce stack (false).
 fn next_light(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) -> bool {
     if (*path).light >= frame.light_count {
+        //#if PATH
+        if path_mode() {
+            // The path integrator's next-event estimation of an emitter comes last.
+            return path_start_emitter(path, trace);
+        }
+        //#endif
         let emission = materials[(*path).material].emission;
         add_contribution(path, (*path).weight * (emission + (*path).direct * (*path).base));
         (*path).phase = PHASE_POP;
@@ -425,6 +443,11 @@ fn shade_step(slot: u32, path: ptr<function, PathState>, trace: ptr<function, Tr
         } else if (*path).phase == PHASE_SHADOW {
             consume_shadow_ray(path, *trace);
         }
+        //#if PATH
+        if (*path).phase == PHASE_EMITTER {
+            path_consume_emitter(path, *trace);
+        }
+        //#endif
     }
     if (*path).phase == PHASE_NEXT_LIGHT {
         // Lights behind the surface cast no ray: skip them here.

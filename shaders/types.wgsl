@@ -249,7 +249,9 @@ struct PathState {
     albedo: vec3<f32>,
     _pad1: u32,
     direct: vec3<f32>,
-    _pad2: u32,
+    // Path integrator: the density of the BRDF sample that made the current ray, or
+    // NO_BRDF_PDF (shaders/path.wgsl).
+    brdf_pdf: f32,
 }
 
 // One pending reflected or refracted ray on a slot's bounce stack.

@@ -2,6 +2,8 @@
 //! culprit and exit status 1 (never a panic, never a damaged output file); a good
 //! scene gives an image of the requested size.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -805,7 +807,7 @@ fn the_sandbox_refuses_model_files() {
 // ---------------------------------------------------------------- integrators
 
 #[test]
-fn the_path_integrator_renders_on_the_cpu_and_auto_says_why() {
+fn the_path_integrator_renders_with_auto_which_says_why_it_chose_the_cpu() {
     let ws = Workspace::new(TINY_SCENE);
     let run = gpu_render(&[
         &ws.arg("scene.toml"),
@@ -817,16 +819,24 @@ fn the_path_integrator_renders_on_the_cpu_and_auto_says_why() {
         "2",
     ]);
     assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
-    assert!(
-        run.stderr.contains("CPU reference") && run.stderr.contains("path integrator"),
-        "stderr:\n{}",
-        run.stderr
-    );
+    // On a CPU device (lavapipe) auto measured the CPU reference faster for path
+    // tracing and says so; a real GPU renders it.
+    if run.stderr.contains("is a CPU device") {
+        assert!(
+            run.stderr.contains("CPU reference") && run.stderr.contains("path-traced"),
+            "stderr:\n{}",
+            run.stderr
+        );
+    }
     assert_eq!(read_png_size(&ws.path("out.png")), (32, 24));
 }
 
 #[test]
-fn the_path_integrator_on_the_gpu_is_refused_before_rendering() {
+fn the_path_integrator_renders_on_the_gpu_when_asked() {
+    // Fails loudly in CI without an adapter, as every GPU test does.
+    if common::gpu::headless_gpu().is_none() {
+        return;
+    }
     let ws = Workspace::new(TINY_SCENE);
     let run = gpu_render(&[
         &ws.arg("scene.toml"),
@@ -834,11 +844,13 @@ fn the_path_integrator_on_the_gpu_is_refused_before_rendering() {
         &ws.arg("out.png"),
         "--integrator",
         "path",
+        "--spp",
+        "2",
         "--backend",
         "gpu",
     ]);
-    assert_fails_with(&run, &["path integrator", "--backend cpu"]);
-    ws.assert_old_output_kept();
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert_eq!(read_png_size(&ws.path("out.png")), (32, 24));
 }
 
 #[test]

@@ -366,19 +366,21 @@ fn a_camera_move_uploads_only_the_trace_constants_and_equals_a_fresh_upload() {
     assert_eq!(gpu_scene.camera(), &moved);
 }
 
-/// Draws `film` into a fresh `format` attachment and reads it back as RGBA8.
+/// Draws `film` into a fresh `format` attachment `scale` times its size and reads it
+/// back as RGBA8.
 fn draw_into(
     gpu: &HeadlessGpu,
     renderer: &Renderer,
     gpu_scene: &GpuScene,
     film: &Film,
     format: wgpu::TextureFormat,
+    scale: u32,
 ) -> Vec<u8> {
     let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some("draw target"),
         size: wgpu::Extent3d {
-            width: film.width(),
-            height: film.height(),
+            width: film.width() * scale,
+            height: film.height() * scale,
             depth_or_array_layers: 1,
         },
         mip_level_count: 1,
@@ -414,6 +416,54 @@ fn draw_into(
     submit_and_wait(gpu, encoder);
     gpu_render::gpu::read_texture(&gpu.device, &gpu.queue, &texture, 4, None)
         .unwrap_or_else(|e| panic!("read_texture: {e}"))
+}
+
+#[test]
+fn draw_scales_the_film_up_to_fill_the_viewport() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let format = wgpu::TextureFormat::Rgba8Unorm;
+    let renderer = renderer(
+        &gpu,
+        RendererOptions {
+            surface_format: Some(format),
+            ..RendererOptions::default()
+        },
+    );
+    let scene = scene("minimal.toml", 24, 1);
+    let gpu_scene = renderer
+        .upload(&gpu.device, &gpu.queue, &scene)
+        .unwrap_or_else(|e| panic!("upload: {e}"));
+    let (width, height) = (gpu_scene.width(), gpu_scene.height());
+    let mut film = renderer
+        .create_film(&gpu.device, &gpu_scene, width, height)
+        .unwrap_or_else(|e| panic!("create_film: {e}"));
+    renderer
+        .render_to_image(&gpu.device, &gpu.queue, &gpu_scene, &mut film)
+        .unwrap_or_else(|e| panic!("render_to_image: {e}"));
+    let one = draw_into(&gpu, &renderer, &gpu_scene, &film, format, 1);
+    let scale = 3;
+    let scaled = draw_into(&gpu, &renderer, &gpu_scene, &film, format, scale);
+    assert_eq!(scaled.len(), one.len() * (scale * scale) as usize);
+    // Every framebuffer pixel shows the film texel under its centre: a block of
+    // scale × scale pixels per texel, exactly its value.
+    let mut wrong = 0;
+    for y in 0..height * scale {
+        for x in 0..width * scale {
+            let big = ((y * width * scale + x) * 4) as usize;
+            let small = (((y / scale) * width + x / scale) * 4) as usize;
+            if scaled[big..big + 4] != one[small..small + 4] {
+                wrong += 1;
+            }
+        }
+    }
+    assert_eq!(
+        wrong, 0,
+        "{wrong} pixels of the 3x draw differ from their texel"
+    );
+    // The image is not uniform, so the comparison tests the mapping.
+    assert!(one.chunks(4).any(|p| p != &one[0..4]));
 }
 
 #[test]
@@ -456,7 +506,7 @@ fn draw_applies_the_scenes_srgb_rule_once_on_any_attachment() {
             let shown = renderer
                 .render_to_image(&gpu.device, &gpu.queue, &gpu_scene, &mut film)
                 .unwrap_or_else(|e| panic!("render_to_image: {e}"));
-            let drawn = draw_into(&gpu, &renderer, &gpu_scene, &film, format);
+            let drawn = draw_into(&gpu, &renderer, &gpu_scene, &film, format, 1);
             assert_eq!(drawn.len(), shown.display_rgba8.len());
             // The attachment's own encoding may round differently from the display
             // pass's exact quantisation: one level at most.

@@ -34,8 +34,8 @@ fn reduced(scene: Scene, lighting_space: LightingSpace) -> Scene {
     let overrides = RenderOverrides {
         samples_per_pixel: Some(2),
         lighting_space: Some(lighting_space),
-        // The path integrator has no GPU twin yet: path-traced scenes (the Cornell
-        // box) are compared as Whitted renders.
+        // Path-traced scenes (the Cornell box, the caustic) are compared as Whitted
+        // renders here; the path integrator's twin has tests/path_gpu.rs.
         integrator: Some(gpu_render::scene::Integrator::Whitted),
         ..RenderOverrides::default()
     };

@@ -10,7 +10,8 @@
 //! - The GPU renders it like the CPU within the tolerance of `tests/gpu_vs_cpu.rs`, and
 //!   like its own flattened render.
 //! - The traversal equals the brute force over every instance's every triangle.
-//! - Path tracing samples emissive instanced meshes as lights.
+//! - Path tracing: emissive meshes placed twice are flattened (and render as before);
+//!   geometry built from parts instances them and the CPU's lights hold every copy.
 //! - Memory: the GPU scene records of 100 placements are those of one plus about 100
 //!   instance records.
 
@@ -377,7 +378,15 @@ fn path_tracing_samples_emissive_instances() {
         instances: transforms.to_vec(),
         ..mesh.clone()
     }]);
-    assert_eq!(SceneGeometry::new(&instanced).instances.len(), 2);
+    // A scene's emissive meshes are flattened (the GPU's emitter list names surfaces
+    // by primitive alone); geometry built from parts instances them, and the CPU's
+    // lights then hold every placement's triangles.
+    assert!(SceneGeometry::new(&instanced).instances.is_empty());
+    let parts =
+        SceneGeometry::from_parts(&[], &instanced.meshes, gpu_render::accel::BuildMethod::Sah);
+    assert_eq!(parts.instances.len(), 2);
+    let lights = gpu_render::cpu::path::AreaLights::new(&parts, &instanced.materials);
+    assert_eq!(lights.entries().len(), 2 * mesh.triangles.len());
     let flat = make(
         transforms
             .iter()

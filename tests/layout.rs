@@ -7,10 +7,19 @@ use std::mem::{offset_of, size_of};
 
 use gpu_render::accel::{BvhNode, PrimKind, PrimRef};
 use gpu_render::gpu::ShaderFeatures;
+use gpu_render::gpu::area_lights::{
+    EMITTER_NONE, EMITTER_SPHERE, EMITTER_TRIANGLE, FLAG_PATH, GpuEmitter, PHASE_EMITTER,
+};
 use gpu_render::gpu::layout::*;
 use gpu_render::gpu::shaders::{
-    TYPES_WGSL, bxdf_eval_shader_source, display_shader_source, trace_shader_source,
+    PATH_TYPES_WGSL, TYPES_WGSL, bxdf_eval_shader_source, display_shader_source,
+    trace_shader_source,
 };
+
+/// The shared records: types.wgsl and the path integrator's path_types.wgsl.
+fn shared_types_wgsl() -> String {
+    format!("{TYPES_WGSL}\n{PATH_TYPES_WGSL}")
+}
 
 /// Rust twin of one WGSL struct: size and (member name, offset) pairs.
 type Twin = (usize, Vec<(&'static str, usize)>);
@@ -200,7 +209,7 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 albedo,
                 _pad1,
                 direct,
-                _pad2
+                brdf_pdf
             }),
         ),
         (
@@ -230,6 +239,21 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
             }),
         ),
         (
+            "Emitter",
+            twin!(GpuEmitter {
+                v0,
+                kind,
+                v1,
+                prim,
+                v2,
+                cdf,
+                normal,
+                selection,
+                radiance,
+                area_density
+            }),
+        ),
+        (
             "Counters",
             twin!(GpuCounters {
                 next_pixel,
@@ -245,7 +269,7 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
 
 #[test]
 fn wgsl_structs_match_rust_twins() {
-    let module = naga::front::wgsl::parse_str(TYPES_WGSL).expect("types.wgsl parses");
+    let module = naga::front::wgsl::parse_str(&shared_types_wgsl()).expect("types.wgsl parses");
     let mut layouter = naga::proc::Layouter::default();
     layouter.update(module.to_ctx()).expect("layouts compute");
     let twins = rust_twins();
@@ -301,7 +325,7 @@ fn wgsl_structs_match_rust_twins() {
 
 #[test]
 fn constants_match() {
-    let module = naga::front::wgsl::parse_str(TYPES_WGSL).expect("types.wgsl parses");
+    let module = naga::front::wgsl::parse_str(&shared_types_wgsl()).expect("types.wgsl parses");
     let rust = BTreeMap::from([
         ("MATERIAL_LAMBERT", MATERIAL_LAMBERT),
         ("MATERIAL_BLINN_PHONG", MATERIAL_BLINN_PHONG),
@@ -336,6 +360,11 @@ fn constants_match() {
         ("PRIM_PLANE", PrimKind::Plane as u32),
         ("PRIM_POLYGON", PrimKind::Polygon as u32),
         ("PRIM_TRIANGLE", PrimKind::Triangle as u32),
+        ("FLAG_PATH", FLAG_PATH),
+        ("PHASE_EMITTER", PHASE_EMITTER),
+        ("EMITTER_SPHERE", EMITTER_SPHERE),
+        ("EMITTER_TRIANGLE", EMITTER_TRIANGLE),
+        ("EMITTER_NONE", EMITTER_NONE),
     ]);
     let mut found = 0;
     for (_, constant) in module.constants.iter() {
@@ -433,6 +462,16 @@ fn wgsl_constants_equal_their_rust_twins() {
     ] {
         assert_eq!(wgsl_f32_const(trace, name), rust as f32, "{name}");
     }
+    let path = gpu_render::gpu::shaders::PATH_WGSL;
+    assert_eq!(
+        wgsl_f32_const(path, "MIN_SURVIVAL"),
+        gpu_render::cpu::path::MIN_SURVIVAL as f32
+    );
+    let roulette = format!(
+        "const ROULETTE_DEPTH: u32 = {}u;",
+        gpu_render::cpu::path::ROULETTE_DEPTH
+    );
+    assert!(path.lines().any(|l| l == roulette), "{roulette}");
 }
 
 #[test]

@@ -81,9 +81,10 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         textures: false,
         mesh_attributes: false,
         instances: false,
+        path: false,
     };
     type Toggle = fn(&mut ShaderFeatures, bool);
-    let toggles: [Toggle; 13] = [
+    let toggles: [Toggle; 14] = [
         |f, v| f.spheres = v,
         |f, v| f.planes = v,
         |f, v| f.polygons = v,
@@ -97,6 +98,7 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         |f, v| f.textures = v,
         |f, v| f.mesh_attributes = v,
         |f, v| f.instances = v,
+        |f, v| f.path = v,
     ];
     let all = function_names(&ShaderFeatures::ALL).len();
     let bare = function_names(&none).len();
@@ -126,8 +128,8 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
 fn reduced(scene: Scene) -> Scene {
     let overrides = RenderOverrides {
         samples_per_pixel: Some(2),
-        // The path integrator has no GPU twin yet: path-traced scenes are compared
-        // as Whitted renders.
+        // Path-traced scenes are compared as Whitted renders here; the path
+        // integrator's twin has tests/path_gpu.rs.
         integrator: Some(gpu_render::scene::Integrator::Whitted),
         ..RenderOverrides::default()
     };

@@ -189,6 +189,82 @@ fn the_screenshot_matches_the_headless_render_of_the_same_samples() {
     assert!(distinct.len() > 100, "{} distinct colours", distinct.len());
 }
 
+/// `--scale 0.5` traces a film of half the window's size and draws it scaled up: each
+/// 2 x 2 block of the screenshot is one pixel of the headless render at half size,
+/// within one 8-bit level except [`OUTLIER_FRACTION`] of pixels. `--adapter` with a
+/// name no adapter has is an error that lists the adapters.
+#[test]
+fn a_scaled_film_fills_the_window_and_the_adapter_can_be_chosen() {
+    let Some(xvfb) = window_environment() else {
+        return;
+    };
+    let dir = output_dir("scaled");
+    let screenshot = dir.join("window.png");
+    let reference = dir.join("headless-half.png");
+    let _ = std::fs::remove_file(&screenshot);
+    let mut view = gpu_render(Some(&xvfb.display));
+    view.args([
+        "view",
+        "scenes/showcase.toml",
+        "--frames",
+        "2",
+        "--scale",
+        "0.5",
+        "--width",
+        "160",
+        "--height",
+        "96",
+        "--spp",
+        "2",
+        "--screenshot",
+    ])
+    .arg(&screenshot);
+    let (status, stderr) = run(view);
+    assert_eq!(status, Some(0), "gpu-render view --scale failed:\n{stderr}");
+
+    let mut render = gpu_render(None);
+    render
+        .args(["scenes/showcase.toml", "--backend", "gpu", "-q", "-o"])
+        .arg(&reference)
+        .args(["--width", "80", "--height", "48", "--spp", "2"]);
+    let (status, stderr) = run(render);
+    assert_eq!(status, Some(0), "the headless render failed:\n{stderr}");
+
+    let shown = load_rgba(&screenshot);
+    let expected = load_rgba(&reference);
+    assert_eq!(shown.dimensions(), (160, 96), "the window keeps its size");
+    let mut outliers = 0usize;
+    for (x, y, a) in shown.enumerate_pixels() {
+        let b = expected.get_pixel(x / 2, y / 2);
+        let difference = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap_or(0);
+        outliers += usize::from(difference > 1);
+    }
+    let pixels = (shown.width() * shown.height()) as usize;
+    let allowed = (pixels as f64 * OUTLIER_FRACTION).floor() as usize;
+    assert!(
+        outliers <= allowed,
+        "{outliers} of {pixels} pixels differ from their half-size pixel by more than one \
+         level; {allowed} allowed. See {}",
+        dir.display()
+    );
+
+    let mut view = gpu_render(Some(&xvfb.display));
+    view.args([
+        "view",
+        "scenes/minimal.toml",
+        "--frames",
+        "1",
+        "--adapter",
+        "no such adapter",
+    ]);
+    let (status, stderr) = run(view);
+    assert_eq!(status, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("matches no adapter") && stderr.contains("0: "),
+        "the error lists the adapters:\n{stderr}"
+    );
+}
+
 /// A scene file that stops parsing while the window is open: the viewer reports the
 /// error, keeps the old scene and goes on; fixing the file reloads it.
 #[test]
@@ -279,6 +355,14 @@ fn bad_input_is_an_error_before_any_window() {
         stderr.contains("error:") && stderr.contains("broken.toml"),
         "{stderr}"
     );
+
+    for bad in ["0", "1.5", "-1", "half"] {
+        let mut view = gpu_render(None);
+        view.args(["view", "scenes/minimal.toml", &format!("--scale={bad}")]);
+        let (status, stderr) = run(view);
+        assert_eq!(status, Some(2), "--scale {bad}:\n{stderr}");
+        assert!(stderr.contains("--scale"), "{stderr}");
+    }
 
     let mut view = gpu_render(None);
     view.args(["view", "scenes/minimal.toml", "--screenshot", "x.png"]);

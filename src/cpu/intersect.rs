@@ -511,8 +511,15 @@ pub fn intersect_triangle(ray: &ShearedRay, vertices: &[DVec3; 3], t_max: f64) -
 /// `scale/65536` is used instead, `scale` being [`crate::accel::ray_offset_scale`] (1 in scenes of
 /// unit size and beyond: the published constants).
 ///
-/// The GPU applies the constants to `f32` bit patterns; here they apply to `f64` bit
-/// patterns, so the CPU offset is the same number of ulps of its own, finer, precision.
+/// The units in the last place are those of the coordinate's `f32` rounding, the GPU's
+/// (`offset_ray_origin` in `shaders/intersect.wgsl`): the CPU moves its `f64` point by
+/// the same displacement the GPU's bit arithmetic makes, so both backends start every
+/// new ray from the same point to within `f32` rounding. An offset of 256 `f64` ulps
+/// (2^29 times smaller) made the two trace different rays: after a bounce on the far
+/// side of a unit sphere the GPU's ray started 6e-5 away from the CPU's, which moved
+/// a later hit near a point light by as much and its `1/d²` by 5%
+/// (`campaign-3-39192`, docs/fuzzing.md). A coordinate beyond `f32`'s range (no GPU
+/// twin) moves by 256 `f64` ulps.
 pub fn offset_ray_origin(point: DVec3, normal: DVec3, scale: f64) -> DVec3 {
     const ORIGIN: f64 = 1.0 / 32.0;
     const FLOAT_SCALE: f64 = 1.0 / 65_536.0;
@@ -521,7 +528,21 @@ pub fn offset_ray_origin(point: DVec3, normal: DVec3, scale: f64) -> DVec3 {
         if p.abs() < ORIGIN * scale {
             return p + FLOAT_SCALE * scale * n;
         }
+        // The GPU's `vec3<i32>(256.0 * n)`: truncated towards zero.
         let ulps = (INT_SCALE * n) as i64;
+        let rounded = p as f32;
+        if rounded.is_finite() {
+            let bits = i64::from(rounded.to_bits() as i32);
+            let moved = if rounded < 0.0 {
+                bits - ulps
+            } else {
+                bits + ulps
+            };
+            let moved = f32::from_bits(moved as i32 as u32);
+            if moved.is_finite() {
+                return p + (f64::from(moved) - f64::from(rounded));
+            }
+        }
         let bits = p.to_bits() as i64;
         let moved = if p < 0.0 { bits - ulps } else { bits + ulps };
         f64::from_bits(moved as u64)
@@ -751,6 +772,32 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn offset_moves_by_the_gpus_f32_ulps() {
+        // The GPU twin's arithmetic on f32 bit patterns, written out.
+        let gpu = |p: f32, n: f32| -> f32 {
+            let ulps = (256.0 * n) as i32;
+            let step = if p < 0.0 { -ulps } else { ulps };
+            f32::from_bits((p.to_bits() as i32).wrapping_add(step) as u32)
+        };
+        let n = DVec3::new(0.48, -0.6, 0.64);
+        for p in [
+            DVec3::new(1.0, -2.0, 0.75),
+            DVec3::new(-0.95, -1.999, 0.3),
+            DVec3::new(1e4, 3.5e-2, -7e6),
+        ] {
+            let moved = offset_ray_origin(p, n, 1.0);
+            for k in 0..3 {
+                let (p32, n32) = (p[k] as f32, n[k] as f32);
+                let expected = f64::from(gpu(p32, n32)) - f64::from(p32);
+                assert_eq!(moved[k] - p[k], expected, "{p} component {k}");
+            }
+        }
+        // Beyond f32's range the offset falls back to f64 ulps, still off the surface.
+        let far = offset_ray_origin(DVec3::new(1e300, 0.0, 0.0), DVec3::X, 1.0);
+        assert!(far.x > 1e300);
     }
 
     #[test]

@@ -187,6 +187,41 @@ impl AreaLights {
         self.emitters.is_empty()
     }
 
+    /// The emitters in selection order, each with its cumulative and own selection
+    /// probabilities (for the GPU twin's upload, `crate::gpu::area_lights`).
+    pub fn entries(&self) -> Vec<EmitterEntry> {
+        self.emitters
+            .iter()
+            .enumerate()
+            .map(|(index, emitter)| {
+                let below = if index == 0 { 0.0 } else { self.cdf[index - 1] };
+                let (shape, area) = match emitter.shape {
+                    EmitterShape::Sphere { center, radius } => (
+                        EmitterEntryShape::Sphere { center, radius },
+                        4.0 * std::f64::consts::PI * radius * radius,
+                    ),
+                    EmitterShape::Triangle { vertices, normal } => {
+                        let [a, b, c] = vertices;
+                        (
+                            EmitterEntryShape::Triangle { vertices, normal },
+                            0.5 * (b - a).cross(c - a).length(),
+                        )
+                    }
+                };
+                EmitterEntry {
+                    shape,
+                    // Scene geometry flattens emissive meshes, so an entry's surface
+                    // is one of the scene's own (`SceneGeometry::with_method`).
+                    prim: emitter.key.prim,
+                    radiance: emitter.radiance,
+                    cdf: self.cdf[index] / self.total,
+                    selection: (self.cdf[index] - below) / self.total,
+                    area,
+                }
+            })
+            .collect()
+    }
+
     /// The emitter chosen by `u ∈ [0, 1)` and its selection probability.
     fn choose(&self, u: f64) -> Option<(&Emitter, f64)> {
         let target = u * self.total;
@@ -223,6 +258,42 @@ impl AreaLights {
             }
         }
     }
+}
+
+/// The shape of an [`EmitterEntry`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum EmitterEntryShape {
+    /// A sphere, sampled by the cone of directions it subtends.
+    Sphere {
+        /// Its centre.
+        center: DVec3,
+        /// Its radius.
+        radius: f64,
+    },
+    /// A triangle, sampled uniformly by area, emitting on the side of `normal`.
+    Triangle {
+        /// Its vertices.
+        vertices: [DVec3; 3],
+        /// The unit normal of its emitting side.
+        normal: DVec3,
+    },
+}
+
+/// One emitter of [`AreaLights`] as the GPU twin uploads it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EmitterEntry {
+    /// Its shape.
+    pub shape: EmitterEntryShape,
+    /// The primitive a ray hits on it.
+    pub prim: PrimRef,
+    /// Its radiance.
+    pub radiance: DVec3,
+    /// The selection probability of it and every emitter before it.
+    pub cdf: f64,
+    /// Its selection probability.
+    pub selection: f64,
+    /// Its area.
+    pub area: f64,
 }
 
 /// The triangles of a polygon of at most `MAX_POLYGON_VERTICES` vertices (earcut in

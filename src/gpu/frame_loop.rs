@@ -315,7 +315,8 @@ impl Renderer {
                 end_sample: pass.end,
                 slot_count: film.slot_count,
                 iteration_budget: self.iteration_budget,
-                flags: FLAG_STORE_SUM,
+                // The scene's own flags (its integrator) kept.
+                flags: FLAG_STORE_SUM | scene.prepared.frame.flags,
                 ..scene.frame_for(film.width(), film.height())
             };
             queue.write_buffer(&film.slots.uniforms, 0, bytemuck::bytes_of(&frame));
@@ -417,8 +418,10 @@ impl Renderer {
     }
 
     /// Draws `film` into the caller's render pass (whose colour attachment has the
-    /// [`RendererOptions::surface_format`]): one fullscreen triangle, film pixel
-    /// (x, y) at framebuffer pixel (x, y) of the pass's viewport. The sRGB curve is
+    /// [`RendererOptions::surface_format`]): one triangle over the pass's viewport,
+    /// which the film fills, each pixel showing the film texel under its centre (a
+    /// viewport of the film's size shows film pixel (x, y) at viewport pixel (x, y);
+    /// a larger one scales the film up by nearest texel). The sRGB curve is
     /// applied exactly once: by the shader for a linear-unorm attachment, by the
     /// attachment for an `*Srgb` one (naive-gamma scenes are decoded first, so that
     /// their display values come out unchanged). Records only; binds the film's bind

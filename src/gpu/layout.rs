@@ -178,10 +178,12 @@ pub struct GpuPathState {
     pub albedo: [f32; 3],
     /// Padding.
     pub _pad1: u32,
-    /// Direct light gathered so far (ambient included).
+    /// Direct light gathered so far (ambient included); with the path integrator,
+    /// the weight of the hit's base-BRDF event.
     pub direct: [f32; 3],
-    /// Padding.
-    pub _pad2: u32,
+    /// Path integrator: the density of the BRDF sample that made the current ray
+    /// (negative when none did).
+    pub brdf_pdf: f32,
 }
 
 /// One pending ray on a slot's bounce stack (`StackEntry` in WGSL).

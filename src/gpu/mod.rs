@@ -27,6 +27,7 @@
 //! # }
 //! ```
 
+pub mod area_lights;
 pub mod context;
 mod display;
 mod draw;

@@ -2,12 +2,13 @@
 //! lights), its image array and its trace constants.
 
 use super::GpuError;
+use super::area_lights::{FLAG_PATH, GpuEmitter, emitter_records};
 use super::features::ShaderFeatures;
 use super::layout::FrameUniforms;
 use super::readback::{Caught, capture};
 use super::upload::{SceneRecords, frame_uniforms, image_layers};
 use crate::accel::{BvhStats, MAX_PLANES, SceneGeometry};
-use crate::scene::Scene;
+use crate::scene::{Integrator, Scene};
 
 /// The storage buffers of an uploaded scene.
 #[derive(Debug)]
@@ -22,6 +23,8 @@ pub(crate) struct SceneBuffers {
     pub bvh_nodes: wgpu::Buffer,
     pub bvh_prims: wgpu::Buffer,
     pub triangle_attributes: wgpu::Buffer,
+    /// The path integrator's emitters (one padding record for Whitted scenes).
+    pub emitters: wgpu::Buffer,
 }
 
 /// A scene uploaded to one device, ready to trace with
@@ -106,13 +109,6 @@ pub(crate) fn upload_scene(
     specialise: bool,
 ) -> Result<PreparedScene, GpuError> {
     scene.render.check().map_err(GpuError::Validation)?;
-    if scene.render.integrator == crate::scene::Integrator::Path {
-        return Err(GpuError::Validation(
-            "the path integrator runs on the CPU reference only; its GPU twin is not \
-             written yet"
-                .into(),
-        ));
-    }
     if geometry.planes.len() > MAX_PLANES {
         return Err(GpuError::DeviceLimit {
             what: "infinite planes (every ray tests every plane; use polygons)".into(),
@@ -122,7 +118,16 @@ pub(crate) fn upload_scene(
     }
     let shaded = scene.in_lighting_space();
     let records = SceneRecords::new(&shaded, geometry);
-    let frame = frame_uniforms(&shaded, geometry);
+    let path = scene.render.integrator == Integrator::Path;
+    let mut frame = frame_uniforms(&shaded, geometry);
+    let emitters = if path {
+        // The integrator is a flag of the trace: every trace of the scene keeps it.
+        frame.flags |= FLAG_PATH;
+        frame.stack_size = frame.stack_size.max(1);
+        emitter_records(geometry, &shaded.materials)
+    } else {
+        vec![GpuEmitter::NONE]
+    };
     let limits = device.limits();
     let max_binding = limits
         .max_storage_buffer_binding_size
@@ -169,11 +174,17 @@ pub(crate) fn upload_scene(
             "triangle attribute",
             bytemuck::cast_slice(&padded.triangle_attributes),
         )?,
+        emitters: upload("emitter", bytemuck::cast_slice(&emitters))?,
     };
     let (images, image_bytes) = upload_images(device, queue, &shaded, &limits)?;
     Ok(PreparedScene {
         frame,
-        stack_size: scene.render.stack_size,
+        // A path keeps its one continuation on the bounce stack.
+        stack_size: if path {
+            scene.render.stack_size.max(1)
+        } else {
+            scene.render.stack_size
+        },
         features: if specialise {
             ShaderFeatures::for_scene(scene)
         } else {

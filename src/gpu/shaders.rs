@@ -29,6 +29,11 @@ pub const BXDF_EVAL_ENTRY_POINT: &str = "eval_brdfs";
 pub const TRAVERSE_WGSL: &str = include_str!("../../shaders/traverse.wgsl");
 /// The wavefront kernels (`shade_paths`, `trace_rays`) and their bindings.
 pub const TRACE_WGSL: &str = include_str!("../../shaders/trace.wgsl");
+/// The path integrator's records and constants (`Emitter`, `FLAG_PATH`), twins of
+/// [`super::area_lights`].
+pub const PATH_TYPES_WGSL: &str = include_str!("../../shaders/path_types.wgsl");
+/// The path integrator (`PATH` feature), twin of [`crate::cpu::path`] and its samplers.
+pub const PATH_WGSL: &str = include_str!("../../shaders/path.wgsl");
 
 /// Entry point of the shading kernel of the trace module.
 pub const SHADE_ENTRY_POINT: &str = "shade_paths";
@@ -46,7 +51,7 @@ pub const WORKGROUP_SIZE: u32 = 8;
 
 /// The complete trace module specialised to `features` (see [`super::features`]): the
 /// constants shared with the Rust side (`MAX_BVH_DEPTH`, `MAX_POLYGON_VERTICES`), then
-/// types, sampling, intersect, texture, bxdf, traverse and trace.
+/// types, path types, sampling, intersect, texture, bxdf, traverse, trace and path.
 ///
 /// Errors: a message if the sources' feature directives are malformed.
 ///
@@ -60,12 +65,14 @@ pub const WORKGROUP_SIZE: u32 = 8;
 pub fn trace_shader_source(features: &ShaderFeatures) -> Result<String, String> {
     let parts = [
         TYPES_WGSL,
+        PATH_TYPES_WGSL,
         SAMPLING_WGSL,
         INTERSECT_WGSL,
         TEXTURE_WGSL,
         BXDF_WGSL,
         TRAVERSE_WGSL,
         TRACE_WGSL,
+        PATH_WGSL,
     ];
     let mut source = format!(
         "const MAX_BVH_DEPTH: u32 = {}u;\nconst MAX_POLYGON_VERTICES: u32 = {}u;\n",

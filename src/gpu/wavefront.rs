@@ -305,6 +305,7 @@ impl SlotBuffers {
                 buffer(binding::TRACES, &self.traces),
                 buffer(binding::TRAVERSAL_STACK, &self.traversal_stack),
                 buffer(binding::TRIANGLE_ATTRIBUTES, &s.triangle_attributes),
+                buffer(binding::EMITTERS, &s.emitters),
             ],
         })
     }

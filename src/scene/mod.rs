@@ -21,5 +21,6 @@ pub use image::{MAX_IMAGE_SIDE, load_image};
 pub use medium::{MEDIUM_STACK_SIZE, MediumStack};
 pub use model::*;
 pub use sphere::{
-    SPHERE_PRECISION_LIMIT, SpherePrecision, sphere_anchor, sphere_level, sphere_precision,
+    FAR_WALL_PRECISION_LIMIT, FarWallPrecision, SPHERE_PRECISION_LIMIT, SphereGap, SpherePrecision,
+    coincident_spheres, far_wall_precision, sphere_anchor, sphere_level, sphere_precision,
 };

@@ -136,7 +136,7 @@ pub enum Integrator {
     Whitted,
     /// Unbiased Monte Carlo path tracing: emissive shapes are lights, next-event
     /// estimation with multiple importance sampling, importance-sampled BRDFs, Russian
-    /// roulette (docs/path-tracing.md). CPU reference only, for now.
+    /// roulette (docs/path-tracing.md). On both backends.
     Path,
 }
 

@@ -252,9 +252,43 @@ pub struct ViewArgs {
     #[arg(long)]
     pub sandbox: bool,
 
+    /// Trace a film this fraction of the window's size and draw it scaled up (nearest
+    /// texel): 0.5 traces a quarter of the pixels, for a faster preview.
+    #[arg(long, value_name = "F", default_value_t = 1.0, value_parser = parse_view_scale)]
+    pub scale: f64,
+
+    /// The GPU adapter to show the window with: an index from the list the viewer
+    /// prints when this does not match, or part of an adapter's name.
+    #[arg(long, value_name = "INDEX|NAME", value_parser = parse_view_adapter)]
+    pub adapter: Option<AdapterArg>,
+
     /// Print nothing but errors and the --frames summary.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// `--scale`: a fraction in (0, 1].
+fn parse_view_scale(text: &str) -> Result<f64, String> {
+    let value: f64 = text
+        .parse()
+        .map_err(|e| format!("expected a number in (0, 1], got `{text}`: {e}"))?;
+    if value > 0.0 && value <= 1.0 {
+        Ok(value)
+    } else {
+        Err(format!("must be in (0, 1], got {text}"))
+    }
+}
+
+/// The viewer's `--adapter`: an index or a name (`list` belongs to the render command).
+fn parse_view_adapter(text: &str) -> Result<AdapterArg, String> {
+    match parse_adapter(text)? {
+        AdapterArg::List => Err(
+            "`gpu-render --adapter list` lists the adapters; the viewer \
+                                 takes an index or part of a name"
+                .into(),
+        ),
+        choice => Ok(choice),
+    }
 }
 
 /// `--tile I/N`: tile `index` of `count`.
@@ -601,7 +635,7 @@ pub enum LightingArg {
 pub enum IntegratorArg {
     /// Whitted ray tracing: shadow rays, mirror and refraction branches, ambient.
     Whitted,
-    /// Path tracing: area lights, indirect light, caustics (CPU reference only).
+    /// Path tracing: area lights, indirect light, caustics.
     Path,
 }
 

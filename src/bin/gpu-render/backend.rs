@@ -79,24 +79,6 @@ impl Backend {
             Some(AdapterArg::Name(name)) => AdapterChoice::NameContains(name.clone()),
             Some(AdapterArg::List) => bail!("--adapter list does not select an adapter"),
         };
-        if scene.render.integrator == Integrator::Path {
-            match choice {
-                BackendArg::Cpu => return Ok(Backend::Cpu { reason: None }),
-                BackendArg::Auto if adapter.is_none() => {
-                    return Ok(Backend::Cpu {
-                        reason: Some(
-                            "the path integrator runs on the CPU reference only (its GPU \
-                             twin is not written yet)"
-                                .into(),
-                        ),
-                    });
-                }
-                _ => bail!(
-                    "the path integrator runs on the CPU reference only (its GPU twin is not \
-                     written yet): use --backend cpu or auto, or --integrator whitted"
-                ),
-            }
-        }
         match choice {
             BackendArg::Cpu => Ok(Backend::Cpu { reason: None }),
             BackendArg::Gpu => Self::open_gpu(&adapter_choice, options),
@@ -242,7 +224,8 @@ impl Backend {
 /// (whose loops have no limit, `gpu::driver_loop_limit`) on scenes without polygons
 /// and without glass (2.7x on the direct-light scene, 1.2x on spheres and planes);
 /// polygons and refraction make it slower (0.45x on `glass.toml`, 0.5x on the
-/// showcase), and so is every scene on older Mesa. On any device, a scene with a sphere
+/// showcase), and so is every scene on older Mesa, and every path-traced scene (the
+/// Cornell box: `BENCHMARKS.md`, "Path tracing on the GPU"). On any device, a scene with a sphere
 /// that only the CPU reference's f64 places precisely enough (`scene::sphere_precision`:
 /// a small sphere far from the origin seen from close by) renders on the CPU. Returns
 /// why the CPU reference is chosen instead, if it is.
@@ -258,6 +241,8 @@ pub fn auto_rule(adapter: &wgpu::AdapterInfo, scene: &Scene) -> Option<String> {
     }
     let why = if gpu::driver_loop_limit(adapter).is_some() {
         "on this driver version the CPU reference is faster for every scene measured"
+    } else if scene.render.integrator == Integrator::Path {
+        "for path-traced scenes the CPU reference is faster"
     } else {
         let features = gpu::ShaderFeatures::for_scene(scene);
         if !(features.polygons || features.refraction) {
@@ -372,6 +357,19 @@ mod tests {
         assert!(
             reason.contains("llvmpipe") && reason.contains("glass"),
             "{reason}"
+        );
+        let path = scene(&format!(
+            "[render]\nintegrator = \"path\"\n{camera}[materials.m]\ntype = \"lambert\"\n\
+             albedo = 0.5\n{sphere}"
+        ));
+        let reason = auto_rule(&new, &path).expect("path tracing renders on the CPU");
+        assert!(reason.contains("path-traced"), "{reason}");
+        assert_eq!(
+            auto_rule(
+                &adapter("NVIDIA H200", wgpu::DeviceType::DiscreteGpu),
+                &path
+            ),
+            None
         );
         let old = lavapipe("22.3.6");
         let reason = auto_rule(&old, &spheres).expect("old llvmpipe is not used");

@@ -339,10 +339,12 @@ fn build_scene(
             checked();
             lights::light(source, i, light)
         })
-        .collect::<Result<_, _>>()?;
+        .collect::<Result<Vec<_>, _>>()?;
     let table = MaterialTable::new(&material_names);
     let base = source.path.parent().unwrap_or(std::path::Path::new(""));
     let mut shapes = Vec::with_capacity(raw.objects.len());
+    // Each shape's object index and span, for the warnings that judge shapes together.
+    let mut shape_items = Vec::with_capacity(raw.objects.len());
     let mut models = Vec::new();
     for (i, object) in raw.objects.into_iter().enumerate() {
         checked();
@@ -356,11 +358,29 @@ fn build_scene(
             {
                 warn(
                     &source
-                        .item(format!("objects[{i}] (sphere)"), Some(span))
+                        .item(format!("objects[{i}] (sphere)"), Some(span.clone()))
                         .warning(message),
                 );
             }
             shapes.push(shape);
+            shape_items.push((i, span));
+        }
+    }
+    if let Some(warn) = options.warning {
+        let extent = objects::scene_extent(&shapes, &lights, camera.eye);
+        for (k, shape) in shapes.iter().enumerate() {
+            let (i, span) = &shape_items[k];
+            let item = || source.item(format!("objects[{i}] (sphere)"), Some(span.clone()));
+            if let Some(message) = objects::far_wall_warning(shape, camera.eye, extent) {
+                warn(&item().warning(message));
+            }
+            for (other, (j, _)) in shapes.iter().zip(&shape_items).skip(k + 1) {
+                let name = format!("objects[{j}]");
+                if let Some(message) = objects::coincident_warning(shape, other, &name, camera.eye)
+                {
+                    warn(&item().warning(message));
+                }
+            }
         }
     }
     let mut scene = Scene {

@@ -9,7 +9,10 @@ use super::LoadOptions;
 use super::check::{Item, Source};
 use super::raw::{RawColor, RawObject, RawVec3};
 use crate::scene::import::{ImportedModel, ModelPlacement, import_model};
-use crate::scene::{SPHERE_PRECISION_LIMIT, SceneError, Shape, sphere_precision};
+use crate::scene::{
+    FAR_WALL_PRECISION_LIMIT, Light, SPHERE_PRECISION_LIMIT, SceneError, Shape, coincident_spheres,
+    far_wall_precision, sphere_precision,
+};
 
 const SPHERE_FIELDS: &[&str] = &["center", "radius", "material"];
 const PLANE_FIELDS: &[&str] = &["point", "normal", "material"];
@@ -209,6 +212,112 @@ pub fn sphere_precision_warning(shape: &Shape, eye: DVec3) -> Option<String> {
         precision.cpu_relative(),
         precision.gpu,
         precision.gpu_relative(),
+    ))
+}
+
+/// The extent of the scene that paths across a sphere around the camera come back to
+/// ([`crate::scene::far_wall_precision`]): the largest side of the box around the eye,
+/// the point lights, the polygons and triangles, and the spheres that neither contain
+/// the eye nor are 100 times larger than their distance from it (those look like
+/// planes from the camera, and planes, which are unbounded, are left out too).
+pub fn scene_extent(shapes: &[Shape], lights: &[Light], eye: DVec3) -> f64 {
+    let mut lo = eye;
+    let mut hi = eye;
+    let mut include = |a: DVec3, b: DVec3| {
+        lo = lo.min(a);
+        hi = hi.max(b);
+    };
+    for light in lights {
+        if let Light::Point { position, .. } = light {
+            include(*position, *position);
+        }
+    }
+    for shape in shapes {
+        match shape {
+            Shape::Sphere { center, radius, .. } => {
+                let precision = sphere_precision(*center, *radius, eye);
+                let inside = (eye - *center).length() < *radius;
+                if !inside && precision.distance * 100.0 > *radius {
+                    include(*center - *radius, *center + *radius);
+                }
+            }
+            Shape::Polygon { vertices, .. } => vertices.iter().for_each(|v| include(*v, *v)),
+            Shape::Triangle { vertices, .. } => vertices.iter().for_each(|v| include(*v, *v)),
+            Shape::Plane { .. } => {}
+        }
+    }
+    (hi - lo).max_element()
+}
+
+/// The warning for a sphere around the camera whose far side the GPU places to more
+/// than [`FAR_WALL_PRECISION_LIMIT`] of `extent` ([`scene_extent`]), or `None`.
+pub fn far_wall_warning(shape: &Shape, eye: DVec3, extent: f64) -> Option<String> {
+    let Shape::Sphere { center, radius, .. } = shape else {
+        return None;
+    };
+    // Zero (nothing but the eye) or NaN: nothing to judge against.
+    if extent.is_nan() || extent <= 0.0 {
+        return None;
+    }
+    let far = far_wall_precision(*center, *radius, eye, extent)?;
+    far.hopeless().then(|| {
+        format!(
+            "radius {radius:e} around the camera: the GPU (f32) places points on its far \
+             side, up to {:.1e} away, to about {:.1e} units, {:.1e} of the {:.1e} across \
+             the rest of the scene spans (more than {FAR_WALL_PRECISION_LIMIT:e}); paths \
+             that cross it and come back (shadow rays from its far side, reflections) may \
+             pass the scene's objects on another side on the GPU than on the CPU \
+             reference (--backend cpu); make the sphere smaller",
+            2.0 * radius,
+            far.gpu,
+            far.relative(),
+            extent,
+        )
+    })
+}
+
+/// The warning for two large spheres whose surfaces near the camera lie closer than
+/// the GPU can place them ([`crate::scene::coincident_spheres`]), naming the other
+/// sphere `other` (as `objects[K]`), or `None`.
+pub fn coincident_warning(
+    first: &Shape,
+    second: &Shape,
+    other: &str,
+    eye: DVec3,
+) -> Option<String> {
+    let (
+        Shape::Sphere {
+            center: c1,
+            radius: r1,
+            ..
+        },
+        Shape::Sphere {
+            center: c2,
+            radius: r2,
+            ..
+        },
+    ) = (first, second)
+    else {
+        return None;
+    };
+    let gap = coincident_spheres((*c1, *r1), (*c2, *r2), eye)?;
+    let consequence = if gap.cpu < gap.gap {
+        format!(
+            "f32 rounding on the GPU (the CPU reference places them to {:.1e}: --backend \
+             cpu)",
+            gap.cpu
+        )
+    } else {
+        format!(
+            "rounding on both backends (the CPU reference, f64, places them to {:.1e})",
+            gap.cpu
+        )
+    };
+    Some(format!(
+        "radius {r1:e}: near the camera its surface lies {:.1e} from that of {other}, \
+         less than the {:.1e} to which the GPU (f32) places them, so which of the two \
+         is in front is decided by {consequence}; move the spheres apart",
+        gap.gap, gap.gpu,
     ))
 }
 

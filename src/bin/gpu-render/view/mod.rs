@@ -22,7 +22,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, anyhow, bail};
 use gpu_render::gpu::{Film, GpuScene, Renderer, RendererOptions, read_texture};
 use gpu_render::output;
-use gpu_render::scene::{self, Camera, Integrator, RenderSettings, Scene};
+use gpu_render::scene::{self, Camera, RenderSettings, Scene};
 use winit::application::ApplicationHandler;
 use winit::dpi::{PhysicalPosition, PhysicalSize};
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -77,8 +77,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     }
 }
 
-/// Loads the scene file (or model file) with the command-line overrides, refusing
-/// what the GPU frame loop cannot show.
+/// Loads the scene file (or model file) with the command-line overrides.
 fn load_view_scene(args: &ViewArgs) -> Result<Scene> {
     let path = args.scene.as_path();
     let mut scene = if scene::import::is_model_path(path) {
@@ -88,13 +87,6 @@ fn load_view_scene(args: &ViewArgs) -> Result<Scene> {
         crate::load(path, args.sandbox, args.quiet)?.scene
     };
     scene.render = crate::apply_overrides(&args.settings, scene.render, Some(path))?;
-    if scene.render.integrator == Integrator::Path {
-        bail!(
-            "{}: the viewer traces on the GPU, and the path integrator runs on the CPU \
-             reference only: use --integrator whitted",
-            path.display()
-        );
-    }
     Ok(scene)
 }
 
@@ -229,6 +221,8 @@ struct Viewer {
     renderer: Renderer,
     scene: GpuScene,
     film: Film,
+    /// The film's size as a fraction of the window's (`--scale`).
+    scale: f64,
     /// What the window shows, in the surface's format.
     offscreen: wgpu::Texture,
     /// The camera of the scene file as last loaded (a reload that changes it wins
@@ -284,17 +278,20 @@ impl Viewer {
         let mut instance_desc = wgpu::InstanceDescriptor::new_with_display_handle(Box::new(
             event_loop.owned_display_handle(),
         ));
-        instance_desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
+        instance_desc.backends = viewer_backends();
         let instance = wgpu::Instance::new(instance_desc);
         let surface = instance
             .create_surface(Arc::clone(&window))
             .context("cannot create a wgpu surface for the window")?;
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            compatible_surface: Some(&surface),
-            ..Default::default()
-        }))
-        .context("no GPU adapter can present to this window")?;
+        let adapter = match &args.adapter {
+            None => pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                compatible_surface: Some(&surface),
+                ..Default::default()
+            }))
+            .context("no GPU adapter can present to this window")?,
+            Some(choice) => choose_adapter(&instance, viewer_backends(), &surface, choice)?,
+        };
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("gpu-render viewer"),
             required_limits: Renderer::required_limits(&adapter.limits()),
@@ -314,7 +311,8 @@ impl Viewer {
         )
         .with_context(|| format!("cannot set up the tracer on {}", adapter.get_info().name))?;
         let gpu_scene = renderer.upload(&device, &queue, &scene)?;
-        let film = renderer.create_film(&device, &gpu_scene, config.width, config.height)?;
+        let (film_width, film_height) = film_size(&config, args.scale);
+        let film = renderer.create_film(&device, &gpu_scene, film_width, film_height)?;
         let offscreen = offscreen_texture(&device, &config);
         if !args.quiet {
             let info = adapter.get_info();
@@ -343,6 +341,7 @@ impl Viewer {
             renderer,
             scene: gpu_scene,
             film,
+            scale: args.scale,
             offscreen,
             file_camera: scene.camera,
             scene_path: args.scene.clone(),
@@ -559,8 +558,9 @@ impl Viewer {
         self.config.width = size.width;
         self.config.height = size.height;
         self.surface.configure(&self.device, &self.config);
+        let (film_width, film_height) = film_size(&self.config, self.scale);
         self.film
-            .resize(&self.device, &self.renderer, size.width, size.height)?;
+            .resize(&self.device, &self.renderer, film_width, film_height)?;
         self.offscreen = offscreen_texture(&self.device, &self.config);
         self.window.request_redraw();
         Ok(())
@@ -679,9 +679,6 @@ impl Viewer {
             crate::load(path, args.sandbox, args.quiet)?.scene
         };
         scene.render = crate::apply_overrides(&args.settings, scene.render, Some(path))?;
-        if scene.render.integrator == Integrator::Path {
-            bail!("the path integrator runs on the CPU reference only: the viewer cannot show it");
-        }
         let file_camera = scene.camera;
         // The interactive camera stays unless the file's camera changed.
         if file_camera == self.file_camera {
@@ -693,16 +690,78 @@ impl Viewer {
             .upload(&self.device, &self.queue, &scene)
             .map_err(|e| anyhow!(e))?;
         if gpu_scene.prepared().stack_size() > self.scene.prepared().stack_size() {
-            self.film = self.renderer.create_film(
-                &self.device,
-                &gpu_scene,
-                self.config.width,
-                self.config.height,
-            )?;
+            let (film_width, film_height) = film_size(&self.config, self.scale);
+            self.film =
+                self.renderer
+                    .create_film(&self.device, &gpu_scene, film_width, film_height)?;
         }
         self.scene = gpu_scene;
         self.file_camera = file_camera;
         Ok(())
+    }
+}
+
+/// The film's size for a window of `config`'s size at `scale` (at least 1 x 1).
+fn film_size(config: &wgpu::SurfaceConfiguration, scale: f64) -> (u32, u32) {
+    let scaled = |n: u32| ((f64::from(n) * scale).round() as u32).max(1);
+    (scaled(config.width), scaled(config.height))
+}
+
+/// The backends the viewer's instance uses.
+fn viewer_backends() -> wgpu::Backends {
+    wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY)
+}
+
+/// The adapter `--adapter` names among those of `backends` that can present to
+/// `surface`; the error lists them.
+fn choose_adapter(
+    instance: &wgpu::Instance,
+    backends: wgpu::Backends,
+    surface: &wgpu::Surface<'_>,
+    choice: &crate::args::AdapterArg,
+) -> Result<wgpu::Adapter> {
+    let adapters: Vec<wgpu::Adapter> = pollster::block_on(instance.enumerate_adapters(backends))
+        .into_iter()
+        .filter(|adapter| adapter.is_surface_supported(surface))
+        .collect();
+    let listing = || {
+        let names: Vec<String> = adapters
+            .iter()
+            .enumerate()
+            .map(|(i, a)| {
+                let info = a.get_info();
+                format!("{i}: {} ({:?})", info.name, info.backend)
+            })
+            .collect();
+        if names.is_empty() {
+            "none can present to this window".to_owned()
+        } else {
+            format!(
+                "those that can present to this window: {}",
+                names.join(", ")
+            )
+        }
+    };
+    let found = match choice {
+        crate::args::AdapterArg::Index(i) => adapters.get(*i),
+        crate::args::AdapterArg::Name(name) => {
+            let name = name.to_lowercase();
+            adapters
+                .iter()
+                .find(|a| a.get_info().name.to_lowercase().contains(&name))
+        }
+        crate::args::AdapterArg::List => None,
+    };
+    match found {
+        Some(adapter) => Ok(adapter.clone()),
+        None => {
+            let asked = match choice {
+                crate::args::AdapterArg::Index(i) => i.to_string(),
+                crate::args::AdapterArg::Name(name) => format!("{name:?}"),
+                crate::args::AdapterArg::List => "list".to_owned(),
+            };
+            bail!("--adapter {asked} matches no adapter; {}", listing())
+        }
     }
 }
 

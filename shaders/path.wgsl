@@ -1,0 +1,721 @@
+//#if PATH
+// The path-tracing integrator (`integrator = "path"`): the WGSL twin of
+// src/cpu/path.rs (path_radiance) and of its samplers, src/cpu/sample.rs, documented
+// in docs/path-tracing.md. It runs in the wavefront engine of shaders/trace.wgsl, one
+// bounce per shading step, when frame.flags has FLAG_PATH:
+//
+// - at a hit (path_closest_hit) the path adds the emission it finds (weighted by
+//   multiple importance sampling against next-event estimation), picks one event of
+//   the material, and decides its continuation at once: the next ray (BRDF-sampled,
+//   or the mirror or refracted one), after Russian roulette, goes on the slot's bounce
+//   stack, which the path integrator uses for that one entry. Every random number is
+//   counter-based (random_number), so drawing them early changes nothing;
+// - for the base BRDF it then gathers direct light as Whitted does, one shadow ray per
+//   point or directional light (PHASE_NEXT_LIGHT, PHASE_SHADOW), each contribution
+//   added on its own, and last one shadow ray towards a point sampled on one emitter
+//   (PHASE_EMITTER), whose sample is drawn again from the same numbers when the ray
+//   comes back, so that nothing but the phase is kept between the two steps;
+// - PHASE_POP then pops the continuation, or ends the sample when there is none.
+//
+// The path therefore draws the CPU's numbers for the CPU's decisions, in the CPU's
+// order of sums: the images agree per pixel within f32 rounding (tests/path_gpu.rs).
+
+// The emitters of the AreaLights distribution (src/gpu/area_lights.rs), in the CPU's
+// order; one EMITTER_NONE record when the scene has none.
+@group(0) @binding(19) var<storage, read> emitters: array<Emitter>;
+
+// Bounces after which Russian roulette may end a path. Twin of ROULETTE_DEPTH.
+const ROULETTE_DEPTH: u32 = 3u;
+// The least survival probability of Russian roulette. Twin of MIN_SURVIVAL.
+const MIN_SURVIVAL: f32 = 0.05;
+// Random dimensions a path uses per bounce: the event (0), the BRDF lobe (1), the
+// BRDF direction (2, 3), the emitter (4), the point on it (5, 6) and roulette (7);
+// dimensions 0 and 1 of a sample are its position in the pixel. Twin of
+// DIMENSIONS_PER_BOUNCE.
+const DIMENSIONS_PER_BOUNCE: u32 = 8u;
+// PathState.brdf_pdf of a ray that no BRDF sample made (a camera ray, or one after a
+// perfectly specular event): its emission is not weighted.
+const NO_BRDF_PDF: f32 = -1.0;
+
+// Whether this trace uses the path integrator.
+fn path_mode() -> bool {
+    return (frame.flags & FLAG_PATH) != 0u;
+}
+
+// A uniform number in [0, 1) for dimension `dimension` of sample `sample` of image
+// pixel `pixel`: the three counters hashed in turn by PCG's RXS-M-XS permutation
+// (Jarzynski and Olano, JCGT 9(3), 2020; pcg_hash in shaders/sampling.wgsl), the top
+// 24 bits scaled by 2^-24, exact in f32. Twin of random_number (src/cpu/sample.rs).
+fn random_number(pixel: u32, sample: u32, dimension: u32) -> f32 {
+    return unit_from_hash(pcg_hash(pcg_hash(pcg_hash(pixel) ^ sample) ^ dimension));
+}
+
+// Random number `k` of the path's current bounce: dimension 2 + 8·depth + k of its
+// sample, for its image pixel (y·width + x).
+fn path_random(path: ptr<function, PathState>, k: u32) -> f32 {
+    let xy = pixel_position((*path).pixel);
+    let dimension = 2u + (*path).depth * DIMENSIONS_PER_BOUNCE + k;
+    return random_number(xy.y * frame.width + xy.x, (*path).sample, dimension);
+}
+
+// Relative luminance of a linear Rec. 709 colour (ITU-R BT.709 weights). Twin of
+// luminance (src/cpu/path.rs), in its order of sums.
+fn path_luminance(c: vec3<f32>) -> f32 {
+    return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+}
+
+// `v / |v|`, or zero for a zero vector (glam's normalize_or_zero).
+fn normalize_or_zero(v: vec3<f32>) -> vec3<f32> {
+    let length_squared = dot(v, v);
+    if !(length_squared > 0.0) {
+        return vec3<f32>(0.0);
+    }
+    return v / sqrt(length_squared);
+}
+
+// An orthonormal basis around a unit normal (z = n), without branches on the normal's
+// direction except its sign (Duff et al., "Building an Orthonormal Basis, Revisited",
+// JCGT 6(1), 2017). Twin of ShadingFrame.
+struct ShadingFrame {
+    x: vec3<f32>,
+    y: vec3<f32>,
+    z: vec3<f32>,
+}
+
+fn shading_frame(n: vec3<f32>) -> ShadingFrame {
+    // copysign(1, n.z), read from the sign bit as Rust's copysign does (-0 gives -1).
+    let sign = select(1.0, -1.0, (bitcast<u32>(n.z) & 0x80000000u) != 0u);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    return ShadingFrame(vec3<f32>(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+                        vec3<f32>(b, sign + n.y * n.y * a, -n.y), n);
+}
+
+fn frame_to_local(f: ShadingFrame, v: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(dot(v, f.x), dot(v, f.y), dot(v, f.z));
+}
+
+fn frame_to_world(f: ShadingFrame, v: vec3<f32>) -> vec3<f32> {
+    return f.x * v.x + f.y * v.y + f.z * v.z;
+}
+
+// A point of the unit disk, uniform in area, by Shirley and Chiu's concentric map ("A
+// Low Distortion Map Between Disk and Square", JGT 2(3), 1997). Twin of
+// sample_concentric_disk.
+fn sample_concentric_disk(u: vec2<f32>) -> vec2<f32> {
+    let p = u * 2.0 - vec2<f32>(1.0);
+    if all(p == vec2<f32>(0.0)) {
+        return vec2<f32>(0.0);
+    }
+    let quarter = PI / 4.0;
+    var r = p.y;
+    var theta = 2.0 * quarter - quarter * (p.x / p.y);
+    if abs(p.x) > abs(p.y) {
+        r = p.x;
+        theta = quarter * (p.y / p.x);
+    }
+    return vec2<f32>(r * cos(theta), r * sin(theta));
+}
+
+// A direction of the upper hemisphere with density cos θ / π (Malley's method: a
+// uniform disk point lifted onto the hemisphere). Twin of sample_cosine_hemisphere.
+fn sample_cosine_hemisphere(u: vec2<f32>) -> vec3<f32> {
+    let d = sample_concentric_disk(u);
+    return vec3<f32>(d.x, d.y, sqrt(max(1.0 - dot(d, d), 0.0)));
+}
+
+// The density of sample_cosine_hemisphere per steradian. Twin of pdf_cosine_hemisphere.
+fn pdf_cosine_hemisphere(w: vec3<f32>) -> f32 {
+    return max(w.z, 0.0) * (1.0 / PI);
+}
+
+//#if COOK_TORRANCE || PBR
+// A microfacet normal of the isotropic GGX distribution visible from the local `wo`:
+// Heitz, "Sampling the GGX Distribution of Visible Normals", JCGT 7(4), 2018, listing
+// 1. Twin of sample_ggx_visible_normal.
+fn sample_ggx_visible_normal(wo: vec3<f32>, alpha: f32, u: vec2<f32>) -> vec3<f32> {
+    // The view direction stretched to alpha = 1, and a basis around it (T1 horizontal).
+    let vh = normalize(vec3<f32>(alpha * wo.x, alpha * wo.y, wo.z));
+    let length_squared = vh.x * vh.x + vh.y * vh.y;
+    var t1 = vec3<f32>(1.0, 0.0, 0.0);
+    if length_squared > 0.0 {
+        t1 = vec3<f32>(-vh.y, vh.x, 0.0) / sqrt(length_squared);
+    }
+    let t2 = cross(vh, t1);
+    // A point of the projected area: a disk, its far half squeezed by vh.z.
+    let r = sqrt(u.x);
+    let phi = 2.0 * PI * u.y;
+    let p1 = r * cos(phi);
+    let s = 0.5 * (1.0 + vh.z);
+    let p2 = (1.0 - s) * sqrt(max(1.0 - p1 * p1, 0.0)) + s * r * sin(phi);
+    // Onto the hemisphere, and back to the ellipsoid configuration.
+    let nh = t1 * p1 + t2 * p2 + vh * sqrt(max(1.0 - p1 * p1 - p2 * p2, 0.0));
+    return normalize(vec3<f32>(alpha * nh.x, alpha * nh.y, max(nh.z, 0.0)));
+}
+
+// Its density per steradian of normals, D_wo(h) = G1(wo)·max(0, wo·h)·D(h) / wo.z
+// (Heitz 2018, eq. 1). Twin of pdf_ggx_visible_normal.
+fn pdf_ggx_visible_normal(wo: vec3<f32>, h: vec3<f32>, alpha: f32) -> f32 {
+    if wo.z <= 0.0 || h.z <= 0.0 {
+        return 0.0;
+    }
+    let g1 = 1.0 / (1.0 + smith_lambda_ggx(wo.z, alpha));
+    return g1 * max(dot(wo, h), 0.0) * distribution_ggx(h.z, alpha) / wo.z;
+}
+//#endif
+
+//#if COOK_TORRANCE
+// A microfacet normal of the Beckmann distribution with density D(h)·cos θ_h:
+// tan² θ_h = -α² ln(1 - u₁), φ = 2π u₂ (Walter et al., "Microfacet Models for
+// Refraction through Rough Surfaces", EGSR 2007, eq. 28). Twin of
+// sample_beckmann_normal.
+fn sample_beckmann_normal(alpha: f32, u: vec2<f32>) -> vec3<f32> {
+    let tan_squared = -alpha * alpha * log(1.0 - u.x);
+    let cos_theta = 1.0 / sqrt(1.0 + tan_squared);
+    let sin_theta = sqrt(max(1.0 - cos_theta * cos_theta, 0.0));
+    let phi = 2.0 * PI * u.y;
+    return vec3<f32>(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
+}
+
+// Its density per steradian of normals. Twin of pdf_beckmann_normal.
+fn pdf_beckmann_normal(h: vec3<f32>, alpha: f32) -> f32 {
+    if h.z <= 0.0 {
+        return 0.0;
+    }
+    return distribution_beckmann(h.z, alpha) * h.z;
+}
+//#endif
+
+//#if BLINN_PHONG
+// A half vector of the normalized Blinn-Phong lobe of exponent n, density
+// (n + 2)/(2π)·cos^(n+1) θ_h: cos θ_h = (1 - u₁)^(1/(n+2)), φ = 2π u₂ (inverting its
+// CDF in cos θ_h). Twin of sample_blinn_phong_half.
+fn sample_blinn_phong_half(n: f32, u: vec2<f32>) -> vec3<f32> {
+    let cos_theta = pow(1.0 - u.x, 1.0 / (n + 2.0));
+    let sin_theta = sqrt(max(1.0 - cos_theta * cos_theta, 0.0));
+    let phi = 2.0 * PI * u.y;
+    return vec3<f32>(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
+}
+
+// Its density per steradian of half vectors. Twin of pdf_blinn_phong_half.
+fn pdf_blinn_phong_half(h: vec3<f32>, n: f32) -> f32 {
+    if h.z <= 0.0 {
+        return 0.0;
+    }
+    return (n + 2.0) / (2.0 * PI) * pow(h.z, n + 1.0);
+}
+//#endif
+
+// The direction `wo` reflects into about the half vector `h`. Twin of reflect_about.
+fn reflect_about(wo: vec3<f32>, h: vec3<f32>) -> vec3<f32> {
+    return h * (2.0 * dot(wo, h)) - wo;
+}
+
+// The density of a reflected direction from its half vector's, by the Jacobian
+// dω_h/dω_i = 1 / (4 |wo·h|) (Walter et al. 2007, eq. 14). Twin of reflected_pdf.
+fn reflected_pdf(pdf_h: f32, wo_dot_h: f32) -> f32 {
+    if wo_dot_h == 0.0 {
+        return 0.0;
+    }
+    return pdf_h / (4.0 * abs(wo_dot_h));
+}
+
+//#if SPHERES
+// A direction from `point` uniform over the cone a sphere subtends, with density
+// 1 / (2π (1 - cos θ_max)); not found inside the sphere (Shirley and Wang, "Direct
+// Lighting Calculation by Monte Carlo Integration", EGWR 1991; pbrt-v4 §6.2.4). Twin
+// of sample_sphere_cone; sin² θ is computed as a(2 - a) with a = 1 - cos θ, which
+// equals the CPU's 1 - cos² θ but keeps f32's precision for small cones.
+struct DirectionSample {
+    wi: vec3<f32>,
+    pdf: f32,
+    found: bool,
+}
+
+fn sample_sphere_cone(point: vec3<f32>, center: vec3<f32>, radius: f32, u: vec2<f32>) -> DirectionSample {
+    var sample = DirectionSample(vec3<f32>(0.0), 0.0, false);
+    let to_center = center - point;
+    let distance_squared = dot(to_center, to_center);
+    if distance_squared <= radius * radius {
+        return sample;
+    }
+    let sin_squared_max = radius * radius / distance_squared;
+    let cos_max = sqrt(max(1.0 - sin_squared_max, 0.0));
+    // 1 - cos θ_max, without cancellation for small, far spheres.
+    let one_minus_cos_max = sin_squared_max / (1.0 + cos_max);
+    let a = u.x * one_minus_cos_max;
+    let cos_theta = 1.0 - a;
+    let sin_theta = sqrt(max(a * (2.0 - a), 0.0));
+    let phi = 2.0 * PI * u.y;
+    let frame = shading_frame(to_center / sqrt(distance_squared));
+    let local = vec3<f32>(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
+    sample.wi = frame_to_world(frame, local);
+    sample.pdf = 1.0 / (2.0 * PI * one_minus_cos_max);
+    sample.found = true;
+    return sample;
+}
+
+// Its density for the unit direction `w`: 0 outside the cone or inside the sphere.
+// Twin of pdf_sphere_cone.
+fn pdf_sphere_cone(point: vec3<f32>, center: vec3<f32>, radius: f32, w: vec3<f32>) -> f32 {
+    let to_center = center - point;
+    let distance_squared = dot(to_center, to_center);
+    if distance_squared <= radius * radius {
+        return 0.0;
+    }
+    let sin_squared_max = radius * radius / distance_squared;
+    let cos_max = sqrt(max(1.0 - sin_squared_max, 0.0));
+    if dot(w, to_center) < cos_max * sqrt(distance_squared) {
+        return 0.0;
+    }
+    return 1.0 / (2.0 * PI * sin_squared_max / (1.0 + cos_max));
+}
+//#endif
+
+// Barycentric coordinates of a point uniform in area over a triangle: b₀ = 1 - √u₁,
+// b₁ = u₂ √u₁ (Turk, "Generating Random Points in Triangles", Graphics Gems, 1990).
+// Twin of sample_triangle_barycentrics.
+fn sample_triangle_barycentrics(u: vec2<f32>) -> vec3<f32> {
+    let root = sqrt(u.x);
+    let b0 = 1.0 - root;
+    let b1 = u.y * root;
+    return vec3<f32>(b0, b1, 1.0 - b0 - b1);
+}
+
+// The density per steradian, seen from `point`, of a point sampled with density
+// `pdf_area` per unit area: pdf_area · r² / |cos θ_light| (pbrt-v4 §4.2.3). Twin of
+// area_to_solid_angle_pdf.
+fn area_to_solid_angle_pdf(pdf_area: f32, point: vec3<f32>, on_light: vec3<f32>, light_normal: vec3<f32>) -> f32 {
+    let to_light = on_light - point;
+    let distance_squared = dot(to_light, to_light);
+    let cos_light = abs(dot(light_normal, to_light)) / sqrt(distance_squared);
+    if cos_light == 0.0 {
+        return 0.0;
+    }
+    return pdf_area * distance_squared / cos_light;
+}
+
+// The power heuristic with exponent 2, a² / (a² + b²) (Veach's thesis, 1997, §9.2.4).
+// Twin of power_heuristic, written with the ratio of the smaller density to the larger
+// so that f32 squares of large densities cannot overflow (equal in exact arithmetic).
+fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
+    if pdf_a == 0.0 && pdf_b == 0.0 {
+        return 0.0;
+    }
+    if pdf_a >= pdf_b {
+        let r = pdf_b / pdf_a;
+        return 1.0 / (1.0 + r * r);
+    }
+    let r = pdf_a / pdf_b;
+    return r * r / (1.0 + r * r);
+}
+
+// The probability that the base BRDF's sampler picks its specular lobe (the lobes mixed
+// in proportion to their weights). Twin of specular_lobe_probability.
+fn specular_lobe_probability(material: Material) -> f32 {
+    var p = 0.0;
+    //#if BLINN_PHONG
+    if material.kind == MATERIAL_BLINN_PHONG {
+        let d = path_luminance(material.diffuse);
+        let s = path_luminance(material.specular);
+        if d + s > 0.0 {
+            p = s / (d + s);
+        }
+    }
+    //#endif
+    //#if COOK_TORRANCE
+    if material.kind == MATERIAL_COOK_TORRANCE {
+        p = select(1.0, 0.5, max_component(material.diffuse) > 0.0);
+    }
+    //#endif
+    //#if PBR
+    if material.kind == MATERIAL_PBR {
+        p = 0.5 + 0.5 * material.metallic;
+    }
+    //#endif
+    return p;
+}
+
+// A half vector of the material's specular lobe in the local frame (`wo` local). Twin
+// of sample_half_vector.
+fn sample_half_vector(material: Material, wo: vec3<f32>, u: vec2<f32>) -> vec3<f32> {
+    var h = vec3<f32>(0.0, 0.0, 1.0);
+    //#if BLINN_PHONG
+    if material.kind == MATERIAL_BLINN_PHONG {
+        h = sample_blinn_phong_half(material.shininess, u);
+    }
+    //#endif
+    //#if COOK_TORRANCE || PBR
+    if material.kind == MATERIAL_COOK_TORRANCE || material.kind == MATERIAL_PBR {
+        let alpha = microfacet_alpha(material.roughness);
+        //#if COOK_TORRANCE
+        if material.kind == MATERIAL_COOK_TORRANCE && material.distribution == DISTRIBUTION_BECKMANN {
+            h = sample_beckmann_normal(alpha, u);
+        } else {
+        //#endif
+            h = sample_ggx_visible_normal(wo, alpha, u);
+        //#if COOK_TORRANCE
+        }
+        //#endif
+    }
+    //#endif
+    return h;
+}
+
+// The density of sample_half_vector at `h`. Twin of pdf_half_vector.
+fn pdf_half_vector(material: Material, wo: vec3<f32>, h: vec3<f32>) -> f32 {
+    var pdf = 0.0;
+    //#if BLINN_PHONG
+    if material.kind == MATERIAL_BLINN_PHONG {
+        pdf = pdf_blinn_phong_half(h, material.shininess);
+    }
+    //#endif
+    //#if COOK_TORRANCE || PBR
+    if material.kind == MATERIAL_COOK_TORRANCE || material.kind == MATERIAL_PBR {
+        let alpha = microfacet_alpha(material.roughness);
+        //#if COOK_TORRANCE
+        if material.kind == MATERIAL_COOK_TORRANCE && material.distribution == DISTRIBUTION_BECKMANN {
+            pdf = pdf_beckmann_normal(h, alpha);
+        } else {
+        //#endif
+            pdf = pdf_ggx_visible_normal(wo, h, alpha);
+        //#if COOK_TORRANCE
+        }
+        //#endif
+    }
+    //#endif
+    return pdf;
+}
+
+// A direction for the base BRDF at a point of shading normal `n` seen from `wo`
+// (world): the specular lobe with its probability, else the cosine sampler. Twin of
+// sample_brdf.
+fn sample_brdf(material: Material, n: vec3<f32>, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> vec3<f32> {
+    let frame = shading_frame(n);
+    let wo_local = frame_to_local(frame, wo);
+    var local = sample_cosine_hemisphere(u);
+    if u_lobe < specular_lobe_probability(material) {
+        local = reflect_about(wo_local, sample_half_vector(material, wo_local, u));
+    }
+    return frame_to_world(frame, local);
+}
+
+// The density per steradian of sample_brdf producing `wi`: the mixture of its lobes'.
+// Twin of pdf_brdf.
+fn pdf_brdf(material: Material, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+    let frame = shading_frame(n);
+    let wo_local = frame_to_local(frame, wo);
+    let wi_local = frame_to_local(frame, wi);
+    let p_specular = specular_lobe_probability(material);
+    var pdf = (1.0 - p_specular) * pdf_cosine_hemisphere(wi_local);
+    if p_specular > 0.0 {
+        let h = normalize_or_zero(wo_local + wi_local);
+        if h.z > 0.0 {
+            pdf += p_specular * reflected_pdf(pdf_half_vector(material, wo_local, h), dot(wo_local, h));
+        }
+    }
+    return pdf;
+}
+
+// How many emitters the scene has (the padding record of none is EMITTER_NONE).
+fn emitter_count() -> u32 {
+    if emitters[0].kind == EMITTER_NONE {
+        return 0u;
+    }
+    return arrayLength(&emitters);
+}
+
+// The emitter chosen by u ∈ [0, 1): the first whose cumulative probability exceeds u,
+// at most the last (CPU: AreaLights::choose, partition_point(c <= u·total)); binary
+// search, at most 32 steps.
+fn choose_emitter(u: f32, count: u32) -> u32 {
+    var low = 0u;
+    var high = count;
+    for (var step = 0u; step < 32u && low < high; step += 1u) {
+        let middle = (low + high) / 2u;
+        if emitters[middle].cdf <= u {
+            low = middle + 1u;
+        } else {
+            high = middle;
+        }
+    }
+    return min(low, count - 1u);
+}
+
+// The first emitter record of primitive `prim`, or NO_PRIM when it is no sampled
+// emitter (CPU: AreaLights::first_of); binary search over the records' ascending prims.
+fn first_emitter_of(prim: u32) -> u32 {
+    let count = emitter_count();
+    var low = 0u;
+    var high = count;
+    for (var step = 0u; step < 32u && low < high; step += 1u) {
+        let middle = (low + high) / 2u;
+        if emitters[middle].prim < prim {
+            low = middle + 1u;
+        } else {
+            high = middle;
+        }
+    }
+    if low < count && emitters[low].prim == prim {
+        return low;
+    }
+    return NO_PRIM;
+}
+
+// The density per steradian with which next-event estimation from `point` samples the
+// direction towards `hit` (0 if `hit` is on no sampled emitter): a sphere's cone
+// density times its selection probability, a flat emitter's selection / area per unit
+// area converted to solid angle. Twin of AreaLights::pdf.
+fn emitter_pdf(point: vec3<f32>, hit: Hit) -> f32 {
+    let index = first_emitter_of(hit.prim);
+    if index == NO_PRIM {
+        return 0.0;
+    }
+    let emitter = emitters[index];
+    //#if SPHERES
+    if emitter.kind == EMITTER_SPHERE {
+        let w = normalize_or_zero(hit.position - point);
+        return emitter.selection * pdf_sphere_cone(point, emitter.v0, emitter.v1.x, w);
+    }
+    //#endif
+    return area_to_solid_angle_pdf(emitter.area_density, point, hit.position, emitter.normal);
+}
+
+// Whether emission of the shape hit is seen from the side the ray arrives on: flat
+// shapes emit on the side of their normal, spheres on both. Twin of emits_towards.
+fn emits_towards(hit: Hit, direction: vec3<f32>) -> bool {
+    return prim_kind(hit.prim) == PRIM_SPHERE || dot(direction, hit.normal) < 0.0;
+}
+
+// Next-event estimation's sample of one emitter from the path's shadow origin: the
+// emitter chosen by power (dimension 4), a direction towards a point on it
+// (dimensions 5, 6) and its density per steradian, selection included; not found when
+// it contributes nothing and casts no ray (inside a sphere, behind a one-sided
+// emitter, below the shading normal). Twin of the sampling part of sample_emitter.
+struct EmitterSample {
+    wi: vec3<f32>,
+    pdf: f32,
+    emitter: u32,
+    found: bool,
+}
+
+fn path_emitter_sample(path: ptr<function, PathState>) -> EmitterSample {
+    var sample = EmitterSample(vec3<f32>(0.0), 0.0, 0u, false);
+    let count = emitter_count();
+    if count == 0u {
+        return sample;
+    }
+    let origin = (*path).shadow_origin;
+    let u = vec2<f32>(path_random(path, 5u), path_random(path, 6u));
+    sample.emitter = choose_emitter(path_random(path, 4u), count);
+    let emitter = emitters[sample.emitter];
+    if emitter.kind == EMITTER_SPHERE {
+        //#if SPHERES
+        let cone = sample_sphere_cone(origin, emitter.v0, emitter.v1.x, u);
+        if !cone.found {
+            return sample;
+        }
+        sample.wi = cone.wi;
+        sample.pdf = cone.pdf * emitter.selection;
+        //#else
+        return sample;
+        //#endif
+    } else {
+        let b = sample_triangle_barycentrics(u);
+        let point = emitter.v0 * b.x + emitter.v1 * b.y + emitter.v2 * b.z;
+        let to_light = point - origin;
+        if dot(to_light, emitter.normal) >= 0.0 {
+            // The back of a one-sided emitter.
+            return sample;
+        }
+        sample.pdf = area_to_solid_angle_pdf(emitter.area_density, origin, point, emitter.normal);
+        sample.wi = normalize_or_zero(to_light);
+    }
+    let cos_i = dot((*path).normal, sample.wi);
+    sample.found = sample.pdf > 0.0 && cos_i > 0.0 && any(sample.wi != vec3<f32>(0.0));
+    return sample;
+}
+
+// Records the path's continuation (origin, direction, throughput after the event,
+// medium) on its bounce stack unless Russian roulette ends it: after ROULETTE_DEPTH
+// bounces it survives with probability clamp(max channel, MIN_SURVIVAL, 1)
+// (dimension 7) and is divided by it. A throughput that is not finite ends the path.
+// Twin of the end of path_radiance's loop.
+fn path_continue(slot: u32, path: ptr<function, PathState>, origin: vec3<f32>, direction: vec3<f32>, throughput: vec3<f32>, medium: MediumStack) {
+    let depth = (*path).depth + 1u;
+    var weight = throughput;
+    if depth >= ROULETTE_DEPTH {
+        let survival = clamp(max_component(weight), MIN_SURVIVAL, 1.0);
+        if path_random(path, 7u) >= survival {
+            return;
+        }
+        weight = weight / survival;
+    }
+    if !finite_radiance(weight) {
+        return;
+    }
+    ray_stack[ray_stack_index(slot, 0u)] = StackEntry(origin, depth, direction, medium.depth,
+                                                      weight, 0u, medium.iors);
+    (*path).stack_len = 1u;
+}
+
+// Shades the hit (or miss) of the path's current ray, one bounce of path_radiance: a
+// miss adds the background; a hit adds its emission (MIS-weighted after a BRDF sample),
+// picks an event in proportion to its weight (dimension 0) and records the
+// continuation; for the base BRDF it samples the next direction (dimensions 1-3) and
+// starts gathering direct light (PHASE_NEXT_LIGHT), else it goes on to PHASE_POP.
+fn path_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) {
+    let ray = Ray((*path).origin, (*path).direction);
+    if trace.best_prim == NO_PRIM {
+        add_contribution(path, (*path).weight * frame.background);
+        (*path).phase = PHASE_POP;
+        return;
+    }
+    let hit = hit_record_in(trace.best_prim, trace.best_instance, ray, trace.best_t);
+    var material = materials[hit.material];
+    material.diffuse = shading_albedo(material, hit.position, hit.normal, hit.uv);
+    // Emission, weighted against next-event estimation where that could have found it;
+    // shadow_origin still holds the previous hit's, where that estimation sampled from.
+    if max_component(material.emission) > 0.0 && emits_towards(hit, ray.direction) {
+        var weight = 1.0;
+        if (*path).depth > 0u && (*path).brdf_pdf > 0.0 {
+            weight = power_heuristic((*path).brdf_pdf, emitter_pdf((*path).shadow_origin, hit));
+        }
+        add_contribution(path, (*path).weight * material.emission * weight);
+    }
+    let entering = dot(ray.direction, hit.normal) < 0.0;
+    let ng = select(-hit.normal, hit.normal, entering);
+    let medium = MediumStack((*path).medium_iors, (*path).medium_depth);
+    //#if REFRACTION
+    let outside_ior = medium_outside_ior(medium, entering);
+    //#else
+    let outside_ior = 1.0;
+    //#endif
+    //#if MESH_ATTRIBUTES
+    let ns = select(-hit.shading_normal, hit.shading_normal, entering);
+    let n = shading_frame_normal(ray.direction, ng, ns);
+    let lifted = shadow_terminator_point(hit, ng);
+    //#else
+    let n = ng;
+    let lifted = hit.position;
+    //#endif
+    let wo = -ray.direction;
+    let response = surface_response(material, ray.direction, n, entering, outside_ior);
+    // The events and their weights; a path whose weights are NaN also ends.
+    var base = 0.0;
+    if has_base_brdf(material.kind) {
+        base = response.base;
+    }
+    let reflect_weight = path_luminance(response.reflect);
+    let transmit_weight = path_luminance(response.transmit);
+    let total = base + reflect_weight + transmit_weight;
+    (*path).phase = PHASE_POP;
+    if !(total > 0.0) {
+        return;
+    }
+    let u_event = path_random(path, 0u) * total;
+    let continues = (*path).depth < frame.max_depth;
+    if u_event < base {
+        let event_weight = (*path).weight * (response.base / (base / total));
+        // The lighting state of the hit; `direct` holds the event's weight.
+        (*path).direct = event_weight;
+        (*path).albedo = material.diffuse;
+        (*path).material = hit.material;
+        (*path).normal = n;
+        (*path).shadow_origin = offset_ray_origin(lifted, ng, frame.offset_scale);
+        (*path).light = 0u;
+        (*path).phase = PHASE_NEXT_LIGHT;
+        (*path).brdf_pdf = NO_BRDF_PDF;
+        if continues {
+            let wi = sample_brdf(material, n, wo, path_random(path, 1u),
+                                 vec2<f32>(path_random(path, 2u), path_random(path, 3u)));
+            let pdf = pdf_brdf(material, n, wo, wi);
+            let cos_i = dot(n, wi);
+            if pdf > 0.0 && cos_i > 0.0 && dot(ng, wi) > 0.0 {
+                let f = eval_brdf(material, n, wi, wo);
+                (*path).brdf_pdf = pdf;
+                path_continue(slot, path, offset_ray_origin(hit.position, ng, frame.offset_scale),
+                              wi, event_weight * f * (cos_i / pdf), medium);
+            }
+        }
+        return;
+    }
+    if !continues {
+        return;
+    }
+    var weight = response.transmit / (transmit_weight / total);
+    var direction = response.transmit_direction;
+    var side = -ng;
+    var next_medium = medium;
+    if u_event < base + reflect_weight {
+        weight = response.reflect / (reflect_weight / total);
+        direction = normalize(reflect_direction(ray.direction, n));
+        side = ng;
+    } else {
+        //#if REFRACTION
+        next_medium = medium_after_refraction(medium, entering, material.ior);
+        //#endif
+    }
+    //#if MESH_ATTRIBUTES
+    if any(n != ng) {
+        direction = keep_on_side(direction, side);
+    }
+    //#endif
+    (*path).brdf_pdf = NO_BRDF_PDF;
+    path_continue(slot, path, offset_ray_origin(hit.position, side, frame.offset_scale),
+                  direction, (*path).weight * weight, next_medium);
+}
+
+// Adds the current light's f·E·cos θi, times the event's weight, if its shadow ray was
+// unblocked, and moves on to the next light. Twin of the light loop of path_radiance.
+fn path_consume_shadow_ray(path: ptr<function, PathState>, trace: TraceRay) {
+    if trace.best_prim == NO_PRIM {
+        let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal);
+        var material = materials[(*path).material];
+        material.diffuse = (*path).albedo;
+        let lit = eval_brdf(material, (*path).normal, sample.wi, -(*path).direction)
+            * sample.irradiance * sample.cos_i;
+        add_contribution(path, (*path).direct * lit);
+    }
+    (*path).light += 1u;
+    (*path).phase = PHASE_NEXT_LIGHT;
+}
+
+// After the last light: starts the shadow ray towards the emitter sample (true), or
+// moves on to the continuation when there is none (false).
+fn path_start_emitter(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) -> bool {
+    let sample = path_emitter_sample(path);
+    if !sample.found {
+        (*path).phase = PHASE_POP;
+        return false;
+    }
+    (*path).rays += 1u;
+    start_trace(trace, (*path).shadow_origin, sample.wi, bitcast<f32>(0x7f800000u), false);
+    (*path).phase = PHASE_EMITTER;
+    return true;
+}
+
+// The emitter sample is visible when the first thing its ray meets is that emitter
+// (its emitting side faces the ray: the sample was drawn only there); then it adds
+// f·L·cos θ / pdf, times the event's weight, weighted by the power heuristic against
+// the BRDF sampler when the path goes on. The sample is drawn again from the same
+// numbers. Twin of sample_emitter.
+fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
+    let sample = path_emitter_sample(path);
+    let emitter = emitters[sample.emitter];
+    if sample.found && trace.best_prim == emitter.prim {
+        var material = materials[(*path).material];
+        material.diffuse = (*path).albedo;
+        let n = (*path).normal;
+        let wo = -(*path).direction;
+        let f = eval_brdf(material, n, sample.wi, wo);
+        var weight = 1.0;
+        if (*path).depth < frame.max_depth {
+            weight = power_heuristic(sample.pdf, pdf_brdf(material, n, wo, sample.wi));
+        }
+        let cos_i = dot(n, sample.wi);
+        add_contribution(path, (*path).direct * (f * emitter.radiance * (cos_i * weight / sample.pdf)));
+    }
+    (*path).phase = PHASE_POP;
+}
+//#endif

@@ -1,0 +1,47 @@
+// Records and constants of the path-tracing integrator (shaders/path.wgsl). Each
+// struct is the twin of the `#[repr(C)]` struct of the same name (with a `Gpu` prefix)
+// in src/gpu/area_lights.rs; tests/layout.rs checks sizes and offsets with naga's
+// layouter.
+
+// FrameUniforms.flags: trace with the path integrator (`integrator = "path"`) instead
+// of Whitted's; only modules with the PATH feature have its code.
+const FLAG_PATH: u32 = 4u;
+
+// PathState.phase of the path integrator: the shadow ray towards a point sampled on an
+// emitter is being traced (next-event estimation of the area lights).
+const PHASE_EMITTER: u32 = 8u;
+
+// Emitter.kind.
+// A sphere, sampled by the cone of directions it subtends.
+const EMITTER_SPHERE: u32 = 0u;
+// A triangle (of a triangle, a mesh or a polygon), sampled uniformly by area.
+const EMITTER_TRIANGLE: u32 = 1u;
+// The padding record of a scene without emitters.
+const EMITTER_NONE: u32 = 2u;
+
+// One emitter of the AreaLights distribution (twin of src/cpu/path.rs): its shape,
+// the primitive a ray hits on it, its radiance, and its share of the selection by
+// power. Records are in the CPU's order, which is ascending PrimRef order (spheres,
+// polygons, triangles, each by index; the triangles of a polygon next to each other),
+// so the first record of a primitive is found by binary search.
+struct Emitter {
+    // Sphere: its centre; triangle: its first vertex.
+    v0: vec3<f32>,
+    kind: u32,
+    // Sphere: (radius, 0, 0); triangle: its second vertex.
+    v1: vec3<f32>,
+    // The PrimRef a ray hits on it.
+    prim: u32,
+    // Triangle: its third vertex.
+    v2: vec3<f32>,
+    // Cumulative selection probability up to and including this emitter (CPU:
+    // AreaLights::cdf / total); the last is 1.
+    cdf: f32,
+    // Triangle: the unit normal of its emitting side.
+    normal: vec3<f32>,
+    // Probability that next-event estimation picks it.
+    selection: f32,
+    radiance: vec3<f32>,
+    // Triangle: selection / area, its density per unit area.
+    area_density: f32,
+}
