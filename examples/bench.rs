@@ -30,7 +30,8 @@ use gpu_render::scene::{RenderOverrides, load_scene};
 
 #[derive(Parser)]
 struct Args {
-    /// Scene file, or `generated:million` for the million-triangle terrain.
+    /// Scene file, `generated:million` for the million-triangle terrain, or
+    /// `generated:instances` for 100 placements of one million-triangle mesh.
     scene: PathBuf,
     /// Image width override.
     #[arg(long)]
@@ -61,6 +62,16 @@ struct Args {
     /// at one ray per pixel.
     #[arg(long)]
     traversal: bool,
+    /// Placements in `generated:instances`.
+    #[arg(long, default_value_t = 100)]
+    copies: usize,
+    /// Flatten `generated:instances` by hand (every placement a world-space mesh of
+    /// its own, placed once), to compare with instancing.
+    #[arg(long)]
+    flatten: bool,
+    /// Quads per side of the mesh of `generated:instances` (708: 1,001,112 triangles).
+    #[arg(long, default_value_t = 708)]
+    mesh_quads: usize,
 }
 
 fn median(mut values: Vec<f64>) -> f64 {
@@ -188,10 +199,160 @@ fn million_triangle_scene() -> gpu_render::scene::Scene {
     }
 }
 
+/// The instancing benchmark scene, generated: one smooth bumpy sphere of 708 x 708
+/// quads (1,001,112 triangles, vertex normals) placed 100 times on a 10 x 10 grid,
+/// each rotated and scaled differently (every seventh mirrored), in four materials,
+/// over a ground plane under a sun and a point light; 1920x1080, 1 spp, depth 4.
+fn instanced_million_scene(
+    copies: usize,
+    flatten: bool,
+    mesh_quads: usize,
+) -> gpu_render::scene::Scene {
+    use glam::{DMat3, DMat4, DVec3};
+    use gpu_render::scene::{Mesh, Shape};
+    let mut scene = million_triangle_scene();
+    let n = mesh_quads.max(2);
+    let mut positions = Vec::with_capacity((n + 1) * (n + 1));
+    let mut normals = Vec::with_capacity((n + 1) * (n + 1));
+    for r in 0..=n {
+        let theta = std::f64::consts::PI * r as f64 / n as f64;
+        for s in 0..=n {
+            let phi = std::f64::consts::TAU * s as f64 / n as f64;
+            let direction = DVec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            );
+            let radius = 1.0 + 0.08 * (9.0 * theta).sin() * (7.0 * phi).cos();
+            positions.push(direction * radius * 0.5);
+            normals.push(direction);
+        }
+    }
+    let index = |r: usize, s: usize| (r * (n + 1) + s) as u32;
+    let mut triangles = Vec::with_capacity(2 * n * n);
+    for r in 0..n {
+        for s in 0..n {
+            let (a, b, c, d) = (
+                index(r, s),
+                index(r + 1, s),
+                index(r + 1, s + 1),
+                index(r, s + 1),
+            );
+            if r > 0 {
+                triangles.push([a, d, c]);
+            }
+            if r + 1 < n {
+                triangles.push([a, c, b]);
+            }
+        }
+    }
+    let mut meshes: Vec<Mesh> = Vec::new();
+    for k in 0..copies {
+        let (i, j) = ((k % 10) as f64, (k / 10) as f64);
+        let mirror = if k % 7 == 3 { -1.0 } else { 1.0 };
+        let scale = DVec3::new(mirror * (0.8 + 0.04 * i), 0.7 + 0.05 * j, 0.9);
+        let transform = DMat4::from_scale_rotation_translation(
+            scale,
+            glam::DQuat::from_rotation_y(0.37 * k as f64),
+            DVec3::new(1.4 * i - 6.3, -0.4, -1.4 * j + 1.0),
+        );
+        let material = (k % 4) as u32 + 1;
+        if flatten {
+            let linear = DMat3::from_mat4(transform);
+            let normal_matrix = linear.inverse().transpose();
+            let mirrored = linear.determinant() < 0.0;
+            meshes.push(Mesh {
+                name: format!("bumpy sphere {k}"),
+                positions: positions
+                    .iter()
+                    .map(|p| transform.transform_point3(*p))
+                    .collect(),
+                normals: Some(
+                    normals
+                        .iter()
+                        .map(|n| (normal_matrix * *n).normalize())
+                        .collect(),
+                ),
+                uvs: None,
+                triangles: triangles
+                    .iter()
+                    .map(|&[a, b, c]| if mirrored { [a, c, b] } else { [a, b, c] })
+                    .collect(),
+                material,
+                instances: vec![DMat4::IDENTITY],
+            });
+            continue;
+        }
+        match meshes.iter_mut().find(|m| m.material == material) {
+            Some(mesh) => mesh.instances.push(transform),
+            None => meshes.push(Mesh {
+                name: "bumpy sphere".into(),
+                positions: positions.clone(),
+                normals: Some(normals.clone()),
+                uvs: None,
+                triangles: triangles.clone(),
+                material,
+                instances: vec![transform],
+            }),
+        }
+    }
+    scene.shapes = vec![Shape::Plane {
+        normal: DVec3::Y,
+        offset: -1.0,
+        material: 0,
+    }];
+    scene.meshes = meshes;
+    scene.camera.eye = DVec3::new(0.0, 4.0, 7.0);
+    scene.camera.look_at = DVec3::new(0.0, -0.5, -4.0);
+    scene
+}
+
+/// Prints what instancing stores for `scene` and how long its geometry takes to build.
+fn instancing_figures(scene: &gpu_render::scene::Scene) {
+    let started = Instant::now();
+    let geometry = gpu_render::accel::SceneGeometry::new(scene);
+    let built = started.elapsed().as_secs_f64();
+    if geometry.instances.is_empty() {
+        return;
+    }
+    let stored: usize = geometry
+        .instanced_meshes
+        .iter()
+        .map(|m| m.triangles.len())
+        .sum();
+    // What the instanced meshes' triangles take on the GPU (records, attributes, their
+    // trees' nodes and references), and what flattening every placement would take.
+    let mesh_bytes: usize = geometry
+        .instanced_meshes
+        .iter()
+        .map(|m| {
+            m.triangles.len() * std::mem::size_of::<gpu_render::gpu::layout::GpuTriangle>()
+                + m.triangle_attributes.len()
+                    * std::mem::size_of::<gpu_render::gpu::layout::GpuTriangleAttributes>()
+                + m.bvh.nodes.len() * std::mem::size_of::<gpu_render::accel::BvhNode>()
+                + m.bvh.prims.len() * 4
+        })
+        .sum();
+    let flattened =
+        mesh_bytes as f64 / stored.max(1) as f64 * geometry.instanced_triangle_count() as f64;
+    println!(
+        "instancing: {} instances of {} mesh(es), {stored} triangles stored for {} placed; \
+         geometry (every BVH) built in {:.0} ms; the stored meshes take {mesh_bytes} bytes \
+         on the GPU, flattened they would take about {:.2} GB",
+        geometry.instances.len(),
+        geometry.instanced_meshes.len(),
+        geometry.instanced_triangle_count(),
+        built * 1e3,
+        flattened / 1e9
+    );
+}
+
 fn main() -> Result<()> {
     let args = Args::parse();
     let mut scene = if args.scene.as_os_str() == "generated:million" {
         million_triangle_scene()
+    } else if args.scene.as_os_str() == "generated:instances" {
+        instanced_million_scene(args.copies, args.flatten, args.mesh_quads)
     } else {
         load_scene(&args.scene)?
     };
@@ -207,6 +368,7 @@ fn main() -> Result<()> {
     if args.traversal {
         traversal_figures(&scene);
     }
+    instancing_figures(&scene);
     let gpu = HeadlessGpu::new(&AdapterChoice::Default).context("no GPU adapter")?;
     let mut renderer = GpuRenderer::new(&gpu.device)?;
     match args.schedule.as_deref() {
@@ -414,7 +576,7 @@ fn compare_schedules(
 /// from each hit to the scene's first light.
 fn traversal_figures(scene: &gpu_render::scene::Scene) {
     use gpu_render::accel::{BuildMethod, SceneGeometry};
-    use gpu_render::cpu::intersect::{Ray, hit_record};
+    use gpu_render::cpu::intersect::{Ray, hit_record_keyed};
     use gpu_render::cpu::traverse::{TraversalCounts, closest_hit_counted, occluded_counted};
     for method in [BuildMethod::Sah, BuildMethod::MedianSplit] {
         let geometry = SceneGeometry::with_method(scene, method);
@@ -445,7 +607,7 @@ fn traversal_figures(scene: &gpu_render::scene::Scene) {
                 else {
                     continue;
                 };
-                let hit = hit_record(&geometry, prim, &ray, t);
+                let hit = hit_record_keyed(&geometry, prim, &ray, t);
                 let n = if ray.direction.dot(hit.normal) < 0.0 {
                     hit.normal
                 } else {

@@ -25,13 +25,111 @@ struct Hit {
     uv: vec2<f32>,
     // Barycentric coordinates in a triangle, else (1, 0, 0).
     barycentrics: vec3<f32>,
+    // The instance of an instanced mesh's triangle (its record's node index; `prim`
+    // then names the mesh's triangle), else NO_INSTANCE.
+    instance: u32,
 }
 
 // A hit without vertex attributes: shading normal = geometric normal.
 fn flat_hit(prim: u32, t: f32, normal: vec3<f32>, material: u32, position: vec3<f32>) -> Hit {
     return Hit(t, normal, material, true, position, prim, normal, vec2<f32>(0.0),
-               vec3<f32>(1.0, 0.0, 0.0));
+               vec3<f32>(1.0, 0.0, 0.0), NO_INSTANCE);
 }
+
+//#if INSTANCES
+// A placement of an instanced mesh (twin of accel::Instance), unpacked from the four
+// bvh_nodes records the host stores it in (instance_records in src/gpu/upload.rs):
+// the columns of object_to_world and of world_to_object (the images of x, y and z,
+// then the translation), the root node of its mesh's tree, its material and whether
+// it mirrors.
+struct Instance {
+    o2w_x: vec3<f32>,
+    o2w_y: vec3<f32>,
+    o2w_z: vec3<f32>,
+    o2w_t: vec3<f32>,
+    w2o_x: vec3<f32>,
+    w2o_y: vec3<f32>,
+    w2o_z: vec3<f32>,
+    w2o_t: vec3<f32>,
+    root: u32,
+    material: u32,
+    mirrored: bool,
+}
+
+fn load_instance(record: u32) -> Instance {
+    let a = bvh_nodes[record];
+    let b = bvh_nodes[record + 1u];
+    let c = bvh_nodes[record + 2u];
+    let d = bvh_nodes[record + 3u];
+    return Instance(a.min, a.max, b.min, b.max, c.min, c.max, d.min, d.max, a.first, a.count,
+                    b.first != 0u);
+}
+
+// A mesh-space point in world space.
+fn instance_point(instance: Instance, p: vec3<f32>) -> vec3<f32> {
+    return instance.o2w_x * p.x + instance.o2w_y * p.y + instance.o2w_z * p.z + instance.o2w_t;
+}
+
+// A mesh-space normal in world space, not normalised: through the inverse transpose
+// of the linear part, which is the transpose of world_to_object's.
+fn instance_normal(instance: Instance, n: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(dot(instance.w2o_x, n), dot(instance.w2o_y, n), dot(instance.w2o_z, n));
+}
+
+// Mesh triangle `index` of instance `record` in world space, as a flattened placement
+// stores it: corners moved, corners 1 and 2 swapped under a mirroring transform (which
+// keeps the winding normal facing out), the instance's material. CPU twin:
+// Instance::world_triangle.
+fn instance_triangle(index: u32, record: u32) -> Triangle {
+    let instance = load_instance(record);
+    var triangle = triangles[index];
+    let v1 = instance_point(instance, triangle.v1);
+    let v2 = instance_point(instance, triangle.v2);
+    triangle.v0 = instance_point(instance, triangle.v0);
+    triangle.v1 = select(v1, v2, instance.mirrored);
+    triangle.v2 = select(v2, v1, instance.mirrored);
+    triangle.material = instance.material;
+    return triangle;
+}
+//#endif
+
+//#if MESH_ATTRIBUTES
+// The triangle a hit is on, in world space: the scene's own, or an instanced mesh's
+// moved by its instance.
+fn world_triangle(prim: u32, instance: u32) -> Triangle {
+    //#if INSTANCES
+    if instance != NO_INSTANCE {
+        return instance_triangle(prim_index(prim), instance);
+    }
+    //#endif
+    return triangles[prim_index(prim)];
+}
+
+// A triangle's shading attributes in world space: an instanced mesh's normals through
+// the normal matrix, normalised (one that vanishes becomes `facing`, the world winding
+// normal), corners 1 and 2 swapped under a mirroring transform. CPU twin:
+// Instance::world_triangle.
+fn world_attributes(index: u32, instance: u32, facing: vec3<f32>) -> TriangleAttributes {
+    var attributes = triangle_attributes[index];
+    //#if INSTANCES
+    if instance != NO_INSTANCE {
+        let placed = load_instance(instance);
+        let n0 = instance_normal(placed, attributes.n0);
+        let n1 = instance_normal(placed, attributes.n1);
+        let n2 = instance_normal(placed, attributes.n2);
+        attributes.n0 = select(facing, normalize(n0), dot(n0, n0) > 0.0);
+        let m1 = select(facing, normalize(n1), dot(n1, n1) > 0.0);
+        let m2 = select(facing, normalize(n2), dot(n2, n2) > 0.0);
+        attributes.n1 = select(m1, m2, placed.mirrored);
+        attributes.n2 = select(m2, m1, placed.mirrored);
+        let uv1 = attributes.uv01.zw;
+        attributes.uv01 = vec4<f32>(attributes.uv01.xy, select(uv1, attributes.uv2, placed.mirrored));
+        attributes.uv2 = select(attributes.uv2, uv1, placed.mirrored);
+    }
+    //#endif
+    return attributes;
+}
+//#endif
 
 //#if TRIANGLES
 // The barycentric coordinates of `p` (on the triangle's plane) in the triangle
@@ -61,9 +159,8 @@ fn triangle_barycentrics(p: vec3<f32>, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f3
 //#if MESH_ATTRIBUTES
 // Fills a mesh triangle hit's shading normal (the interpolated vertex normals, kept
 // only where they are not degenerate and face the geometric normal's side) and texture
-// coordinates. CPU twin: the attribute part of hit_record.
-fn apply_triangle_attributes(hit: ptr<function, Hit>, index: u32) {
-    let attributes = triangle_attributes[index];
+// coordinates from its world-space `attributes`. CPU twin: triangle_hit.
+fn apply_triangle_attributes(hit: ptr<function, Hit>, attributes: TriangleAttributes) {
     let b = (*hit).barycentrics;
     if attributes.has_normals != 0u {
         let interpolated = attributes.n0 * b.x + attributes.n1 * b.y + attributes.n2 * b.z;
@@ -89,11 +186,11 @@ fn shadow_terminator_point(hit: Hit, facing: vec3<f32>) -> vec3<f32> {
     if prim_kind(hit.prim) != PRIM_TRIANGLE {
         return hit.position;
     }
-    let triangle = triangles[prim_index(hit.prim)];
+    let triangle = world_triangle(hit.prim, hit.instance);
     if triangle.attributes == NO_ATTRIBUTES {
         return hit.position;
     }
-    let attributes = triangle_attributes[triangle.attributes];
+    let attributes = world_attributes(triangle.attributes, hit.instance, hit.normal);
     if attributes.has_normals == 0u {
         return hit.position;
     }
@@ -384,6 +481,40 @@ fn intersect_prim(prim: u32, ray: Ray, sheared: ShearedRay, t_max: f32) -> f32 {
     }
 }
 
+//#if TRIANGLES
+// The hit record of the world-space `triangle` (primitive `prim` of `instance`) at
+// the point p = ray_at(ray, t): its winding normal, p projected onto its plane, its
+// barycentric coordinates and its interpolated attributes. CPU twin: triangle_hit.
+fn triangle_hit(prim: u32, instance: u32, triangle: Triangle, p: vec3<f32>, t: f32) -> Hit {
+    let normal = triangle_normal(triangle.v0, triangle.v1, triangle.v2);
+    var hit = flat_hit(prim, t, normal, triangle.material,
+                       project_onto_plane(p, normal, dot(normal, triangle.v0)));
+    hit.instance = instance;
+    hit.barycentrics = triangle_barycentrics(hit.position, triangle.v0, triangle.v1, triangle.v2);
+    //#if MESH_ATTRIBUTES
+    if triangle.attributes != NO_ATTRIBUTES {
+        apply_triangle_attributes(&hit, world_attributes(triangle.attributes, instance, normal));
+    }
+    //#endif
+    return hit;
+}
+//#endif
+
+// hit_record of the surface (`prim`, `instance`): for an instanced mesh's triangle,
+// made from the triangle moved to world space (instance_triangle) at the world point.
+// CPU twin: hit_record_keyed.
+fn hit_record_in(prim: u32, instance: u32, ray: Ray, t: f32) -> Hit {
+    //#if INSTANCES
+    //#if TRIANGLES
+    if instance != NO_INSTANCE {
+        return triangle_hit(prim, instance, instance_triangle(prim_index(prim), instance),
+                            ray_at(ray, t), t);
+    }
+    //#endif
+    //#endif
+    return hit_record(prim, ray, t);
+}
+
 // The hit record of `prim` at parameter `t` along `ray`: the shape's unit geometric
 // normal, its material, and the hit point re-projected onto the surface (Wächter and
 // Binder, Ray Tracing Gems, ch. 6, §6.2.1).
@@ -415,17 +546,7 @@ fn hit_record(prim: u32, ray: Ray, t: f32) -> Hit {
         //#endif
         //#if TRIANGLES
         case PRIM_TRIANGLE: {
-            let triangle = triangles[i];
-            let normal = triangle_normal(triangle.v0, triangle.v1, triangle.v2);
-            var hit = flat_hit(prim, t, normal, triangle.material,
-                               project_onto_plane(p, normal, dot(normal, triangle.v0)));
-            hit.barycentrics = triangle_barycentrics(hit.position, triangle.v0, triangle.v1, triangle.v2);
-            //#if MESH_ATTRIBUTES
-            if triangle.attributes != NO_ATTRIBUTES {
-                apply_triangle_attributes(&hit, triangle.attributes);
-            }
-            //#endif
-            return hit;
+            return triangle_hit(prim, NO_INSTANCE, triangles[i], p, t);
         }
         //#endif
         default: {

@@ -571,7 +571,7 @@ fn path_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) 
         (*path).phase = PHASE_POP;
         return;
     }
-    let hit = hit_record(trace.best_prim, ray, trace.best_t);
+    let hit = hit_record_in(trace.best_prim, trace.best_instance, ray, trace.best_t);
     var material = materials[hit.material];
     material.diffuse = shading_albedo(material, hit.position, hit.normal, hit.uv);
     // Emission, weighted against next-event estimation where that could have found it;

@@ -143,7 +143,7 @@ fn push_branch(slot: u32, path: ptr<function, PathState>, entry: StackEntry) {
 // whether anything lies there.
 fn start_trace(trace: ptr<function, TraceRay>, origin: vec3<f32>, direction: vec3<f32>, t_max: f32, any_hit: bool) {
     *trace = TraceRay(origin, t_max, direction, TRACE_PENDING, t_max, NO_PRIM, 0u, NO_NODE,
-                      0u, 0u, u32(any_hit), 0u);
+                      0u, 0u, u32(any_hit), NO_INSTANCE, NO_INSTANCE, 0u, 0u, 0u);
 }
 
 // What a light does at a shading point: the direction to it, its distance, the
@@ -230,7 +230,7 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
         (*path).phase = PHASE_POP;
         return;
     }
-    let hit = hit_record(trace.best_prim, ray, trace.best_t);
+    let hit = hit_record_in(trace.best_prim, trace.best_instance, ray, trace.best_t);
     var material = materials[hit.material];
     material.diffuse = shading_albedo(material, hit.position, hit.normal, hit.uv);
     let entering = dot(ray.direction, hit.normal) < 0.0;

@@ -60,12 +60,31 @@ fn slab_enter(index: u32, origin: vec3<f32>, inverse: vec3<f32>, t_max: f32) -> 
 // The exclusive distance limit for testing `prim` against the best hit so far: the
 // best distance, or just beyond it for a smaller reference, which wins exact ties.
 fn tie_limit(prim: u32, best_t: f32, best_prim: u32) -> f32 {
-    if best_prim != NO_PRIM && prim < best_prim && best_t < bitcast<f32>(0x7f800000u) {
+    return tie_limit_in(prim, NO_INSTANCE, best_t, best_prim, NO_INSTANCE);
+}
+
+// tie_limit for surfaces with instances: the key (instance, prim) decides ties, the
+// scene's own primitives (NO_INSTANCE) after every instance. CPU twin: HitKey's order.
+fn tie_limit_in(prim: u32, instance: u32, best_t: f32, best_prim: u32, best_instance: u32) -> f32 {
+    let smaller = instance < best_instance || (instance == best_instance && prim < best_prim);
+    if best_prim != NO_PRIM && smaller && best_t < bitcast<f32>(0x7f800000u) {
         // The next f32 up: best_t is positive and finite.
         return bitcast<f32>(bitcast<u32>(best_t) + 1u);
     }
     return best_t;
 }
+
+//#if INSTANCES
+// `ray` in an instance's mesh space: origin and direction through world_to_object, the
+// direction not renormalised, so that a point keeps its ray parameter and hits in
+// different instances compare by distance. CPU twin: object_ray.
+fn object_ray(instance: Instance, ray: Ray) -> Ray {
+    let o = ray.origin;
+    let d = ray.direction;
+    return Ray(instance.w2o_x * o.x + instance.w2o_y * o.y + instance.w2o_z * o.z + instance.w2o_t,
+               instance.w2o_x * d.x + instance.w2o_y * d.y + instance.w2o_z * d.z);
+}
+//#endif
 
 // Where level `level` of slot `slot`'s traversal stack lives: levels are interleaved
 // across slots, so the lanes of one vector touch neighbouring words.
@@ -77,17 +96,37 @@ fn traversal_stack_index(slot: u32, level: u32) -> u32 {
 // (false: the state is saved in `trace` and the slot's traversal stack). For an
 // any-hit trace (a shadow ray) the first hit ends it; best_prim != NO_PRIM then means
 // occluded.
+//
+// Instances (a two-level BVH, src/accel/instance.rs): a leaf primitive of kind
+// PRIM_INSTANCE is entered as one step: the leaf's position is saved, the ray moves to
+// the mesh's space (object_ray) and the traversal continues in the mesh's tree, on the
+// same stack above the depth it entered at (stack_base); when that tree is done, one
+// more step moves the ray back and resumes the leaf. A suspended traversal inside an
+// instance recomputes the object-space ray from its record when it resumes.
 fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
-    let ray = Ray((*trace).origin, (*trace).direction);
-    let inverse = inverse_direction(ray.direction);
-    let sheared = shear_ray(ray);
+    let world_ray = Ray((*trace).origin, (*trace).direction);
+    var ray = world_ray;
+    var inverse = inverse_direction(ray.direction);
+    var sheared = shear_ray(ray);
     let any_hit = (*trace).any_hit != 0u;
     var best_t = (*trace).best_t;
     var best_prim = (*trace).best_prim;
+    var best_instance = (*trace).best_instance;
     var node = (*trace).node;
     var cursor = (*trace).cursor;
     var leaf_end = (*trace).leaf_end;
     var stack_len = (*trace).stack_len;
+    var instance = (*trace).instance;
+    var stack_base = (*trace).stack_base;
+    var world_cursor = (*trace).world_cursor;
+    var world_leaf_end = (*trace).world_leaf_end;
+    //#if INSTANCES
+    if (*trace).status == TRACE_RUNNING && instance != NO_INSTANCE {
+        ray = object_ray(load_instance(instance), world_ray);
+        inverse = inverse_direction(ray.direction);
+        sheared = shear_ray(ray);
+    }
+    //#endif
     if (*trace).status == TRACE_PENDING {
         //#if PLANES
         // Planes are unbounded: every ray tests every plane, before the tree.
@@ -98,10 +137,12 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
             }
             iterations += 1u;
             let prim = (PRIM_PLANE << PRIM_KIND_SHIFT) | i;
-            let t = intersect_prim(prim, ray, sheared, tie_limit(prim, best_t, best_prim));
+            let t = intersect_prim(prim, ray, sheared,
+                                   tie_limit_in(prim, NO_INSTANCE, best_t, best_prim, best_instance));
             if t != NO_HIT {
                 best_t = t;
                 best_prim = prim;
+                best_instance = NO_INSTANCE;
             }
             i += 1u;
         }
@@ -113,6 +154,8 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
         cursor = 0u;
         leaf_end = 0u;
         stack_len = 0u;
+        instance = NO_INSTANCE;
+        stack_base = 0u;
         if frame.node_count > 0u && slab_enter(0u, ray.origin, inverse, best_t) != NO_HIT {
             node = 0u;
         }
@@ -129,7 +172,8 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
     var suspended = false;
     var simulated_cut = false;
     loop {
-        if (any_hit && best_prim != NO_PRIM) || (cursor >= leaf_end && node == NO_NODE && stack_len == 0u) {
+        if (any_hit && best_prim != NO_PRIM)
+            || (cursor >= leaf_end && node == NO_NODE && stack_len == 0u && instance == NO_INSTANCE) {
             finished = true;
             exited = true;
             break;
@@ -141,9 +185,11 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
         if simulated_cut {
             break;
         }
-        // Descend: pop and visit inner nodes until a leaf is reached or none is left.
+        // Descend: pop and visit inner nodes until a leaf is reached or none is left
+        // (in an instance's tree: none above the depth it began at; leaving it is a
+        // step).
         loop {
-            if cursor < leaf_end || (node == NO_NODE && stack_len == 0u) {
+            if cursor < leaf_end || (node == NO_NODE && stack_len == stack_base && instance == NO_INSTANCE) {
                 break;
             }
             if steps > 0u && (frame.flags & FLAG_SIMULATE_LOOP_CUT) != 0u {
@@ -156,6 +202,19 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
             }
             steps += 1u;
             iterations += 1u;
+            //#if INSTANCES
+            if node == NO_NODE && stack_len == stack_base {
+                // The instance's tree is done: back to the scene's ray and leaf.
+                instance = NO_INSTANCE;
+                stack_base = 0u;
+                ray = world_ray;
+                inverse = inverse_direction(ray.direction);
+                sheared = shear_ray(ray);
+                cursor = world_cursor;
+                leaf_end = world_leaf_end;
+                continue;
+            }
+            //#endif
             if node == NO_NODE {
                 // Pop; a node pushed earlier may lie beyond a hit found since.
                 stack_len -= 1u;
@@ -216,10 +275,33 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
             iterations += 1u;
             let prim = bvh_prims[cursor];
             cursor += 1u;
-            let t = intersect_prim(prim, ray, sheared, tie_limit(prim, best_t, best_prim));
+            //#if INSTANCES
+            if prim_kind(prim) == PRIM_INSTANCE {
+                // Enter the instance: its mesh's tree, with the ray in the mesh's space.
+                let record = prim_index(prim);
+                let placed = load_instance(record);
+                world_cursor = cursor;
+                world_leaf_end = leaf_end;
+                cursor = 0u;
+                leaf_end = 0u;
+                instance = record;
+                stack_base = stack_len;
+                ray = object_ray(placed, world_ray);
+                inverse = inverse_direction(ray.direction);
+                sheared = shear_ray(ray);
+                node = NO_NODE;
+                if slab_enter(placed.root, ray.origin, inverse, best_t) != NO_HIT {
+                    node = placed.root;
+                }
+                break;
+            }
+            //#endif
+            let t = intersect_prim(prim, ray, sheared,
+                                   tie_limit_in(prim, instance, best_t, best_prim, best_instance));
             if t != NO_HIT {
                 best_t = t;
                 best_prim = prim;
+                best_instance = instance;
             }
         }
     }
@@ -228,9 +310,14 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
     }
     (*trace).best_t = best_t;
     (*trace).best_prim = best_prim;
+    (*trace).best_instance = best_instance;
     (*trace).node = node;
     (*trace).cursor = cursor;
     (*trace).leaf_end = leaf_end;
     (*trace).stack_len = stack_len;
+    (*trace).instance = instance;
+    (*trace).stack_base = stack_base;
+    (*trace).world_cursor = world_cursor;
+    (*trace).world_leaf_end = world_leaf_end;
     return finished;
 }

@@ -167,15 +167,20 @@ struct BvhNode {
     count: u32,
 }
 
-// A primitive reference (twin of `accel::PrimRef`): kind << 30 | index in its list;
-// also the tie-break key (the smaller wins at equal distance).
-const PRIM_KIND_SHIFT: u32 = 30u;
-const PRIM_INDEX_MASK: u32 = 0x3fffffffu;
+// A primitive reference (twin of `accel::PrimRef`): kind << 29 | index in its list;
+// with the instance, the tie-break key (the smaller (instance, prim) wins at equal
+// distance; the scene's own primitives have instance NO_INSTANCE).
+const PRIM_KIND_SHIFT: u32 = 29u;
+const PRIM_INDEX_MASK: u32 = 0x1fffffffu;
 const PRIM_SPHERE: u32 = 0u;
 const PRIM_PLANE: u32 = 1u;
 const PRIM_POLYGON: u32 = 2u;
 const PRIM_TRIANGLE: u32 = 3u;
+// A placement of an instanced mesh; its index is the node index of its record in
+// bvh_nodes (see load_instance in shaders/traverse.wgsl).
+const PRIM_INSTANCE: u32 = 4u;
 const NO_PRIM: u32 = 0xffffffffu;
+const NO_INSTANCE: u32 = 0xffffffffu;
 const NO_NODE: u32 = 0xffffffffu;
 
 // TraceRay.status
@@ -186,7 +191,9 @@ const TRACE_DONE: u32 = 3u;
 
 // One traversal of one ray through the scene, resumable: the ray, its distance
 // limit, the best hit so far and where the traversal stands (the current node, the
-// next primitive of the current leaf, and the depth of the slot's traversal stack).
+// next primitive of the current leaf, and the depth of the slot's traversal stack;
+// inside an instanced mesh, the instance, the stack depth it began at and the scene
+// leaf to go back to).
 struct TraceRay {
     origin: vec3<f32>,
     t_max: f32,
@@ -199,7 +206,11 @@ struct TraceRay {
     cursor: u32,
     leaf_end: u32,
     any_hit: u32,
-    _pad: u32,
+    best_instance: u32,
+    instance: u32,
+    stack_base: u32,
+    world_cursor: u32,
+    world_leaf_end: u32,
 }
 
 // PathState.phase: what a path does next (see shaders/trace.wgsl).

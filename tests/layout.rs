@@ -177,7 +177,11 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 cursor,
                 leaf_end,
                 any_hit,
-                _pad
+                best_instance,
+                instance,
+                stack_base,
+                world_cursor,
+                world_leaf_end
             }),
         ),
         (

@@ -126,13 +126,20 @@ fn a_placed_model_lands_where_its_transform_says() {
     }
 }
 
-/// Side triangles of the renderer's geometry (normals mostly horizontal), and how many
-/// of them face away from the vase's vertical axis.
+/// Side triangles of the renderer's geometry (normals mostly horizontal; instanced
+/// meshes' triangles as they stand in world space), and how many of them face away from
+/// the vase's vertical axis.
 fn outward_side_triangles(scene: &Scene) -> (usize, usize) {
     let geometry = gpu_render::accel::SceneGeometry::new(scene);
+    let mut world: Vec<[DVec3; 3]> = geometry.triangles.iter().map(|t| t.vertices).collect();
+    for instance in &geometry.instances {
+        let mesh = &geometry.instanced_meshes[instance.mesh as usize];
+        world
+            .extend((0..mesh.triangles.len()).map(|j| instance.world_triangle(mesh, j).0.vertices));
+    }
     let (mut outward, mut sides) = (0, 0);
-    for triangle in &geometry.triangles {
-        let [a, b, c] = triangle.vertices;
+    for vertices in &world {
+        let [a, b, c] = *vertices;
         let normal = (b - a).cross(c - a).normalize();
         let centre = (a + b + c) / 3.0;
         let radial = DVec3::new(centre.x, 0.0, centre.z);

@@ -80,10 +80,11 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         pbr: false,
         textures: false,
         mesh_attributes: false,
+        instances: false,
         path: false,
     };
     type Toggle = fn(&mut ShaderFeatures, bool);
-    let toggles: [Toggle; 13] = [
+    let toggles: [Toggle; 14] = [
         |f, v| f.spheres = v,
         |f, v| f.planes = v,
         |f, v| f.polygons = v,
@@ -96,6 +97,7 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         |f, v| f.pbr = v,
         |f, v| f.textures = v,
         |f, v| f.mesh_attributes = v,
+        |f, v| f.instances = v,
         |f, v| f.path = v,
     ];
     let all = function_names(&ShaderFeatures::ALL).len();

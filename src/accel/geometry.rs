@@ -4,6 +4,7 @@
 use glam::{DVec2, DVec3};
 
 use super::bvh::{Aabb32, BuildMethod, Bvh};
+use super::instance::{Instance, InstancedMesh, mesh_groups};
 use crate::scene::{Mesh, PolygonPlane, Scene, Shape, polygon_plane, project_to_plane};
 
 /// Polygons with more vertices than this are triangulated when the geometry is built
@@ -15,7 +16,7 @@ pub const MAX_POLYGON_VERTICES: usize = 32;
 /// count bounds the work of one traversal step.
 pub const MAX_PLANES: usize = 1024;
 
-/// The kind of a primitive, stored in the top two bits of a [`PrimRef`]. The order
+/// The kind of a primitive, stored in the top three bits of a [`PrimRef`]. The order
 /// (spheres, planes, polygons, triangles) decides exact ties between kinds: a polygon
 /// lying in a plane, such as the bottom of a box standing on the floor, loses to the
 /// plane, as it did before the BVH on both backends.
@@ -29,9 +30,12 @@ pub enum PrimKind {
     Polygon = 2,
     /// An entry of [`SceneGeometry::triangles`].
     Triangle = 3,
+    /// An entry of [`SceneGeometry::instances`]: a placement of an instanced mesh,
+    /// which the traversal enters (never a hit itself; see [`super::instance`]).
+    Instance = 4,
 }
 
-/// A primitive named by its kind and its index in that kind's list: `kind << 30 |
+/// A primitive named by its kind and its index in that kind's list: `kind << 29 |
 /// index`. It is also the tie-break key: of two hits at exactly the same distance, the
 /// smaller `PrimRef` wins (on both backends).
 #[derive(
@@ -42,8 +46,8 @@ pub struct PrimRef(pub u32);
 
 impl PrimRef {
     /// Bits of a [`PrimRef`] that hold the index.
-    pub const INDEX_BITS: u32 = 30;
-    /// Largest index a [`PrimRef`] can hold (one less than 2^30).
+    pub const INDEX_BITS: u32 = 29;
+    /// Largest index a [`PrimRef`] can hold (one less than 2^29).
     pub const MAX_INDEX: u32 = (1 << Self::INDEX_BITS) - 1;
 
     /// The reference to entry `index` of `kind`'s list (`index` at most
@@ -59,7 +63,8 @@ impl PrimRef {
             0 => PrimKind::Sphere,
             1 => PrimKind::Plane,
             2 => PrimKind::Polygon,
-            _ => PrimKind::Triangle,
+            3 => PrimKind::Triangle,
+            _ => PrimKind::Instance,
         }
     }
 
@@ -140,12 +145,19 @@ pub struct SceneGeometry {
     /// Polygons of at most [`MAX_POLYGON_VERTICES`] vertices, in scene order.
     pub polygons: Vec<PolygonShape>,
     /// Triangles: the scene's own in scene order, then those of the polygons that had
-    /// more than [`MAX_POLYGON_VERTICES`] vertices, then the meshes' (every instance,
-    /// in world space).
+    /// more than [`MAX_POLYGON_VERTICES`] vertices, then those of the meshes placed
+    /// once, in world space. Meshes placed more than once are in `instanced_meshes`.
     pub triangles: Vec<TriangleShape>,
     /// Shading attributes of the mesh triangles that have any.
     pub triangle_attributes: Vec<TriangleAttributes>,
-    /// Mesh triangles left out because they have no area in world space.
+    /// Meshes placed more than once (the same geometry in one or more [`Mesh`]es),
+    /// each stored once in its own space with its own BVH.
+    pub instanced_meshes: Vec<InstancedMesh>,
+    /// The placements of `instanced_meshes`, which the BVH holds as
+    /// [`PrimKind::Instance`] primitives.
+    pub instances: Vec<Instance>,
+    /// Mesh triangles left out because they have no area (in world space for meshes
+    /// placed once, per placement; in their own space for instanced meshes, once).
     pub degenerate_triangles: usize,
     /// How many of the scene's polygons were triangulated.
     pub triangulated_polygons: usize,
@@ -162,9 +174,18 @@ impl SceneGeometry {
         Self::with_method(scene, BuildMethod::Sah)
     }
 
-    /// The geometry of `scene` with a BVH built by `method`.
+    /// The geometry of `scene` with a BVH built by `method`. Meshes with an emissive
+    /// material are flattened even where placed more than once: the GPU's emitter
+    /// list names the surfaces a ray hits by primitive alone (`crate::gpu`'s
+    /// `area_lights`), and lights are small.
     pub fn with_method(scene: &Scene, method: BuildMethod) -> Self {
-        Self::from_parts(&scene.shapes, &scene.meshes, method)
+        let emissive = |material: u32| {
+            scene
+                .materials
+                .get(material as usize)
+                .is_some_and(|m| m.emission.max_element() > 0.0)
+        };
+        Self::build(&scene.shapes, &scene.meshes, method, &emissive)
     }
 
     /// The geometry of `shapes` (validated, as in a [`Scene`]) with a BVH built by
@@ -174,14 +195,27 @@ impl SceneGeometry {
     }
 
     /// The geometry of `shapes` and `meshes` (validated, as in a [`Scene`]) with a BVH
-    /// built by `method`.
+    /// built by `method`; every mesh placed more than once is instanced.
     pub fn from_parts(shapes: &[Shape], meshes: &[Mesh], method: BuildMethod) -> Self {
+        Self::build(shapes, meshes, method, &|_| false)
+    }
+
+    /// [`SceneGeometry::from_parts`], flattening the meshes whose material
+    /// `flattened` names.
+    fn build(
+        shapes: &[Shape],
+        meshes: &[Mesh],
+        method: BuildMethod,
+        flattened: &dyn Fn(u32) -> bool,
+    ) -> Self {
         let mut geometry = Self {
             spheres: Vec::new(),
             planes: Vec::new(),
             polygons: Vec::new(),
             triangles: Vec::new(),
             triangle_attributes: Vec::new(),
+            instanced_meshes: Vec::new(),
+            instances: Vec::new(),
             degenerate_triangles: 0,
             triangulated_polygons: 0,
             offset_scale: 1.0,
@@ -242,9 +276,7 @@ impl SceneGeometry {
         for (plane, vertices, material) in large_polygons {
             triangulate_polygon(&plane, vertices, material, &mut geometry.triangles);
         }
-        for mesh in meshes {
-            geometry.add_mesh(mesh);
-        }
+        geometry.add_meshes(meshes, method, flattened);
         geometry.offset_scale = geometry.ray_offset_scale();
         let bounds = geometry.bounded_primitives();
         geometry.bvh = Bvh::build(&bounds, method);
@@ -281,7 +313,58 @@ impl SceneGeometry {
                 Aabb32::around_points(&t.vertices),
             )
         });
-        spheres.chain(polygons).chain(triangles).collect()
+        let instances = self
+            .instances
+            .iter()
+            .enumerate()
+            .map(|(i, instance)| (PrimRef::new(PrimKind::Instance, index(i)), instance.bounds));
+        spheres
+            .chain(polygons)
+            .chain(triangles)
+            .chain(instances)
+            .collect()
+    }
+
+    /// Adds `meshes`: those whose geometry is placed once as world-space triangles
+    /// ([`SceneGeometry::add_mesh`]), the others stored once as an [`InstancedMesh`]
+    /// with one [`Instance`] per placement (of every mesh sharing that geometry, each
+    /// with its mesh's material); meshes whose material `flattened` names are always
+    /// flattened.
+    fn add_meshes(
+        &mut self,
+        meshes: &[Mesh],
+        method: BuildMethod,
+        flattened: &dyn Fn(u32) -> bool,
+    ) {
+        for group in mesh_groups(meshes) {
+            let (flat, group): (Vec<usize>, Vec<usize>) = group
+                .into_iter()
+                .partition(|&i| flattened(meshes[i].material));
+            flat.iter().for_each(|&i| self.add_mesh(&meshes[i]));
+            let placements: usize = group.iter().map(|&i| meshes[i].instances.len()).sum();
+            if placements <= 1 {
+                group.iter().for_each(|&i| self.add_mesh(&meshes[i]));
+                continue;
+            }
+            let stored =
+                InstancedMesh::new(&meshes[group[0]], method, &mut self.degenerate_triangles);
+            let Some(root) = stored.bvh.root_bounds() else {
+                // Every triangle degenerate: nothing to place.
+                continue;
+            };
+            let mesh_index = self.instanced_meshes.len() as u32;
+            for &i in &group {
+                for transform in &meshes[i].instances {
+                    self.instances.push(Instance::new(
+                        mesh_index,
+                        transform,
+                        meshes[i].material,
+                        root,
+                    ));
+                }
+            }
+            self.instanced_meshes.push(stored);
+        }
     }
 
     /// Adds every instance of `mesh` as world-space triangles. A transform that
@@ -340,6 +423,11 @@ impl SceneGeometry {
         self.triangles
             .iter()
             .for_each(|t| t.vertices.iter().copied().for_each(&mut include));
+        // An instance by its world box: a little larger than its triangles' extent.
+        self.instances.iter().for_each(|i| {
+            include(DVec3::from_array(i.bounds.min.map(f64::from)));
+            include(DVec3::from_array(i.bounds.max.map(f64::from)));
+        });
         if extent > 0.0 && extent < 1.0 {
             extent
         } else {
@@ -354,12 +442,21 @@ impl SceneGeometry {
             PrimKind::Polygon => self.polygons[prim.index()].material,
             PrimKind::Triangle => self.triangles[prim.index()].material,
             PrimKind::Plane => self.planes[prim.index()].material,
+            PrimKind::Instance => self.instances[prim.index()].material,
         }
     }
 
-    /// The number of bounded primitives (those in the BVH).
+    /// The number of bounded primitives (those in the BVH, instances counted once).
     pub fn bounded_count(&self) -> usize {
-        self.spheres.len() + self.polygons.len() + self.triangles.len()
+        self.spheres.len() + self.polygons.len() + self.triangles.len() + self.instances.len()
+    }
+
+    /// The triangles the instances stand for: what flattening them would store.
+    pub fn instanced_triangle_count(&self) -> usize {
+        self.instances
+            .iter()
+            .map(|i| self.instanced_meshes[i.mesh as usize].triangles.len())
+            .sum()
     }
 }
 
@@ -427,6 +524,7 @@ mod tests {
             PrimKind::Polygon,
             PrimKind::Triangle,
             PrimKind::Plane,
+            PrimKind::Instance,
         ] {
             for index in [0, 1, 12345, PrimRef::MAX_INDEX] {
                 let prim = PrimRef::new(kind, index);

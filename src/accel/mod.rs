@@ -15,13 +15,17 @@
 //! - planes are unbounded and stay a short list tested before the tree.
 //!
 //! - [`geometry`]: the primitive lists and [`SceneGeometry`];
-//! - [`bvh`]: the tree, its `f32` node records and its two builders.
+//! - [`bvh`]: the tree, its `f32` node records and its two builders;
+//! - [`instance`]: meshes placed more than once, stored once with a BVH of their own
+//!   and entered through their placements' transforms (a two-level BVH).
 
 pub mod bvh;
 pub mod geometry;
+pub mod instance;
 
 pub use bvh::{BuildMethod, Bvh, BvhNode, BvhStats, MAX_BVH_DEPTH, MAX_LEAF_PRIMITIVES};
 pub use geometry::{
     MAX_PLANES, MAX_POLYGON_VERTICES, PlaneShape, PolygonShape, PrimKind, PrimRef, SceneGeometry,
     SphereShape, TriangleAttributes, TriangleShape, ray_offset_scale,
 };
+pub use instance::{HitKey, Instance, InstanceId, InstancedMesh};

@@ -5,7 +5,9 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::accel::{PrimKind, PrimRef, SceneGeometry};
+use crate::accel::{
+    HitKey, InstanceId, PrimKind, PrimRef, SceneGeometry, TriangleAttributes, TriangleShape,
+};
 use crate::scene::PolygonPlane;
 pub use crate::scene::project_to_plane;
 
@@ -49,6 +51,45 @@ pub struct Hit {
     /// Barycentric coordinates of the hit in a triangle (weights of its three
     /// corners), else `(1, 0, 0)`.
     pub barycentrics: DVec3,
+    /// The instance of an instanced mesh's triangle (then `prim` indexes its mesh's
+    /// triangles), else `None`.
+    pub instance: InstanceId,
+}
+
+impl Hit {
+    /// The surface that was hit: its primitive and instance.
+    pub fn key(&self) -> HitKey {
+        HitKey {
+            prim: self.prim,
+            instance: self.instance,
+        }
+    }
+}
+
+/// A triangle as it stands in world space, with its world-space attributes: one of
+/// the scene's own, or an instanced mesh's moved by its instance
+/// ([`crate::accel::Instance::world_triangle`]). `None` for other primitives.
+pub fn world_triangle(
+    geometry: &SceneGeometry,
+    key: HitKey,
+) -> Option<(TriangleShape, Option<TriangleAttributes>)> {
+    if key.prim.kind() != PrimKind::Triangle {
+        return None;
+    }
+    match key.instance {
+        None => {
+            let triangle = geometry.triangles[key.prim.index()];
+            let attributes = triangle
+                .attributes
+                .map(|a| geometry.triangle_attributes[a as usize]);
+            Some((triangle, attributes))
+        }
+        Some(i) => {
+            let instance = &geometry.instances[i as usize];
+            let mesh = &geometry.instanced_meshes[instance.mesh as usize];
+            Some(instance.world_triangle(mesh, key.prim.index()))
+        }
+    }
 }
 
 /// The ray parameter of `prim`'s nearest hit along `ray` in (0, `t_max`); `sheared`
@@ -75,6 +116,8 @@ pub fn intersect_prim(
             let p = &geometry.planes[i];
             intersect_plane(ray, p.normal, p.offset, t_max)
         }
+        // The traversal enters instances; they are never hit themselves.
+        PrimKind::Instance => None,
     }
 }
 
@@ -89,8 +132,28 @@ pub fn intersect_prim(
 /// assumes. A sphere point becomes `c + r·normalize(p - c)`; a point of a plane,
 /// polygon or triangle is projected orthogonally onto its plane, `p - (N·p - d)·N`.
 pub fn hit_record(geometry: &SceneGeometry, prim: PrimRef, ray: &Ray, t: f64) -> Hit {
+    hit_record_keyed(geometry, HitKey::world(prim), ray, t)
+}
+
+/// [`hit_record`] of the surface `key`, which may be an instanced mesh's triangle: the
+/// record is then made from the triangle moved to world space
+/// ([`world_triangle`]), at the world point `ray.at(t)`.
+pub fn hit_record_keyed(geometry: &SceneGeometry, key: HitKey, ray: &Ray, t: f64) -> Hit {
+    if key.instance.is_some()
+        && let Some((triangle, attributes)) = world_triangle(geometry, key)
+    {
+        return triangle_hit(&triangle, attributes.as_ref(), key, ray.at(t), t);
+    }
+    let prim = key.prim;
     let point = ray.at(t);
     let i = prim.index();
+    if prim.kind() == PrimKind::Triangle {
+        let triangle = &geometry.triangles[i];
+        let attributes = triangle
+            .attributes
+            .map(|a| &geometry.triangle_attributes[a as usize]);
+        return triangle_hit(triangle, attributes, key, point, t);
+    }
     let (normal, position) = match prim.kind() {
         PrimKind::Sphere => {
             let s = &geometry.spheres[i];
@@ -106,20 +169,14 @@ pub fn hit_record(geometry: &SceneGeometry, prim: PrimRef, ray: &Ray, t: f64) ->
                 project_onto_plane(point, plane.normal, plane.offset),
             )
         }
-        PrimKind::Triangle => {
-            let vertices = &geometry.triangles[i].vertices;
-            let normal = triangle_normal(vertices);
-            (
-                normal,
-                project_onto_plane(point, normal, normal.dot(vertices[0])),
-            )
-        }
         PrimKind::Plane => {
             let p = &geometry.planes[i];
             (p.normal, project_onto_plane(point, p.normal, p.offset))
         }
+        // Triangles are handled above; an instance is never a hit.
+        PrimKind::Triangle | PrimKind::Instance => (DVec3::Z, point),
     };
-    let mut hit = Hit {
+    Hit {
         t,
         normal,
         material: geometry.material(prim),
@@ -128,25 +185,48 @@ pub fn hit_record(geometry: &SceneGeometry, prim: PrimRef, ray: &Ray, t: f64) ->
         shading_normal: normal,
         uv: DVec2::ZERO,
         barycentrics: DVec3::X,
+        instance: None,
+    }
+}
+
+/// The hit record of a world-space `triangle` (with its world-space `attributes`) at
+/// `point = ray.at(t)`: the winding normal, the point projected onto its plane, its
+/// barycentric coordinates, and the interpolated shading normal and texture
+/// coordinates.
+fn triangle_hit(
+    triangle: &TriangleShape,
+    attributes: Option<&TriangleAttributes>,
+    key: HitKey,
+    point: DVec3,
+    t: f64,
+) -> Hit {
+    let vertices = &triangle.vertices;
+    let normal = triangle_normal(vertices);
+    let position = project_onto_plane(point, normal, normal.dot(vertices[0]));
+    let mut hit = Hit {
+        t,
+        normal,
+        material: triangle.material,
+        position,
+        prim: key.prim,
+        shading_normal: normal,
+        uv: DVec2::ZERO,
+        barycentrics: triangle_barycentrics(position, vertices),
+        instance: key.instance,
     };
-    if prim.kind() == PrimKind::Triangle {
-        let triangle = &geometry.triangles[i];
-        hit.barycentrics = triangle_barycentrics(position, &triangle.vertices);
-        if let Some(attributes) = triangle.attributes {
-            let attributes = &geometry.triangle_attributes[attributes as usize];
-            let b = hit.barycentrics;
-            if let Some(n) = attributes.normals {
-                let interpolated = n[0] * b.x + n[1] * b.y + n[2] * b.z;
-                // Degenerate interpolations and normals facing away from the surface
-                // fall back to the geometric normal.
-                let shading = interpolated.normalize_or(normal);
-                if shading.dot(normal) > 0.0 {
-                    hit.shading_normal = shading;
-                }
+    if let Some(attributes) = attributes {
+        let b = hit.barycentrics;
+        if let Some(n) = attributes.normals {
+            let interpolated = n[0] * b.x + n[1] * b.y + n[2] * b.z;
+            // Degenerate interpolations and normals facing away from the surface
+            // fall back to the geometric normal.
+            let shading = interpolated.normalize_or(normal);
+            if shading.dot(normal) > 0.0 {
+                hit.shading_normal = shading;
             }
-            if let Some(uv) = attributes.uvs {
-                hit.uv = uv[0] * b.x + uv[1] * b.y + uv[2] * b.z;
-            }
+        }
+        if let Some(uv) = attributes.uvs {
+            hit.uv = uv[0] * b.x + uv[1] * b.y + uv[2] * b.z;
         }
     }
     hit
@@ -180,13 +260,13 @@ pub fn triangle_barycentrics(point: DVec3, vertices: &[DVec3; 3]) -> DVec3 {
 /// it the neighbouring flat facets shadow a point that its smooth normal says is lit:
 /// black, faceted terminators on low-poly meshes. Other shapes keep the hit point.
 pub fn shadow_terminator_point(geometry: &SceneGeometry, hit: &Hit, facing: DVec3) -> DVec3 {
-    if hit.prim.kind() != PrimKind::Triangle {
-        return hit.position;
-    }
-    let triangle = &geometry.triangles[hit.prim.index()];
-    let Some(normals) = triangle
-        .attributes
-        .and_then(|a| geometry.triangle_attributes[a as usize].normals)
+    let Some((
+        triangle,
+        Some(TriangleAttributes {
+            normals: Some(normals),
+            ..
+        }),
+    )) = world_triangle(geometry, hit.key())
     else {
         return hit.position;
     };

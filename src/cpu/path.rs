@@ -32,7 +32,7 @@ use super::trace::{
     PreparedScene, direct_light, finite_radiance, keep_on_side, shading_frame_normal,
 };
 use super::traverse::intersect_scene;
-use crate::accel::{PrimKind, PrimRef, SceneGeometry};
+use crate::accel::{HitKey, PrimKind, PrimRef, SceneGeometry};
 use crate::scene::{Material, MaterialKind, MediumStack, MicrofacetDistribution, project_to_plane};
 
 /// Bounces after which Russian roulette may end a path.
@@ -62,11 +62,12 @@ enum EmitterShape {
     Triangle { vertices: [DVec3; 3], normal: DVec3 },
 }
 
-/// One emitter: its shape, the primitive a ray hits on it, and its radiance.
+/// One emitter: its shape, the surface a ray hits on it (an instanced mesh's triangle
+/// with its instance), and its radiance.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Emitter {
     shape: EmitterShape,
-    prim: PrimRef,
+    key: HitKey,
     radiance: DVec3,
 }
 
@@ -78,8 +79,8 @@ struct Emitter {
 #[derive(Debug, Clone, Default)]
 pub struct AreaLights {
     emitters: Vec<Emitter>,
-    /// The first emitter of each primitive.
-    first_of: std::collections::HashMap<PrimRef, usize>,
+    /// The first emitter of each surface.
+    first_of: std::collections::HashMap<HitKey, usize>,
     /// Cumulative selection weights.
     cdf: Vec<f64>,
     total: f64,
@@ -100,7 +101,7 @@ impl AreaLights {
                             center: s.center,
                             radius: s.radius,
                         },
-                        prim: PrimRef::new(PrimKind::Sphere, i as u32),
+                        key: HitKey::world(PrimRef::new(PrimKind::Sphere, i as u32)),
                         radiance,
                     },
                     area,
@@ -112,7 +113,7 @@ impl AreaLights {
             if radiance.max_element() <= 0.0 || p.plane.normal == DVec3::ZERO {
                 continue;
             }
-            let prim = PrimRef::new(PrimKind::Polygon, i as u32);
+            let prim = HitKey::world(PrimRef::new(PrimKind::Polygon, i as u32));
             for vertices in polygon_triangles(&p.vertices, p.plane.dropped_axis) {
                 lights.push_triangle(vertices, p.plane.normal, prim, radiance);
             }
@@ -125,27 +126,42 @@ impl AreaLights {
             let [a, b, c] = t.vertices;
             let normal = (b - a).cross(c - a).normalize_or_zero();
             if normal != DVec3::ZERO {
-                let prim = PrimRef::new(PrimKind::Triangle, i as u32);
+                let prim = HitKey::world(PrimRef::new(PrimKind::Triangle, i as u32));
                 lights.push_triangle(t.vertices, normal, prim, radiance);
+            }
+        }
+        // Emissive instanced meshes: each instance's triangles moved to world space for
+        // sampling (the BVH keeps the mesh once; the emitter list has every copy).
+        for (i, instance) in geometry.instances.iter().enumerate() {
+            let radiance = emission(instance.material);
+            if radiance.max_element() <= 0.0 {
+                continue;
+            }
+            let mesh = &geometry.instanced_meshes[instance.mesh as usize];
+            for j in 0..mesh.triangles.len() {
+                let (t, _) = instance.world_triangle(mesh, j);
+                let [a, b, c] = t.vertices;
+                let normal = (b - a).cross(c - a).normalize_or_zero();
+                if normal != DVec3::ZERO {
+                    let key = HitKey {
+                        prim: PrimRef::new(PrimKind::Triangle, j as u32),
+                        instance: Some(i as u32),
+                    };
+                    lights.push_triangle(t.vertices, normal, key, radiance);
+                }
             }
         }
         lights
     }
 
-    fn push_triangle(
-        &mut self,
-        vertices: [DVec3; 3],
-        normal: DVec3,
-        prim: PrimRef,
-        radiance: DVec3,
-    ) {
+    fn push_triangle(&mut self, vertices: [DVec3; 3], normal: DVec3, key: HitKey, radiance: DVec3) {
         let [a, b, c] = vertices;
         let area = 0.5 * (b - a).cross(c - a).length();
         if area > 0.0 {
             self.push(
                 Emitter {
                     shape: EmitterShape::Triangle { vertices, normal },
-                    prim,
+                    key,
                     radiance,
                 },
                 area,
@@ -161,7 +177,7 @@ impl AreaLights {
         self.total += weight;
         self.cdf.push(self.total);
         self.first_of
-            .entry(emitter.prim)
+            .entry(emitter.key)
             .or_insert(self.emitters.len());
         self.emitters.push(emitter);
     }
@@ -194,7 +210,9 @@ impl AreaLights {
                 };
                 EmitterEntry {
                     shape,
-                    prim: emitter.prim,
+                    // Scene geometry flattens emissive meshes, so an entry's surface
+                    // is one of the scene's own (`SceneGeometry::with_method`).
+                    prim: emitter.key.prim,
                     radiance: emitter.radiance,
                     cdf: self.cdf[index] / self.total,
                     selection: (self.cdf[index] - below) / self.total,
@@ -223,7 +241,7 @@ impl AreaLights {
     fn pdf(&self, point: DVec3, hit: &Hit) -> f64 {
         // Every flat emitter piece of a primitive has the density luminance / total per
         // unit area; a sphere has its cone density times its selection probability.
-        let Some(&index) = self.first_of.get(&hit.prim) else {
+        let Some(&index) = self.first_of.get(&hit.key()) else {
             return 0.0;
         };
         let below = if index == 0 { 0.0 } else { self.cdf[index - 1] };
@@ -593,7 +611,7 @@ fn sample_emitter(
     // Visible when the first thing the ray meets is the emitter itself, on its
     // emitting side.
     let visible = intersect_scene(&scene.geometry, &shadow, f64::INFINITY)
-        .is_some_and(|hit| hit.prim == emitter.prim && emits_towards(&hit, wi));
+        .is_some_and(|hit| hit.key() == emitter.key && emits_towards(&hit, wi));
     if !visible {
         return (DVec3::ZERO, 1);
     }

@@ -8,8 +8,12 @@
 
 use glam::DVec3;
 
-use super::intersect::{Hit, Ray, hit_record, intersect_prim, shear_ray};
-use crate::accel::{BvhNode, MAX_BVH_DEPTH, PrimKind, PrimRef, SceneGeometry};
+use super::intersect::{
+    Hit, Ray, ShearedRay, hit_record_keyed, intersect_prim, intersect_triangle, shear_ray,
+};
+use crate::accel::{
+    Bvh, BvhNode, HitKey, Instance, MAX_BVH_DEPTH, PrimKind, PrimRef, SceneGeometry,
+};
 
 /// Direction components smaller than this in magnitude are replaced by it (with their
 /// sign) before the slab test divides by them: an exactly parallel ray then gets huge
@@ -69,111 +73,174 @@ impl SlabRay {
     }
 }
 
-/// The exclusive distance limit for testing `prim` against the best hit so far: the
-/// best distance, or just beyond it for a smaller reference, which wins exact ties.
+/// The exclusive distance limit for testing the surface `key` against the best hit so
+/// far: the best distance, or just beyond it for a smaller key, which wins exact ties.
 /// Without a hit yet, the query's own exclusive `t_max`.
-fn limit_for(prim: PrimRef, best_t: f64, best: Option<PrimRef>) -> f64 {
+fn limit_for(key: HitKey, best_t: f64, best: Option<HitKey>) -> f64 {
     match best {
-        Some(b) if prim < b && best_t.is_finite() => best_t.next_up(),
+        Some(b) if key < b && best_t.is_finite() => best_t.next_up(),
         _ => best_t,
+    }
+}
+
+/// One query's state: the best hit so far and the work done.
+struct Query<'a> {
+    geometry: &'a SceneGeometry,
+    any_hit: bool,
+    best_t: f64,
+    best: Option<HitKey>,
+    counts: &'a mut TraversalCounts,
+}
+
+impl Query<'_> {
+    fn done(&self) -> bool {
+        self.any_hit && self.best.is_some()
+    }
+
+    /// Tests the surface `key` with the query's tie rule, `hit` giving its distance
+    /// below a limit.
+    fn consider(&mut self, key: HitKey, hit: impl FnOnce(f64) -> Option<f64>) {
+        self.counts.primitives += 1;
+        if let Some(t) = hit(limit_for(key, self.best_t, self.best)) {
+            self.best_t = t;
+            self.best = Some(key);
+        }
+    }
+
+    /// A primitive of the scene's BVH: tested, or for an instance, entered.
+    fn world_prim(&mut self, prim: PrimRef, ray: &Ray, sheared: &ShearedRay) {
+        if prim.kind() == PrimKind::Instance {
+            self.enter_instance(prim.index(), ray);
+        } else {
+            let geometry = self.geometry;
+            self.consider(HitKey::world(prim), |limit| {
+                intersect_prim(geometry, prim, ray, sheared, limit)
+            });
+        }
+    }
+
+    /// Traverses instance `index`'s mesh with `ray` moved to its space (twin of the
+    /// instance entry in `shaders/traverse.wgsl`).
+    fn enter_instance(&mut self, index: usize, ray: &Ray) {
+        let geometry = self.geometry;
+        let instance = &geometry.instances[index];
+        let mesh = &geometry.instanced_meshes[instance.mesh as usize];
+        let local = object_ray(instance, ray);
+        let sheared = shear_ray(&local);
+        let id = Some(index as u32);
+        self.walk(&mesh.bvh, &local, |query, prim| {
+            query.consider(HitKey { prim, instance: id }, |limit| {
+                intersect_triangle(&sheared, &mesh.triangles[prim.index()].vertices, limit)
+            });
+        });
+    }
+
+    /// Descends `bvh` nearest child first, each popped node re-tested against the best
+    /// hit so far, handing each leaf's primitives in order to `leaf_prim`.
+    fn walk(&mut self, bvh: &Bvh, ray: &Ray, mut leaf_prim: impl FnMut(&mut Self, PrimRef)) {
+        let nodes = &bvh.nodes;
+        let slab = SlabRay::new(ray);
+        let mut stack = [0u32; MAX_BVH_DEPTH as usize];
+        let mut stack_len = 0usize;
+        let mut current = match nodes.first() {
+            Some(root) if slab.enter(root, self.best_t).is_some() => Some(0u32),
+            _ => None,
+        };
+        loop {
+            if self.done() {
+                break;
+            }
+            let Some(index) = current else {
+                // Pop; a node pushed earlier may lie beyond a hit found since.
+                if stack_len == 0 {
+                    break;
+                }
+                stack_len -= 1;
+                let candidate = stack[stack_len];
+                current = slab
+                    .enter(&nodes[candidate as usize], self.best_t)
+                    .map(|_| candidate);
+                continue;
+            };
+            self.counts.nodes += 1;
+            let node = &nodes[index as usize];
+            current = None;
+            if node.is_leaf() {
+                for &prim in &bvh.prims[node.first as usize..(node.first + node.count) as usize] {
+                    leaf_prim(self, prim);
+                    if self.done() {
+                        break;
+                    }
+                }
+                continue;
+            }
+            let (a, b) = (node.first, node.first + 1);
+            let enter_a = slab.enter(&nodes[a as usize], self.best_t);
+            let enter_b = slab.enter(&nodes[b as usize], self.best_t);
+            current = match (enter_a, enter_b) {
+                (Some(ta), Some(tb)) => {
+                    // Nearest child first; the other waits on the stack.
+                    let (near, far) = if tb < ta { (b, a) } else { (a, b) };
+                    stack[stack_len] = far;
+                    stack_len += 1;
+                    Some(near)
+                }
+                (Some(_), None) => Some(a),
+                (None, Some(_)) => Some(b),
+                (None, None) => None,
+            };
+        }
+    }
+}
+
+/// `ray` in the space of `instance`'s mesh: origin and direction through its
+/// world-to-object transform, the direction not renormalised, so that a point keeps
+/// its ray parameter (twin: `object_ray` in `shaders/traverse.wgsl`).
+pub fn object_ray(instance: &Instance, ray: &Ray) -> Ray {
+    Ray {
+        origin: instance.world_to_object.transform_point3(ray.origin),
+        direction: instance.world_to_object.transform_vector3(ray.direction),
     }
 }
 
 /// The traversal both queries share, twin of `advance_traversal` in
 /// `shaders/traverse.wgsl` (without its budget: the CPU never suspends a traversal):
-/// the planes, then the tree nearest child first, each leaf's primitives in order,
-/// each popped node re-tested against the best hit so far. With `any_hit` the first
-/// hit ends it. Returns the best hit, counting the work into `counts`.
+/// the planes, then the tree nearest child first, each leaf's primitives in order
+/// (an instance's mesh traversed in its own space where the leaf names it), each
+/// popped node re-tested against the best hit so far. With `any_hit` the first hit
+/// ends it. Returns the best hit, counting the work into `counts`.
 fn traverse(
     geometry: &SceneGeometry,
     ray: &Ray,
     t_max: f64,
     any_hit: bool,
     counts: &mut TraversalCounts,
-) -> Option<(f64, PrimRef)> {
+) -> Option<(f64, HitKey)> {
     let sheared = shear_ray(ray);
-    let mut best_t = t_max;
-    let mut best: Option<PrimRef> = None;
-    let mut consider = |prim: PrimRef, best_t: &mut f64, best: &mut Option<PrimRef>| {
-        counts.primitives += 1;
-        let limit = limit_for(prim, *best_t, *best);
-        if let Some(t) = intersect_prim(geometry, prim, ray, &sheared, limit) {
-            *best_t = t;
-            *best = Some(prim);
-        }
+    let mut query = Query {
+        geometry,
+        any_hit,
+        best_t: t_max,
+        best: None,
+        counts,
     };
     for i in 0..geometry.planes.len() {
-        consider(
-            PrimRef::new(PrimKind::Plane, i as u32),
-            &mut best_t,
-            &mut best,
-        );
+        query.world_prim(PrimRef::new(PrimKind::Plane, i as u32), ray, &sheared);
     }
-    let nodes = &geometry.bvh.nodes;
-    let slab = SlabRay::new(ray);
-    let mut stack = [0u32; MAX_BVH_DEPTH as usize];
-    let mut stack_len = 0usize;
-    let mut current = match nodes.first() {
-        Some(root) if slab.enter(root, best_t).is_some() => Some(0u32),
-        _ => None,
-    };
-    loop {
-        if any_hit && best.is_some() {
-            break;
-        }
-        let Some(index) = current else {
-            // Pop; a node pushed earlier may lie beyond a hit found since.
-            if stack_len == 0 {
-                break;
-            }
-            stack_len -= 1;
-            let candidate = stack[stack_len];
-            current = slab
-                .enter(&nodes[candidate as usize], best_t)
-                .map(|_| candidate);
-            continue;
-        };
-        counts.nodes += 1;
-        let node = &nodes[index as usize];
-        current = None;
-        if node.is_leaf() {
-            for &prim in
-                &geometry.bvh.prims[node.first as usize..(node.first + node.count) as usize]
-            {
-                consider(prim, &mut best_t, &mut best);
-                if any_hit && best.is_some() {
-                    break;
-                }
-            }
-            continue;
-        }
-        let (a, b) = (node.first, node.first + 1);
-        let enter_a = slab.enter(&nodes[a as usize], best_t);
-        let enter_b = slab.enter(&nodes[b as usize], best_t);
-        current = match (enter_a, enter_b) {
-            (Some(ta), Some(tb)) => {
-                // Nearest child first; the other waits on the stack.
-                let (near, far) = if tb < ta { (b, a) } else { (a, b) };
-                stack[stack_len] = far;
-                stack_len += 1;
-                Some(near)
-            }
-            (Some(_), None) => Some(a),
-            (None, Some(_)) => Some(b),
-            (None, None) => None,
-        };
-    }
-    best.map(|prim| (best_t, prim))
+    query.walk(&geometry.bvh, ray, |query, prim| {
+        query.world_prim(prim, ray, &sheared);
+    });
+    query.best.map(|key| (query.best_t, key))
 }
 
-/// The nearest primitive along `ray` in (0, `t_max`) and its distance, counting the
+/// The nearest surface along `ray` in (0, `t_max`) and its distance, counting the
 /// work into `counts`.
 pub fn closest_hit_counted(
     geometry: &SceneGeometry,
     ray: &Ray,
     t_max: f64,
     counts: &mut TraversalCounts,
-) -> Option<(f64, PrimRef)> {
+) -> Option<(f64, HitKey)> {
     traverse(geometry, ray, t_max, false, counts)
 }
 
@@ -182,7 +249,7 @@ pub fn closest_hit_counted(
 pub fn intersect_scene(geometry: &SceneGeometry, ray: &Ray, t_max: f64) -> Option<Hit> {
     let mut counts = TraversalCounts::default();
     closest_hit_counted(geometry, ray, t_max, &mut counts)
-        .map(|(t, prim)| hit_record(geometry, prim, ray, t))
+        .map(|(t, key)| hit_record_keyed(geometry, key, ray, t))
 }
 
 /// Whether anything lies along `ray` in (0, `t_max`): the shadow-ray query, which
@@ -202,15 +269,21 @@ pub fn occluded_counted(
     traverse(geometry, ray, t_max, true, counts).is_some()
 }
 
-/// The nearest hit by testing every primitive, with the same tie rule: the oracle of
-/// the traversal tests.
+/// The nearest hit by testing every primitive (every instance's every triangle in its
+/// own space), with the same tie rule: the oracle of the traversal tests.
 pub fn closest_hit_brute_force(
     geometry: &SceneGeometry,
     ray: &Ray,
     t_max: f64,
-) -> Option<(f64, PrimRef)> {
+) -> Option<(f64, HitKey)> {
     let mut best_t = t_max;
-    let mut best: Option<PrimRef> = None;
+    let mut best: Option<HitKey> = None;
+    let mut consider = |key: HitKey, hit: &dyn Fn(f64) -> Option<f64>| {
+        if let Some(t) = hit(limit_for(key, best_t, best)) {
+            best_t = t;
+            best = Some(key);
+        }
+    };
     let kinds = [
         (PrimKind::Sphere, geometry.spheres.len()),
         (PrimKind::Plane, geometry.planes.len()),
@@ -221,12 +294,24 @@ pub fn closest_hit_brute_force(
     for (kind, count) in kinds {
         for i in 0..count {
             let prim = PrimRef::new(kind, i as u32);
-            let limit = limit_for(prim, best_t, best);
-            if let Some(t) = intersect_prim(geometry, prim, ray, &sheared, limit) {
-                best_t = t;
-                best = Some(prim);
-            }
+            consider(HitKey::world(prim), &|limit| {
+                intersect_prim(geometry, prim, ray, &sheared, limit)
+            });
         }
     }
-    best.map(|prim| (best_t, prim))
+    for (i, instance) in geometry.instances.iter().enumerate() {
+        let mesh = &geometry.instanced_meshes[instance.mesh as usize];
+        let local = object_ray(instance, ray);
+        let sheared = shear_ray(&local);
+        for (j, triangle) in mesh.triangles.iter().enumerate() {
+            let key = HitKey {
+                prim: PrimRef::new(PrimKind::Triangle, j as u32),
+                instance: Some(i as u32),
+            };
+            consider(key, &|limit| {
+                intersect_triangle(&sheared, &triangle.vertices, limit)
+            });
+        }
+    }
+    best.map(|key| (best_t, key))
 }

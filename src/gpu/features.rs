@@ -40,6 +40,9 @@ pub struct ShaderFeatures {
     /// Mesh vertex normals and texture coordinates: smooth shading, the shadow
     /// terminator fix and UV lookups (`MESH_ATTRIBUTES`).
     pub mesh_attributes: bool,
+    /// Instanced meshes: entering their trees with transformed rays, and their hit
+    /// records (`INSTANCES`; see `crate::accel::instance`).
+    pub instances: bool,
     /// The path-tracing integrator (`PATH`, `shaders/path.wgsl`); a module with it
     /// traces with it only when the trace's flags ask for it.
     pub path: bool,
@@ -60,6 +63,7 @@ impl ShaderFeatures {
         pbr: true,
         textures: true,
         mesh_attributes: true,
+        instances: true,
         path: true,
     };
 
@@ -91,6 +95,7 @@ impl ShaderFeatures {
                 .meshes
                 .iter()
                 .any(|m| m.normals.is_some() || m.uvs.is_some()),
+            instances: crate::accel::instance::has_instances(&scene.meshes),
             path: scene.render.integrator == crate::scene::Integrator::Path,
         }
     }
@@ -122,7 +127,7 @@ impl ShaderFeatures {
 type FeatureFlag = fn(&ShaderFeatures) -> bool;
 
 /// The name of each feature in the WGSL directives, with the flag it reads.
-const FEATURE_NAMES: [(&str, FeatureFlag); 13] = [
+const FEATURE_NAMES: [(&str, FeatureFlag); 14] = [
     ("SPHERES", |f| f.spheres),
     ("PLANES", |f| f.planes),
     ("POLYGONS", |f| f.polygons),
@@ -135,6 +140,7 @@ const FEATURE_NAMES: [(&str, FeatureFlag); 13] = [
     ("PBR", |f| f.pbr),
     ("TEXTURES", |f| f.textures),
     ("MESH_ATTRIBUTES", |f| f.mesh_attributes),
+    ("INSTANCES", |f| f.instances),
     ("PATH", |f| f.path),
 ];
 

@@ -117,8 +117,18 @@ pub struct GpuTraceRay {
     pub leaf_end: u32,
     /// 1 for a shadow ray (the first hit ends it).
     pub any_hit: u32,
-    /// Padding.
-    pub _pad: u32,
+    /// The best hit's instance (the node index of its record), or `u32::MAX` for the
+    /// scene's own primitives.
+    pub best_instance: u32,
+    /// The instance whose mesh is being traversed (its record's node index), or
+    /// `u32::MAX` in the scene's own tree.
+    pub instance: u32,
+    /// Stack depth at which the current instance's traversal began.
+    pub stack_base: u32,
+    /// Inside an instance: the next primitive of the scene tree's leaf that named it.
+    pub world_cursor: u32,
+    /// Inside an instance: one past that leaf's last primitive.
+    pub world_leaf_end: u32,
 }
 
 /// The state of one slot's path tree between dispatches (`PathState` in WGSL). Only

@@ -13,7 +13,10 @@ use super::layout::{
     MATERIAL_LAMBERT, MATERIAL_MIRROR, MATERIAL_OREN_NAYAR, MATERIAL_PBR, MATERIAL_TABULATED,
     NO_ATTRIBUTES, NO_IMAGE, WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT, WRAP_REPEAT,
 };
-use crate::accel::{BvhNode, PolygonShape, SceneGeometry, TriangleAttributes};
+use crate::accel::{
+    BvhNode, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry, TriangleAttributes,
+    TriangleShape,
+};
 use crate::camera::CameraFrame;
 use crate::scene::{
     FresnelModel, Image, Light, Material, MaterialKind, MediumStack, MicrofacetDistribution, Scene,
@@ -35,18 +38,23 @@ pub struct SceneRecords {
     /// polygon's inside-test projection ([`crate::scene::project_to_plane`] by the
     /// plane's dropped axis): all the inside test reads, in half the bytes.
     pub polygon_points: Vec<[f32; 2]>,
-    /// Triangles, in [`SceneGeometry::triangles`] order.
+    /// Triangles, in [`SceneGeometry::triangles`] order, then each instanced mesh's
+    /// (in its own space, once).
     pub triangles: Vec<GpuTriangle>,
     /// Mesh triangles' vertex normals and texture coordinates, in
-    /// [`SceneGeometry::triangle_attributes`] order.
+    /// [`SceneGeometry::triangle_attributes`] order, then each instanced mesh's.
     pub triangle_attributes: Vec<GpuTriangleAttributes>,
     /// Materials, indexed by the shapes' `material`.
     pub materials: Vec<GpuMaterial>,
     /// Lights, in scene order.
     pub lights: Vec<GpuLight>,
-    /// The BVH nodes, as both tracers read them.
+    /// The BVH nodes, as both tracers read them (the scene's tree from node 0), then
+    /// each instanced mesh's tree, then four records per instance
+    /// ([`instance_records`]).
     pub bvh_nodes: Vec<BvhNode>,
-    /// The BVH's primitive references (`PrimRef` values), leaf by leaf.
+    /// The BVH's primitive references (`PrimRef` values), leaf by leaf: the scene's
+    /// tree's (an instance named by the node index of its records), then each
+    /// instanced mesh's (its triangles by their index in `triangles`).
     pub bvh_prims: Vec<u32>,
 }
 
@@ -78,14 +86,7 @@ impl SceneRecords {
             triangles: geometry
                 .triangles
                 .iter()
-                .map(|t| GpuTriangle {
-                    v0: vec3(t.vertices[0]),
-                    material: t.material,
-                    v1: vec3(t.vertices[1]),
-                    attributes: t.attributes.unwrap_or(NO_ATTRIBUTES),
-                    v2: vec3(t.vertices[2]),
-                    _pad2: 0,
-                })
+                .map(|t| triangle_record(t, 0))
                 .collect(),
             triangle_attributes: geometry
                 .triangle_attributes
@@ -96,6 +97,7 @@ impl SceneRecords {
             bvh_prims: geometry.bvh.prims.iter().map(|p| p.0).collect(),
             ..Self::default()
         };
+        records.append_instances(geometry);
         for polygon in &geometry.polygons {
             let first_vertex = records.polygon_points.len();
             records
@@ -115,6 +117,57 @@ impl SceneRecords {
         records
     }
 
+    /// Appends the instanced meshes (triangles, attributes, trees with their node and
+    /// primitive indices shifted to where they land) and the instances' records, and
+    /// renames the scene tree's instance references to their records' node index.
+    fn append_instances(&mut self, geometry: &SceneGeometry) {
+        if geometry.instances.is_empty() {
+            return;
+        }
+        let index = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+        let mut roots = Vec::with_capacity(geometry.instanced_meshes.len());
+        for mesh in &geometry.instanced_meshes {
+            let first_triangle = index(self.triangles.len());
+            let first_attributes = index(self.triangle_attributes.len());
+            self.triangles.extend(
+                mesh.triangles
+                    .iter()
+                    .map(|t| triangle_record(t, first_attributes)),
+            );
+            self.triangle_attributes.extend(
+                mesh.triangle_attributes
+                    .iter()
+                    .map(triangle_attributes_record),
+            );
+            let first_node = index(self.bvh_nodes.len());
+            let first_prim = index(self.bvh_prims.len());
+            roots.push(first_node);
+            self.bvh_nodes
+                .extend(mesh.bvh.nodes.iter().map(|n| BvhNode {
+                    first: n.first + if n.is_leaf() { first_prim } else { first_node },
+                    ..*n
+                }));
+            self.bvh_prims.extend(
+                mesh.bvh
+                    .prims
+                    .iter()
+                    .map(|p| PrimRef::new(PrimKind::Triangle, first_triangle + p.index() as u32).0),
+            );
+        }
+        let first_record = self.bvh_nodes.len();
+        for instance in &geometry.instances {
+            let root = roots[instance.mesh as usize];
+            self.bvh_nodes.extend(instance_records(instance, root));
+        }
+        let record = |i: usize| index(first_record + INSTANCE_RECORD_NODES * i);
+        for prim in &mut self.bvh_prims[..geometry.bvh.prims.len()] {
+            let p = PrimRef(*prim);
+            if p.kind() == PrimKind::Instance {
+                *prim = PrimRef::new(PrimKind::Instance, record(p.index())).0;
+            }
+        }
+    }
+
     /// The same lists with one zeroed record in place of each empty list: WGSL has no
     /// zero-sized storage buffers, and the real counts travel in [`FrameUniforms`]
     /// (or, for the BVH, in an empty tree's node count of 0).
@@ -131,6 +184,55 @@ impl SceneRecords {
             bvh_nodes: pad(&self.bvh_nodes),
             bvh_prims: pad(&self.bvh_prims),
         }
+    }
+}
+
+/// Node records per instance in [`SceneRecords::bvh_nodes`].
+pub const INSTANCE_RECORD_NODES: usize = 4;
+
+/// The [`INSTANCE_RECORD_NODES`] node records that hold `instance` for the shaders
+/// (`load_instance` in `shaders/intersect.wgsl`), whose mesh's tree has its root at
+/// node `root`: the columns of `object_to_world` (the images of x, y and z, then the
+/// translation) in the first two records' corners, those of `world_to_object` in the
+/// last two; the first record's `first` and `count` hold the root and the material,
+/// the second's `first` whether the transform mirrors. The normal matrix is the
+/// transpose of `world_to_object`'s linear part and is not stored.
+pub fn instance_records(instance: &Instance, root: u32) -> [BvhNode; INSTANCE_RECORD_NODES] {
+    let o2w = &instance.object_to_world;
+    let w2o = &instance.world_to_object;
+    let node = |min: DVec3, first: u32, max: DVec3, count: u32| BvhNode {
+        min: vec3(min),
+        first,
+        max: vec3(max),
+        count,
+    };
+    [
+        node(
+            o2w.matrix3.x_axis,
+            root,
+            o2w.matrix3.y_axis,
+            instance.material,
+        ),
+        node(
+            o2w.matrix3.z_axis,
+            u32::from(instance.mirrored),
+            o2w.translation,
+            0,
+        ),
+        node(w2o.matrix3.x_axis, 0, w2o.matrix3.y_axis, 0),
+        node(w2o.matrix3.z_axis, 0, w2o.translation, 0),
+    ]
+}
+
+/// The record of a triangle whose attributes index is shifted by `first_attributes`.
+fn triangle_record(t: &TriangleShape, first_attributes: u32) -> GpuTriangle {
+    GpuTriangle {
+        v0: vec3(t.vertices[0]),
+        material: t.material,
+        v1: vec3(t.vertices[1]),
+        attributes: t.attributes.map_or(NO_ATTRIBUTES, |a| a + first_attributes),
+        v2: vec3(t.vertices[2]),
+        _pad2: 0,
     }
 }
 
@@ -586,5 +688,64 @@ mod tests {
             assert_eq!(rec.emission, [1.0, 2.0, 3.0]);
             assert_eq!(rec.transmittance, [1.0; 3]);
         }
+    }
+
+    #[test]
+    fn instances_become_node_records_and_shifted_trees() {
+        let mut s = scene(vec![], vec![]);
+        s.materials.push(Material::lambert(DVec3::splat(0.9)));
+        let mesh = crate::scene::Mesh {
+            name: "tri".into(),
+            positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
+            normals: Some(vec![DVec3::Z; 3]),
+            uvs: None,
+            triangles: vec![[0, 1, 2]],
+            material: 1,
+            instances: vec![
+                glam::DMat4::from_translation(DVec3::new(3.0, 0.0, 0.0)),
+                glam::DMat4::from_scale(DVec3::new(-1.0, 2.0, 1.0)),
+            ],
+        };
+        s.meshes.push(mesh);
+        let geometry = SceneGeometry::new(&s);
+        assert_eq!(geometry.instances.len(), 2);
+        let r = SceneRecords::new(&s, &geometry);
+        // The mesh's one triangle and its attributes, once.
+        assert_eq!((r.triangles.len(), r.triangle_attributes.len()), (1, 1));
+        assert_eq!(r.triangles[0].attributes, 0);
+        let world_nodes = geometry.bvh.nodes.len();
+        let mesh_nodes = geometry.instanced_meshes[0].bvh.nodes.len();
+        assert_eq!(
+            r.bvh_nodes.len(),
+            world_nodes + mesh_nodes + 2 * INSTANCE_RECORD_NODES
+        );
+        // The mesh's leaf names the triangle at its place in the triangle list.
+        let leaf = r.bvh_nodes[world_nodes];
+        assert!(leaf.is_leaf());
+        let prim = PrimRef(r.bvh_prims[leaf.first as usize]);
+        assert_eq!((prim.kind(), prim.index()), (PrimKind::Triangle, 0));
+        // The scene's tree names each instance by its records' node index.
+        let mut records: Vec<usize> = r.bvh_prims[..geometry.bvh.prims.len()]
+            .iter()
+            .map(|&p| PrimRef(p))
+            .filter(|p| p.kind() == PrimKind::Instance)
+            .map(PrimRef::index)
+            .collect();
+        records.sort_unstable();
+        let first = world_nodes + mesh_nodes;
+        assert_eq!(records, [first, first + INSTANCE_RECORD_NODES]);
+        let second = &r.bvh_nodes[first + INSTANCE_RECORD_NODES..];
+        assert_eq!(
+            second[0].first as usize, world_nodes,
+            "the mesh tree's root"
+        );
+        assert_eq!(second[0].count, 1, "the material");
+        assert_eq!(second[1].first, 1, "mirrored");
+        assert_eq!(
+            second[0].min,
+            [-1.0, 0.0, 0.0],
+            "object_to_world's x column"
+        );
+        assert_eq!(second[2].max, [0.0, 0.5, 0.0], "world_to_object's y column");
     }
 }

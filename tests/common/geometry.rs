@@ -1,9 +1,9 @@
 //! Generated geometry for the traversal tests: mixed random shapes, closed meshes and
 //! the rays that test them.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use gpu_render::cpu::intersect::Ray;
-use gpu_render::scene::Shape;
+use gpu_render::scene::{Mesh, Shape};
 
 /// A small deterministic generator (SplitMix64), so the tests need no crate.
 pub struct SplitMix(pub u64);
@@ -222,4 +222,57 @@ pub fn rays_through_mesh_edges() -> (Vec<Shape>, Vec<Ray>) {
         }
     }
     (shapes, rays)
+}
+
+/// A closed, bumpy sphere of `rings × segments` quads with smooth normals and texture
+/// coordinates, wound counter-clockwise seen from outside, in the unit box.
+pub fn blob(rings: usize, segments: usize) -> Mesh {
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    let mut uvs = Vec::new();
+    for r in 0..=rings {
+        let theta = std::f64::consts::PI * r as f64 / rings as f64;
+        for s in 0..=segments {
+            let phi = std::f64::consts::TAU * s as f64 / segments as f64;
+            let direction = DVec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            );
+            let radius = 0.8 + 0.15 * (3.0 * theta).sin() * (2.0 * phi).cos();
+            positions.push(direction * radius);
+            normals.push(direction);
+            uvs.push(DVec2::new(
+                s as f64 / segments as f64,
+                r as f64 / rings as f64,
+            ));
+        }
+    }
+    let index = |r: usize, s: usize| (r * (segments + 1) + s) as u32;
+    let mut triangles = Vec::new();
+    for r in 0..rings {
+        for s in 0..segments {
+            let (a, b, c, d) = (
+                index(r, s),
+                index(r + 1, s),
+                index(r + 1, s + 1),
+                index(r, s + 1),
+            );
+            if r > 0 {
+                triangles.push([a, d, c]);
+            }
+            if r + 1 < rings {
+                triangles.push([a, c, b]);
+            }
+        }
+    }
+    Mesh {
+        name: "blob".into(),
+        positions,
+        normals: Some(normals),
+        uvs: Some(uvs),
+        triangles,
+        material: 1,
+        instances: vec![],
+    }
 }

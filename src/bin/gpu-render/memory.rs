@@ -122,8 +122,10 @@ impl fmt::Display for Estimate {
 }
 
 /// Bytes of the scene the render holds: shapes, polygon vertices, image texels and
-/// mesh triangles (each instance in world space with its attributes, as the geometry
-/// holds them), in the model and (for the GPU) once more in upload form.
+/// mesh triangles (a mesh placed once in world space with its attributes, one placed
+/// more than once stored once plus a record per placement, as the geometry holds them;
+/// `gpu_render::accel::instance`), in the model and (for the GPU) once more in upload
+/// form.
 fn scene_bytes(scene: &Scene) -> u64 {
     use gpu_render::scene::Shape;
     let vertices: usize = scene
@@ -137,15 +139,23 @@ fn scene_bytes(scene: &Scene) -> u64 {
     let texels: usize = scene.images.iter().map(|image| image.texels.len()).sum();
     // A world-space mesh triangle: 3 f64 corners plus a material and attribute index
     // (80 B), its attributes (3 normals and 3 UVs, 128 B) and its BVH share (~40 B).
-    let mesh_triangles: usize = scene
-        .meshes
-        .iter()
-        .map(|m| m.triangles.len() * m.instances.len())
-        .sum();
+    let (mut mesh_triangles, mut instances) = (0, 0);
+    for group in gpu_render::accel::instance::mesh_groups(&scene.meshes) {
+        let placements: usize = group.iter().map(|&i| scene.meshes[i].instances.len()).sum();
+        let triangles = scene.meshes[group[0]].triangles.len();
+        if placements > 1 {
+            mesh_triangles += triangles;
+            instances += placements;
+        } else {
+            mesh_triangles += triangles * placements;
+        }
+    }
+    // An instance: its transforms, bounds and material (~250 B), and its records.
     let bytes = scene.shapes.len() * std::mem::size_of::<Shape>()
         + vertices * 24
         + texels * 16
-        + mesh_triangles * 248;
+        + mesh_triangles * 248
+        + instances * 400;
     2 * bytes as u64
 }
 

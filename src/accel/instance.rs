@@ -1,0 +1,349 @@
+//! Instancing: a mesh placed more than once is stored once, in its own space, with a
+//! bottom-level BVH of its own, and each placement is an [`Instance`]: an affine
+//! transform pair and a material, standing in the scene's BVH as one primitive of kind
+//! [`PrimKind::Instance`] bounded by its world box (a two-level BVH).
+//!
+//! Both tracers transform a ray that reaches an instance into the mesh's space
+//! (`world_to_object`, the direction not renormalised, so that the ray parameter `t`
+//! is the same in both spaces and hits of different instances compare directly), run
+//! the same watertight triangle test there, and transform the hit back: the hit record
+//! is made from the triangle moved to world space exactly as a flattened placement
+//! would store it (corners 1 and 2 swapped under a mirroring transform, normals through
+//! the inverse transpose), so an instanced mesh shades as the flattened one does.
+
+use glam::{DAffine3, DMat3, DMat4, DVec3};
+
+use super::bvh::{Aabb32, BuildMethod, Bvh};
+use super::geometry::{PrimKind, PrimRef, TriangleAttributes, TriangleShape};
+use crate::scene::Mesh;
+
+/// Which placement of which mesh a surface belongs to: `None` for the scene's own
+/// (flattened) primitives, `Some(i)` for entry `i` of [`super::SceneGeometry::instances`].
+pub type InstanceId = Option<u32>;
+
+/// A surface a ray can hit: a primitive and, for an instanced mesh's triangle (then an
+/// index into its [`InstancedMesh::triangles`]), the instance it was hit in.
+///
+/// It is also the tie-break key of both tracers: of two hits at exactly the same
+/// distance the smaller key wins, ordered by instance first (the scene's own
+/// primitives, `None`, after every instance), then by primitive.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct HitKey {
+    /// The primitive (for an instance: a [`PrimKind::Triangle`] of its mesh).
+    pub prim: PrimRef,
+    /// The instance, if any.
+    pub instance: InstanceId,
+}
+
+impl HitKey {
+    /// The key of one of the scene's own primitives.
+    pub fn world(prim: PrimRef) -> Self {
+        Self {
+            prim,
+            instance: None,
+        }
+    }
+
+    /// `(instance or u32::MAX, prim)`: the order both tracers compare.
+    fn order(&self) -> (u32, PrimRef) {
+        (self.instance.unwrap_or(u32::MAX), self.prim)
+    }
+}
+
+impl PartialOrd for HitKey {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for HitKey {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.order().cmp(&other.order())
+    }
+}
+
+/// A mesh stored once for all its placements: its triangles in its own space, their
+/// shading attributes, and the bottom-level BVH over them.
+#[derive(Debug, Clone)]
+pub struct InstancedMesh {
+    /// The scene mesh it came from (the first of identical ones), for messages.
+    pub name: String,
+    /// Triangles in the mesh's own space, in mesh order (those without area left out);
+    /// `material` is the first placement's (each instance has its own).
+    pub triangles: Vec<TriangleShape>,
+    /// Object-space shading attributes, indexed by [`TriangleShape::attributes`].
+    pub triangle_attributes: Vec<TriangleAttributes>,
+    /// The hierarchy over `triangles` ([`PrimKind::Triangle`] references into them).
+    pub bvh: Bvh,
+}
+
+/// One placement of an [`InstancedMesh`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Instance {
+    /// Index into [`super::SceneGeometry::instanced_meshes`].
+    pub mesh: u32,
+    /// Mesh-to-world transform (affine, invertible).
+    pub object_to_world: DAffine3,
+    /// Its inverse.
+    pub world_to_object: DAffine3,
+    /// The inverse transpose of the linear part: how normals go to world space.
+    pub normal_matrix: DMat3,
+    /// Whether the transform mirrors (negative determinant): the winding of its
+    /// triangles is reversed in world space, as a flattened placement stores it.
+    pub mirrored: bool,
+    /// Material index of every triangle of this placement.
+    pub material: u32,
+    /// The conservative world box: the mesh BVH's root box, transformed.
+    pub bounds: Aabb32,
+}
+
+impl Instance {
+    /// The instance of `mesh` under `transform` (finite and invertible, as validated
+    /// meshes' instances are) with `material`; `object_bounds` is the mesh BVH's root
+    /// box.
+    pub fn new(mesh: u32, transform: &DMat4, material: u32, object_bounds: Aabb32) -> Self {
+        let object_to_world = DAffine3::from_mat4(*transform);
+        let world_to_object = object_to_world.inverse();
+        let linear = object_to_world.matrix3;
+        let mut lo = DVec3::INFINITY;
+        let mut hi = DVec3::NEG_INFINITY;
+        for corner in 0..8 {
+            let pick = |axis: usize| {
+                let bit = (corner >> axis) & 1 == 1;
+                f64::from(if bit {
+                    object_bounds.max[axis]
+                } else {
+                    object_bounds.min[axis]
+                })
+            };
+            let p = object_to_world.transform_point3(DVec3::new(pick(0), pick(1), pick(2)));
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        Self {
+            mesh,
+            object_to_world,
+            world_to_object,
+            normal_matrix: linear.inverse().transpose(),
+            mirrored: linear.determinant() < 0.0,
+            material,
+            bounds: Aabb32::around(lo, hi),
+        }
+    }
+
+    /// The corner order of a triangle of this instance in world space: corners 1 and
+    /// 2 swapped when the transform mirrors, which keeps the winding normal facing out.
+    pub fn corner_order(&self) -> [usize; 3] {
+        if self.mirrored { [0, 2, 1] } else { [0, 1, 2] }
+    }
+
+    /// Triangle `index` of `mesh` moved to world space as a flattened placement stores
+    /// it (corner order of [`Instance::corner_order`], this instance's material), with
+    /// its world-space attributes (normals through the normal matrix, normalised; one
+    /// that vanishes becomes the triangle's facing).
+    pub fn world_triangle(
+        &self,
+        mesh: &InstancedMesh,
+        index: usize,
+    ) -> (TriangleShape, Option<TriangleAttributes>) {
+        let triangle = &mesh.triangles[index];
+        let order = self.corner_order();
+        let vertices = order.map(|k| self.object_to_world.transform_point3(triangle.vertices[k]));
+        let facing = (vertices[1] - vertices[0])
+            .cross(vertices[2] - vertices[0])
+            .normalize_or_zero();
+        let attributes = triangle.attributes.map(|a| {
+            let object = &mesh.triangle_attributes[a as usize];
+            TriangleAttributes {
+                normals: object
+                    .normals
+                    .map(|n| order.map(|k| (self.normal_matrix * n[k]).normalize_or(facing))),
+                uvs: object.uvs.map(|uv| order.map(|k| uv[k])),
+            }
+        });
+        (
+            TriangleShape {
+                vertices,
+                material: self.material,
+                attributes: triangle.attributes,
+            },
+            attributes,
+        )
+    }
+}
+
+impl InstancedMesh {
+    /// The mesh stored once: its triangles with area in object space (the others are
+    /// counted into `degenerate`), their attributes, and the BVH over them.
+    pub fn new(mesh: &Mesh, method: BuildMethod, degenerate: &mut usize) -> Self {
+        let mut stored = Self {
+            name: mesh.name.clone(),
+            triangles: Vec::with_capacity(mesh.triangles.len()),
+            triangle_attributes: Vec::new(),
+            bvh: Bvh::default(),
+        };
+        for corners in &mesh.triangles {
+            let order = corners.map(|i| i as usize);
+            let vertices = order.map(|i| mesh.positions[i]);
+            let area = (vertices[1] - vertices[0]).cross(vertices[2] - vertices[0]);
+            if !(area.length_squared() > 0.0 && area.is_finite()) {
+                *degenerate += 1;
+                continue;
+            }
+            let normals = mesh
+                .normals
+                .as_ref()
+                .map(|normals| order.map(|i| normals[i]));
+            let uvs = mesh.uvs.as_ref().map(|uvs| order.map(|i| uvs[i]));
+            let attributes = (normals.is_some() || uvs.is_some()).then(|| {
+                stored
+                    .triangle_attributes
+                    .push(TriangleAttributes { normals, uvs });
+                (stored.triangle_attributes.len() - 1) as u32
+            });
+            stored.triangles.push(TriangleShape {
+                vertices,
+                material: mesh.material,
+                attributes,
+            });
+        }
+        let bounds: Vec<(PrimRef, Aabb32)> = stored
+            .triangles
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let index = u32::try_from(i).unwrap_or(PrimRef::MAX_INDEX);
+                (
+                    PrimRef::new(PrimKind::Triangle, index),
+                    Aabb32::around_points(&t.vertices),
+                )
+            })
+            .collect();
+        stored.bvh = Bvh::build(&bounds, method);
+        stored
+    }
+}
+
+/// Whether two meshes have the same geometry and attributes (the same file's same
+/// mesh, placed twice): they may then share one [`InstancedMesh`].
+fn same_geometry(a: &Mesh, b: &Mesh) -> bool {
+    a.triangles == b.triangles
+        && a.positions == b.positions
+        && a.normals == b.normals
+        && a.uvs == b.uvs
+}
+
+/// The scene's meshes grouped by identical geometry ([`Mesh::positions`], normals,
+/// texture coordinates and triangles), in the order of their first members; each
+/// group lists indices into `meshes`. A cheap fingerprint (sizes, first and last
+/// vertex) decides which pairs are compared in full.
+pub fn mesh_groups(meshes: &[Mesh]) -> Vec<Vec<usize>> {
+    type Fingerprint = (usize, usize, bool, bool, Option<[u64; 6]>);
+    let fingerprint = |m: &Mesh| -> Fingerprint {
+        let bits = |v: DVec3| v.to_array().map(f64::to_bits);
+        let ends = m.positions.first().zip(m.positions.last()).map(|(f, l)| {
+            let (f, l) = (bits(*f), bits(*l));
+            [f[0], f[1], f[2], l[0], l[1], l[2]]
+        });
+        (
+            m.positions.len(),
+            m.triangles.len(),
+            m.normals.is_some(),
+            m.uvs.is_some(),
+            ends,
+        )
+    };
+    let mut groups: Vec<(Fingerprint, Vec<usize>)> = Vec::new();
+    for (i, mesh) in meshes.iter().enumerate() {
+        let print = fingerprint(mesh);
+        let found = groups
+            .iter_mut()
+            .find(|(p, members)| *p == print && same_geometry(&meshes[members[0]], mesh));
+        match found {
+            Some((_, members)) => members.push(i),
+            None => groups.push((print, vec![i])),
+        }
+    }
+    groups.into_iter().map(|(_, members)| members).collect()
+}
+
+/// Whether `meshes` place some geometry more than once, so that the geometry built
+/// from them has instances.
+pub fn has_instances(meshes: &[Mesh]) -> bool {
+    mesh_groups(meshes).iter().any(|group| {
+        group
+            .iter()
+            .map(|&i| meshes[i].instances.len())
+            .sum::<usize>()
+            > 1
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad(instances: Vec<DMat4>) -> Mesh {
+        Mesh {
+            name: "quad".into(),
+            positions: vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y],
+            normals: Some(vec![DVec3::Z; 4]),
+            uvs: None,
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+            material: 0,
+            instances,
+        }
+    }
+
+    #[test]
+    fn identical_meshes_group_and_count_placements() {
+        let a = quad(vec![DMat4::IDENTITY]);
+        let mut b = quad(vec![DMat4::from_translation(DVec3::X)]);
+        b.material = 3;
+        let mut c = quad(vec![DMat4::IDENTITY]);
+        c.positions[2].x = 2.0;
+        let meshes = [a.clone(), b, c];
+        assert_eq!(mesh_groups(&meshes), vec![vec![0, 1], vec![2]]);
+        assert!(has_instances(&meshes));
+        assert!(!has_instances(&meshes[2..]));
+        assert!(has_instances(&[quad(vec![DMat4::IDENTITY; 2])]));
+    }
+
+    #[test]
+    fn hit_keys_order_instances_before_the_scenes_own_primitives() {
+        let t = |i| PrimRef::new(PrimKind::Triangle, i);
+        let world = HitKey::world(t(0));
+        let first = HitKey {
+            prim: t(9),
+            instance: Some(0),
+        };
+        let second = HitKey {
+            prim: t(1),
+            instance: Some(1),
+        };
+        assert!(first < second && second < world);
+    }
+
+    #[test]
+    fn a_mirrored_instance_keeps_the_winding_normal_and_transforms_normals() {
+        let mut degenerate = 0;
+        let mesh = InstancedMesh::new(&quad(vec![]), BuildMethod::Sah, &mut degenerate);
+        assert_eq!(degenerate, 0);
+        let root = mesh.bvh.root_bounds().expect("two triangles");
+        let mirror = DMat4::from_scale(DVec3::new(-2.0, 1.0, 1.0));
+        let instance = Instance::new(0, &mirror, 5, root);
+        assert!(instance.mirrored);
+        let (triangle, attributes) = instance.world_triangle(&mesh, 0);
+        assert_eq!(triangle.material, 5);
+        let [a, b, c] = triangle.vertices;
+        assert_eq!(
+            [a, b, c],
+            [DVec3::ZERO, DVec3::new(-2.0, 1.0, 0.0), -2.0 * DVec3::X]
+        );
+        let normal = (b - a).cross(c - a).normalize();
+        assert!((normal - DVec3::Z).length() < 1e-15, "{normal}");
+        let normals = attributes.and_then(|a| a.normals).expect("normals");
+        assert!(normals.iter().all(|n| (*n - DVec3::Z).length() < 1e-15));
+        assert!(instance.bounds.min[0] <= -2.0 && instance.bounds.max[0] >= 0.0);
+    }
+}
