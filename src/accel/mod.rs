@@ -19,10 +19,12 @@
 //! - [`instance`]: meshes placed more than once, stored once with a BVH of their own
 //!   and entered through their placements' transforms (a two-level BVH).
 
+pub mod area_lights;
 pub mod bvh;
 pub mod geometry;
 pub mod instance;
 
+pub use area_lights::{AreaLights, EmitterEntry, EmitterEntryShape, luminance};
 pub use bvh::{BuildMethod, Bvh, BvhNode, BvhStats, MAX_BVH_DEPTH, MAX_LEAF_PRIMITIVES};
 pub use geometry::{
     MAX_PLANES, MAX_POLYGON_VERTICES, PlaneShape, PolygonShape, PrimKind, PrimRef, SceneGeometry,

@@ -32,8 +32,9 @@ use super::trace::{
     PreparedScene, direct_light, finite_radiance, keep_on_side, shading_frame_normal,
 };
 use super::traverse::intersect_scene;
-use crate::accel::{HitKey, PrimKind, PrimRef, SceneGeometry};
-use crate::scene::{Material, MaterialKind, MediumStack, MicrofacetDistribution, project_to_plane};
+use crate::accel::area_lights::{Emitter, EmitterShape};
+use crate::accel::{AreaLights, PrimKind, luminance};
+use crate::scene::{Material, MaterialKind, MediumStack, MicrofacetDistribution};
 
 /// Bounces after which Russian roulette may end a path.
 pub const ROULETTE_DEPTH: u32 = 3;
@@ -47,272 +48,25 @@ pub const MIN_SURVIVAL: f64 = 0.05;
 /// Dimensions 0 and 1 of a pixel's sample are its position in the pixel.
 const DIMENSIONS_PER_BOUNCE: u32 = 8;
 
-/// Relative luminance of a linear Rec. 709 colour (ITU-R BT.709 weights).
-pub fn luminance(c: DVec3) -> f64 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
-}
-
-/// An emissive shape that next-event estimation samples.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum EmitterShape {
-    /// A sphere, sampled by the cone of directions it subtends.
-    Sphere { center: DVec3, radius: f64 },
-    /// A triangle (of a triangle, a mesh or a polygon), sampled uniformly by area; it
-    /// emits on the side its unit `normal` points to.
-    Triangle { vertices: [DVec3; 3], normal: DVec3 },
-}
-
-/// One emitter: its shape, the surface a ray hits on it (an instanced mesh's triangle
-/// with its instance), and its radiance.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Emitter {
-    shape: EmitterShape,
-    key: HitKey,
-    radiance: DVec3,
-}
-
-/// The emissive spheres, polygons and triangles of a scene and the distribution by
-/// which next-event estimation picks one: in proportion to luminance times area (its
-/// power, up to π), so that every point of the flat emitters has the same density per
-/// unit area. Infinite planes are never sampled: their emission is found by BRDF
-/// sampling alone.
-#[derive(Debug, Clone, Default)]
-pub struct AreaLights {
-    emitters: Vec<Emitter>,
-    /// The first emitter of each surface.
-    first_of: std::collections::HashMap<HitKey, usize>,
-    /// Cumulative selection weights.
-    cdf: Vec<f64>,
-    total: f64,
-}
-
-impl AreaLights {
-    /// The emitters of `geometry` with `materials` (in the lighting space).
-    pub fn new(geometry: &SceneGeometry, materials: &[Material]) -> Self {
-        let mut lights = Self::default();
-        let emission = |material: u32| materials[material as usize].emission;
-        for (i, s) in geometry.spheres.iter().enumerate() {
-            let radiance = emission(s.material);
-            if radiance.max_element() > 0.0 {
-                let area = 4.0 * std::f64::consts::PI * s.radius * s.radius;
-                lights.push(
-                    Emitter {
-                        shape: EmitterShape::Sphere {
-                            center: s.center,
-                            radius: s.radius,
-                        },
-                        key: HitKey::world(PrimRef::new(PrimKind::Sphere, i as u32)),
-                        radiance,
-                    },
-                    area,
-                );
-            }
+/// The density per steradian with which next-event estimation from `point` samples
+/// the direction towards `hit` on an emitter of `lights` (0 if `hit` is on none).
+fn emitter_pdf(lights: &AreaLights, point: DVec3, hit: &Hit) -> f64 {
+    // Every flat emitter piece of a primitive has the density luminance / total per
+    // unit area; a sphere has its cone density times its selection probability.
+    let Some((emitter, selection)) = lights.first_piece(&hit.key()) else {
+        return 0.0;
+    };
+    match emitter.shape {
+        EmitterShape::Sphere { center, radius } => {
+            let w = (hit.position - point).normalize_or_zero();
+            selection * pdf_sphere_cone(point, center, radius, w)
         }
-        for (i, p) in geometry.polygons.iter().enumerate() {
-            let radiance = emission(p.material);
-            if radiance.max_element() <= 0.0 || p.plane.normal == DVec3::ZERO {
-                continue;
-            }
-            let prim = HitKey::world(PrimRef::new(PrimKind::Polygon, i as u32));
-            for vertices in polygon_triangles(&p.vertices, p.plane.dropped_axis) {
-                lights.push_triangle(vertices, p.plane.normal, prim, radiance);
-            }
-        }
-        for (i, t) in geometry.triangles.iter().enumerate() {
-            let radiance = emission(t.material);
-            if radiance.max_element() <= 0.0 {
-                continue;
-            }
-            let [a, b, c] = t.vertices;
-            let normal = (b - a).cross(c - a).normalize_or_zero();
-            if normal != DVec3::ZERO {
-                let prim = HitKey::world(PrimRef::new(PrimKind::Triangle, i as u32));
-                lights.push_triangle(t.vertices, normal, prim, radiance);
-            }
-        }
-        // Emissive instanced meshes: each instance's triangles moved to world space for
-        // sampling (the BVH keeps the mesh once; the emitter list has every copy).
-        for (i, instance) in geometry.instances.iter().enumerate() {
-            let radiance = emission(instance.material);
-            if radiance.max_element() <= 0.0 {
-                continue;
-            }
-            let mesh = &geometry.instanced_meshes[instance.mesh as usize];
-            for j in 0..mesh.triangles.len() {
-                let (t, _) = instance.world_triangle(mesh, j);
-                let [a, b, c] = t.vertices;
-                let normal = (b - a).cross(c - a).normalize_or_zero();
-                if normal != DVec3::ZERO {
-                    let key = HitKey {
-                        prim: PrimRef::new(PrimKind::Triangle, j as u32),
-                        instance: Some(i as u32),
-                    };
-                    lights.push_triangle(t.vertices, normal, key, radiance);
-                }
-            }
-        }
-        lights
-    }
-
-    fn push_triangle(&mut self, vertices: [DVec3; 3], normal: DVec3, key: HitKey, radiance: DVec3) {
-        let [a, b, c] = vertices;
-        let area = 0.5 * (b - a).cross(c - a).length();
-        if area > 0.0 {
-            self.push(
-                Emitter {
-                    shape: EmitterShape::Triangle { vertices, normal },
-                    key,
-                    radiance,
-                },
-                area,
-            );
+        EmitterShape::Triangle { vertices, normal } => {
+            let [a, b, c] = vertices;
+            let area = 0.5 * (b - a).cross(c - a).length();
+            area_to_solid_angle_pdf(selection / area, point, hit.position, normal)
         }
     }
-
-    fn push(&mut self, emitter: Emitter, area: f64) {
-        let weight = luminance(emitter.radiance).max(1e-12 * emitter.radiance.max_element()) * area;
-        if !(weight > 0.0 && weight.is_finite()) {
-            return;
-        }
-        self.total += weight;
-        self.cdf.push(self.total);
-        self.first_of
-            .entry(emitter.key)
-            .or_insert(self.emitters.len());
-        self.emitters.push(emitter);
-    }
-
-    /// Whether the scene has any emitter to sample.
-    pub fn is_empty(&self) -> bool {
-        self.emitters.is_empty()
-    }
-
-    /// The emitters in selection order, each with its cumulative and own selection
-    /// probabilities (for the GPU twin's upload, `crate::gpu::area_lights`).
-    pub fn entries(&self) -> Vec<EmitterEntry> {
-        self.emitters
-            .iter()
-            .enumerate()
-            .map(|(index, emitter)| {
-                let below = if index == 0 { 0.0 } else { self.cdf[index - 1] };
-                let (shape, area) = match emitter.shape {
-                    EmitterShape::Sphere { center, radius } => (
-                        EmitterEntryShape::Sphere { center, radius },
-                        4.0 * std::f64::consts::PI * radius * radius,
-                    ),
-                    EmitterShape::Triangle { vertices, normal } => {
-                        let [a, b, c] = vertices;
-                        (
-                            EmitterEntryShape::Triangle { vertices, normal },
-                            0.5 * (b - a).cross(c - a).length(),
-                        )
-                    }
-                };
-                EmitterEntry {
-                    shape,
-                    // Scene geometry flattens emissive meshes, so an entry's surface
-                    // is one of the scene's own (`SceneGeometry::with_method`).
-                    prim: emitter.key.prim,
-                    radiance: emitter.radiance,
-                    cdf: self.cdf[index] / self.total,
-                    selection: (self.cdf[index] - below) / self.total,
-                    area,
-                }
-            })
-            .collect()
-    }
-
-    /// The emitter chosen by `u ∈ [0, 1)` and its selection probability.
-    fn choose(&self, u: f64) -> Option<(&Emitter, f64)> {
-        let target = u * self.total;
-        let index = self
-            .cdf
-            .partition_point(|&c| c <= target)
-            .min(self.emitters.len().checked_sub(1)?);
-        let below = if index == 0 { 0.0 } else { self.cdf[index - 1] };
-        Some((
-            &self.emitters[index],
-            (self.cdf[index] - below) / self.total,
-        ))
-    }
-
-    /// The density per steradian with which next-event estimation from `point` samples
-    /// the direction towards `hit` on an emitter (0 if `hit` is on no sampled emitter).
-    fn pdf(&self, point: DVec3, hit: &Hit) -> f64 {
-        // Every flat emitter piece of a primitive has the density luminance / total per
-        // unit area; a sphere has its cone density times its selection probability.
-        let Some(&index) = self.first_of.get(&hit.key()) else {
-            return 0.0;
-        };
-        let below = if index == 0 { 0.0 } else { self.cdf[index - 1] };
-        let selection = (self.cdf[index] - below) / self.total;
-        match self.emitters[index].shape {
-            EmitterShape::Sphere { center, radius } => {
-                let w = (hit.position - point).normalize_or_zero();
-                selection * pdf_sphere_cone(point, center, radius, w)
-            }
-            EmitterShape::Triangle { vertices, normal } => {
-                let [a, b, c] = vertices;
-                let area = 0.5 * (b - a).cross(c - a).length();
-                area_to_solid_angle_pdf(selection / area, point, hit.position, normal)
-            }
-        }
-    }
-}
-
-/// The shape of an [`EmitterEntry`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum EmitterEntryShape {
-    /// A sphere, sampled by the cone of directions it subtends.
-    Sphere {
-        /// Its centre.
-        center: DVec3,
-        /// Its radius.
-        radius: f64,
-    },
-    /// A triangle, sampled uniformly by area, emitting on the side of `normal`.
-    Triangle {
-        /// Its vertices.
-        vertices: [DVec3; 3],
-        /// The unit normal of its emitting side.
-        normal: DVec3,
-    },
-}
-
-/// One emitter of [`AreaLights`] as the GPU twin uploads it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct EmitterEntry {
-    /// Its shape.
-    pub shape: EmitterEntryShape,
-    /// The primitive a ray hits on it.
-    pub prim: PrimRef,
-    /// Its radiance.
-    pub radiance: DVec3,
-    /// The selection probability of it and every emitter before it.
-    pub cdf: f64,
-    /// Its selection probability.
-    pub selection: f64,
-    /// Its area.
-    pub area: f64,
-}
-
-/// The triangles of a polygon of at most `MAX_POLYGON_VERTICES` vertices (earcut in
-/// the projection dropping `dropped_axis`), for sampling it by area.
-fn polygon_triangles(vertices: &[DVec3], dropped_axis: u32) -> Vec<[DVec3; 3]> {
-    let projected: Vec<[f64; 2]> = vertices
-        .iter()
-        .map(|v| {
-            let (u, w) = project_to_plane(*v, dropped_axis);
-            [u, w]
-        })
-        .collect();
-    let mut indices: Vec<u32> = Vec::new();
-    earcut::Earcut::new().earcut(projected.iter().copied(), &[] as &[u32], &mut indices);
-    indices
-        .chunks_exact(3)
-        .map(|c| c.iter().map(|&i| vertices[i as usize]).collect::<Vec<_>>())
-        .map(|t| [t[0], t[1], t[2]])
-        .collect()
 }
 
 /// Whether emission of the shape hit is seen from the side the ray arrives on: flat
@@ -425,7 +179,9 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
         // found it.
         if material.emission.max_element() > 0.0 && emits_towards(&hit, ray.direction) {
             let weight = match brdf_pdf {
-                Some(pdf) => power_heuristic(pdf, scene.area_lights.pdf(previous_point, &hit)),
+                Some(pdf) => {
+                    power_heuristic(pdf, emitter_pdf(&scene.area_lights, previous_point, &hit))
+                }
                 None => 1.0,
             };
             add(&mut radiance, throughput * material.emission * weight);

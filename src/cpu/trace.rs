@@ -6,9 +6,10 @@ use glam::DVec3;
 
 use super::bxdf::{eval_brdf, has_base_brdf, reflect_direction, surface_response};
 use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
-use super::path::{AreaLights, path_radiance};
+use super::path::path_radiance;
 use super::texture::shading_albedo;
 use super::traverse::{intersect_scene, occluded};
+use crate::accel::AreaLights;
 use crate::accel::SceneGeometry;
 use crate::camera::{CameraFrame, SamplePattern};
 pub use crate::scene::MediumStack;

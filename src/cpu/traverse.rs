@@ -245,7 +245,7 @@ pub fn closest_hit_counted(
 }
 
 /// The nearest hit along `ray` in (0, `t_max`), its point re-projected onto the
-/// primitive ([`hit_record`]).
+/// primitive ([`super::intersect::hit_record_keyed`]).
 pub fn intersect_scene(geometry: &SceneGeometry, ray: &Ray, t_max: f64) -> Option<Hit> {
     let mut counts = TraversalCounts::default();
     closest_hit_counted(geometry, ray, t_max, &mut counts)

@@ -1,4 +1,4 @@
-//! The path integrator's emitters on the device: the CPU reference's [`AreaLights`]
+//! The path integrator's emitters on the device: the shared [`AreaLights`]
 //! distribution (emitters chosen by power, spheres sampled by cone, triangles by area)
 //! as a storage buffer of [`GpuEmitter`] records that `shaders/path.wgsl` samples, and
 //! the constants it shares with `shaders/path_types.wgsl` (checked by
@@ -7,7 +7,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::accel::SceneGeometry;
-use crate::cpu::path::{AreaLights, EmitterEntry, EmitterEntryShape};
+use crate::accel::{AreaLights, EmitterEntry, EmitterEntryShape};
 use crate::scene::Material;
 
 /// `FrameUniforms.flags`: trace with the path integrator (`FLAG_PATH` in WGSL).
