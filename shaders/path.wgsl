@@ -572,8 +572,7 @@ fn path_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) 
         return;
     }
     let hit = hit_record_in(trace.best_prim, trace.best_instance, ray, trace.best_t);
-    var material = materials[hit.material];
-    material.diffuse = shading_albedo(material, hit.position, hit.normal, hit.uv);
+    let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv);
     // Emission, weighted against next-event estimation where that could have found it;
     // shadow_origin still holds the previous hit's, where that estimation sampled from.
     if max_component(material.emission) > 0.0 && emits_towards(hit, ray.direction) {
@@ -620,6 +619,8 @@ fn path_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) 
         // The lighting state of the hit; `direct` holds the event's weight.
         (*path).direct = event_weight;
         (*path).albedo = material.diffuse;
+        (*path).roughness = material.roughness;
+        (*path).metallic = material.metallic;
         (*path).material = hit.material;
         (*path).normal = n;
         (*path).shadow_origin = offset_ray_origin(lifted, ng, frame.offset_scale);
@@ -673,6 +674,8 @@ fn path_consume_shadow_ray(path: ptr<function, PathState>, trace: TraceRay) {
         let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal);
         var material = materials[(*path).material];
         material.diffuse = (*path).albedo;
+        material.roughness = (*path).roughness;
+        material.metallic = (*path).metallic;
         let lit = eval_brdf(material, (*path).normal, sample.wi, -(*path).direction)
             * sample.irradiance * sample.cos_i;
         add_contribution(path, (*path).direct * lit);
@@ -706,6 +709,8 @@ fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
     if sample.found && trace.best_prim == emitter.prim {
         var material = materials[(*path).material];
         material.diffuse = (*path).albedo;
+        material.roughness = (*path).roughness;
+        material.metallic = (*path).metallic;
         let n = (*path).normal;
         let wo = -(*path).direction;
         let f = eval_brdf(material, n, sample.wi, wo);

@@ -98,6 +98,28 @@ fn sample_brdf_map(layer: u32, size: u32, theta_i: f32, theta_r: f32) -> vec3<f3
 }
 //#endif
 
+// The material at a hit: its albedo from shading_albedo, and its metalness and
+// perceptual roughness times the blue and green channels of the metallic/roughness
+// texture where there is one (glTF 2.0 §3.9.2), looked up at the albedo texture's
+// coordinates. Twin of shading_material (src/cpu/texture.rs).
+fn shading_material(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> Material {
+    var shaded = material;
+    shaded.diffuse = shading_albedo(material, position, normal, uv);
+    //#if TEXTURES
+    if material.metallic_roughness_layer != NO_IMAGE {
+        let st = texture_coordinates(material, position, normal, uv);
+        let wrap = vec2<u32>(material.metallic_roughness_wrap & 0xffu,
+                             (material.metallic_roughness_wrap >> 8u) & 0xffu);
+        let texel = sample_texture(material.metallic_roughness_layer,
+                                   material.metallic_roughness_width,
+                                   material.metallic_roughness_height, st, wrap);
+        shaded.metallic = material.metallic * texel.z;
+        shaded.roughness = material.roughness * texel.y;
+    }
+    //#endif
+    return shaded;
+}
+
 // The albedo at a hit at `position` with geometric normal `normal` and mesh texture
 // coordinates `uv`: material.diffuse, times the albedo texture where there is one.
 fn shading_albedo(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> vec3<f32> {

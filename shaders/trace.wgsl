@@ -231,8 +231,7 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
         return;
     }
     let hit = hit_record_in(trace.best_prim, trace.best_instance, ray, trace.best_t);
-    var material = materials[hit.material];
-    material.diffuse = shading_albedo(material, hit.position, hit.normal, hit.uv);
+    let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv);
     let entering = dot(ray.direction, hit.normal) < 0.0;
     // Shading happens on the side the ray came from.
     let ng = select(-hit.normal, hit.normal, entering);
@@ -276,6 +275,8 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
     if has_base_brdf(material.kind) && response.base > 0.0 {
         (*path).direct = material.diffuse * frame.ambient;
         (*path).albedo = material.diffuse;
+        (*path).roughness = material.roughness;
+        (*path).metallic = material.metallic;
         (*path).material = hit.material;
         (*path).normal = n;
         (*path).base = response.base;
@@ -301,6 +302,8 @@ fn consume_shadow_ray(path: ptr<function, PathState>, trace: TraceRay) {
         let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal);
         var material = materials[(*path).material];
         material.diffuse = (*path).albedo;
+        material.roughness = (*path).roughness;
+        material.metallic = (*path).metallic;
         (*path).direct += eval_brdf(material, (*path).normal, sample.wi, -(*path).direction)
             * sample.irradiance * sample.cos_i;
     }

@@ -146,6 +146,12 @@ struct Material {
     // alignment would move them.
     texture_wrap_u: u32,
     texture_wrap_v: u32,
+    // The metallic/roughness texture (green: roughness, blue: metallic), or NO_IMAGE;
+    // its wrap modes as u in bits 0-7 and v in bits 8-15.
+    metallic_roughness_layer: u32,
+    metallic_roughness_width: u32,
+    metallic_roughness_height: u32,
+    metallic_roughness_wrap: u32,
 }
 
 const LIGHT_POINT: u32 = 0u;
@@ -245,9 +251,11 @@ struct PathState {
     shadow_origin: vec3<f32>,
     base: f32,
     normal: vec3<f32>,
-    _pad0: u32,
+    // The hit's roughness, albedo and metalness with its textures applied (the shadow
+    // rays' BRDF evaluations read the rest of the material from its record).
+    roughness: f32,
     albedo: vec3<f32>,
-    _pad1: u32,
+    metallic: f32,
     direct: vec3<f32>,
     // Path integrator: the density of the BRDF sample that made the current ray, or
     // NO_BRDF_PDF (shaders/path.wgsl).

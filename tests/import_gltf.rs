@@ -465,6 +465,43 @@ fn materials_map_with_their_textures_and_wrap_modes() {
     let default = model.materials[model.meshes[2].material as usize].material;
     assert_eq!(default.kind, MaterialKind::Pbr);
     assert_eq!((default.diffuse, default.metallic), (DVec3::ONE, 0.0));
+
+    // Placed in a scene, the base colour and metallic/roughness textures travel with
+    // the material (each image once); only the emissive one is left, with a warning.
+    let mut scene = gpu_render::scene::Scene {
+        render: Default::default(),
+        camera: gpu_render::scene::Camera {
+            eye: DVec3::Z,
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y_degrees: 40.0,
+        },
+        environment: Default::default(),
+        materials: vec![],
+        material_names: vec![],
+        lights: vec![],
+        shapes: vec![],
+        meshes: vec![],
+        images: vec![],
+    };
+    let warnings = model.add_to_scene(
+        &mut scene,
+        &gpu_render::scene::import::ModelPlacement::IDENTITY,
+    );
+    let placed = scene.materials[model.meshes[0].material as usize];
+    let mr = placed
+        .metallic_roughness_texture
+        .expect("the metallic/roughness texture is placed");
+    let texel = scene.images[mr as usize].texel(0, 0);
+    assert!((texel[1] - 128.0 / 255.0).abs() < 1e-6, "{texel:?}");
+    assert_eq!(
+        placed.metallic_roughness_wrap,
+        [gpu_render::scene::TextureWrap::Repeat; 2]
+    );
+    assert!(placed.albedo_texture.is_some_and(|a| a != mr));
+    assert_eq!(scene.images.len(), 2, "the emissive image stays behind");
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(warnings[0].contains("emissive texture"), "{warnings:?}");
 }
 
 #[test]

@@ -139,6 +139,10 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 brdf_map_size,
                 texture_wrap_u,
                 texture_wrap_v,
+                metallic_roughness_layer,
+                metallic_roughness_width,
+                metallic_roughness_height,
+                metallic_roughness_wrap,
             }),
         ),
         (
@@ -205,9 +209,9 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 shadow_origin,
                 base,
                 normal,
-                _pad0,
+                roughness,
                 albedo,
-                _pad1,
+                metallic,
                 direct,
                 brdf_pdf
             }),

@@ -2,7 +2,8 @@
 //! UVs run from -1.25 to 2.25 (so every mode repeats, mirrors or clamps the image
 //! several times across them), one per mode and a fourth mixing modes per axis,
 //! rendered on the GPU and on the CPU reference and compared per pixel; and the CPU's
-//! `wrap_index` against each mode's definition (glTF 2.0 §5.26, OpenGL's wrap rules).
+//! `wrap_index` against each mode's definition (glTF 2.0 §5.26, OpenGL's wrap rules);
+//! and metallic/roughness textures (glTF 2.0 §3.9.2) the same way.
 
 mod common;
 
@@ -134,6 +135,98 @@ fn uv_textures_wrap_alike_on_both_backends() {
         .render(&gpu.device, &gpu.queue, &scene, None)
         .unwrap_or_else(|e| panic!("GPU render failed: {e}"));
     assert_images_match("uv-wrap", &cpu.image, &gpu_image.image, TOLERANCE);
+}
+
+/// The UV scene with metal/roughness materials whose roughness and metalness come from
+/// the texture's green and blue channels (glTF's `metallicRoughnessTexture`), under a
+/// point light that makes the highlights depend on the roughness.
+fn metallic_roughness_scene(texture: Option<u32>) -> Scene {
+    let mut scene = scene();
+    for material in &mut scene.materials {
+        let wrap = material.texture_wrap;
+        *material = Material {
+            kind: gpu_render::scene::MaterialKind::Pbr,
+            diffuse: DVec3::new(0.8, 0.6, 0.4),
+            metallic: 1.0,
+            roughness: 1.0,
+            texture_mapping: TextureMapping::Uv,
+            metallic_roughness_texture: texture,
+            metallic_roughness_wrap: wrap,
+            ..Material::blank(gpu_render::scene::MaterialKind::Pbr)
+        };
+    }
+    scene.lights.push(Light::Point {
+        position: DVec3::new(0.5, 1.0, 3.0),
+        intensity: DVec3::splat(20.0),
+    });
+    scene
+}
+
+#[test]
+fn metallic_roughness_textures_shade_alike_on_both_backends() {
+    let scene = metallic_roughness_scene(Some(0));
+    let cpu = gpu_render::cpu::render(&scene, None);
+    let untextured = gpu_render::cpu::render(&metallic_roughness_scene(None), None);
+    let changed = cpu
+        .image
+        .pixels
+        .iter()
+        .zip(&untextured.image.pixels)
+        .filter(|(a, b)| (0..3).any(|c| (a[c] - b[c]).abs() > 1e-3))
+        .count();
+    assert!(
+        changed * 4 > cpu.image.pixels.len(),
+        "the texture changes only {changed} pixels"
+    );
+
+    // Green scales the roughness and blue the metalness: a constant texel of
+    // (_, 0.5, 0.25) is the untextured material with those factors.
+    let mut constant = metallic_roughness_scene(Some(0));
+    constant.images[0].texels = vec![[0.9, 0.5, 0.25, 1.0]; 12];
+    let mut factors = metallic_roughness_scene(None);
+    for material in &mut factors.materials {
+        material.roughness = 0.5;
+        material.metallic = 0.25;
+    }
+    let a = gpu_render::cpu::render(&constant, None);
+    let b = gpu_render::cpu::render(&factors, None);
+    for (p, q) in a.image.pixels.iter().zip(&b.image.pixels) {
+        for c in 0..3 {
+            assert!(
+                (p[c] - q[c]).abs() <= 1e-6 * q[c].abs().max(1.0),
+                "{p:?} vs {q:?}"
+            );
+        }
+    }
+
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let renderer = common::gpu::renderer(&gpu);
+    let gpu_image = renderer
+        .render(&gpu.device, &gpu.queue, &scene, None)
+        .unwrap_or_else(|e| panic!("GPU render failed: {e}"));
+    assert_images_match(
+        "metallic-roughness",
+        &cpu.image,
+        &gpu_image.image,
+        TOLERANCE,
+    );
+
+    // The path integrator's twin reads the textured material at its shadow rays too.
+    let mut path = metallic_roughness_scene(Some(0));
+    path.render.integrator = gpu_render::scene::Integrator::Path;
+    path.render.max_depth = 3;
+    let cpu_path = gpu_render::cpu::render(&path, None);
+    let gpu_path = renderer
+        .render(&gpu.device, &gpu.queue, &path, None)
+        .unwrap_or_else(|e| panic!("GPU path render failed: {e}"));
+    assert_images_match(
+        "metallic-roughness-path",
+        &cpu_path.image,
+        &gpu_path.image,
+        TOLERANCE,
+    );
 }
 
 #[test]

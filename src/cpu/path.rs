@@ -27,7 +27,7 @@ use super::sample::{
     sample_cosine_hemisphere, sample_ggx_visible_normal, sample_sphere_cone,
     sample_triangle_barycentrics,
 };
-use super::texture::shading_albedo;
+use super::texture::shading_material;
 use super::trace::{
     PreparedScene, direct_light, finite_radiance, keep_on_side, shading_frame_normal,
 };
@@ -172,9 +172,13 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
             add(&mut radiance, throughput * scene.background);
             break;
         };
-        let mut material = scene.materials[hit.material as usize];
-        material.diffuse =
-            shading_albedo(&material, &scene.images, hit.position, hit.normal, hit.uv);
+        let material = shading_material(
+            &scene.materials[hit.material as usize],
+            &scene.images,
+            hit.position,
+            hit.normal,
+            hit.uv,
+        );
         // Emission, weighted against next-event estimation where that could have
         // found it.
         if material.emission.max_element() > 0.0 && emits_towards(&hit, ray.direction) {

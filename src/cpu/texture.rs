@@ -119,6 +119,45 @@ fn bilinear(image: &Image, xs: [u32; 2], ys: [u32; 2], fx: f64, fy: f64) -> DVec
     top * (1.0 - fy) + bottom * fy
 }
 
+/// The metalness and perceptual roughness at a hit at `position` with geometric normal
+/// `normal` and mesh texture coordinates `uv`: `material.metallic` and
+/// `material.roughness`, times the blue and green channels of the metallic/roughness
+/// texture where there is one (glTF 2.0 §3.9.2), at the albedo texture's coordinates.
+pub fn shading_metallic_roughness(
+    material: &Material,
+    images: &[Image],
+    position: DVec3,
+    normal: DVec3,
+    uv: DVec2,
+) -> (f64, f64) {
+    match material.metallic_roughness_texture {
+        Some(index) => {
+            let (u, v) = texture_coordinates(material, position, normal, uv);
+            let image = &images[index as usize];
+            let texel = sample_texture(image, u, v, material.metallic_roughness_wrap);
+            (material.metallic * texel.z, material.roughness * texel.y)
+        }
+        None => (material.metallic, material.roughness),
+    }
+}
+
+/// The material at a hit: [`shading_albedo`] as its albedo, and
+/// [`shading_metallic_roughness`] as its metalness and roughness. Twin of
+/// `shading_material` in `shaders/texture.wgsl`.
+pub fn shading_material(
+    material: &Material,
+    images: &[Image],
+    position: DVec3,
+    normal: DVec3,
+    uv: DVec2,
+) -> Material {
+    let mut shaded = *material;
+    shaded.diffuse = shading_albedo(material, images, position, normal, uv);
+    (shaded.metallic, shaded.roughness) =
+        shading_metallic_roughness(material, images, position, normal, uv);
+    shaded
+}
+
 /// The albedo at a hit at `position` with geometric normal `normal` and mesh texture
 /// coordinates `uv`: `material.diffuse`, times the albedo texture where there is one.
 pub fn shading_albedo(

@@ -7,7 +7,7 @@ use glam::DVec3;
 use super::bxdf::{eval_brdf, has_base_brdf, reflect_direction, surface_response};
 use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
 use super::path::path_radiance;
-use super::texture::shading_albedo;
+use super::texture::shading_material;
 use super::traverse::{intersect_scene, occluded};
 use crate::accel::AreaLights;
 use crate::accel::SceneGeometry;
@@ -277,8 +277,13 @@ pub fn keep_on_side(d: DVec3, side: DVec3) -> DVec3 {
 /// direction and refraction use [`shading_frame_normal`].
 pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumStack) -> ShadedHit {
     let position = hit.position;
-    let mut material = scene.materials[hit.material as usize];
-    material.diffuse = shading_albedo(&material, &scene.images, position, hit.normal, hit.uv);
+    let material = shading_material(
+        &scene.materials[hit.material as usize],
+        &scene.images,
+        position,
+        hit.normal,
+        hit.uv,
+    );
     let material = &material;
     let entering = ray.direction.dot(hit.normal) < 0.0;
     // Shading happens on the side the ray came from.

@@ -172,12 +172,12 @@ pub struct GpuPathState {
     pub base: f32,
     /// Shading normal (facing the incoming ray).
     pub normal: [f32; 3],
-    /// Padding.
-    pub _pad0: u32,
+    /// Perceptual roughness at the hit (metallic/roughness texture applied).
+    pub roughness: f32,
     /// Albedo at the hit (texture applied).
     pub albedo: [f32; 3],
-    /// Padding.
-    pub _pad1: u32,
+    /// Metalness at the hit (metallic/roughness texture applied).
+    pub metallic: f32,
     /// Direct light gathered so far (ambient included); with the path integrator,
     /// the weight of the hit's base-BRDF event.
     pub direct: [f32; 3],
@@ -358,6 +358,14 @@ pub struct GpuMaterial {
     pub texture_wrap_u: u32,
     /// How the albedo texture wraps along `v`: one of the `WRAP_*` constants.
     pub texture_wrap_v: u32,
+    /// Layer of the metallic/roughness texture in the image array, or [`NO_IMAGE`].
+    pub metallic_roughness_layer: u32,
+    /// Width of the metallic/roughness texture in texels.
+    pub metallic_roughness_width: u32,
+    /// Height of the metallic/roughness texture in texels.
+    pub metallic_roughness_height: u32,
+    /// Its wrap modes: the `WRAP_*` code along `u` in bits 0-7, along `v` in bits 8-15.
+    pub metallic_roughness_wrap: u32,
 }
 
 /// The shading attributes of one mesh triangle (`TriangleAttributes` in WGSL): vertex

@@ -287,6 +287,8 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
         };
     let (texture_layer, texture_width, texture_height) = image(material.albedo_texture);
     let (brdf_map_layer, brdf_map_size, _) = image(material.brdf_map);
+    let (metallic_roughness_layer, metallic_roughness_width, metallic_roughness_height) =
+        image(material.metallic_roughness_texture);
     GpuMaterial {
         diffuse: vec3(material.diffuse),
         shininess: material.shininess as f32,
@@ -324,6 +326,11 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
         brdf_map_size,
         texture_wrap_u: wrap_code(material.texture_wrap[0]),
         texture_wrap_v: wrap_code(material.texture_wrap[1]),
+        metallic_roughness_layer,
+        metallic_roughness_width,
+        metallic_roughness_height,
+        metallic_roughness_wrap: wrap_code(material.metallic_roughness_wrap[0])
+            | wrap_code(material.metallic_roughness_wrap[1]) << 8,
     }
 }
 

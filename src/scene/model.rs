@@ -298,6 +298,13 @@ pub struct Material {
     pub texture_wrap: [TextureWrap; 2],
     /// Index into [`Scene::images`] of the tabulated BRDF (Tabulated).
     pub brdf_map: Option<u32>,
+    /// Index into [`Scene::images`] of a texture of linear data whose green channel
+    /// multiplies `roughness` and blue channel `metallic` (glTF 2.0's
+    /// `metallicRoughnessTexture`, §3.9.2), looked up with the albedo texture's
+    /// coordinates (`texture_mapping`), if any (PBR).
+    pub metallic_roughness_texture: Option<u32>,
+    /// Wrap modes of the metallic/roughness texture along `u` and `v`.
+    pub metallic_roughness_wrap: [TextureWrap; 2],
 }
 
 impl Material {
@@ -327,6 +334,8 @@ impl Material {
             texture_scale: 1.0,
             texture_wrap: [TextureWrap::Repeat; 2],
             brdf_map: None,
+            metallic_roughness_texture: None,
+            metallic_roughness_wrap: [TextureWrap::Repeat; 2],
         }
     }
 

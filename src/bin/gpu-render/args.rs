@@ -267,6 +267,7 @@ pub struct ViewArgs {
     pub quiet: bool,
 }
 
+#[cfg(feature = "viewer")]
 /// `--scale`: a fraction in (0, 1].
 fn parse_view_scale(text: &str) -> Result<f64, String> {
     let value: f64 = text
@@ -279,6 +280,7 @@ fn parse_view_scale(text: &str) -> Result<f64, String> {
     }
 }
 
+#[cfg(feature = "viewer")]
 /// The viewer's `--adapter`: an index or a name (`list` belongs to the render command).
 fn parse_view_adapter(text: &str) -> Result<AdapterArg, String> {
     match parse_adapter(text)? {

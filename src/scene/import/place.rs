@@ -57,8 +57,8 @@ impl ImportedModel {
     /// (instances composed with the placement), its materials (named
     /// `<file stem>/<material>`) unless the placement overrides them, and the base
     /// colour textures they use (as UV-mapped albedo textures with the file's wrap
-    /// modes). Returns warnings for what the renderers do not model: metallic/roughness
-    /// and emissive textures (their constant factors are kept).
+    /// modes). Returns warnings for what the renderers do not model: emissive textures
+    /// (the constant emission is kept).
     pub fn add_to_scene(&self, scene: &mut Scene, placement: &ModelPlacement) -> Vec<String> {
         let mut warnings = Vec::new();
         let stem = self
@@ -67,8 +67,15 @@ impl ImportedModel {
             .map_or_else(|| "model".into(), |s| s.to_string_lossy().into_owned());
         let material_base = scene.materials.len() as u32;
         if placement.material.is_none() {
-            // Only the images a base colour texture uses travel to the GPU.
+            // Only the images a base colour or metallic/roughness texture uses travel
+            // to the GPU, each once.
             let mut image_index = vec![None; self.images.len()];
+            let mut scene_image = |scene: &mut Scene, image: u32| {
+                *image_index[image as usize].get_or_insert_with(|| {
+                    scene.images.push(self.images[image as usize].clone());
+                    scene.images.len() as u32 - 1
+                })
+            };
             for imported in &self.materials {
                 let mut material: Material = imported.material;
                 if let Some(TextureRef {
@@ -77,27 +84,27 @@ impl ImportedModel {
                     wrap_v,
                 }) = imported.base_color_texture
                 {
-                    let slot = &mut image_index[image as usize];
-                    let index = *slot.get_or_insert_with(|| {
-                        scene.images.push(self.images[image as usize].clone());
-                        scene.images.len() as u32 - 1
-                    });
-                    material.albedo_texture = Some(index);
+                    material.albedo_texture = Some(scene_image(scene, image));
                     material.texture_mapping = TextureMapping::Uv;
                     material.texture_wrap = [texture_wrap(wrap_u), texture_wrap(wrap_v)];
                 }
-                for (texture, what) in [
-                    (imported.metallic_roughness_texture, "metallic/roughness"),
-                    (imported.emissive_texture, "emissive"),
-                ] {
-                    if texture.is_some() {
-                        warnings.push(format!(
-                            "{}: material `{}`: its {what} texture is not used (the \
-                             renderers take the material's constant factors)",
-                            self.path.display(),
-                            imported.name
-                        ));
-                    }
+                if let Some(TextureRef {
+                    image,
+                    wrap_u,
+                    wrap_v,
+                }) = imported.metallic_roughness_texture
+                {
+                    material.metallic_roughness_texture = Some(scene_image(scene, image));
+                    material.texture_mapping = TextureMapping::Uv;
+                    material.metallic_roughness_wrap = [texture_wrap(wrap_u), texture_wrap(wrap_v)];
+                }
+                if imported.emissive_texture.is_some() {
+                    warnings.push(format!(
+                        "{}: material `{}`: its emissive texture is not used (the renderers \
+                         take the material's constant emission)",
+                        self.path.display(),
+                        imported.name
+                    ));
                 }
                 scene.materials.push(material);
                 scene
