@@ -260,7 +260,7 @@ fn a_scaled_film_fills_the_window_and_the_adapter_can_be_chosen() {
     let (status, stderr) = run(view);
     assert_eq!(status, Some(1), "{stderr}");
     assert!(
-        stderr.contains("matches no adapter") && stderr.contains("0: "),
+        stderr.contains("matches none of the adapters") && stderr.contains("0: "),
         "the error lists the adapters:\n{stderr}"
     );
 }

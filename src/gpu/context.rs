@@ -57,6 +57,53 @@ pub fn list_adapters() -> Vec<wgpu::AdapterInfo> {
     adapters.iter().map(wgpu::Adapter::get_info).collect()
 }
 
+/// `adapters` numbered as [`AdapterChoice::Index`] counts them, for error messages:
+/// `available: 0: NAME (BACKEND), ...`, or `no adapters found`.
+pub fn adapter_listing(adapters: &[wgpu::Adapter]) -> String {
+    let list: Vec<String> = adapters
+        .iter()
+        .enumerate()
+        .map(|(i, a)| {
+            let info = a.get_info();
+            format!("{i}: {} ({:?})", info.name, info.backend)
+        })
+        .collect();
+    if list.is_empty() {
+        "no adapters found".to_string()
+    } else {
+        format!("available: {}", list.join(", "))
+    }
+}
+
+/// The adapter of `adapters` that `choice` names: by index, or the first whose name
+/// contains the text (case-insensitive); [`AdapterChoice::Default`] takes the first.
+/// A window's program passes the adapters that can present to its surface.
+///
+/// Errors: [`GpuError::NoAdapter`] naming the choice and listing `adapters`.
+pub fn select_adapter(
+    adapters: &[wgpu::Adapter],
+    choice: &AdapterChoice,
+) -> Result<wgpu::Adapter, GpuError> {
+    let found = match choice {
+        AdapterChoice::Default => adapters.first(),
+        AdapterChoice::Index(i) => adapters.get(*i),
+        AdapterChoice::NameContains(text) => {
+            let wanted = text.to_lowercase();
+            adapters
+                .iter()
+                .find(|a| a.get_info().name.to_lowercase().contains(&wanted))
+        }
+    };
+    found.cloned().ok_or_else(|| {
+        let asked = match choice {
+            AdapterChoice::Default => "no adapter".to_string(),
+            AdapterChoice::Index(i) => format!("no adapter with index {i}"),
+            AdapterChoice::NameContains(text) => format!("no adapter name contains {text:?}"),
+        };
+        GpuError::NoAdapter(format!("{asked}; {}", adapter_listing(adapters)))
+    })
+}
+
 /// A wgpu instance, adapter, device and queue without any window.
 ///
 /// The device is created with the adapter's own limits (not [`wgpu::Limits::default`]),
@@ -98,21 +145,6 @@ impl HeadlessGpu {
     /// ```
     pub fn new(choice: &AdapterChoice) -> Result<Self, GpuError> {
         let (instance, adapters) = instance_with_adapters();
-        let names = || {
-            let list: Vec<String> = adapters
-                .iter()
-                .enumerate()
-                .map(|(i, a)| {
-                    let info = a.get_info();
-                    format!("{i}: {} ({:?})", info.name, info.backend)
-                })
-                .collect();
-            if list.is_empty() {
-                "no adapters found".to_string()
-            } else {
-                format!("available: {}", list.join(", "))
-            }
-        };
         let adapter = match choice {
             AdapterChoice::Default => {
                 let options = wgpu::RequestAdapterOptions {
@@ -123,28 +155,12 @@ impl HeadlessGpu {
                     Ok(adapter) => adapter,
                     // request_adapter may decline where enumeration found something
                     // (for example only a CPU adapter): take the first one then.
-                    Err(e) => adapters
-                        .first()
-                        .cloned()
-                        .ok_or_else(|| GpuError::NoAdapter(format!("{e}; {}", names())))?,
+                    Err(e) => adapters.first().cloned().ok_or_else(|| {
+                        GpuError::NoAdapter(format!("{e}; {}", adapter_listing(&adapters)))
+                    })?,
                 }
             }
-            AdapterChoice::Index(i) => adapters.get(*i).cloned().ok_or_else(|| {
-                GpuError::NoAdapter(format!("no adapter with index {i}; {}", names()))
-            })?,
-            AdapterChoice::NameContains(text) => {
-                let wanted = text.to_lowercase();
-                adapters
-                    .iter()
-                    .find(|a| a.get_info().name.to_lowercase().contains(&wanted))
-                    .cloned()
-                    .ok_or_else(|| {
-                        GpuError::NoAdapter(format!(
-                            "no adapter name contains {text:?}; {}",
-                            names()
-                        ))
-                    })?
-            }
+            _ => select_adapter(&adapters, choice)?,
         };
         // Timestamp queries time the trace passes on the GPU itself (see
         // `RenderStats::gpu_time`); request them only where the adapter offers them.

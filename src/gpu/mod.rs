@@ -47,7 +47,7 @@ pub mod shaders;
 pub mod upload;
 mod wavefront;
 
-pub use context::{AdapterChoice, HeadlessGpu, list_adapters};
+pub use context::{AdapterChoice, HeadlessGpu, adapter_listing, list_adapters, select_adapter};
 pub use error::GpuError;
 pub use features::ShaderFeatures;
 pub use film::Film;

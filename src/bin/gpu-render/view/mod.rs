@@ -20,7 +20,9 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
-use gpu_render::gpu::{Film, GpuScene, Renderer, RendererOptions, read_texture};
+use gpu_render::gpu::{
+    AdapterChoice, Film, GpuScene, Renderer, RendererOptions, read_texture, select_adapter,
+};
 use gpu_render::output;
 use gpu_render::scene::{self, Camera, RenderSettings, Scene};
 use winit::application::ApplicationHandler;
@@ -724,45 +726,13 @@ fn choose_adapter(
         .into_iter()
         .filter(|adapter| adapter.is_surface_supported(surface))
         .collect();
-    let listing = || {
-        let names: Vec<String> = adapters
-            .iter()
-            .enumerate()
-            .map(|(i, a)| {
-                let info = a.get_info();
-                format!("{i}: {} ({:?})", info.name, info.backend)
-            })
-            .collect();
-        if names.is_empty() {
-            "none can present to this window".to_owned()
-        } else {
-            format!(
-                "those that can present to this window: {}",
-                names.join(", ")
-            )
-        }
+    let choice = match choice {
+        crate::args::AdapterArg::Index(i) => AdapterChoice::Index(*i),
+        crate::args::AdapterArg::Name(name) => AdapterChoice::NameContains(name.clone()),
+        crate::args::AdapterArg::List => AdapterChoice::Default,
     };
-    let found = match choice {
-        crate::args::AdapterArg::Index(i) => adapters.get(*i),
-        crate::args::AdapterArg::Name(name) => {
-            let name = name.to_lowercase();
-            adapters
-                .iter()
-                .find(|a| a.get_info().name.to_lowercase().contains(&name))
-        }
-        crate::args::AdapterArg::List => None,
-    };
-    match found {
-        Some(adapter) => Ok(adapter.clone()),
-        None => {
-            let asked = match choice {
-                crate::args::AdapterArg::Index(i) => i.to_string(),
-                crate::args::AdapterArg::Name(name) => format!("{name:?}"),
-                crate::args::AdapterArg::List => "list".to_owned(),
-            };
-            bail!("--adapter {asked} matches no adapter; {}", listing())
-        }
-    }
+    select_adapter(&adapters, &choice)
+        .context("--adapter matches none of the adapters that can present to this window")
 }
 
 /// The surface configuration: an 8-bit format (sRGB preferred) the surface offers,
