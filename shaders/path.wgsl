@@ -482,9 +482,10 @@ fn emitter_pdf(point: vec3<f32>, hit: Hit) -> f32 {
 }
 
 // Whether emission of the shape hit is seen from the side the ray arrives on: flat
-// shapes emit on the side of their normal, spheres on both. Twin of emits_towards.
-fn emits_towards(hit: Hit, direction: vec3<f32>) -> bool {
-    return prim_kind(hit.prim) == PRIM_SPHERE || dot(direction, hit.normal) < 0.0;
+// shapes emit on the side of their normal, or on both for a two_sided material;
+// spheres on both. Twin of emits_towards.
+fn emits_towards(hit: Hit, direction: vec3<f32>, two_sided: bool) -> bool {
+    return two_sided || prim_kind(hit.prim) == PRIM_SPHERE || dot(direction, hit.normal) < 0.0;
 }
 
 // Next-event estimation's sample of one emitter from the path's shadow origin: the
@@ -524,7 +525,7 @@ fn path_emitter_sample(path: ptr<function, PathState>) -> EmitterSample {
         let b = sample_triangle_barycentrics(u);
         let point = emitter.v0 * b.x + emitter.v1 * b.y + emitter.v2 * b.z;
         let to_light = point - origin;
-        if dot(to_light, emitter.normal) >= 0.0 {
+        if emitter.kind != EMITTER_TWO_SIDED_TRIANGLE && dot(to_light, emitter.normal) >= 0.0 {
             // The back of a one-sided emitter.
             return sample;
         }
@@ -575,7 +576,7 @@ fn path_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) 
     let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv);
     // Emission, weighted against next-event estimation where that could have found it;
     // shadow_origin still holds the previous hit's, where that estimation sampled from.
-    if max_component(material.emission) > 0.0 && emits_towards(hit, ray.direction) {
+    if max_component(material.emission) > 0.0 && emits_towards(hit, ray.direction, material.two_sided != 0u) {
         var weight = 1.0;
         if (*path).depth > 0u && (*path).brdf_pdf > 0.0 {
             weight = power_heuristic((*path).brdf_pdf, emitter_pdf((*path).shadow_origin, hit));

@@ -18,6 +18,8 @@ const EMITTER_SPHERE: u32 = 0u;
 const EMITTER_TRIANGLE: u32 = 1u;
 // The padding record of a scene without emitters.
 const EMITTER_NONE: u32 = 2u;
+// A triangle of a two_sided material: it emits from its back too.
+const EMITTER_TWO_SIDED_TRIANGLE: u32 = 3u;
 
 // One emitter of the AreaLights distribution (twin of src/cpu/path.rs): its shape,
 // the primitive a ray hits on it, its radiance, and its share of the selection by

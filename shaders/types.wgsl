@@ -152,6 +152,11 @@ struct Material {
     metallic_roughness_width: u32,
     metallic_roughness_height: u32,
     metallic_roughness_wrap: u32,
+    // 1 when flat shapes of this material emit from both sides (path integrator).
+    two_sided: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 const LIGHT_POINT: u32 = 0u;

@@ -8,7 +8,8 @@ use std::mem::{offset_of, size_of};
 use gpu_render::accel::{BvhNode, PrimKind, PrimRef};
 use gpu_render::gpu::ShaderFeatures;
 use gpu_render::gpu::area_lights::{
-    EMITTER_NONE, EMITTER_SPHERE, EMITTER_TRIANGLE, FLAG_PATH, GpuEmitter, PHASE_EMITTER,
+    EMITTER_NONE, EMITTER_SPHERE, EMITTER_TRIANGLE, EMITTER_TWO_SIDED_TRIANGLE, FLAG_PATH,
+    GpuEmitter, PHASE_EMITTER,
 };
 use gpu_render::gpu::layout::*;
 use gpu_render::gpu::shaders::{
@@ -143,6 +144,10 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 metallic_roughness_width,
                 metallic_roughness_height,
                 metallic_roughness_wrap,
+                two_sided,
+                _pad0,
+                _pad1,
+                _pad2,
             }),
         ),
         (
@@ -369,6 +374,7 @@ fn constants_match() {
         ("EMITTER_SPHERE", EMITTER_SPHERE),
         ("EMITTER_TRIANGLE", EMITTER_TRIANGLE),
         ("EMITTER_NONE", EMITTER_NONE),
+        ("EMITTER_TWO_SIDED_TRIANGLE", EMITTER_TWO_SIDED_TRIANGLE),
     ]);
     let mut found = 0;
     for (_, constant) in module.constants.iter() {

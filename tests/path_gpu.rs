@@ -128,6 +128,28 @@ fn gpu_path_tracing_matches_the_cpu_on_the_cornell_box() {
         "path-cornell-box",
         &shipped("cornell-box.toml", 48, 8),
     );
+    // The lamp made two-sided lights the ceiling above it too: brighter overall, and
+    // the same on both backends.
+    let one_sided = shipped("cornell-box.toml", 48, 8);
+    let mut two_sided = one_sided.clone();
+    for material in &mut two_sided.materials {
+        if material.emission != glam::DVec3::ZERO {
+            material.two_sided = true;
+        }
+    }
+    let total = |scene: &Scene| -> f64 {
+        gpu_render::cpu::render(scene, None)
+            .image
+            .pixels
+            .iter()
+            .map(|p| f64::from(p[0] + p[1] + p[2]))
+            .sum()
+    };
+    assert!(
+        total(&two_sided) > total(&one_sided) * 1.001,
+        "the lamp's back lights nothing"
+    );
+    compare(&gpu, &renderer, "path-cornell-box-two-sided", &two_sided);
 }
 
 #[test]

@@ -167,7 +167,8 @@ fn polygon_irradiance(vertices: &[DVec3], radiance: f64) -> f64 {
 }
 
 /// A square light facing down over the floor, off centre: its irradiance by Lambert's
-/// formula; turned to face up, it lights nothing (one-sided emission).
+/// formula; turned to face up, it lights nothing (one-sided emission), unless its
+/// material is `two_sided`.
 #[test]
 fn a_square_light_lights_the_floor_as_lamberts_formula_says_and_only_from_its_front() {
     let (radiance, rho) = (3.0, 0.5);
@@ -211,6 +212,32 @@ fn a_square_light_lights_the_floor_as_lamberts_formula_says_and_only_from_its_fr
     );
     let (mean, _) = pixel_statistics(&s);
     assert_eq!(mean, 0.0, "a light facing away lit the floor");
+
+    // A two_sided material emits from the back as well: facing up, the square lights
+    // the floor as it did facing down.
+    let up: Vec<DVec3> = down.iter().rev().copied().collect();
+    for depth in [0, 2] {
+        let mut s = scene(
+            vec![
+                floor(0),
+                Shape::Polygon {
+                    vertices: up.clone(),
+                    material: 1,
+                },
+            ],
+            vec![
+                Material::lambert(DVec3::splat(rho)),
+                Material {
+                    two_sided: true,
+                    ..emissive(radiance)
+                },
+            ],
+            floor_camera(),
+        );
+        s.render.max_depth = depth;
+        s.render.samples_per_pixel = 256;
+        assert_converges(&format!("two-sided, depth {depth}"), &s, expected, 0.01);
+    }
 }
 
 /// With point lights only and no bounces, both integrators compute direct light by

@@ -20,8 +20,12 @@ pub(crate) enum EmitterShape {
     /// A sphere, sampled by the cone of directions it subtends.
     Sphere { center: DVec3, radius: f64 },
     /// A triangle (of a triangle, a mesh or a polygon), sampled uniformly by area; it
-    /// emits on the side its unit `normal` points to.
-    Triangle { vertices: [DVec3; 3], normal: DVec3 },
+    /// emits on the side its unit `normal` points to, and on both if `two_sided`.
+    Triangle {
+        vertices: [DVec3; 3],
+        normal: DVec3,
+        two_sided: bool,
+    },
 }
 
 /// One emitter: its shape, the surface a ray hits on it (an instanced mesh's triangle
@@ -53,6 +57,7 @@ impl AreaLights {
     pub fn new(geometry: &SceneGeometry, materials: &[Material]) -> Self {
         let mut lights = Self::default();
         let emission = |material: u32| materials[material as usize].emission;
+        let two_sided = |material: u32| materials[material as usize].two_sided;
         for (i, s) in geometry.spheres.iter().enumerate() {
             let radiance = emission(s.material);
             if radiance.max_element() > 0.0 {
@@ -77,7 +82,13 @@ impl AreaLights {
             }
             let prim = HitKey::world(PrimRef::new(PrimKind::Polygon, i as u32));
             for vertices in polygon_triangles(&p.vertices, p.plane.dropped_axis) {
-                lights.push_triangle(vertices, p.plane.normal, prim, radiance);
+                lights.push_triangle(
+                    vertices,
+                    p.plane.normal,
+                    two_sided(p.material),
+                    prim,
+                    radiance,
+                );
             }
         }
         for (i, t) in geometry.triangles.iter().enumerate() {
@@ -89,7 +100,7 @@ impl AreaLights {
             let normal = (b - a).cross(c - a).normalize_or_zero();
             if normal != DVec3::ZERO {
                 let prim = HitKey::world(PrimRef::new(PrimKind::Triangle, i as u32));
-                lights.push_triangle(t.vertices, normal, prim, radiance);
+                lights.push_triangle(t.vertices, normal, two_sided(t.material), prim, radiance);
             }
         }
         // Emissive instanced meshes: each instance's triangles moved to world space for
@@ -109,20 +120,37 @@ impl AreaLights {
                         prim: PrimRef::new(PrimKind::Triangle, j as u32),
                         instance: Some(i as u32),
                     };
-                    lights.push_triangle(t.vertices, normal, key, radiance);
+                    lights.push_triangle(
+                        t.vertices,
+                        normal,
+                        two_sided(instance.material),
+                        key,
+                        radiance,
+                    );
                 }
             }
         }
         lights
     }
 
-    fn push_triangle(&mut self, vertices: [DVec3; 3], normal: DVec3, key: HitKey, radiance: DVec3) {
+    fn push_triangle(
+        &mut self,
+        vertices: [DVec3; 3],
+        normal: DVec3,
+        two_sided: bool,
+        key: HitKey,
+        radiance: DVec3,
+    ) {
         let [a, b, c] = vertices;
         let area = 0.5 * (b - a).cross(c - a).length();
         if area > 0.0 {
             self.push(
                 Emitter {
-                    shape: EmitterShape::Triangle { vertices, normal },
+                    shape: EmitterShape::Triangle {
+                        vertices,
+                        normal,
+                        two_sided,
+                    },
                     key,
                     radiance,
                 },
@@ -162,10 +190,18 @@ impl AreaLights {
                         EmitterEntryShape::Sphere { center, radius },
                         4.0 * std::f64::consts::PI * radius * radius,
                     ),
-                    EmitterShape::Triangle { vertices, normal } => {
+                    EmitterShape::Triangle {
+                        vertices,
+                        normal,
+                        two_sided,
+                    } => {
                         let [a, b, c] = vertices;
                         (
-                            EmitterEntryShape::Triangle { vertices, normal },
+                            EmitterEntryShape::Triangle {
+                                vertices,
+                                normal,
+                                two_sided,
+                            },
                             0.5 * (b - a).cross(c - a).length(),
                         )
                     }
@@ -220,12 +256,15 @@ pub enum EmitterEntryShape {
         /// Its radius.
         radius: f64,
     },
-    /// A triangle, sampled uniformly by area, emitting on the side of `normal`.
+    /// A triangle, sampled uniformly by area, emitting on the side of `normal` (on
+    /// both if `two_sided`).
     Triangle {
         /// Its vertices.
         vertices: [DVec3; 3],
         /// The unit normal of its emitting side.
         normal: DVec3,
+        /// Whether it emits from its back too.
+        two_sided: bool,
     },
 }
 

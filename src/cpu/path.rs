@@ -61,7 +61,9 @@ fn emitter_pdf(lights: &AreaLights, point: DVec3, hit: &Hit) -> f64 {
             let w = (hit.position - point).normalize_or_zero();
             selection * pdf_sphere_cone(point, center, radius, w)
         }
-        EmitterShape::Triangle { vertices, normal } => {
+        EmitterShape::Triangle {
+            vertices, normal, ..
+        } => {
             let [a, b, c] = vertices;
             let area = 0.5 * (b - a).cross(c - a).length();
             area_to_solid_angle_pdf(selection / area, point, hit.position, normal)
@@ -70,10 +72,11 @@ fn emitter_pdf(lights: &AreaLights, point: DVec3, hit: &Hit) -> f64 {
 }
 
 /// Whether emission of the shape hit is seen from the side the ray arrives on: flat
-/// shapes (polygons, triangles, planes) emit on the side of their normal, spheres on
-/// both (outside and, for a camera inside, inside).
-fn emits_towards(hit: &Hit, direction: DVec3) -> bool {
-    hit.prim.kind() == PrimKind::Sphere || direction.dot(hit.normal) < 0.0
+/// shapes (polygons, triangles, planes) emit on the side of their normal, or on both
+/// when their material is `two_sided`; spheres on both (outside and, for a camera
+/// inside, inside).
+fn emits_towards(hit: &Hit, direction: DVec3, two_sided: bool) -> bool {
+    two_sided || hit.prim.kind() == PrimKind::Sphere || direction.dot(hit.normal) < 0.0
 }
 
 /// The base BRDF's importance sampler: the lobes of `material` mixed in proportion to
@@ -181,7 +184,9 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
         );
         // Emission, weighted against next-event estimation where that could have
         // found it.
-        if material.emission.max_element() > 0.0 && emits_towards(&hit, ray.direction) {
+        if material.emission.max_element() > 0.0
+            && emits_towards(&hit, ray.direction, material.two_sided)
+        {
             let weight = match brdf_pdf {
                 Some(pdf) => {
                     power_heuristic(pdf, emitter_pdf(&scene.area_lights, previous_point, &hit))
@@ -346,11 +351,15 @@ fn sample_emitter(
                 None => return (DVec3::ZERO, 0),
             }
         }
-        EmitterShape::Triangle { vertices, normal } => {
+        EmitterShape::Triangle {
+            vertices,
+            normal,
+            two_sided,
+        } => {
             let b = sample_triangle_barycentrics(u);
             let point = vertices[0] * b.x + vertices[1] * b.y + vertices[2] * b.z;
             let to_light = point - origin;
-            if to_light.dot(normal) >= 0.0 {
+            if !two_sided && to_light.dot(normal) >= 0.0 {
                 // The back of a one-sided emitter.
                 return (DVec3::ZERO, 0);
             }
@@ -370,8 +379,10 @@ fn sample_emitter(
     };
     // Visible when the first thing the ray meets is the emitter itself, on its
     // emitting side.
-    let visible = intersect_scene(&scene.geometry, &shadow, f64::INFINITY)
-        .is_some_and(|hit| hit.key() == emitter.key && emits_towards(&hit, wi));
+    let visible = intersect_scene(&scene.geometry, &shadow, f64::INFINITY).is_some_and(|hit| {
+        hit.key() == emitter.key
+            && emits_towards(&hit, wi, scene.materials[hit.material as usize].two_sided)
+    });
     if !visible {
         return (DVec3::ZERO, 1);
     }

@@ -20,6 +20,9 @@ pub const EMITTER_SPHERE: u32 = 0;
 pub const EMITTER_TRIANGLE: u32 = 1;
 /// [`GpuEmitter::kind`] of the padding record of a scene without emitters.
 pub const EMITTER_NONE: u32 = 2;
+/// [`GpuEmitter::kind`] of a triangle that emits from both sides (a `two_sided`
+/// material).
+pub const EMITTER_TWO_SIDED_TRIANGLE: u32 = 3;
 
 /// One emitter (`Emitter` in WGSL), in the CPU's selection order, which is ascending
 /// [`crate::accel::PrimRef`] order.
@@ -84,8 +87,16 @@ pub fn emitter_record(entry: &EmitterEntry) -> GpuEmitter {
             record.v0 = vec3(center);
             record.v1 = [radius as f32, 0.0, 0.0];
         }
-        EmitterEntryShape::Triangle { vertices, normal } => {
-            record.kind = EMITTER_TRIANGLE;
+        EmitterEntryShape::Triangle {
+            vertices,
+            normal,
+            two_sided,
+        } => {
+            record.kind = if two_sided {
+                EMITTER_TWO_SIDED_TRIANGLE
+            } else {
+                EMITTER_TRIANGLE
+            };
             record.v0 = vec3(vertices[0]);
             record.v1 = vec3(vertices[1]);
             record.v2 = vec3(vertices[2]);

@@ -366,6 +366,14 @@ pub struct GpuMaterial {
     pub metallic_roughness_height: u32,
     /// Its wrap modes: the `WRAP_*` code along `u` in bits 0-7, along `v` in bits 8-15.
     pub metallic_roughness_wrap: u32,
+    /// 1 when flat shapes of this material emit from both sides (path integrator).
+    pub two_sided: u32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
 }
 
 /// The shading attributes of one mesh triangle (`TriangleAttributes` in WGSL): vertex

@@ -331,6 +331,10 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
         metallic_roughness_height,
         metallic_roughness_wrap: wrap_code(material.metallic_roughness_wrap[0])
             | wrap_code(material.metallic_roughness_wrap[1]) << 8,
+        two_sided: u32::from(material.two_sided),
+        _pad0: 0,
+        _pad1: 0,
+        _pad2: 0,
     }
 }
 

@@ -305,6 +305,11 @@ pub struct Material {
     pub metallic_roughness_texture: Option<u32>,
     /// Wrap modes of the metallic/roughness texture along `u` and `v`.
     pub metallic_roughness_wrap: [TextureWrap; 2],
+    /// Whether flat shapes (polygons, triangles, meshes) of this material emit
+    /// `emission` from both sides; by default only from the side their normal points
+    /// to (spheres always emit on both). The path integrator's rule: Whitted shows
+    /// emission on either side.
+    pub two_sided: bool,
 }
 
 impl Material {
@@ -336,6 +341,7 @@ impl Material {
             brdf_map: None,
             metallic_roughness_texture: None,
             metallic_roughness_wrap: [TextureWrap::Repeat; 2],
+            two_sided: false,
         }
     }
 

@@ -254,7 +254,7 @@ pub fn material(
     let kind = untyped.require("type", raw.kind.clone())?;
     let item = source.item(format!("materials.{name} ({kind})"), Some(span));
     let given = raw.given_fields();
-    match kind.as_str() {
+    let mut material = match kind.as_str() {
         "lambert" => {
             item.only_fields(&kind, LAMBERT_FIELDS, &given)?;
             lambert(&item, &raw, images)
@@ -294,7 +294,17 @@ pub fn material(
         other => Err(untyped.fail(format_args!(
             "unknown material type `{other}` (expected one of: {KINDS})"
         ))),
+    }?;
+    if let Some(two_sided) = raw.two_sided {
+        if two_sided && material.emission == DVec3::ZERO {
+            return Err(item.fail(format_args!(
+                "two_sided = true applies to emission, and this material emits nothing \
+                 (give it `emission`, or `radiance` for an emissive one)"
+            )));
+        }
+        material.two_sided = two_sided;
     }
+    Ok(material)
 }
 
 fn lambert(

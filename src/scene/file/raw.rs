@@ -135,6 +135,7 @@ pub struct RawMaterial {
     pub texture_mapping: Option<String>,
     pub texture_scale: Option<f64>,
     pub brdf_map: Option<String>,
+    pub two_sided: Option<bool>,
 }
 
 impl RawMaterial {

@@ -332,3 +332,37 @@ fn ordinary_and_ground_spheres_load_without_a_warning() {
         assert!(found.is_empty(), "{center} {radius}: {found:?}");
     }
 }
+
+#[test]
+fn two_sided_emission_is_read_and_needs_emission() {
+    let scene = parse(&format!(
+        "{CAMERA}[materials.lamp]\ntype = \"emissive\"\nradiance = [2, 2, 2]\ntwo_sided = true\n\
+         [materials.glow]\ntype = \"lambert\"\nalbedo = [0.5, 0.5, 0.5]\nemission = [1, 0, 0]\n\
+         [materials.plain]\ntype = \"lambert\"\nalbedo = [0.5, 0.5, 0.5]\ntwo_sided = false\n"
+    ));
+    let by_name = |name: &str| {
+        let index = scene
+            .material_names
+            .iter()
+            .position(|n| n == name)
+            .unwrap_or_else(|| panic!("no material {name}"));
+        scene.materials[index]
+    };
+    assert!(by_name("lamp").two_sided);
+    assert!(!by_name("glow").two_sided, "one-sided by default");
+    assert!(!by_name("plain").two_sided);
+
+    let text = format!(
+        "{CAMERA}[materials.dull]\ntype = \"lambert\"\nalbedo = [0.5, 0.5, 0.5]\ntwo_sided = true\n"
+    );
+    let error = match parse_scene(&text, Path::new("test.toml")) {
+        Ok(_) => panic!("two_sided without emission was accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        error.contains("materials.dull")
+            && error.contains("two_sided")
+            && error.contains("test.toml"),
+        "{error}"
+    );
+}

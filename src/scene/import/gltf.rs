@@ -734,6 +734,11 @@ impl Importer<'_> {
                 ..Material::blank(MaterialKind::Pbr)
             }
         };
+        // glTF's doubleSided lights both sides of a surface: an emitter emits from both.
+        let ours = Material {
+            two_sided: material.double_sided() && ours.emission != DVec3::ZERO,
+            ..ours
+        };
         let base_color_texture = match pbr.base_color_texture() {
             Some(info) => Some(self.texture(&info, Encoding::Color, &name, "baseColorTexture")?),
             None => None,
