@@ -11,8 +11,9 @@
 //! - [`cpu`]: the reference tracer (f64).
 //! - [`gpu`]: the wgpu backend, built from the caller's `Device` and `Queue`.
 //! - [`output`]: writing PNG, EXR and HDR files atomically.
-//! - [`plausibility`]: the lecture's three rules checked on a tabulated BRDF map.
-//! - [`quality`]: the named presets chosen from the measured front.
+//! - `plausibility` (with the default `cli` feature): the lecture's three rules checked
+//!   on a tabulated BRDF map, for `gpu-render brdf-check`.
+//! - `quality` (with `cli`): the named presets chosen from the measured front.
 //! - [`tiles`]: windows of an image rendered apart, their EXR tile files and merging
 //!   them into the whole image.
 //! - `tradeoff` (with the default `cli` feature): measuring time against error for the
@@ -27,7 +28,9 @@ pub mod cpu;
 pub mod film;
 pub mod gpu;
 pub mod output;
+#[cfg(feature = "cli")]
 pub mod plausibility;
+#[cfg(feature = "cli")]
 pub mod quality;
 pub mod scene;
 pub mod tiles;
