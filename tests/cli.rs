@@ -5,7 +5,7 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 
 /// A small valid scene in the documented format.
 const TINY_SCENE: &str = r#"
@@ -32,33 +32,7 @@ material = "white"
 /// Bytes that must survive a failed run untouched.
 const OLD_OUTPUT: &[u8] = b"an older image that a failed run must not touch";
 
-struct Run {
-    status: Option<i32>,
-    stdout: String,
-    stderr: String,
-}
-
-fn gpu_render(args: &[&str]) -> Run {
-    let Output {
-        status,
-        stdout,
-        stderr,
-    } = Command::new(env!("CARGO_BIN_EXE_gpu-render"))
-        .args(args)
-        .output()
-        .expect("run gpu-render");
-    let run = Run {
-        status: status.code(),
-        stdout: String::from_utf8_lossy(&stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&stderr).into_owned(),
-    };
-    assert!(
-        !run.stderr.contains("panicked"),
-        "gpu-render panicked on {args:?}:\n{}",
-        run.stderr
-    );
-    run
-}
+use common::process::{Run, gpu_render};
 
 /// A temporary directory holding `scene.toml` with `text` and an existing `out.png`.
 struct Workspace {

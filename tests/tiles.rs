@@ -7,38 +7,12 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 
 /// The showcase (polygons, triangles, glass, a mirror, three lights) made small.
 const SHOWCASE_ARGS: [&str; 6] = ["--width", "96", "--height", "54", "--spp", "2"];
 
-struct Run {
-    status: Option<i32>,
-    stderr: String,
-    stdout: String,
-}
-
-fn gpu_render<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Run {
-    let Output {
-        status,
-        stdout,
-        stderr,
-    } = Command::new(env!("CARGO_BIN_EXE_gpu-render"))
-        .args(args)
-        .output()
-        .expect("run gpu-render");
-    let run = Run {
-        status: status.code(),
-        stdout: String::from_utf8_lossy(&stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&stderr).into_owned(),
-    };
-    assert!(
-        !run.stderr.contains("panicked"),
-        "gpu-render panicked:\n{}",
-        run.stderr
-    );
-    run
-}
+use common::process::{Run, gpu_render};
 
 fn succeeds(run: Run) -> Run {
     assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);

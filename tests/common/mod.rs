@@ -4,4 +4,5 @@
 pub mod compare;
 pub mod geometry;
 pub mod gpu;
+pub mod process;
 pub mod scenes;
