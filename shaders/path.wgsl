@@ -673,10 +673,7 @@ fn path_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) 
 fn path_consume_shadow_ray(path: ptr<function, PathState>, trace: TraceRay) {
     if trace.best_prim == NO_PRIM {
         let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal);
-        var material = materials[(*path).material];
-        material.diffuse = (*path).albedo;
-        material.roughness = (*path).roughness;
-        material.metallic = (*path).metallic;
+        let material = lit_material(path);
         let lit = eval_brdf(material, (*path).normal, sample.wi, -(*path).direction)
             * sample.irradiance * sample.cos_i;
         add_contribution(path, (*path).direct * lit);
@@ -708,10 +705,7 @@ fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
     let sample = path_emitter_sample(path);
     let emitter = emitters[sample.emitter];
     if sample.found && trace.best_prim == emitter.prim {
-        var material = materials[(*path).material];
-        material.diffuse = (*path).albedo;
-        material.roughness = (*path).roughness;
-        material.metallic = (*path).metallic;
+        let material = lit_material(path);
         let n = (*path).normal;
         let wo = -(*path).direction;
         let f = eval_brdf(material, n, sample.wi, wo);

@@ -289,6 +289,16 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
     }
 }
 
+// The material of the hit the path is lighting, as shading_material made it: its
+// record with the textured albedo, roughness and metalness kept in the path state.
+fn lit_material(path: ptr<function, PathState>) -> Material {
+    var material = materials[(*path).material];
+    material.diffuse = (*path).albedo;
+    material.roughness = (*path).roughness;
+    material.metallic = (*path).metallic;
+    return material;
+}
+
 // Adds the current light's f(wi, wo)·E·cos θi if its shadow ray was unblocked, and
 // moves on to the next light.
 fn consume_shadow_ray(path: ptr<function, PathState>, trace: TraceRay) {
@@ -300,10 +310,7 @@ fn consume_shadow_ray(path: ptr<function, PathState>, trace: TraceRay) {
     //#endif
     if trace.best_prim == NO_PRIM {
         let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal);
-        var material = materials[(*path).material];
-        material.diffuse = (*path).albedo;
-        material.roughness = (*path).roughness;
-        material.metallic = (*path).metallic;
+        let material = lit_material(path);
         (*path).direct += eval_brdf(material, (*path).normal, sample.wi, -(*path).direction)
             * sample.irradiance * sample.cos_i;
     }
