@@ -12,6 +12,7 @@ use std::path::Path;
 
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
+use gpu_render::accel::BrdfMapCdfs;
 use gpu_render::cpu::bxdf::eval_brdf;
 use gpu_render::gpu::shaders::{BXDF_EVAL_ENTRY_POINT, bxdf_eval_shader_source};
 use gpu_render::gpu::upload::{image_layers, material_record};
@@ -227,7 +228,8 @@ fn evaluate(
         usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let (width, height, layers, texels) = image_layers(images);
+    // The BRDFs read no inverse-CDF tables.
+    let (width, height, layers, texels) = image_layers(images, &BrdfMapCdfs::default());
     let extent = wgpu::Extent3d {
         width,
         height,

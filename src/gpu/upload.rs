@@ -14,8 +14,8 @@ use super::layout::{
     NO_ATTRIBUTES, NO_IMAGE, WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT, WRAP_REPEAT,
 };
 use crate::accel::{
-    BvhNode, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry, TriangleAttributes,
-    TriangleShape,
+    BrdfMapCdfs, BvhNode, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry,
+    TriangleAttributes, TriangleShape,
 };
 use crate::camera::CameraFrame;
 use crate::scene::{
@@ -372,9 +372,12 @@ pub fn triangle_attributes_record(attributes: &TriangleAttributes) -> GpuTriangl
 /// The scene's images as the layers of one `Rgba32Float` texture array: every layer is
 /// as large as the largest image, each image in its layer's top-left corner (the
 /// shaders only read texels inside the image's own width and height), the rest zero.
+/// The alpha channel of a BRDF map's layer holds its inverse-CDF table from `cdfs`
+/// (texel `(x, y)` = [`crate::accel::BrdfMapCdf::value`]`(x, y)`), which the path
+/// integrator samples the map by; no material reads an image's alpha otherwise.
 /// Returns `(width, height, layers, texels)` with texels layer by layer, row-major; a
 /// scene without images gets one 1×1 zero layer (WGSL needs a bound texture).
-pub fn image_layers(images: &[Image]) -> (u32, u32, u32, Vec<[f32; 4]>) {
+pub fn image_layers(images: &[Image], cdfs: &BrdfMapCdfs) -> (u32, u32, u32, Vec<[f32; 4]>) {
     let width = images.iter().map(|i| i.width).max().unwrap_or(1);
     let height = images.iter().map(|i| i.height).max().unwrap_or(1);
     let layers = images.len().max(1);
@@ -384,6 +387,11 @@ pub fn image_layers(images: &[Image]) -> (u32, u32, u32, Vec<[f32; 4]>) {
             let row = &image.texels[y * image.width as usize..(y + 1) * image.width as usize];
             let start = (layer * height as usize + y) * width as usize;
             texels[start..start + row.len()].copy_from_slice(row);
+            if let Some(cdf) = cdfs.of_image(layer) {
+                for (x, texel) in texels[start..start + row.len()].iter_mut().enumerate() {
+                    texel[3] = cdf.value(x as u32, y as u32);
+                }
+            }
         }
     }
     (width, height, layers as u32, texels)
