@@ -689,6 +689,40 @@ mod tests {
         assert_eq!(f.background, [0.1, 0.2, 0.3]);
     }
 
+    /// A BRDF map's layer carries its inverse-CDF table in alpha, every other image its
+    /// own texels; the colour channels are the images'.
+    #[test]
+    fn brdf_map_layers_carry_their_inverse_cdf_in_alpha() {
+        let image = |width: u32, height: u32, value: f32| Image {
+            path: "test".into(),
+            width,
+            height,
+            texels: (0..width * height)
+                .map(|i| [value * i as f32, value, value, 1.0])
+                .collect(),
+        };
+        let images = [image(4, 2, 0.5), image(3, 3, 0.25)];
+        let map = Material {
+            brdf_map: Some(1),
+            ..Material::blank(MaterialKind::Tabulated)
+        };
+        let cdfs = BrdfMapCdfs::new(&images, &[map]);
+        let table = cdfs.of_image(1).expect("the map's table");
+        let (width, height, layers, texels) = image_layers(&images, &cdfs);
+        assert_eq!((width, height, layers), (4, 3, 2));
+        let texel = |layer: usize, x: usize, y: usize| texels[(layer * 3 + y) * 4 + x];
+        assert_eq!(texel(0, 3, 1), images[0].texel(3, 1));
+        for y in 0..3 {
+            for x in 0..3 {
+                let t = texel(1, x, y);
+                assert_eq!(&t[..3], &images[1].texel(x as u32, y as u32)[..3]);
+                assert_eq!(t[3], table.value(x as u32, y as u32));
+            }
+        }
+        assert_eq!(texel(1, 2, 2)[3], 1.0);
+        assert!(texel(1, 1, 0)[3] > 0.0 && texel(1, 1, 0)[3] < 1.0);
+    }
+
     #[test]
     fn material_kinds_map_to_constants() {
         for (kind, code) in [
