@@ -7,11 +7,9 @@
 //! `tests/gpu_vs_cpu.rs`. A pixel may still fail where one of its paths takes another
 //! branch in f32 than in f64 (a ray grazing an edge, an event or roulette number within
 //! rounding of its threshold), and from then on draws other numbers: at most
-//! [`OUTLIERS`] of the pixels may (measured on lavapipe, 2026-12-01: none does on the
-//! other scenes, whose largest difference is 2.1e-3, on a bright Cornell box pixel,
-//! RMSE at most 2.7e-5; one of the 2,560 of `tabulated.toml` does, a path whose Russian
-//! roulette number lies 3e-4 (relative) below its throughput after a bounce off a
-//! peaked BRDF map, RMSE 2.9e-4). On failure both images and their difference are
+//! [`OUTLIERS`] of the pixels may (measured on lavapipe, 2026-12-01: none does on any
+//! of these scenes; the largest difference is 2.1e-3, on a bright Cornell box pixel,
+//! RMSE at most 2.7e-5). On failure both images and their difference are
 //! written under `target/test-output/`.
 //!
 //! Also: the ray counts agree, a tiny iteration budget (many resumed dispatches) gives
