@@ -88,10 +88,14 @@ fn materials() -> Vec<Material> {
             });
         }
     }
-    list.push(Material {
-        brdf_map: Some(0),
-        ..Material::blank(MaterialKind::Tabulated)
-    });
+    // The near-Lambertian map and the glossy one, whose steep lobe amplifies any error
+    // in the angles.
+    for map in [0, 1] {
+        list.push(Material {
+            brdf_map: Some(map),
+            ..Material::blank(MaterialKind::Tabulated)
+        });
+    }
     list
 }
 
@@ -118,8 +122,11 @@ fn wgsl_brdfs_match_the_cpu_reference() {
         return;
     };
     let (device, queue) = (&gpu.device, &gpu.queue);
-    let map = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/brdf/plausible.png");
-    let images: Vec<Image> = vec![load_image(&map).expect("map loads")];
+    let maps = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/brdf");
+    let images: Vec<Image> = ["plausible.png", "glossy.exr"]
+        .iter()
+        .map(|file| load_image(&maps.join(file)).expect("map loads"))
+        .collect();
     let materials = materials();
     // A tilted normal, so that no axis is special.
     let n = DVec3::new(0.2, 1.0, -0.1).normalize();
