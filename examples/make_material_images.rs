@@ -1,5 +1,6 @@
 //! Writes the images the shipped scenes use: `scenes/brdf/plausible.png`,
-//! `scenes/brdf/implausible.exr` and `scenes/textures/checker.png`.
+//! `scenes/brdf/implausible.exr`, `scenes/brdf/glossy.exr`, `scenes/brdf/grazing.exr`
+//! and `scenes/textures/checker.png`.
 //!
 //! ```sh
 //! cargo run --example make_material_images
@@ -35,6 +36,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Rgb([value, value, value])
     });
     implausible.save(root.join("brdf/implausible.exr"))?;
+    // Glossy: π·f = 0.05 + 5 exp(−((θi − θr)/0.08)²), a narrow lobe along θi = θr
+    // (azimuth-independent, so a ring around the normal), symmetric, directional albedo
+    // at most 0.77. The same maps as the tests of src/cpu/path.rs and
+    // tests/sampler_chi2.rs; 65 × 65 puts the bands' edges on those tests' grids.
+    let glossy = Rgb32FImage::from_fn(65, 65, |x, y| {
+        let (ti, tr) = (angle(x, 65), angle(y, 65));
+        let value = (0.05 + 5.0 * (-((ti - tr) / 0.08).powi(2)).exp()) as f32;
+        Rgb([value, value, value])
+    });
+    glossy.save(root.join("brdf/glossy.exr"))?;
+    // Grazing: π·f = 3.6 (sin θi sin θr)⁶, bright only where light and view both graze
+    // (a sheen-like rim), symmetric, albedo 0.9 sin⁶ θr at most 0.9.
+    let grazing = Rgb32FImage::from_fn(33, 33, |x, y| {
+        let (ti, tr) = (angle(x, 33), angle(y, 33));
+        let value = (3.6 * (ti.sin() * tr.sin()).powi(6)) as f32;
+        Rgb([value, 0.8 * value, 0.6 * value])
+    });
+    grazing.save(root.join("brdf/grazing.exr"))?;
     // An 8×8 checkerboard of two colours, 8 texels per square.
     let checker = ImageBuffer::from_fn(64, 64, |x, y| {
         let colour: [f64; 3] = if (x / 8 + y / 8) % 2 == 0 {

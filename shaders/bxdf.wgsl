@@ -321,13 +321,16 @@ fn brdf_oren_nayar(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32
 //#endif
 
 //#if TABULATED
-// The tabulated BRDF at the angles of wi and wo from the normal (isotropic).
+// The tabulated BRDF at the angles of wi and wo from the normal (isotropic). The angles
+// are atan2(|n × w|, n · w), equal to acos(n · w) for unit vectors but accurate in f32
+// on GPUs, whose acos is an approximation (on lavapipe it put the path-traced
+// tabulated.toml 2.9e-4 RMSE from the CPU; with atan2, 8e-7). Twin of brdf_tabulated.
 fn brdf_tabulated(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     if material.brdf_map_layer == NO_IMAGE {
         return vec3<f32>(0.0);
     }
-    let theta_i = acos(clamp(dot(n, wi), -1.0, 1.0));
-    let theta_r = acos(clamp(dot(n, wo), -1.0, 1.0));
+    let theta_i = atan2(length(cross(n, wi)), dot(n, wi));
+    let theta_r = atan2(length(cross(n, wo)), dot(n, wo));
     return sample_brdf_map(material.brdf_map_layer, material.brdf_map_size, theta_i, theta_r);
 }
 //#endif

@@ -388,11 +388,17 @@ fn pdf_half_vector(material: Material, wo: vec3<f32>, h: vec3<f32>) -> f32 {
 }
 
 // A direction for the base BRDF at a point of shading normal `n` seen from `wo`
-// (world): the specular lobe with its probability, else the cosine sampler. Twin of
-// sample_brdf.
+// (world): a tabulated BRDF by its map's inverse CDF (shaders/tabulated.wgsl), else the
+// specular lobe with its probability, else the cosine sampler. Twin of sample_brdf.
 fn sample_brdf(material: Material, n: vec3<f32>, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> vec3<f32> {
     let frame = shading_frame(n);
     let wo_local = frame_to_local(frame, wo);
+    //#if TABULATED
+    if material.kind == MATERIAL_TABULATED && material.brdf_map_layer != NO_IMAGE {
+        return frame_to_world(frame, sample_tabulated(material.brdf_map_layer,
+                                                      material.brdf_map_size, wo_local, u_lobe, u));
+    }
+    //#endif
     var local = sample_cosine_hemisphere(u);
     if u_lobe < specular_lobe_probability(material) {
         local = reflect_about(wo_local, sample_half_vector(material, wo_local, u));
@@ -406,6 +412,11 @@ fn pdf_brdf(material: Material, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f
     let frame = shading_frame(n);
     let wo_local = frame_to_local(frame, wo);
     let wi_local = frame_to_local(frame, wi);
+    //#if TABULATED
+    if material.kind == MATERIAL_TABULATED && material.brdf_map_layer != NO_IMAGE {
+        return pdf_tabulated(material.brdf_map_layer, material.brdf_map_size, wo_local, wi_local);
+    }
+    //#endif
     let p_specular = specular_lobe_probability(material);
     var pdf = (1.0 - p_specular) * pdf_cosine_hemisphere(wi_local);
     if p_specular > 0.0 {

@@ -12,6 +12,7 @@ use std::path::Path;
 
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
+use gpu_render::accel::BrdfMapCdfs;
 use gpu_render::cpu::bxdf::eval_brdf;
 use gpu_render::gpu::shaders::{BXDF_EVAL_ENTRY_POINT, bxdf_eval_shader_source};
 use gpu_render::gpu::upload::{image_layers, material_record};
@@ -87,10 +88,14 @@ fn materials() -> Vec<Material> {
             });
         }
     }
-    list.push(Material {
-        brdf_map: Some(0),
-        ..Material::blank(MaterialKind::Tabulated)
-    });
+    // The near-Lambertian map and the glossy one, whose steep lobe amplifies any error
+    // in the angles.
+    for map in [0, 1] {
+        list.push(Material {
+            brdf_map: Some(map),
+            ..Material::blank(MaterialKind::Tabulated)
+        });
+    }
     list
 }
 
@@ -117,8 +122,11 @@ fn wgsl_brdfs_match_the_cpu_reference() {
         return;
     };
     let (device, queue) = (&gpu.device, &gpu.queue);
-    let map = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/brdf/plausible.png");
-    let images: Vec<Image> = vec![load_image(&map).expect("map loads")];
+    let maps = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/brdf");
+    let images: Vec<Image> = ["plausible.png", "glossy.exr"]
+        .iter()
+        .map(|file| load_image(&maps.join(file)).expect("map loads"))
+        .collect();
     let materials = materials();
     // A tilted normal, so that no axis is special.
     let n = DVec3::new(0.2, 1.0, -0.1).normalize();
@@ -227,7 +235,8 @@ fn evaluate(
         usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let (width, height, layers, texels) = image_layers(images);
+    // The BRDFs read no inverse-CDF tables.
+    let (width, height, layers, texels) = image_layers(images, &BrdfMapCdfs::default());
     let extent = wgpu::Extent3d {
         width,
         height,

@@ -477,6 +477,13 @@ fn wgsl_constants_equal_their_rust_twins() {
         wgsl_f32_const(path, "MIN_SURVIVAL"),
         gpu_render::cpu::path::MIN_SURVIVAL as f32
     );
+    assert_eq!(
+        wgsl_f32_const(
+            gpu_render::gpu::shaders::TABULATED_WGSL,
+            "TABULATED_COSINE_PROBABILITY"
+        ),
+        gpu_render::cpu::tabulated::TABULATED_COSINE_PROBABILITY as f32
+    );
     let roulette = format!(
         "const ROULETTE_DEPTH: u32 = {}u;",
         gpu_render::cpu::path::ROULETTE_DEPTH

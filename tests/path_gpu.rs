@@ -204,6 +204,23 @@ fn gpu_path_tracing_matches_the_cpu_on_meshes_and_every_material() {
     );
 }
 
+/// Tabulated BRDF maps sampled by their inverse-CDF tables (in the alpha channel of
+/// the maps' layers on the GPU, from the same host-built `f32` values as the CPU's): a
+/// glossy map, a grazing one and a near-Lambertian one (`scenes/tabulated.toml`).
+#[test]
+fn gpu_path_tracing_matches_the_cpu_on_brdf_maps() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let renderer = common::gpu::renderer(&gpu);
+    compare(
+        &gpu,
+        &renderer,
+        "path-tabulated",
+        &shipped("tabulated.toml", 64, 8),
+    );
+}
+
 #[test]
 fn gpu_path_tracing_matches_the_cpu_in_furnaces() {
     let Some(gpu) = common::gpu::headless_gpu() else {

@@ -1,4 +1,5 @@
-//! Chi-square tests of every importance sampler against its density (src/cpu/sample.rs),
+//! Chi-square tests of every importance sampler against its density (src/cpu/sample.rs,
+//! and the tabulated BRDF maps' inverse-CDF sampler of src/cpu/tabulated.rs),
 //! as pbrt-v4 and Mitsuba 3 test theirs: the sphere of directions is cut into a grid
 //! of cells in (θ, φ), a cell's expected count is the sample count times the density
 //! integrated over the cell (the midpoint rule on a 32 × 32 grid in θ and φ, with the
@@ -9,11 +10,18 @@
 //! deterministic (counter-based), so a pass is reproducible. Each density is also
 //! checked to integrate to 1 over the sphere.
 
+use std::cell::Cell;
+
 use glam::{DVec2, DVec3};
+use gpu_render::accel::BrdfMapCdf;
 use gpu_render::cpu::sample::*;
+use gpu_render::cpu::tabulated::{
+    TABULATED_COSINE_PROBABILITY, pdf_brdf_map_direction, pdf_tabulated, sample_tabulated,
+};
+use gpu_render::scene::Image;
 
 /// Tests in this file that compute a p-value (for Šidák's correction).
-const TESTS: f64 = 15.0;
+const TESTS: f64 = 24.0;
 /// Overall significance.
 const ALPHA: f64 = 0.01;
 const THETA_CELLS: usize = 24;
@@ -349,4 +357,91 @@ fn power_heuristic_weights_sum_to_one() {
         assert!((power_heuristic(a, b) + power_heuristic(b, a) - 1.0).abs() < 1e-12);
     }
     assert_eq!(power_heuristic(0.0, 0.0), 0.0);
+}
+
+/// A BRDF map of `n × n` texels holding `π·f = value(θi, θr)` in every channel.
+fn brdf_map(n: u32, value: impl Fn(f64, f64) -> f64) -> Image {
+    let angle = |i: u32| f64::from(i) / f64::from(n - 1) * std::f64::consts::FRAC_PI_2;
+    let texels = (0..n * n)
+        .map(|i| {
+            let v = value(angle(i % n), angle(i / n)) as f32;
+            [v, v, v, 1.0]
+        })
+        .collect();
+    Image {
+        path: "test map".into(),
+        width: n,
+        height: n,
+        texels,
+    }
+}
+
+/// The tabulated sampler needs a third number (the lobe and the row): drawn from the
+/// same generator, in the order `check_directions` draws its pairs.
+fn tabulated_sampler(cdf: &BrdfMapCdf, wo: DVec3, seed: u32) -> impl Fn(DVec2) -> Option<DVec3> {
+    let index = Cell::new(0u32);
+    move |u| {
+        let i = index.get();
+        index.set(i + 1);
+        Some(sample_tabulated(cdf, wo, random_number(i, seed, 2), u))
+    }
+}
+
+/// Tabulated BRDF maps sampled by inverse CDF, mixed with the cosine lobe, against the
+/// mixture's density, for outgoing angles on a row of the map (0° and 45°), between
+/// rows and near grazing: a glossy map peaked along θi = θr (65 × 65, 64 bands of
+/// 1.41°) and one bright only at grazing angles (33 × 33). Both sides are chosen so
+/// that the bands' edges fall on the integration grid's (24 cells of 7.5° in θ over the
+/// sphere, 32 points each), where the piecewise-constant density jumps.
+#[test]
+fn tabulated_brdf_map_sampling_follows_its_density() {
+    let glossy = brdf_map(65, |ti, tr| {
+        0.05 + 5.0 * (-((ti - tr) / 0.08).powi(2)).exp()
+    });
+    let grazing = brdf_map(33, |ti, tr| 3.6 * (ti.sin() * tr.sin()).powi(6));
+    let mut seed = 70;
+    for (name, map) in [("glossy", glossy), ("grazing", grazing)] {
+        let cdf = BrdfMapCdf::new(&map).expect("a square map");
+        for theta_o in [0.0, 45f64.to_radians(), 0.55, 1.45] {
+            let wo = DVec3::new(theta_o.sin(), 0.0, theta_o.cos());
+            seed += 1;
+            check_directions(
+                &format!("tabulated {name}, theta_o {theta_o:.3}"),
+                seed,
+                tabulated_sampler(&cdf, wo, seed),
+                |wi| pdf_tabulated(&cdf, wo, wi),
+            );
+        }
+    }
+}
+
+/// The test has the power to see a subtle error of the tabulated density: mixing the
+/// two rows around θo with each other's weight. Row 0 of this 3 × 3 map reflects only
+/// towards grazing, rows 1 and 2 only towards the normal; at θo = 30° the rows weigh
+/// 1/3 and 2/3.
+#[test]
+fn the_test_rejects_a_tabulated_density_with_swapped_row_weights() {
+    let map = brdf_map(3, |ti, tr| {
+        let grazing = ti > 1.0;
+        if (tr < 0.1) == grazing { 1.0 } else { 0.0 }
+    });
+    let cdf = BrdfMapCdf::new(&map).expect("a square map");
+    let theta_o = 30f64.to_radians();
+    let wo = DVec3::new(theta_o.sin(), 0.0, theta_o.cos());
+    // The right density passes.
+    check_directions("3x3 map", 90, tabulated_sampler(&cdf, wo, 90), |wi| {
+        pdf_tabulated(&cdf, wo, wi)
+    });
+    // θr = 15° weighs the same rows 2/3 and 1/3.
+    let swapped = 15f64.to_radians().cos();
+    let result = std::panic::catch_unwind(|| {
+        check_directions("swapped rows", 91, tabulated_sampler(&cdf, wo, 91), |wi| {
+            let c = TABULATED_COSINE_PROBABILITY;
+            c * pdf_cosine_hemisphere(wi) + (1.0 - c) * pdf_brdf_map_direction(&cdf, swapped, wi)
+        });
+    });
+    assert!(
+        result.is_err(),
+        "a density with swapped row weights passed the test"
+    );
 }

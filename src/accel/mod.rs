@@ -18,13 +18,19 @@
 //! - [`bvh`]: the tree, its `f32` node records and its two builders;
 //! - [`instance`]: meshes placed more than once, stored once with a BVH of their own
 //!   and entered through their placements' transforms (a two-level BVH).
+//!
+//! Also built once on the host for both backends: [`area_lights`], the emitters the
+//! path integrator samples, and [`brdf_map_cdf`], the inverse-CDF tables of tabulated
+//! BRDF maps.
 
 pub mod area_lights;
+pub mod brdf_map_cdf;
 pub mod bvh;
 pub mod geometry;
 pub mod instance;
 
 pub use area_lights::{AreaLights, EmitterEntry, EmitterEntryShape, luminance};
+pub use brdf_map_cdf::{BrdfMapCdf, BrdfMapCdfs};
 pub use bvh::{BuildMethod, Bvh, BvhNode, BvhStats, MAX_BVH_DEPTH, MAX_LEAF_PRIMITIVES};
 pub use geometry::{
     MAX_PLANES, MAX_POLYGON_VERTICES, PlaneShape, PolygonShape, PrimKind, PrimRef, SceneGeometry,

@@ -304,10 +304,12 @@ pub fn brdf_oren_nayar(material: &Material, n: DVec3, wi: DVec3, wo: DVec3) -> D
 }
 
 /// The tabulated BRDF at the angles of `wi` and `wo` from the normal (isotropic,
-/// independent of azimuth; see [`sample_brdf_map`]).
+/// independent of azimuth; see [`sample_brdf_map`]). The angles are `atan2(|n × w|, n ·
+/// w)`, which is `acos(n · w)` for unit vectors, as the WGSL twin computes them (GPUs
+/// approximate `acos`).
 pub fn brdf_tabulated(map: &Image, n: DVec3, wi: DVec3, wo: DVec3) -> DVec3 {
-    let theta_i = n.dot(wi).clamp(-1.0, 1.0).acos();
-    let theta_r = n.dot(wo).clamp(-1.0, 1.0).acos();
+    let theta_i = n.cross(wi).length().atan2(n.dot(wi));
+    let theta_r = n.cross(wo).length().atan2(n.dot(wo));
     sample_brdf_map(map, theta_i, theta_r)
 }
 

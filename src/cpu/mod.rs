@@ -9,6 +9,7 @@ pub mod bxdf;
 pub mod intersect;
 pub mod path;
 pub mod sample;
+pub mod tabulated;
 pub mod texture;
 pub mod trace;
 pub mod traverse;

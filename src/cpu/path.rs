@@ -27,13 +27,14 @@ use super::sample::{
     sample_cosine_hemisphere, sample_ggx_visible_normal, sample_sphere_cone,
     sample_triangle_barycentrics,
 };
+use super::tabulated::{pdf_tabulated, sample_tabulated};
 use super::texture::shading_material;
 use super::trace::{
     PreparedScene, direct_light, finite_radiance, keep_on_side, shading_frame_normal,
 };
 use super::traverse::intersect_scene;
 use crate::accel::area_lights::{Emitter, EmitterShape};
-use crate::accel::{AreaLights, PrimKind, luminance};
+use crate::accel::{AreaLights, BrdfMapCdfs, PrimKind, luminance};
 use crate::scene::{Material, MaterialKind, MediumStack, MicrofacetDistribution};
 
 /// Bounces after which Russian roulette may end a path.
@@ -124,11 +125,21 @@ fn pdf_half_vector(material: &Material, wo: DVec3, h: DVec3) -> f64 {
 }
 
 /// A direction for the base BRDF of `material` at a point with shading normal `n`,
-/// seen from `wo` (world), from the uniform numbers `u_lobe` and `u`.
-fn sample_brdf(material: &Material, n: DVec3, wo: DVec3, u_lobe: f64, u: DVec2) -> DVec3 {
+/// seen from `wo` (world), from the uniform numbers `u_lobe` and `u`. A tabulated
+/// material with a map in `cdfs` is sampled by its map's inverse CDF ([`sample_tabulated`]).
+fn sample_brdf(
+    material: &Material,
+    cdfs: &BrdfMapCdfs,
+    n: DVec3,
+    wo: DVec3,
+    u_lobe: f64,
+    u: DVec2,
+) -> DVec3 {
     let frame = ShadingFrame::new(n);
     let wo_local = frame.to_local(wo);
-    let local = if u_lobe < specular_lobe_probability(material) {
+    let local = if let Some(cdf) = cdfs.of(material) {
+        sample_tabulated(cdf, wo_local, u_lobe, u)
+    } else if u_lobe < specular_lobe_probability(material) {
         reflect_about(wo_local, sample_half_vector(material, wo_local, u))
     } else {
         sample_cosine_hemisphere(u)
@@ -137,9 +148,12 @@ fn sample_brdf(material: &Material, n: DVec3, wo: DVec3, u_lobe: f64, u: DVec2) 
 }
 
 /// The density per steradian of [`sample_brdf`] producing `wi`.
-fn pdf_brdf(material: &Material, n: DVec3, wo: DVec3, wi: DVec3) -> f64 {
+fn pdf_brdf(material: &Material, cdfs: &BrdfMapCdfs, n: DVec3, wo: DVec3, wi: DVec3) -> f64 {
     let frame = ShadingFrame::new(n);
     let (wo_local, wi_local) = (frame.to_local(wo), frame.to_local(wi));
+    if let Some(cdf) = cdfs.of(material) {
+        return pdf_tabulated(cdf, wo_local, wi_local);
+    }
     let p_specular = specular_lobe_probability(material);
     let mut pdf = (1.0 - p_specular) * pdf_cosine_hemisphere(wi_local);
     if p_specular > 0.0 {
@@ -256,12 +270,13 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
             }
             let wi = sample_brdf(
                 &material,
+                &scene.brdf_map_cdfs,
                 n,
                 wo,
                 random(1),
                 DVec2::new(random(2), random(3)),
             );
-            let pdf = pdf_brdf(&material, n, wo, wi);
+            let pdf = pdf_brdf(&material, &scene.brdf_map_cdfs, n, wo, wi);
             let cos_i = n.dot(wi);
             if pdf.is_nan() || pdf <= 0.0 || cos_i <= 0.0 || ng.dot(wi) <= 0.0 {
                 break;
@@ -388,7 +403,7 @@ fn sample_emitter(
     }
     let f = eval_brdf(material, &scene.images, n, wi, wo);
     let weight = if mis {
-        power_heuristic(pdf, pdf_brdf(material, n, wo, wi))
+        power_heuristic(pdf, pdf_brdf(material, &scene.brdf_map_cdfs, n, wo, wi))
     } else {
         1.0
     };
@@ -398,11 +413,11 @@ fn sample_emitter(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::FresnelModel;
+    use crate::scene::{FresnelModel, Image};
 
     /// `∫ f(wi, wo) cos θi dωi` over the hemisphere (the directional albedo), by the
     /// midpoint rule on a fine (θ, φ) grid.
-    fn albedo_by_quadrature(material: &Material, wo: DVec3) -> DVec3 {
+    fn albedo_by_quadrature(material: &Material, images: &[Image], wo: DVec3) -> DVec3 {
         let (nt, np) = (256, 512);
         let (dt, dp) = (
             std::f64::consts::FRAC_PI_2 / nt as f64,
@@ -418,7 +433,7 @@ mod tests {
                     theta.sin() * phi.sin(),
                     theta.cos(),
                 );
-                let f = eval_brdf(material, &[], DVec3::Z, wi, wo);
+                let f = eval_brdf(material, images, DVec3::Z, wi, wo);
                 sum += f * (wi.z * theta.sin() * dt * dp);
             }
         }
@@ -475,15 +490,22 @@ mod tests {
         let wo = DVec3::new(theta_o.sin(), 0.0, theta_o.cos());
         let n = 200_000u32;
         for (name, material) in materials {
-            let expected = albedo_by_quadrature(&material, wo);
+            let expected = albedo_by_quadrature(&material, &[], wo);
             let (mut sum, mut squares) = (DVec3::ZERO, DVec3::ZERO);
             for i in 0..n {
                 let u = |d| random_number(i, 7, d);
-                let wi = sample_brdf(&material, DVec3::Z, wo, u(0), DVec2::new(u(1), u(2)));
+                let wi = sample_brdf(
+                    &material,
+                    &BrdfMapCdfs::default(),
+                    DVec3::Z,
+                    wo,
+                    u(0),
+                    DVec2::new(u(1), u(2)),
+                );
                 if wi.z <= 0.0 {
                     continue;
                 }
-                let pdf = pdf_brdf(&material, DVec3::Z, wo, wi);
+                let pdf = pdf_brdf(&material, &BrdfMapCdfs::default(), DVec3::Z, wo, wi);
                 assert!(pdf > 0.0, "{name}: a sampled direction has density 0");
                 let value = eval_brdf(&material, &[], DVec3::Z, wi, wo) * (wi.z / pdf);
                 sum += value;
@@ -500,6 +522,91 @@ mod tests {
                      (tolerance {tolerance})",
                     mean[c],
                     expected[c]
+                );
+            }
+        }
+    }
+
+    /// A map of `n × n` texels holding `π·f = value(θi, θr)` in every channel.
+    fn brdf_map(n: u32, value: impl Fn(f64, f64) -> f64) -> Image {
+        let angle = |i: u32| f64::from(i) / f64::from(n - 1) * std::f64::consts::FRAC_PI_2;
+        let texels = (0..n * n)
+            .map(|i| {
+                let v = value(angle(i % n), angle(i / n)) as f32;
+                [v, v, v, 1.0]
+            })
+            .collect();
+        Image {
+            path: "test map".into(),
+            width: n,
+            height: n,
+            texels,
+        }
+    }
+
+    /// Sampling tabulated BRDFs by their maps' inverse CDF keeps the path's estimator
+    /// unbiased (its mean is the directional albedo by quadrature, for outgoing angles
+    /// on and between the map's rows) and makes it less noisy than the cosine sampler:
+    /// on a glossy map peaked along θi = θr, and on a map bright only at grazing angles,
+    /// the variance per sample is at least 4 times smaller (measured: see the
+    /// assertion's message with `--nocapture`).
+    #[test]
+    fn brdf_map_sampling_is_unbiased_and_less_noisy_than_cosine_sampling() {
+        let glossy = brdf_map(65, |ti, tr| {
+            0.05 + 5.0 * (-((ti - tr) / 0.08).powi(2)).exp()
+        });
+        let grazing = brdf_map(33, |ti, tr| 3.6 * (ti.sin() * tr.sin()).powi(6));
+        for (name, image) in [("glossy", glossy), ("grazing", grazing)] {
+            let images = [image];
+            let material = Material {
+                brdf_map: Some(0),
+                ..Material::blank(MaterialKind::Tabulated)
+            };
+            let cdfs = BrdfMapCdfs::new(&images, &[material]);
+            assert!(cdfs.of(&material).is_some());
+            for theta_o in [40f64.to_radians(), 1.2, 75f64.to_radians()] {
+                let wo = DVec3::new(theta_o.sin(), 0.0, theta_o.cos());
+                let expected = albedo_by_quadrature(&material, &images, wo).x;
+                let n = 200_000u32;
+                let (mut sum, mut squares) = (0.0, 0.0);
+                let mut cosine_squares = 0.0;
+                for i in 0..n {
+                    let u = |d| random_number(i, 11, d);
+                    let uv = DVec2::new(u(1), u(2));
+                    let wi = sample_brdf(&material, &cdfs, DVec3::Z, wo, u(0), uv);
+                    let f = eval_brdf(&material, &images, DVec3::Z, wi, wo).x;
+                    if wi.z > 0.0 {
+                        let pdf = pdf_brdf(&material, &cdfs, DVec3::Z, wo, wi);
+                        assert!(pdf > 0.0, "{name}: a sampled direction has density 0");
+                        let value = f * wi.z / pdf;
+                        sum += value;
+                        squares += value * value;
+                    }
+                    // The cosine sampler's estimate from the same numbers.
+                    let wc = sample_cosine_hemisphere(uv);
+                    let value =
+                        eval_brdf(&material, &images, DVec3::Z, wc, wo).x * std::f64::consts::PI;
+                    cosine_squares += value * value;
+                }
+                let count = f64::from(n);
+                let mean = sum / count;
+                let variance = squares / count - mean * mean;
+                let cosine_variance = cosine_squares / count - expected * expected;
+                let tolerance = 4.0 * (variance.max(0.0) / count).sqrt() + 2e-3 * expected;
+                assert!(
+                    (mean - expected).abs() <= tolerance,
+                    "{name}, θo {theta_o:.3}: the estimator's mean {mean} against the albedo \
+                     {expected} (tolerance {tolerance})"
+                );
+                let reduction = cosine_variance / variance;
+                assert!(
+                    reduction >= 4.0,
+                    "{name}, θo {theta_o:.3}: variance {variance:.3e} against the cosine \
+                     sampler's {cosine_variance:.3e} (ratio {reduction:.1})"
+                );
+                eprintln!(
+                    "{name}, θo {theta_o:.3}: albedo {expected:.4}, mean {mean:.4}, variance \
+                     {variance:.3e} against cosine {cosine_variance:.3e} (ratio {reduction:.1})"
                 );
             }
         }

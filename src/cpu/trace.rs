@@ -9,8 +9,8 @@ use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
 use super::path::path_radiance;
 use super::texture::shading_material;
 use super::traverse::{intersect_scene, occluded};
-use crate::accel::AreaLights;
 use crate::accel::SceneGeometry;
+use crate::accel::{AreaLights, BrdfMapCdfs};
 use crate::camera::{CameraFrame, SamplePattern};
 pub use crate::scene::MediumStack;
 use crate::scene::{Image, Integrator, Light, Material, RenderSettings, Scene};
@@ -41,6 +41,9 @@ pub struct PreparedScene {
     pub images: Vec<Image>,
     /// The emissive shapes the path integrator samples.
     pub area_lights: AreaLights,
+    /// The inverse-CDF tables of the BRDF maps, which the path integrator samples
+    /// tabulated materials by.
+    pub brdf_map_cdfs: BrdfMapCdfs,
 }
 
 impl PreparedScene {
@@ -53,9 +56,12 @@ impl PreparedScene {
     /// the one the GPU backend uploaded, so both trace the same tree).
     pub fn with_geometry(scene: &Scene, geometry: SceneGeometry) -> Self {
         let scene = scene.in_lighting_space();
-        let area_lights = match scene.render.integrator {
-            Integrator::Path => AreaLights::new(&geometry, &scene.materials),
-            Integrator::Whitted => AreaLights::default(),
+        let (area_lights, brdf_map_cdfs) = match scene.render.integrator {
+            Integrator::Path => (
+                AreaLights::new(&geometry, &scene.materials),
+                BrdfMapCdfs::new(&scene.images, &scene.materials),
+            ),
+            Integrator::Whitted => (AreaLights::default(), BrdfMapCdfs::default()),
         };
         Self {
             settings: scene.render,
@@ -69,6 +75,7 @@ impl PreparedScene {
             camera_medium: MediumStack::from_outermost_first(&scene.camera_medium()),
             images: scene.images,
             area_lights,
+            brdf_map_cdfs,
         }
     }
 }

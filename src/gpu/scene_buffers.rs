@@ -7,7 +7,7 @@ use super::features::ShaderFeatures;
 use super::layout::FrameUniforms;
 use super::readback::{Caught, capture};
 use super::upload::{SceneRecords, frame_uniforms, image_layers};
-use crate::accel::{BvhStats, MAX_PLANES, SceneGeometry};
+use crate::accel::{BrdfMapCdfs, BvhStats, MAX_PLANES, SceneGeometry};
 use crate::scene::{Integrator, Scene};
 
 /// The storage buffers of an uploaded scene.
@@ -207,7 +207,8 @@ fn upload_images(
     scene: &Scene,
     limits: &wgpu::Limits,
 ) -> Result<(wgpu::TextureView, u64), GpuError> {
-    let (width, height, layers, texels) = image_layers(&scene.images);
+    let cdfs = BrdfMapCdfs::new(&scene.images, &scene.materials);
+    let (width, height, layers, texels) = image_layers(&scene.images, &cdfs);
     if layers > limits.max_texture_array_layers {
         return Err(GpuError::DeviceLimit {
             what: "images (texture array layers)".to_string(),

@@ -34,6 +34,9 @@ pub const TRACE_WGSL: &str = include_str!("../../shaders/trace.wgsl");
 pub const PATH_TYPES_WGSL: &str = include_str!("../../shaders/path_types.wgsl");
 /// The path integrator (`PATH` feature), twin of [`crate::cpu::path`] and its samplers.
 pub const PATH_WGSL: &str = include_str!("../../shaders/path.wgsl");
+/// The inverse-CDF sampler of tabulated BRDF maps (`PATH` and `TABULATED` features),
+/// twin of [`crate::cpu::tabulated`].
+pub const TABULATED_WGSL: &str = include_str!("../../shaders/tabulated.wgsl");
 
 /// Entry point of the shading kernel of the trace module.
 pub const SHADE_ENTRY_POINT: &str = "shade_paths";
@@ -51,7 +54,8 @@ pub const WORKGROUP_SIZE: u32 = 8;
 
 /// The complete trace module specialised to `features` (see [`super::features`]): the
 /// constants shared with the Rust side (`MAX_BVH_DEPTH`, `MAX_POLYGON_VERTICES`), then
-/// types, path types, sampling, intersect, texture, bxdf, traverse, trace and path.
+/// types, path types, sampling, intersect, texture, bxdf, traverse, trace, path and
+/// the tabulated BRDF sampler.
 ///
 /// Errors: a message if the sources' feature directives are malformed.
 ///
@@ -73,6 +77,7 @@ pub fn trace_shader_source(features: &ShaderFeatures) -> Result<String, String> 
         TRAVERSE_WGSL,
         TRACE_WGSL,
         PATH_WGSL,
+        TABULATED_WGSL,
     ];
     let mut source = format!(
         "const MAX_BVH_DEPTH: u32 = {}u;\nconst MAX_POLYGON_VERTICES: u32 = {}u;\n",

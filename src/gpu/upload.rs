@@ -14,8 +14,8 @@ use super::layout::{
     NO_ATTRIBUTES, NO_IMAGE, WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT, WRAP_REPEAT,
 };
 use crate::accel::{
-    BvhNode, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry, TriangleAttributes,
-    TriangleShape,
+    BrdfMapCdfs, BvhNode, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry,
+    TriangleAttributes, TriangleShape,
 };
 use crate::camera::CameraFrame;
 use crate::scene::{
@@ -372,9 +372,12 @@ pub fn triangle_attributes_record(attributes: &TriangleAttributes) -> GpuTriangl
 /// The scene's images as the layers of one `Rgba32Float` texture array: every layer is
 /// as large as the largest image, each image in its layer's top-left corner (the
 /// shaders only read texels inside the image's own width and height), the rest zero.
+/// The alpha channel of a BRDF map's layer holds its inverse-CDF table from `cdfs`
+/// (texel `(x, y)` = [`crate::accel::BrdfMapCdf::value`]`(x, y)`), which the path
+/// integrator samples the map by; no material reads an image's alpha otherwise.
 /// Returns `(width, height, layers, texels)` with texels layer by layer, row-major; a
 /// scene without images gets one 1×1 zero layer (WGSL needs a bound texture).
-pub fn image_layers(images: &[Image]) -> (u32, u32, u32, Vec<[f32; 4]>) {
+pub fn image_layers(images: &[Image], cdfs: &BrdfMapCdfs) -> (u32, u32, u32, Vec<[f32; 4]>) {
     let width = images.iter().map(|i| i.width).max().unwrap_or(1);
     let height = images.iter().map(|i| i.height).max().unwrap_or(1);
     let layers = images.len().max(1);
@@ -384,6 +387,11 @@ pub fn image_layers(images: &[Image]) -> (u32, u32, u32, Vec<[f32; 4]>) {
             let row = &image.texels[y * image.width as usize..(y + 1) * image.width as usize];
             let start = (layer * height as usize + y) * width as usize;
             texels[start..start + row.len()].copy_from_slice(row);
+            if let Some(cdf) = cdfs.of_image(layer) {
+                for (x, texel) in texels[start..start + row.len()].iter_mut().enumerate() {
+                    texel[3] = cdf.value(x as u32, y as u32);
+                }
+            }
         }
     }
     (width, height, layers as u32, texels)
@@ -679,6 +687,40 @@ mod tests {
         assert_eq!(f.aspect, 2.0);
         assert_eq!(f.forward, [0.0, 0.0, -1.0]);
         assert_eq!(f.background, [0.1, 0.2, 0.3]);
+    }
+
+    /// A BRDF map's layer carries its inverse-CDF table in alpha, every other image its
+    /// own texels; the colour channels are the images'.
+    #[test]
+    fn brdf_map_layers_carry_their_inverse_cdf_in_alpha() {
+        let image = |width: u32, height: u32, value: f32| Image {
+            path: "test".into(),
+            width,
+            height,
+            texels: (0..width * height)
+                .map(|i| [value * i as f32, value, value, 1.0])
+                .collect(),
+        };
+        let images = [image(4, 2, 0.5), image(3, 3, 0.25)];
+        let map = Material {
+            brdf_map: Some(1),
+            ..Material::blank(MaterialKind::Tabulated)
+        };
+        let cdfs = BrdfMapCdfs::new(&images, &[map]);
+        let table = cdfs.of_image(1).expect("the map's table");
+        let (width, height, layers, texels) = image_layers(&images, &cdfs);
+        assert_eq!((width, height, layers), (4, 3, 2));
+        let texel = |layer: usize, x: usize, y: usize| texels[(layer * 3 + y) * 4 + x];
+        assert_eq!(texel(0, 3, 1), images[0].texel(3, 1));
+        for y in 0..3 {
+            for x in 0..3 {
+                let t = texel(1, x, y);
+                assert_eq!(&t[..3], &images[1].texel(x as u32, y as u32)[..3]);
+                assert_eq!(t[3], table.value(x as u32, y as u32));
+            }
+        }
+        assert_eq!(texel(1, 2, 2)[3], 1.0);
+        assert!(texel(1, 1, 0)[3] > 0.0 && texel(1, 1, 0)[3] < 1.0);
     }
 
     #[test]
