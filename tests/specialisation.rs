@@ -82,9 +82,10 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         mesh_attributes: false,
         instances: false,
         path: false,
+        environment_map: false,
     };
     type Toggle = fn(&mut ShaderFeatures, bool);
-    let toggles: [Toggle; 14] = [
+    let toggles: [Toggle; 15] = [
         |f, v| f.spheres = v,
         |f, v| f.planes = v,
         |f, v| f.polygons = v,
@@ -99,6 +100,7 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         |f, v| f.mesh_attributes = v,
         |f, v| f.instances = v,
         |f, v| f.path = v,
+        |f, v| f.environment_map = v,
     ];
     let all = function_names(&ShaderFeatures::ALL).len();
     let bare = function_names(&none).len();

@@ -31,9 +31,9 @@ use super::texture::shading_material;
 use super::trace::{
     PreparedScene, direct_light, finite_radiance, keep_on_side, shading_frame_normal,
 };
-use super::traverse::intersect_scene;
+use super::traverse::{intersect_scene, occluded};
 use crate::accel::area_lights::{Emitter, EmitterShape};
-use crate::accel::{AreaLights, PrimKind, luminance};
+use crate::accel::{AreaLights, EnvironmentLight, PrimKind, luminance};
 use crate::scene::{Material, MaterialKind, MediumStack, MicrofacetDistribution};
 
 /// Bounces after which Russian roulette may end a path.
@@ -48,8 +48,15 @@ pub const MIN_SURVIVAL: f64 = 0.05;
 /// Dimensions 0 and 1 of a pixel's sample are its position in the pixel.
 const DIMENSIONS_PER_BOUNCE: u32 = 8;
 
+/// The probability that next-event estimation picks the environment map rather than
+/// an area light (0 without a map; [`EnvironmentLight::selection`]).
+fn environment_selection(scene: &PreparedScene) -> f64 {
+    scene.environment.as_ref().map_or(0.0, |e| e.selection)
+}
+
 /// The density per steradian with which next-event estimation from `point` samples
-/// the direction towards `hit` on an emitter of `lights` (0 if `hit` is on none).
+/// the direction towards `hit` on an emitter of `lights` (0 if `hit` is on none),
+/// the environment's share of the choice (`environment_selection`) left out.
 fn emitter_pdf(lights: &AreaLights, point: DVec3, hit: &Hit) -> f64 {
     // Every flat emitter piece of a primitive has the density luminance / total per
     // unit area; a sphere has its cone density times its selection probability.
@@ -172,7 +179,22 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
         let random = move |k: u32| random_number(pixel, sample, first_dimension + k);
         rays += 1;
         let Some(hit) = intersect_scene(geometry, &ray, f64::INFINITY) else {
-            add(&mut radiance, throughput * scene.background);
+            // The environment, weighted against next-event estimation where that
+            // could have found it.
+            let background = match &scene.environment {
+                Some(environment) => {
+                    let weight = match brdf_pdf {
+                        Some(pdf) => power_heuristic(
+                            pdf,
+                            environment.selection * environment.pdf(ray.direction),
+                        ),
+                        None => 1.0,
+                    };
+                    environment.map.radiance(ray.direction) * weight
+                }
+                None => scene.background,
+            };
+            add(&mut radiance, throughput * background);
             break;
         };
         let material = shading_material(
@@ -188,9 +210,11 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
             && emits_towards(&hit, ray.direction, material.two_sided)
         {
             let weight = match brdf_pdf {
-                Some(pdf) => {
-                    power_heuristic(pdf, emitter_pdf(&scene.area_lights, previous_point, &hit))
-                }
+                Some(pdf) => power_heuristic(
+                    pdf,
+                    (1.0 - environment_selection(scene))
+                        * emitter_pdf(&scene.area_lights, previous_point, &hit),
+                ),
                 None => 1.0,
             };
             add(&mut radiance, throughput * material.emission * weight);
@@ -235,12 +259,33 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
                 rays += traced;
                 add(&mut radiance, event_weight * lit);
             }
-            // One emitter, chosen by power.
-            if let Some((emitter, selection)) = scene.area_lights.choose(random(4)) {
+            // One light: the environment with its selection probability, else an
+            // emitter chosen by power with the rest of the numbers' range.
+            let u_light = random(4);
+            let p_environment = environment_selection(scene);
+            if let Some(environment) = &scene.environment
+                && u_light < p_environment
+            {
+                let (lit, traced) = sample_environment(
+                    scene,
+                    environment,
+                    &material,
+                    shadow_origin,
+                    n,
+                    wo,
+                    DVec2::new(random(5), random(6)),
+                    continues,
+                );
+                rays += traced;
+                add(&mut radiance, event_weight * lit);
+            } else if let Some((emitter, selection)) = scene
+                .area_lights
+                .choose((u_light - p_environment) / (1.0 - p_environment))
+            {
                 let (lit, traced) = sample_emitter(
                     scene,
                     emitter,
-                    selection,
+                    selection * (1.0 - p_environment),
                     &material,
                     shadow_origin,
                     n,
@@ -393,6 +438,46 @@ fn sample_emitter(
         1.0
     };
     (f * emitter.radiance * (cos_i * weight / pdf), 1)
+}
+
+/// Next-event estimation of the environment map (chosen with its selection
+/// probability) from `origin`: a direction drawn from its distribution, `f · L · cos θ
+/// / pdf` if the ray escapes, weighted by the power heuristic against the BRDF's
+/// sampler when `mis`. Returns it and the rays traced.
+#[allow(clippy::too_many_arguments)]
+fn sample_environment(
+    scene: &PreparedScene,
+    environment: &EnvironmentLight,
+    material: &Material,
+    origin: DVec3,
+    n: DVec3,
+    wo: DVec3,
+    u: DVec2,
+    mis: bool,
+) -> (DVec3, u64) {
+    let Some(sample) = environment.sample(u) else {
+        return (DVec3::ZERO, 0);
+    };
+    let pdf = sample.pdf * environment.selection;
+    let wi = sample.wi;
+    let cos_i = n.dot(wi);
+    if pdf.is_nan() || pdf <= 0.0 || cos_i <= 0.0 {
+        return (DVec3::ZERO, 0);
+    }
+    let shadow = Ray {
+        origin,
+        direction: wi,
+    };
+    if occluded(&scene.geometry, &shadow, f64::INFINITY) {
+        return (DVec3::ZERO, 1);
+    }
+    let f = eval_brdf(material, &scene.images, n, wi, wo);
+    let weight = if mis {
+        power_heuristic(pdf, pdf_brdf(material, n, wo, wi))
+    } else {
+        1.0
+    };
+    (f * sample.radiance * (cos_i * weight / pdf), 1)
 }
 
 #[cfg(test)]

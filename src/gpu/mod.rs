@@ -29,6 +29,7 @@
 
 pub mod area_lights;
 pub mod context;
+pub mod environment;
 mod display;
 mod draw;
 mod error;

@@ -166,10 +166,14 @@ pub struct Camera {
 }
 
 /// Light that does not come from a light source.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Environment {
-    /// Radiance (W/(sr·m²) per channel) carried by rays that hit nothing.
+    /// Radiance (W/(sr·m²) per channel) carried by rays that hit nothing, when there
+    /// is no [`Environment::map`].
     pub background: DVec3,
+    /// An environment map: the radiance of rays that hit nothing by direction (it
+    /// replaces `background`), and a light the path integrator samples.
+    pub map: Option<std::sync::Arc<super::EnvironmentMap>>,
     /// Constant ambient radiance added as `albedo * ambient` at every diffuse hit:
     /// the classic Whitted ambient term. Default 0 (physically based).
     pub ambient: DVec3,
@@ -560,6 +564,14 @@ impl Scene {
                 m.emission = encode(m.emission);
             }
             scene.environment.background = encode(scene.environment.background);
+            if let Some(map) = &mut scene.environment.map {
+                let map = std::sync::Arc::make_mut(map);
+                for texel in &mut map.image.texels {
+                    for c in &mut texel[..3] {
+                        *c = crate::color::srgb_encode_extended(f64::from(*c)) as f32;
+                    }
+                }
+            }
             scene.environment.ambient = encode(scene.environment.ambient);
         }
         scene

@@ -313,7 +313,12 @@ fn build_scene(
     let render = settings::render(source, raw.render)?;
     let camera = settings::camera(source, raw.camera)?;
     let camera_path = animation::animation(source, raw.animation, &camera)?;
-    let environment = settings::environment(source, raw.environment)?;
+    let environment = settings::environment(
+        source,
+        raw.environment,
+        source.path.parent().unwrap_or(std::path::Path::new("")),
+        options,
+    )?;
     let total = (raw.materials.len() + raw.lights.len() + raw.objects.len()) as u64;
     let mut done = 0;
     let mut checked = || {
