@@ -9,8 +9,8 @@ use std::sync::Arc;
 
 use glam::DVec3;
 use gpu_render::scene::{
-    Camera, Environment, EnvironmentMap, Image, Integrator, Material, RenderSettings, Scene,
-    Shape, load_scene,
+    Camera, Environment, EnvironmentMap, Image, Integrator, Material, RenderSettings, Scene, Shape,
+    load_scene,
 };
 
 /// A `width × height` map of one colour.
@@ -99,7 +99,12 @@ fn classify_pixels() -> (Vec<usize>, Vec<usize>) {
 #[test]
 fn a_lambert_sphere_under_a_uniform_sky_converges_to_rho_times_l() {
     let (on, off) = classify_pixels();
-    assert!(on.len() > 20 && off.len() > 100, "{} {}", on.len(), off.len());
+    assert!(
+        on.len() > 20 && off.len() > 100,
+        "{} {}",
+        on.len(),
+        off.len()
+    );
     let radiance = 0.8 * 1.5;
     for (rho, max_depth) in [(0.6, 5), (0.6, 0), (0.9, 3)] {
         let map = EnvironmentMap {
@@ -176,7 +181,12 @@ fn a_black_map_renders_black_without_nan() {
     };
     let scene = sphere_under(map, 0.8, Integrator::Path, 4);
     let image = gpu_render::cpu::render(&scene, None).image;
-    assert!(image.pixels.iter().all(|p| p[..3].iter().all(|&c| c == 0.0)));
+    assert!(
+        image
+            .pixels
+            .iter()
+            .all(|p| p[..3].iter().all(|&c| c == 0.0))
+    );
 }
 
 /// A folder of its own under the target directory for this test's files.
@@ -229,10 +239,9 @@ fn a_map_is_read_relative_to_the_scene_file_with_rotation_and_scale() {
     assert_eq!(map.scale, DVec3::new(1.0, 2.0, 3.0));
     assert_eq!(scene.environment.ambient, DVec3::splat(0.1));
     // The shipped scene's map.
-    let shipped = load_scene(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/env-materials.toml"),
-    )
-    .expect("scenes/env-materials.toml loads");
+    let shipped =
+        load_scene(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/env-materials.toml"))
+            .expect("scenes/env-materials.toml loads");
     let sky = shipped.environment.map.expect("a map");
     assert_eq!((sky.image.width, sky.image.height), (256, 128));
 }
@@ -242,7 +251,9 @@ fn bad_maps_are_clear_errors_naming_the_file_and_the_problem() {
     let dir = scratch("bad");
     let missing = load_error(&scene_with(&dir, "map = \"nowhere.hdr\""));
     assert!(
-        missing.contains("environment") && missing.contains("nowhere.hdr") && missing.contains("cannot read"),
+        missing.contains("environment")
+            && missing.contains("nowhere.hdr")
+            && missing.contains("cannot read"),
         "{missing}"
     );
     std::fs::write(dir.join("text.hdr"), "not an image").expect("written");
@@ -265,7 +276,10 @@ fn bad_maps_are_clear_errors_naming_the_file_and_the_problem() {
     }
     write_exr(&dir.join("ok.exr"), 1.0);
     for (fields, problem) in [
-        ("map = \"ok.exr\"\nbackground = 1", "either background or map"),
+        (
+            "map = \"ok.exr\"\nbackground = 1",
+            "either background or map",
+        ),
         ("map = \"ok.exr\"\nrotation = nan", "rotation is NaN"),
         ("map = \"ok.exr\"\nscale = -1", "scale must be >= 0"),
         ("rotation = 10", "there is no map"),

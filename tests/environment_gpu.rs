@@ -113,7 +113,11 @@ fn gpu_environment_lighting_matches_the_cpu_beside_an_area_light_and_rotated() {
     compare(&gpu, &renderer, "env-materials-lamp", &lamp);
     // The map turned by 73° and tinted: the sun moves, both backends alike.
     let mut turned = env_materials(Integrator::Path, 64, 8);
-    let map = turned.environment.map.as_mut().expect("the scene has a map");
+    let map = turned
+        .environment
+        .map
+        .as_mut()
+        .expect("the scene has a map");
     let map = Arc::make_mut(map);
     map.rotation_degrees = 73.0;
     map.scale = DVec3::new(1.3, 0.9, 0.7);

@@ -262,7 +262,11 @@ fn environment_map_sampling_follows_its_density() {
                 0.0
             } else {
                 // Uneven values, a bright patch, colour.
-                let patch = if (5..8).contains(&x) && (1..3).contains(&y) { 20.0 } else { 0.0 };
+                let patch = if (5..8).contains(&x) && (1..3).contains(&y) {
+                    20.0
+                } else {
+                    0.0
+                };
                 0.2 + f64::from((x * 7 + y * 13) % 11) * 0.3 + patch
             };
             [v as f32, (0.5 * v) as f32, (0.8 * v) as f32, 1.0]
@@ -300,7 +304,11 @@ fn environment_map_sampling_follows_its_density() {
                 continue;
             };
             let want = environment.pdf(s.wi);
-            assert!((s.pdf - want).abs() <= 1e-6 * want, "{} against {want}", s.pdf);
+            assert!(
+                (s.pdf - want).abs() <= 1e-6 * want,
+                "{} against {want}",
+                s.pdf
+            );
             assert!(s.radiance.distance(environment.map.radiance(s.wi)) <= 1e-9);
             assert!(s.radiance.max_element() > 0.0, "a black texel was sampled");
         }

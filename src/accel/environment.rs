@@ -132,7 +132,8 @@ impl EnvironmentLight {
             })
             .collect();
         let marginal = Distribution1D::new(conditional.iter().map(|c| c.integral).collect());
-        let selection = if !(marginal.integral > 0.0) {
+        // The function's values are finite and at least 0, so the integral is never NaN.
+        let selection = if marginal.integral <= 0.0 {
             0.0
         } else if has_area_lights {
             ENVIRONMENT_SELECTION
@@ -150,7 +151,7 @@ impl EnvironmentLight {
     /// A direction drawn from `u ∈ [0, 1)²` (the row by `u.y`, the texel in it by
     /// `u.x`), or `None` at a pole or for a black map.
     pub fn sample(&self, u: DVec2) -> Option<EnvironmentSample> {
-        if !(self.marginal.integral > 0.0) {
+        if self.marginal.integral <= 0.0 {
             return None;
         }
         let (row, v) = self.marginal.sample(u.y);
@@ -173,7 +174,7 @@ impl EnvironmentLight {
     /// The density per steradian of [`EnvironmentLight::sample`] at the unit world
     /// direction `wi` (the selection not included).
     pub fn pdf(&self, wi: DVec3) -> f64 {
-        if !(self.marginal.integral > 0.0) {
+        if self.marginal.integral <= 0.0 {
             return 0.0;
         }
         let local = self.map.to_local(wi);

@@ -47,7 +47,7 @@ pub struct GpuEnvironmentHeader {
 /// zero-padded to a multiple of 16 bytes and at least [`MIN_ENVIRONMENT_BYTES`].
 pub fn environment_buffer(environment: Option<&EnvironmentLight>) -> Vec<u8> {
     let mut bytes = environment_bytes(environment);
-    while bytes.len() < MIN_ENVIRONMENT_BYTES || bytes.len() % 16 != 0 {
+    while bytes.len() < MIN_ENVIRONMENT_BYTES || !bytes.len().is_multiple_of(16) {
         bytes.push(0);
     }
     bytes

@@ -29,9 +29,9 @@
 
 pub mod area_lights;
 pub mod context;
-pub mod environment;
 mod display;
 mod draw;
+pub mod environment;
 mod error;
 pub mod features;
 mod film;

@@ -166,7 +166,8 @@ fn environment_image(
     } else {
         base.join(file)
     };
-    let fail = |message: String| item.fail(format_args!("map `{file}` ({}): {message}", path.display()));
+    let fail =
+        |message: String| item.fail(format_args!("map `{file}` ({}): {message}", path.display()));
     let image = load_image(&path).map_err(fail)?;
     for (i, texel) in image.texels.iter().enumerate() {
         for (channel, value) in ["r", "g", "b"].into_iter().zip(texel.iter().copied()) {
