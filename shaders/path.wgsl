@@ -31,7 +31,8 @@ const ROULETTE_DEPTH: u32 = 3u;
 // The least survival probability of Russian roulette. Twin of MIN_SURVIVAL.
 const MIN_SURVIVAL: f32 = 0.05;
 // Random dimensions a path uses per bounce: the event (0), the BRDF lobe (1), the
-// BRDF direction (2, 3), the emitter (4), the point on it (5, 6) and roulette (7);
+// BRDF direction (2, 3), the light (4: the environment map or an emitter), the point
+// on the emitter or the map's direction (5, 6) and roulette (7);
 // dimensions 0 and 1 of a sample are its position in the pixel. Twin of
 // DIMENSIONS_PER_BOUNCE.
 const DIMENSIONS_PER_BOUNCE: u32 = 8u;

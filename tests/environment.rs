@@ -9,8 +9,8 @@ use std::sync::Arc;
 
 use glam::DVec3;
 use gpu_render::scene::{
-    Camera, Environment, EnvironmentMap, Image, Integrator, Material, RenderSettings, Scene, Shape,
-    load_scene,
+    Camera, Environment, EnvironmentMap, Image, Integrator, LoadOptions, Material, RenderSettings,
+    Scene, Shape, load_scene, load_scene_with,
 };
 
 /// A `width × height` map of one colour.
@@ -287,4 +287,19 @@ fn bad_maps_are_clear_errors_naming_the_file_and_the_problem() {
         let message = load_error(&scene_with(&dir, fields));
         assert!(message.contains(problem), "{fields}: {message}");
     }
+    // A sandbox confines the map to the scene's folder.
+    let outside = scene_with(&dir, "map = \"../environment-bad/ok.exr\"");
+    let options = LoadOptions {
+        sandbox: true,
+        ..LoadOptions::default()
+    };
+    let confined = match load_scene_with(&outside, &options) {
+        Ok(_) => panic!("a map outside the folder loaded in a sandbox"),
+        Err(e) => e.to_string(),
+    };
+    assert!(confined.contains("map"), "{confined}");
+    assert!(
+        load_scene(&outside).is_ok(),
+        "without a sandbox the path is trusted"
+    );
 }

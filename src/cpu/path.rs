@@ -6,9 +6,11 @@
 //! mirror or coat reflection, the refraction) with probability in proportion to its
 //! weight. For the base BRDF it gathers direct light by next-event estimation: every
 //! point and directional light with a shadow ray, and one emissive shape chosen by
-//! power and sampled (spheres by the cone they subtend, polygons and triangles by area),
-//! combined with the BRDF-sampled hits of emitters by multiple importance sampling
-//! (the power heuristic; Veach's thesis, 1997, ch. 9). Then it continues in a
+//! power and sampled (spheres by the cone they subtend, polygons and triangles by area)
+//! or the environment map by its luminance (`crate::accel::EnvironmentLight`),
+//! combined with the BRDF-sampled hits of emitters and escapes to the map by multiple
+//! importance sampling (the power heuristic; Veach's thesis, 1997, ch. 9). Then it
+//! continues in a
 //! direction drawn from the BRDF's importance sampler (`sample.rs`), and Russian
 //! roulette ends it in proportion to its throughput after [`ROULETTE_DEPTH`] bounces.
 //! Random numbers come from the counter-based generator [`random_number`] of the
@@ -44,7 +46,8 @@ pub const ROULETTE_DEPTH: u32 = 3;
 pub const MIN_SURVIVAL: f64 = 0.05;
 
 /// Random dimensions a path uses per bounce: the event (0), the BRDF lobe (1), the
-/// BRDF direction (2, 3), the emitter (4), the point on it (5, 6) and roulette (7).
+/// BRDF direction (2, 3), the light (4: the environment map or an emitter), the point
+/// on the emitter or the map's direction (5, 6) and roulette (7).
 /// Dimensions 0 and 1 of a pixel's sample are its position in the pixel.
 const DIMENSIONS_PER_BOUNCE: u32 = 8;
 

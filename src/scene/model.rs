@@ -545,7 +545,8 @@ impl Scene {
     /// transmittances, emission, background and ambient radiance) is replaced by its
     /// sRGB-encoded value, the number an artist picking colours on screen would type,
     /// so that shading happens on gamma-encoded values as in the lecture's wrong
-    /// example. Light intensities are physical quantities and stay as they are.
+    /// example. Light intensities are physical quantities and stay as they are, as do
+    /// images (textures, BRDF maps and the environment map).
     pub fn in_lighting_space(&self) -> Scene {
         let mut scene = self.clone();
         if self.render.lighting_space == LightingSpace::NaiveGamma {
@@ -564,14 +565,6 @@ impl Scene {
                 m.emission = encode(m.emission);
             }
             scene.environment.background = encode(scene.environment.background);
-            if let Some(map) = &mut scene.environment.map {
-                let map = std::sync::Arc::make_mut(map);
-                for texel in &mut map.image.texels {
-                    for c in &mut texel[..3] {
-                        *c = crate::color::srgb_encode_extended(f64::from(*c)) as f32;
-                    }
-                }
-            }
             scene.environment.ambient = encode(scene.environment.ambient);
         }
         scene

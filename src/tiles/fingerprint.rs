@@ -203,7 +203,10 @@ mod tests {
             b.environment.map = Some(std::sync::Arc::new(changed));
             Fingerprint::of(&b)
         };
-        assert_eq!(with(|m| m.image.path = "/srv/b/sky.hdr".into()), Fingerprint::of(&a));
+        assert_eq!(
+            with(|m| m.image.path = "/srv/b/sky.hdr".into()),
+            Fingerprint::of(&a)
+        );
         assert_ne!(with(|m| m.image.texels[1][2] = 0.5), Fingerprint::of(&a));
         assert_ne!(with(|m| m.rotation_degrees = 11.0), Fingerprint::of(&a));
         assert_ne!(with(|m| m.scale.y = 2.0), Fingerprint::of(&a));

@@ -44,7 +44,8 @@ pub const MAX_SCENE_VALUES: u64 = 8_000_000;
 /// silent, as [`load_scene`] is.
 #[derive(Clone, Copy, Default)]
 pub struct LoadOptions<'a> {
-    /// Confine the files the scene names (albedo textures, BRDF maps) to the scene
+    /// Confine the files the scene names (albedo textures, BRDF maps, the environment
+    /// map) to the scene
     /// file's folder: refuse absolute paths, `..` and links that lead out of it (see
     /// [`confined_path`]). Without it a scene file is trusted input, like a program:
     /// it may name any file the user can read.
