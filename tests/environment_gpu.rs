@@ -2,7 +2,7 @@
 //! next-event code of `shaders/path.wgsl` and `shaders/trace.wgsl`) against the CPU
 //! reference, per pixel in linear float, on the shipped environment-lit scene with
 //! both integrators, with an area light beside the map (the light choice between the
-//! two), and with a rotated, tinted map.
+//! two), with a rotated, tinted map, and with a black map (never sampled).
 //!
 //! Both backends draw the same numbers for the same decisions, so a GPU pixel is the
 //! CPU pixel up to f32 rounding: a channel passes when `|gpu - cpu| <= 1e-3 +
@@ -125,4 +125,11 @@ fn gpu_environment_lighting_matches_the_cpu_beside_an_area_light_and_rotated() {
     map.rotation_degrees = 73.0;
     map.scale = DVec3::new(1.3, 0.9, 0.7);
     compare(&gpu, &renderer, "env-materials-rotated", &turned);
+    // A black map beside the lamp: never sampled (its selection is 0), no NaN.
+    let mut black = lamp.clone();
+    let map = black.environment.map.as_mut().expect("the scene has a map");
+    for texel in &mut Arc::make_mut(map).image.texels {
+        *texel = [0.0, 0.0, 0.0, 1.0];
+    }
+    compare(&gpu, &renderer, "env-materials-black-map", &black);
 }
