@@ -65,6 +65,31 @@ fn a_scene_without_dielectrics_gets_no_refraction_code() {
     }
 }
 
+/// A scene without an environment map gets none of its code (the constant background
+/// and a zero selection remain); the shipped environment-lit scene gets it.
+#[test]
+fn only_a_scene_with_an_environment_map_gets_its_code() {
+    const ENVIRONMENT_CODE: [&str; 4] = [
+        "environment_sample",
+        "environment_pdf",
+        "environment_radiance",
+        "environment_sample_1d",
+    ];
+    let cornell = ShaderFeatures::for_scene(&scene("cornell-box.toml"));
+    assert!(cornell.path && !cornell.environment_map);
+    let names = function_names(&cornell);
+    for function in ENVIRONMENT_CODE {
+        assert!(!names.contains(function), "{function} is in the module");
+    }
+    assert!(names.contains("background_radiance") && names.contains("environment_selection"));
+    let lit = ShaderFeatures::for_scene(&scene("env-materials.toml"));
+    assert!(lit.environment_map);
+    let names = function_names(&lit);
+    for function in ENVIRONMENT_CODE {
+        assert!(names.contains(function), "{function} is missing");
+    }
+}
+
 #[test]
 fn every_feature_alone_and_every_feature_left_out_validates() {
     let none = ShaderFeatures {
