@@ -275,6 +275,8 @@ fn bad_maps_are_clear_errors_naming_the_file_and_the_problem() {
         );
     }
     write_exr(&dir.join("ok.exr"), 1.0);
+    // Finite texels and scale whose product is not finite in f32.
+    write_exr(&dir.join("big.exr"), 100.0);
     for (fields, problem) in [
         (
             "map = \"ok.exr\"\nbackground = 1",
@@ -282,6 +284,7 @@ fn bad_maps_are_clear_errors_naming_the_file_and_the_problem() {
         ),
         ("map = \"ok.exr\"\nrotation = nan", "rotation is NaN"),
         ("map = \"ok.exr\"\nscale = -1", "scale must be >= 0"),
+        ("map = \"big.exr\"\nscale = 1e37", "beyond the largest f32"),
         ("rotation = 10", "there is no map"),
     ] {
         let message = load_error(&scene_with(&dir, fields));

@@ -127,6 +127,22 @@ pub fn environment(
             let rotation_degrees = item.number("rotation", raw.rotation.unwrap_or(0.0))?;
             let scale = item.colour_or("scale", raw.scale, ColourRange::Radiance, DVec3::ONE)?;
             let image = environment_image(&item, file, base, options)?;
+            // The GPU holds radiance and the sampling tables in f32.
+            let brightest = image
+                .texels
+                .iter()
+                .map(|t| {
+                    (DVec3::new(f64::from(t[0]), f64::from(t[1]), f64::from(t[2])) * scale)
+                        .max_element()
+                })
+                .fold(0.0, f64::max);
+            if brightest > f64::from(f32::MAX) {
+                return Err(item.fail(format_args!(
+                    "map `{file}` times scale reaches {brightest:e}, beyond the largest f32 \
+                     ({:e}); lower scale",
+                    f32::MAX
+                )));
+            }
             Some(Arc::new(EnvironmentMap {
                 image,
                 rotation_degrees,
