@@ -1,5 +1,5 @@
 //! Renders with a per-pixel variance estimate, for comparisons with an independent
-//! renderer's reference image (tests/environment_reference.rs).
+//! renderer's reference image (tests/path_reference.rs, tests/environment_reference.rs).
 
 use glam::DVec3;
 use gpu_render::cpu::intersect::Ray;
