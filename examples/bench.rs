@@ -166,6 +166,7 @@ fn million_triangle_scene() -> gpu_render::scene::Scene {
         environment: Environment {
             background: DVec3::new(0.35, 0.45, 0.6),
             ambient: DVec3::ZERO,
+            map: None,
         },
         materials: vec![
             lambert(0.45, 0.5, 0.35),

@@ -4,6 +4,8 @@
 // in docs/path-tracing.md. It runs in the wavefront engine of shaders/trace.wgsl, one
 // bounce per shading step, when frame.flags has FLAG_PATH:
 //
+// - a miss adds the background, or the environment map's radiance weighted by multiple
+//   importance sampling against its next-event estimation (shaders/environment.wgsl);
 // - at a hit (path_closest_hit) the path adds the emission it finds (weighted by
 //   multiple importance sampling against next-event estimation), picks one event of
 //   the material, and decides its continuation at once: the next ray (BRDF-sampled,
@@ -13,7 +15,7 @@
 // - for the base BRDF it then gathers direct light as Whitted does, one shadow ray per
 //   point or directional light (PHASE_NEXT_LIGHT, PHASE_SHADOW), each contribution
 //   added on its own, and last one shadow ray towards a point sampled on one emitter
-//   (PHASE_EMITTER), whose sample is drawn again from the same numbers when the ray
+//   or a direction sampled from the environment map (PHASE_EMITTER), whose sample is drawn again from the same numbers when the ray
 //   comes back, so that nothing but the phase is kept between the two steps;
 // - PHASE_POP then pops the continuation, or ends the sample when there is none.
 //
@@ -29,7 +31,8 @@ const ROULETTE_DEPTH: u32 = 3u;
 // The least survival probability of Russian roulette. Twin of MIN_SURVIVAL.
 const MIN_SURVIVAL: f32 = 0.05;
 // Random dimensions a path uses per bounce: the event (0), the BRDF lobe (1), the
-// BRDF direction (2, 3), the emitter (4), the point on it (5, 6) and roulette (7);
+// BRDF direction (2, 3), the light (4: the environment map or an emitter), the point
+// on the emitter or the map's direction (5, 6) and roulette (7);
 // dimensions 0 and 1 of a sample are its position in the pixel. Twin of
 // DIMENSIONS_PER_BOUNCE.
 const DIMENSIONS_PER_BOUNCE: u32 = 8u;
@@ -499,28 +502,53 @@ fn emits_towards(hit: Hit, direction: vec3<f32>, two_sided: bool) -> bool {
     return two_sided || prim_kind(hit.prim) == PRIM_SPHERE || dot(direction, hit.normal) < 0.0;
 }
 
-// Next-event estimation's sample of one emitter from the path's shadow origin: the
-// emitter chosen by power (dimension 4), a direction towards a point on it
-// (dimensions 5, 6) and its density per steradian, selection included; not found when
-// it contributes nothing and casts no ray (inside a sphere, behind a one-sided
-// emitter, below the shading normal). Twin of the sampling part of sample_emitter.
+// Next-event estimation's sample of one light from the path's shadow origin: the
+// environment with its selection probability (dimension 4 below it), else an emitter
+// chosen by power with the rest of dimension 4's range; a direction towards a point
+// on it (dimensions 5, 6), its density per steradian, selection included, and the
+// radiance arriving along it; not found when it contributes nothing and casts no ray
+// (inside a sphere, behind a one-sided emitter, below the shading normal, a pole of
+// the map). Twin of the choice in path_radiance and of the sampling parts of
+// sample_emitter and sample_environment.
 struct EmitterSample {
     wi: vec3<f32>,
     pdf: f32,
+    radiance: vec3<f32>,
+    // The emitter record, or ENVIRONMENT_EMITTER.
     emitter: u32,
     found: bool,
 }
 
+// EmitterSample.emitter of a sample of the environment map.
+const ENVIRONMENT_EMITTER: u32 = 0xffffffffu;
+
 fn path_emitter_sample(path: ptr<function, PathState>) -> EmitterSample {
-    var sample = EmitterSample(vec3<f32>(0.0), 0.0, 0u, false);
+    var sample = EmitterSample(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0u, false);
+    let origin = (*path).shadow_origin;
+    let u_light = path_random(path, 4u);
+    let u = vec2<f32>(path_random(path, 5u), path_random(path, 6u));
+    let p_environment = environment_selection();
+    //#if ENVIRONMENT_MAP
+    if u_light < p_environment {
+        let drawn = environment_sample(u);
+        if !drawn.found {
+            return sample;
+        }
+        sample.emitter = ENVIRONMENT_EMITTER;
+        sample.wi = drawn.wi;
+        sample.pdf = drawn.pdf * p_environment;
+        sample.radiance = drawn.radiance;
+        sample.found = sample.pdf > 0.0 && dot((*path).normal, sample.wi) > 0.0;
+        return sample;
+    }
+    //#endif
     let count = emitter_count();
     if count == 0u {
         return sample;
     }
-    let origin = (*path).shadow_origin;
-    let u = vec2<f32>(path_random(path, 5u), path_random(path, 6u));
-    sample.emitter = choose_emitter(path_random(path, 4u), count);
+    sample.emitter = choose_emitter((u_light - p_environment) / (1.0 - p_environment), count);
     let emitter = emitters[sample.emitter];
+    sample.radiance = emitter.radiance;
     if emitter.kind == EMITTER_SPHERE {
         //#if SPHERES
         let cone = sample_sphere_cone(origin, emitter.v0, emitter.v1.x, u);
@@ -528,7 +556,7 @@ fn path_emitter_sample(path: ptr<function, PathState>) -> EmitterSample {
             return sample;
         }
         sample.wi = cone.wi;
-        sample.pdf = cone.pdf * emitter.selection;
+        sample.pdf = cone.pdf * (emitter.selection * (1.0 - p_environment));
         //#else
         return sample;
         //#endif
@@ -540,7 +568,8 @@ fn path_emitter_sample(path: ptr<function, PathState>) -> EmitterSample {
             // The back of a one-sided emitter.
             return sample;
         }
-        sample.pdf = area_to_solid_angle_pdf(emitter.area_density, origin, point, emitter.normal);
+        sample.pdf = area_to_solid_angle_pdf(emitter.area_density * (1.0 - p_environment), origin,
+                                             point, emitter.normal);
         sample.wi = normalize_or_zero(to_light);
     }
     let cos_i = dot((*path).normal, sample.wi);
@@ -579,7 +608,20 @@ fn path_continue(slot: u32, path: ptr<function, PathState>, origin: vec3<f32>, d
 fn path_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) {
     let ray = Ray((*path).origin, (*path).direction);
     if trace.best_prim == NO_PRIM {
-        add_contribution(path, (*path).weight * frame.background);
+        var background = frame.background;
+        //#if ENVIRONMENT_MAP
+        if environment_present() {
+            // The environment, weighted against next-event estimation where that could
+            // have found it.
+            var weight = 1.0;
+            if (*path).depth > 0u && (*path).brdf_pdf > 0.0 {
+                weight = power_heuristic((*path).brdf_pdf,
+                                         environment.header.selection * environment_pdf(ray.direction));
+            }
+            background = environment_radiance(ray.direction) * weight;
+        }
+        //#endif
+        add_contribution(path, (*path).weight * background);
         (*path).phase = PHASE_POP;
         return;
     }
@@ -590,7 +632,8 @@ fn path_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) 
     if max_component(material.emission) > 0.0 && emits_towards(hit, ray.direction, material.two_sided != 0u) {
         var weight = 1.0;
         if (*path).depth > 0u && (*path).brdf_pdf > 0.0 {
-            weight = power_heuristic((*path).brdf_pdf, emitter_pdf((*path).shadow_origin, hit));
+            weight = power_heuristic((*path).brdf_pdf,
+                                     (1.0 - environment_selection()) * emitter_pdf((*path).shadow_origin, hit));
         }
         add_contribution(path, (*path).weight * material.emission * weight);
     }
@@ -702,20 +745,26 @@ fn path_start_emitter(path: ptr<function, PathState>, trace: ptr<function, Trace
         return false;
     }
     (*path).rays += 1u;
-    start_trace(trace, (*path).shadow_origin, sample.wi, bitcast<f32>(0x7f800000u), false);
+    // The environment's sample is visible when its ray hits nothing: any hit will do.
+    start_trace(trace, (*path).shadow_origin, sample.wi, bitcast<f32>(0x7f800000u),
+                sample.emitter == ENVIRONMENT_EMITTER);
     (*path).phase = PHASE_EMITTER;
     return true;
 }
 
 // The emitter sample is visible when the first thing its ray meets is that emitter
-// (its emitting side faces the ray: the sample was drawn only there); then it adds
-// f·L·cos θ / pdf, times the event's weight, weighted by the power heuristic against
-// the BRDF sampler when the path goes on. The sample is drawn again from the same
-// numbers. Twin of sample_emitter.
+// (its emitting side faces the ray: the sample was drawn only there), the environment's
+// when its ray meets nothing; then it adds f·L·cos θ / pdf, times the event's weight,
+// weighted by the power heuristic against the BRDF sampler when the path goes on. The
+// sample is drawn again from the same numbers. Twin of sample_emitter and
+// sample_environment.
 fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
     let sample = path_emitter_sample(path);
-    let emitter = emitters[sample.emitter];
-    if sample.found && trace.best_prim == emitter.prim {
+    var visible = trace.best_prim == NO_PRIM;
+    if sample.emitter != ENVIRONMENT_EMITTER {
+        visible = trace.best_prim == emitters[sample.emitter].prim;
+    }
+    if sample.found && visible {
         let material = lit_material(path);
         let n = (*path).normal;
         let wo = -(*path).direction;
@@ -725,7 +774,7 @@ fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
             weight = power_heuristic(sample.pdf, pdf_brdf(material, n, wo, sample.wi));
         }
         let cos_i = dot(n, sample.wi);
-        add_contribution(path, (*path).direct * (f * emitter.radiance * (cos_i * weight / sample.pdf)));
+        add_contribution(path, (*path).direct * (f * sample.radiance * (cos_i * weight / sample.pdf)));
     }
     (*path).phase = PHASE_POP;
 }

@@ -47,3 +47,22 @@ struct Emitter {
     // Triangle: selection / area, its density per unit area.
     area_density: f32,
 }
+
+// The header of the environment buffer (binding 20, shaders/environment.wgsl): the
+// map's size, rotation, scale and sampling constants, followed by its f32 data (twin
+// of GpuEnvironmentHeader in src/gpu/environment.rs, which documents the data's
+// order). A width of 0 means the scene has no map.
+struct EnvironmentHeader {
+    scale: vec3<f32>,
+    width: u32,
+    // (cos α, sin α) of the rotation α about +y.
+    rotation: vec2<f32>,
+    height: u32,
+    // The probability that next-event estimation picks the environment.
+    selection: f32,
+    // ∫ f over the unit square (the marginal distribution's integral); 0 when black.
+    integral: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}

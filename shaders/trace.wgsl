@@ -214,7 +214,8 @@ fn keep_on_side(d: vec3<f32>, side: vec3<f32>) -> vec3<f32> {
 //#endif
 
 // Shades the hit (or miss) of the path's current ray, as shade_hit and trace_radiance
-// do on the CPU: a miss adds the background; a hit pushes the refracted, then the
+// do on the CPU: a miss adds the background (background_radiance: the environment map
+// or the constant); a hit pushes the refracted, then the
 // reflected branch, and either adds its emission at once or, for a surface with a base
 // BRDF, starts gathering its lights (PHASE_NEXT_LIGHT), the ambient term first.
 fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) {
@@ -226,7 +227,7 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
     //#endif
     let ray = Ray((*path).origin, (*path).direction);
     if trace.best_prim == NO_PRIM {
-        add_contribution(path, (*path).weight * frame.background);
+        add_contribution(path, (*path).weight * background_radiance(ray.direction));
         (*path).phase = PHASE_POP;
         return;
     }

@@ -107,6 +107,7 @@ fn scaled_scene(s: f64) -> Scene {
         environment: Environment {
             background: DVec3::new(0.2, 0.3, 0.5),
             ambient: DVec3::ZERO,
+            map: None,
         },
         materials: vec![
             Material::lambert(DVec3::splat(0.6)),
@@ -397,6 +398,7 @@ fn grazing_and_tangent_rays_are_finite_and_acne_free() {
         environment: Environment {
             background: DVec3::splat(0.1),
             ambient: DVec3::ZERO,
+            map: None,
         },
         materials: vec![Material::lambert(DVec3::splat(0.7)), dielectric(1.5)],
         meshes: vec![],
@@ -636,6 +638,7 @@ fn camera_inside_glass_sees_the_background() {
         environment: Environment {
             background: DVec3::new(0.5, 0.25, 1.0),
             ambient: DVec3::ZERO,
+            map: None,
         },
         materials: vec![dielectric(1.5)],
         meshes: vec![],
@@ -714,6 +717,7 @@ fn glass_scene(outer_ior: f64, inner_ior: Option<f64>) -> Scene {
         environment: Environment {
             background: DVec3::new(0.3, 0.35, 0.45),
             ambient: DVec3::ZERO,
+            map: None,
         },
         materials: vec![
             Material::lambert(DVec3::splat(0.7)),
@@ -993,6 +997,7 @@ fn camera_inside_nested_dielectrics_starts_in_the_innermost() {
         environment: Environment {
             background: DVec3::ONE,
             ambient: DVec3::ZERO,
+            map: None,
         },
         materials: vec![dielectric(1.5), dielectric(1.33)],
         meshes: vec![],

@@ -41,6 +41,7 @@ fn scene(samples_per_pixel: u32) -> Scene {
         environment: Environment {
             background: DVec3::new(0.2, 0.3, 0.5),
             ambient: DVec3::ZERO,
+            map: None,
         },
         materials: vec![Material::lambert(DVec3::splat(0.6))],
         material_names: vec!["grey".into()],

@@ -119,6 +119,7 @@ fn base_scene(width: u32, meshes: Vec<Mesh>) -> Scene {
         environment: Environment {
             background: DVec3::new(0.1, 0.12, 0.15),
             ambient: DVec3::splat(0.05),
+            map: None,
         },
         material_names: (0..materials.len()).map(|i| format!("m{i}")).collect(),
         materials,

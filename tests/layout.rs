@@ -11,6 +11,7 @@ use gpu_render::gpu::area_lights::{
     EMITTER_NONE, EMITTER_SPHERE, EMITTER_TRIANGLE, EMITTER_TWO_SIDED_TRIANGLE, FLAG_PATH,
     GpuEmitter, PHASE_EMITTER,
 };
+use gpu_render::gpu::environment::GpuEnvironmentHeader;
 use gpu_render::gpu::layout::*;
 use gpu_render::gpu::shaders::{
     PATH_TYPES_WGSL, TYPES_WGSL, bxdf_eval_shader_source, display_shader_source,
@@ -260,6 +261,18 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 selection,
                 radiance,
                 area_density
+            }),
+        ),
+        (
+            "EnvironmentHeader",
+            twin!(GpuEnvironmentHeader {
+                scale,
+                width,
+                rotation,
+                height,
+                selection,
+                integral,
+                _pad
             }),
         ),
         (

@@ -11,63 +11,17 @@
 //! once in 16,000). Against bias, each channel's image mean must agree within 4 of its
 //! standard error (the pixels are independent, so the variances add) and within 0.5%.
 
+mod common;
+
 use std::path::Path;
 
 use glam::DVec3;
-use gpu_render::cpu::intersect::Ray;
-use gpu_render::cpu::path::path_radiance;
 use gpu_render::cpu::trace::PreparedScene;
 use gpu_render::scene::load_scene;
 
 const SIZE: u32 = 32;
 const SAMPLES: u32 = 1024;
 const REFERENCE_SAMPLES: f64 = 65_536.0;
-
-/// Per pixel: the mean and the sample variance of our samples.
-fn render_with_variance(scene: &PreparedScene) -> Vec<(DVec3, DVec3)> {
-    let pixels: Vec<u32> = (0..SIZE * SIZE).collect();
-    let threads = std::thread::available_parallelism().map_or(1, usize::from);
-    let chunk = pixels.len().div_ceil(threads);
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = pixels
-            .chunks(chunk)
-            .map(|part| {
-                scope.spawn(move || {
-                    part.iter()
-                        .map(|&p| {
-                            let (x, y) = (p % SIZE, p / SIZE);
-                            let (mut sum, mut squares) = (DVec3::ZERO, DVec3::ZERO);
-                            for s in 0..SAMPLES {
-                                let (dx, dy) = scene.samples.offset(x, y, s);
-                                let direction = scene.camera.ray_direction(
-                                    f64::from(x) + dx,
-                                    f64::from(y) + dy,
-                                    SIZE,
-                                    SIZE,
-                                );
-                                let ray = Ray {
-                                    origin: scene.camera.eye,
-                                    direction,
-                                };
-                                let (radiance, _) = path_radiance(scene, ray, p, s);
-                                sum += radiance;
-                                squares += radiance * radiance;
-                            }
-                            let n = f64::from(SAMPLES);
-                            let mean = sum / n;
-                            let variance = (squares / n - mean * mean) * (n / (n - 1.0));
-                            (mean, variance.max(DVec3::ZERO))
-                        })
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().expect("render thread"))
-            .collect()
-    })
-}
 
 #[test]
 fn the_cornell_box_agrees_with_mitsuba_within_its_statistical_error() {
@@ -77,7 +31,7 @@ fn the_cornell_box_agrees_with_mitsuba_within_its_statistical_error() {
     scene.render.height = SIZE;
     scene.render.samples_per_pixel = SAMPLES;
     let prepared = PreparedScene::new(&scene);
-    let ours = render_with_variance(&prepared);
+    let ours = common::reference::render_with_variance(&prepared, SIZE, SIZE, SAMPLES);
     let reference = image::open(root.join("tests/fixtures/mitsuba/cornell-box-32.exr"))
         .expect("the Mitsuba reference")
         .to_rgb32f();

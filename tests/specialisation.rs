@@ -65,6 +65,31 @@ fn a_scene_without_dielectrics_gets_no_refraction_code() {
     }
 }
 
+/// A scene without an environment map gets none of its code (the constant background
+/// and a zero selection remain); the shipped environment-lit scene gets it.
+#[test]
+fn only_a_scene_with_an_environment_map_gets_its_code() {
+    const ENVIRONMENT_CODE: [&str; 4] = [
+        "environment_sample",
+        "environment_pdf",
+        "environment_radiance",
+        "environment_sample_1d",
+    ];
+    let cornell = ShaderFeatures::for_scene(&scene("cornell-box.toml"));
+    assert!(cornell.path && !cornell.environment_map);
+    let names = function_names(&cornell);
+    for function in ENVIRONMENT_CODE {
+        assert!(!names.contains(function), "{function} is in the module");
+    }
+    assert!(names.contains("background_radiance") && names.contains("environment_selection"));
+    let lit = ShaderFeatures::for_scene(&scene("env-materials.toml"));
+    assert!(lit.environment_map);
+    let names = function_names(&lit);
+    for function in ENVIRONMENT_CODE {
+        assert!(names.contains(function), "{function} is missing");
+    }
+}
+
 #[test]
 fn every_feature_alone_and_every_feature_left_out_validates() {
     let none = ShaderFeatures {
@@ -82,9 +107,10 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         mesh_attributes: false,
         instances: false,
         path: false,
+        environment_map: false,
     };
     type Toggle = fn(&mut ShaderFeatures, bool);
-    let toggles: [Toggle; 14] = [
+    let toggles: [Toggle; 15] = [
         |f, v| f.spheres = v,
         |f, v| f.planes = v,
         |f, v| f.polygons = v,
@@ -99,6 +125,7 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         |f, v| f.mesh_attributes = v,
         |f, v| f.instances = v,
         |f, v| f.path = v,
+        |f, v| f.environment_map = v,
     ];
     let all = function_names(&ShaderFeatures::ALL).len();
     let bare = function_names(&none).len();

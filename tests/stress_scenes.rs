@@ -58,6 +58,7 @@ fn scene(
         environment: Environment {
             background: DVec3::new(0.2, 0.25, 0.35),
             ambient: DVec3::ZERO,
+            map: None,
         },
         materials,
         material_names: names,

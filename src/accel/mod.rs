@@ -26,12 +26,14 @@
 pub mod area_lights;
 pub mod brdf_map_cdf;
 pub mod bvh;
+pub mod environment;
 pub mod geometry;
 pub mod instance;
 
 pub use area_lights::{AreaLights, EmitterEntry, EmitterEntryShape, luminance};
 pub use brdf_map_cdf::{BrdfMapCdf, BrdfMapCdfs};
 pub use bvh::{BuildMethod, Bvh, BvhNode, BvhStats, MAX_BVH_DEPTH, MAX_LEAF_PRIMITIVES};
+pub use environment::{Distribution1D, ENVIRONMENT_SELECTION, EnvironmentLight, EnvironmentSample};
 pub use geometry::{
     MAX_PLANES, MAX_POLYGON_VERTICES, PlaneShape, PolygonShape, PrimKind, PrimRef, SceneGeometry,
     SphereShape, TriangleAttributes, TriangleShape, ray_offset_scale,

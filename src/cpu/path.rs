@@ -6,9 +6,11 @@
 //! mirror or coat reflection, the refraction) with probability in proportion to its
 //! weight. For the base BRDF it gathers direct light by next-event estimation: every
 //! point and directional light with a shadow ray, and one emissive shape chosen by
-//! power and sampled (spheres by the cone they subtend, polygons and triangles by area),
-//! combined with the BRDF-sampled hits of emitters by multiple importance sampling
-//! (the power heuristic; Veach's thesis, 1997, ch. 9). Then it continues in a
+//! power and sampled (spheres by the cone they subtend, polygons and triangles by area)
+//! or the environment map by its luminance (`crate::accel::EnvironmentLight`),
+//! combined with the BRDF-sampled hits of emitters and escapes to the map by multiple
+//! importance sampling (the power heuristic; Veach's thesis, 1997, ch. 9). Then it
+//! continues in a
 //! direction drawn from the BRDF's importance sampler (`sample.rs`), and Russian
 //! roulette ends it in proportion to its throughput after [`ROULETTE_DEPTH`] bounces.
 //! Random numbers come from the counter-based generator [`random_number`] of the
@@ -32,9 +34,9 @@ use super::texture::shading_material;
 use super::trace::{
     PreparedScene, direct_light, finite_radiance, keep_on_side, shading_frame_normal,
 };
-use super::traverse::intersect_scene;
+use super::traverse::{intersect_scene, occluded};
 use crate::accel::area_lights::{Emitter, EmitterShape};
-use crate::accel::{AreaLights, BrdfMapCdfs, PrimKind, luminance};
+use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight, PrimKind, luminance};
 use crate::scene::{Material, MaterialKind, MediumStack, MicrofacetDistribution};
 
 /// Bounces after which Russian roulette may end a path.
@@ -45,12 +47,20 @@ pub const ROULETTE_DEPTH: u32 = 3;
 pub const MIN_SURVIVAL: f64 = 0.05;
 
 /// Random dimensions a path uses per bounce: the event (0), the BRDF lobe (1), the
-/// BRDF direction (2, 3), the emitter (4), the point on it (5, 6) and roulette (7).
+/// BRDF direction (2, 3), the light (4: the environment map or an emitter), the point
+/// on the emitter or the map's direction (5, 6) and roulette (7).
 /// Dimensions 0 and 1 of a pixel's sample are its position in the pixel.
 const DIMENSIONS_PER_BOUNCE: u32 = 8;
 
+/// The probability that next-event estimation picks the environment map rather than
+/// an area light (0 without a map; [`EnvironmentLight::selection`]).
+fn environment_selection(scene: &PreparedScene) -> f64 {
+    scene.environment.as_ref().map_or(0.0, |e| e.selection)
+}
+
 /// The density per steradian with which next-event estimation from `point` samples
-/// the direction towards `hit` on an emitter of `lights` (0 if `hit` is on none).
+/// the direction towards `hit` on an emitter of `lights` (0 if `hit` is on none),
+/// the environment's share of the choice (`environment_selection`) left out.
 fn emitter_pdf(lights: &AreaLights, point: DVec3, hit: &Hit) -> f64 {
     // Every flat emitter piece of a primitive has the density luminance / total per
     // unit area; a sphere has its cone density times its selection probability.
@@ -186,7 +196,22 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
         let random = move |k: u32| random_number(pixel, sample, first_dimension + k);
         rays += 1;
         let Some(hit) = intersect_scene(geometry, &ray, f64::INFINITY) else {
-            add(&mut radiance, throughput * scene.background);
+            // The environment, weighted against next-event estimation where that
+            // could have found it.
+            let background = match &scene.environment {
+                Some(environment) => {
+                    let weight = match brdf_pdf {
+                        Some(pdf) => power_heuristic(
+                            pdf,
+                            environment.selection * environment.pdf(ray.direction),
+                        ),
+                        None => 1.0,
+                    };
+                    environment.map.radiance(ray.direction) * weight
+                }
+                None => scene.background,
+            };
+            add(&mut radiance, throughput * background);
             break;
         };
         let material = shading_material(
@@ -202,9 +227,11 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
             && emits_towards(&hit, ray.direction, material.two_sided)
         {
             let weight = match brdf_pdf {
-                Some(pdf) => {
-                    power_heuristic(pdf, emitter_pdf(&scene.area_lights, previous_point, &hit))
-                }
+                Some(pdf) => power_heuristic(
+                    pdf,
+                    (1.0 - environment_selection(scene))
+                        * emitter_pdf(&scene.area_lights, previous_point, &hit),
+                ),
                 None => 1.0,
             };
             add(&mut radiance, throughput * material.emission * weight);
@@ -249,12 +276,33 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
                 rays += traced;
                 add(&mut radiance, event_weight * lit);
             }
-            // One emitter, chosen by power.
-            if let Some((emitter, selection)) = scene.area_lights.choose(random(4)) {
+            // One light: the environment with its selection probability, else an
+            // emitter chosen by power with the rest of the numbers' range.
+            let u_light = random(4);
+            let p_environment = environment_selection(scene);
+            if let Some(environment) = &scene.environment
+                && u_light < p_environment
+            {
+                let (lit, traced) = sample_environment(
+                    scene,
+                    environment,
+                    &material,
+                    shadow_origin,
+                    n,
+                    wo,
+                    DVec2::new(random(5), random(6)),
+                    continues,
+                );
+                rays += traced;
+                add(&mut radiance, event_weight * lit);
+            } else if let Some((emitter, selection)) = scene
+                .area_lights
+                .choose((u_light - p_environment) / (1.0 - p_environment))
+            {
                 let (lit, traced) = sample_emitter(
                     scene,
                     emitter,
-                    selection,
+                    selection * (1.0 - p_environment),
                     &material,
                     shadow_origin,
                     n,
@@ -408,6 +456,46 @@ fn sample_emitter(
         1.0
     };
     (f * emitter.radiance * (cos_i * weight / pdf), 1)
+}
+
+/// Next-event estimation of the environment map (chosen with its selection
+/// probability) from `origin`: a direction drawn from its distribution, `f · L · cos θ
+/// / pdf` if the ray escapes, weighted by the power heuristic against the BRDF's
+/// sampler when `mis`. Returns it and the rays traced.
+#[allow(clippy::too_many_arguments)]
+fn sample_environment(
+    scene: &PreparedScene,
+    environment: &EnvironmentLight,
+    material: &Material,
+    origin: DVec3,
+    n: DVec3,
+    wo: DVec3,
+    u: DVec2,
+    mis: bool,
+) -> (DVec3, u64) {
+    let Some(sample) = environment.sample(u) else {
+        return (DVec3::ZERO, 0);
+    };
+    let pdf = sample.pdf * environment.selection;
+    let wi = sample.wi;
+    let cos_i = n.dot(wi);
+    if pdf.is_nan() || pdf <= 0.0 || cos_i <= 0.0 {
+        return (DVec3::ZERO, 0);
+    }
+    let shadow = Ray {
+        origin,
+        direction: wi,
+    };
+    if occluded(&scene.geometry, &shadow, f64::INFINITY) {
+        return (DVec3::ZERO, 1);
+    }
+    let f = eval_brdf(material, &scene.images, n, wi, wo);
+    let weight = if mis {
+        power_heuristic(pdf, pdf_brdf(material, &scene.brdf_map_cdfs, n, wo, wi))
+    } else {
+        1.0
+    };
+    (f * sample.radiance * (cos_i * weight / pdf), 1)
 }
 
 #[cfg(test)]

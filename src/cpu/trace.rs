@@ -10,7 +10,7 @@ use super::path::path_radiance;
 use super::texture::shading_material;
 use super::traverse::{intersect_scene, occluded};
 use crate::accel::SceneGeometry;
-use crate::accel::{AreaLights, BrdfMapCdfs};
+use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight};
 use crate::camera::{CameraFrame, SamplePattern};
 pub use crate::scene::MediumStack;
 use crate::scene::{Image, Integrator, Light, Material, RenderSettings, Scene};
@@ -25,8 +25,11 @@ pub struct PreparedScene {
     pub camera: CameraFrame,
     /// Where each sample lies in its pixel.
     pub samples: SamplePattern,
-    /// Radiance of escaping rays.
+    /// Radiance of escaping rays without an environment map.
     pub background: DVec3,
+    /// The environment map, with its sampling distribution for the path integrator:
+    /// the radiance of escaping rays by direction.
+    pub environment: Option<EnvironmentLight>,
     /// Whitted ambient radiance.
     pub ambient: DVec3,
     /// Materials in the lighting space.
@@ -68,6 +71,11 @@ impl PreparedScene {
             camera: CameraFrame::new(&scene.camera, scene.render.width, scene.render.height),
             samples: SamplePattern::new(&scene.render),
             background: scene.environment.background,
+            environment: scene
+                .environment
+                .map
+                .clone()
+                .map(|map| EnvironmentLight::new(map, !area_lights.is_empty())),
             ambient: scene.environment.ambient,
             materials: scene.materials.clone(),
             lights: scene.lights.clone(),
@@ -103,6 +111,15 @@ pub fn finite_radiance(c: DVec3) -> bool {
     // skip it).
     let limit = f64::from(f32::MAX);
     c.x.abs() <= limit && c.y.abs() <= limit && c.z.abs() <= limit
+}
+
+/// The radiance a ray escaping along the unit `direction` sees: the environment map's
+/// texel times its scale, or the constant background.
+pub fn background_radiance(scene: &PreparedScene, direction: DVec3) -> DVec3 {
+    match &scene.environment {
+        Some(environment) => environment.map.radiance(direction),
+        None => scene.background,
+    }
 }
 
 /// One pending ray on the bounce stack.
@@ -183,7 +200,7 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
     while let Some(entry) = stack.pop() {
         rays += 1;
         let Some(hit) = intersect_scene(&scene.geometry, &entry.ray, f64::INFINITY) else {
-            let contribution = entry.weight * scene.background;
+            let contribution = entry.weight * background_radiance(scene, entry.ray.direction);
             if finite_radiance(contribution) {
                 radiance += contribution;
             }

@@ -46,6 +46,9 @@ pub struct ShaderFeatures {
     /// The path-tracing integrator (`PATH`, `shaders/path.wgsl`); a module with it
     /// traces with it only when the trace's flags ask for it.
     pub path: bool,
+    /// An environment map as the background and, for the path integrator, a light
+    /// (`ENVIRONMENT_MAP`, `shaders/environment.wgsl`).
+    pub environment_map: bool,
 }
 
 impl ShaderFeatures {
@@ -65,6 +68,7 @@ impl ShaderFeatures {
         mesh_attributes: true,
         instances: true,
         path: true,
+        environment_map: true,
     };
 
     /// Exactly the features `scene` uses.
@@ -100,6 +104,7 @@ impl ShaderFeatures {
                 .any(|m| m.normals.is_some() || m.uvs.is_some()),
             instances: crate::accel::instance::has_instances(&scene.meshes),
             path: scene.render.integrator == crate::scene::Integrator::Path,
+            environment_map: scene.environment.map.is_some(),
         }
     }
 
@@ -130,7 +135,7 @@ impl ShaderFeatures {
 type FeatureFlag = fn(&ShaderFeatures) -> bool;
 
 /// The name of each feature in the WGSL directives, with the flag it reads.
-const FEATURE_NAMES: [(&str, FeatureFlag); 14] = [
+const FEATURE_NAMES: [(&str, FeatureFlag); 15] = [
     ("SPHERES", |f| f.spheres),
     ("PLANES", |f| f.planes),
     ("POLYGONS", |f| f.polygons),
@@ -145,6 +150,7 @@ const FEATURE_NAMES: [(&str, FeatureFlag); 14] = [
     ("MESH_ATTRIBUTES", |f| f.mesh_attributes),
     ("INSTANCES", |f| f.instances),
     ("PATH", |f| f.path),
+    ("ENVIRONMENT_MAP", |f| f.environment_map),
 ];
 
 /// Keeps the lines of `source` whose enclosing `//#if` directives hold for `features`

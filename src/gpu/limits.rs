@@ -7,9 +7,9 @@ use super::RenderError;
 use super::pipelines::TRACE_STORAGE_BUFFERS;
 use super::shaders::{SLOT_WORKGROUP_SIZE, WORKGROUP_SIZE};
 
-/// Bindings in the trace kernels' bind group (`shaders/trace.wgsl`, 0 to 18, and
-/// `shaders/path.wgsl`'s 19).
-const TRACE_BINDINGS: u32 = 20;
+/// Bindings in the trace kernels' bind group (`shaders/trace.wgsl`, 0 to 18,
+/// `shaders/path.wgsl`'s 19 and `shaders/environment.wgsl`'s 20).
+const TRACE_BINDINGS: u32 = 21;
 
 /// One limit the renderer needs at least: the field of [`wgpu::Limits`] by name and
 /// by accessor, and the minimum.

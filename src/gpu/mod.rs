@@ -31,6 +31,7 @@ pub mod area_lights;
 pub mod context;
 mod display;
 mod draw;
+pub mod environment;
 mod error;
 pub mod features;
 mod film;

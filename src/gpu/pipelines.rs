@@ -22,7 +22,8 @@ pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// planes, polygons, polygon points, triangles, materials, lights; 8 the linear
 /// output; 9 counters; 10 accumulation; 11 images; 12–13 BVH nodes and primitives;
 /// 14–17 path states, bounce stacks, traces, traversal stacks; 18 mesh triangles'
-/// vertex normals and texture coordinates; 19 the path integrator's emitters.
+/// vertex normals and texture coordinates; 19 the path integrator's emitters; 20 the
+/// environment map and its sampling tables.
 pub(crate) mod binding {
     pub const FRAME: u32 = 0;
     pub const SPHERES: u32 = 1;
@@ -44,10 +45,11 @@ pub(crate) mod binding {
     pub const TRAVERSAL_STACK: u32 = 17;
     pub const TRIANGLE_ATTRIBUTES: u32 = 18;
     pub const EMITTERS: u32 = 19;
+    pub const ENVIRONMENT: u32 = 20;
 }
 
 /// Storage buffers the trace kernels bind in one stage.
-pub const TRACE_STORAGE_BUFFERS: u32 = 17;
+pub const TRACE_STORAGE_BUFFERS: u32 = 18;
 
 /// The kernels of one trace module.
 #[derive(Debug, Clone)]
@@ -160,6 +162,7 @@ impl Pipelines {
                         storage_entry(TRAVERSAL_STACK, false),
                         storage_entry(TRIANGLE_ATTRIBUTES, true),
                         storage_entry(EMITTERS, true),
+                        storage_entry(ENVIRONMENT, true),
                     ],
                 })
             })?;

@@ -2,12 +2,13 @@
 //! lights), its image array and its trace constants.
 
 use super::GpuError;
-use super::area_lights::{FLAG_PATH, GpuEmitter, emitter_records};
+use super::area_lights::{EMITTER_NONE, FLAG_PATH, GpuEmitter, emitter_records};
+use super::environment::environment_buffer;
 use super::features::ShaderFeatures;
 use super::layout::FrameUniforms;
 use super::readback::{Caught, capture};
 use super::upload::{SceneRecords, frame_uniforms, image_layers};
-use crate::accel::{BrdfMapCdfs, BvhStats, MAX_PLANES, SceneGeometry};
+use crate::accel::{BrdfMapCdfs, BvhStats, EnvironmentLight, MAX_PLANES, SceneGeometry};
 use crate::scene::{Integrator, Scene};
 
 /// The storage buffers of an uploaded scene.
@@ -25,6 +26,8 @@ pub(crate) struct SceneBuffers {
     pub triangle_attributes: wgpu::Buffer,
     /// The path integrator's emitters (one padding record for Whitted scenes).
     pub emitters: wgpu::Buffer,
+    /// The environment map and its sampling tables (a header alone without a map).
+    pub environment: wgpu::Buffer,
 }
 
 /// A scene uploaded to one device, ready to trace with
@@ -128,6 +131,18 @@ pub(crate) fn upload_scene(
     } else {
         vec![GpuEmitter::NONE]
     };
+    // The map's distribution, shared with the CPU reference (`crate::cpu::PreparedScene`).
+    let environment = environment_buffer(
+        shaded
+            .environment
+            .map
+            .clone()
+            .map(|map| {
+                let has_area_lights = path && emitters[0].kind != EMITTER_NONE;
+                EnvironmentLight::new(map, has_area_lights)
+            })
+            .as_ref(),
+    );
     let limits = device.limits();
     let max_binding = limits
         .max_storage_buffer_binding_size
@@ -175,6 +190,7 @@ pub(crate) fn upload_scene(
             bytemuck::cast_slice(&padded.triangle_attributes),
         )?,
         emitters: upload("emitter", bytemuck::cast_slice(&emitters))?,
+        environment: upload("environment map", &environment)?,
     };
     let (images, image_bytes) = upload_images(device, queue, &shaded, &limits)?;
     Ok(PreparedScene {

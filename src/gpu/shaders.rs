@@ -32,6 +32,10 @@ pub const TRACE_WGSL: &str = include_str!("../../shaders/trace.wgsl");
 /// The path integrator's records and constants (`Emitter`, `FLAG_PATH`), twins of
 /// [`super::area_lights`].
 pub const PATH_TYPES_WGSL: &str = include_str!("../../shaders/path_types.wgsl");
+/// The environment map (`ENVIRONMENT_MAP` feature): its radiance by direction and its
+/// sampler, twins of [`crate::scene::EnvironmentMap`] and
+/// [`crate::accel::EnvironmentLight`].
+pub const ENVIRONMENT_WGSL: &str = include_str!("../../shaders/environment.wgsl");
 /// The path integrator (`PATH` feature), twin of [`crate::cpu::path`] and its samplers.
 pub const PATH_WGSL: &str = include_str!("../../shaders/path.wgsl");
 /// The inverse-CDF sampler of tabulated BRDF maps (`PATH` and `TABULATED` features),
@@ -54,8 +58,8 @@ pub const WORKGROUP_SIZE: u32 = 8;
 
 /// The complete trace module specialised to `features` (see [`super::features`]): the
 /// constants shared with the Rust side (`MAX_BVH_DEPTH`, `MAX_POLYGON_VERTICES`), then
-/// types, path types, sampling, intersect, texture, bxdf, traverse, trace, path and
-/// the tabulated BRDF sampler.
+/// types, path types, sampling, intersect, texture, bxdf, environment, traverse, trace,
+/// path and the tabulated BRDF sampler.
 ///
 /// Errors: a message if the sources' feature directives are malformed.
 ///
@@ -74,6 +78,7 @@ pub fn trace_shader_source(features: &ShaderFeatures) -> Result<String, String> 
         INTERSECT_WGSL,
         TEXTURE_WGSL,
         BXDF_WGSL,
+        ENVIRONMENT_WGSL,
         TRAVERSE_WGSL,
         TRACE_WGSL,
         PATH_WGSL,

@@ -491,6 +491,7 @@ mod tests {
             environment: Environment {
                 background: DVec3::new(0.1, 0.2, 0.3),
                 ambient: DVec3::ZERO,
+                map: None,
             },
             materials: vec![Material::lambert(DVec3::splat(0.5))],
             material_names: vec!["grey".into()],

@@ -306,6 +306,7 @@ impl SlotBuffers {
                 buffer(binding::TRAVERSAL_STACK, &self.traversal_stack),
                 buffer(binding::TRIANGLE_ATTRIBUTES, &s.triangle_attributes),
                 buffer(binding::EMITTERS, &s.emitters),
+                buffer(binding::ENVIRONMENT, &s.environment),
             ],
         })
     }

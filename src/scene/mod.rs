@@ -2,6 +2,7 @@
 //! (documented field by field in `docs/scene-format.md`).
 
 mod animation;
+mod environment;
 mod error;
 mod file;
 mod image;
@@ -11,6 +12,7 @@ mod model;
 mod sphere;
 
 pub use animation::{CameraKey, CameraPath, Interpolation, MAX_FRAMES};
+pub use environment::{EnvironmentMap, direction_to_uv, texel_at, uv_to_direction};
 pub use error::{SceneError, SceneWarning};
 pub(crate) use file::view_problem;
 pub use file::{

@@ -166,10 +166,14 @@ pub struct Camera {
 }
 
 /// Light that does not come from a light source.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Environment {
-    /// Radiance (W/(sr·m²) per channel) carried by rays that hit nothing.
+    /// Radiance (W/(sr·m²) per channel) carried by rays that hit nothing, when there
+    /// is no [`Environment::map`].
     pub background: DVec3,
+    /// An environment map: the radiance of rays that hit nothing by direction (it
+    /// replaces `background`), and a light the path integrator samples.
+    pub map: Option<std::sync::Arc<super::EnvironmentMap>>,
     /// Constant ambient radiance added as `albedo * ambient` at every diffuse hit:
     /// the classic Whitted ambient term. Default 0 (physically based).
     pub ambient: DVec3,
@@ -541,7 +545,8 @@ impl Scene {
     /// transmittances, emission, background and ambient radiance) is replaced by its
     /// sRGB-encoded value, the number an artist picking colours on screen would type,
     /// so that shading happens on gamma-encoded values as in the lecture's wrong
-    /// example. Light intensities are physical quantities and stay as they are.
+    /// example. Light intensities are physical quantities and stay as they are, as do
+    /// images (textures, BRDF maps and the environment map).
     pub fn in_lighting_space(&self) -> Scene {
         let mut scene = self.clone();
         if self.render.lighting_space == LightingSpace::NaiveGamma {

@@ -3,7 +3,8 @@
 //!
 //! The scene hash covers everything a pixel depends on apart from the render
 //! settings: the camera (of the frame, for an animation), the environment, the
-//! materials, the lights, the shapes, the meshes and the texels of every image, but not the paths
+//! materials, the lights, the shapes, the meshes and the texels of every image (the
+//! environment map's included), but not the paths
 //! the files were read from (a farm mounts them in other places). The settings hash
 //! covers the image size, samples per pixel, depth, stack size, lighting space and
 //! ray-weight cutoff. Settings that only change how the work is scheduled (the GPU's
@@ -22,7 +23,7 @@ use crate::scene::{RenderSettings, Scene};
 
 /// Changes whenever what the hashes cover changes, so that tiles hashed differently
 /// never agree.
-pub const FINGERPRINT_VERSION: u32 = 2;
+pub const FINGERPRINT_VERSION: u32 = 3;
 
 /// The hashes a tile records of its render.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -54,6 +55,11 @@ impl Fingerprint {
         for image in &scene.images {
             hash.debug("image", &(image.width, image.height));
             hash.bytes(bytemuck::cast_slice(&image.texels));
+        }
+        // The environment's `Debug` has the map's size, rotation and scale; its texels
+        // are hashed here.
+        if let Some(map) = &scene.environment.map {
+            hash.bytes(bytemuck::cast_slice(&map.image.texels));
         }
         Self {
             scene: hash.finish(),
@@ -174,6 +180,37 @@ mod tests {
         assert_eq!(Fingerprint::of(&a), Fingerprint::of(&b));
         b.images[0].texels[0][1] = 0.25;
         assert_ne!(Fingerprint::of(&a).scene, Fingerprint::of(&b).scene);
+    }
+
+    #[test]
+    fn an_environment_maps_texels_rotation_and_scale_count_but_not_its_path() {
+        let map = crate::scene::EnvironmentMap {
+            image: crate::scene::Image {
+                path: "/mnt/a/sky.hdr".into(),
+                width: 2,
+                height: 1,
+                texels: vec![[1.0; 4]; 2],
+            },
+            rotation_degrees: 10.0,
+            scale: glam::DVec3::ONE,
+        };
+        let mut a = scene("");
+        a.environment.map = Some(std::sync::Arc::new(map.clone()));
+        let with = |change: fn(&mut crate::scene::EnvironmentMap)| {
+            let mut changed = map.clone();
+            change(&mut changed);
+            let mut b = a.clone();
+            b.environment.map = Some(std::sync::Arc::new(changed));
+            Fingerprint::of(&b)
+        };
+        assert_eq!(
+            with(|m| m.image.path = "/srv/b/sky.hdr".into()),
+            Fingerprint::of(&a)
+        );
+        assert_ne!(with(|m| m.image.texels[1][2] = 0.5), Fingerprint::of(&a));
+        assert_ne!(with(|m| m.rotation_degrees = 11.0), Fingerprint::of(&a));
+        assert_ne!(with(|m| m.scale.y = 2.0), Fingerprint::of(&a));
+        assert_ne!(Fingerprint::of(&a), Fingerprint::of(&scene("")));
     }
 
     #[test]

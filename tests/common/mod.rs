@@ -5,4 +5,5 @@ pub mod compare;
 pub mod geometry;
 pub mod gpu;
 pub mod process;
+pub mod reference;
 pub mod scenes;

@@ -44,7 +44,8 @@ pub const MAX_SCENE_VALUES: u64 = 8_000_000;
 /// silent, as [`load_scene`] is.
 #[derive(Clone, Copy, Default)]
 pub struct LoadOptions<'a> {
-    /// Confine the files the scene names (albedo textures, BRDF maps) to the scene
+    /// Confine the files the scene names (albedo textures, BRDF maps, the environment
+    /// map) to the scene
     /// file's folder: refuse absolute paths, `..` and links that lead out of it (see
     /// [`confined_path`]). Without it a scene file is trusted input, like a program:
     /// it may name any file the user can read.
@@ -313,7 +314,12 @@ fn build_scene(
     let render = settings::render(source, raw.render)?;
     let camera = settings::camera(source, raw.camera)?;
     let camera_path = animation::animation(source, raw.animation, &camera)?;
-    let environment = settings::environment(source, raw.environment)?;
+    let environment = settings::environment(
+        source,
+        raw.environment,
+        source.path.parent().unwrap_or(std::path::Path::new("")),
+        options,
+    )?;
     let total = (raw.materials.len() + raw.lights.len() + raw.objects.len()) as u64;
     let mut done = 0;
     let mut checked = || {

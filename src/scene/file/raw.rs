@@ -104,6 +104,9 @@ pub struct RawCamera {
 pub struct RawEnvironment {
     pub background: Option<RawColor>,
     pub ambient: Option<RawColor>,
+    pub map: Option<String>,
+    pub rotation: Option<f64>,
+    pub scale: Option<RawColor>,
 }
 
 /// `[materials.NAME]`: the union of every material type's fields.

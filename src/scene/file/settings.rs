@@ -1,11 +1,19 @@
 //! The singleton tables: `[render]`, `[camera]` and `[environment]`.
 
+use std::path::Path;
+use std::sync::Arc;
+
 use glam::DVec3;
 use toml::Spanned;
 
-use super::check::{ColourRange, Source};
+use super::LoadOptions;
+use super::check::{ColourRange, Item, Source};
+use super::paths::confined_path;
 use super::raw::{RawCamera, RawEnvironment, RawIntegrator, RawLighting, RawRender};
-use crate::scene::{Camera, Environment, Integrator, LightingSpace, RenderSettings, SceneError};
+use crate::scene::{
+    Camera, Environment, EnvironmentMap, Image, Integrator, LightingSpace, RenderSettings,
+    SceneError, load_image,
+};
 
 /// Default image width in pixels.
 const DEFAULT_WIDTH: u32 = 640;
@@ -97,15 +105,59 @@ pub fn view_problem(eye: DVec3, look_at: DVec3, up: DVec3) -> Option<String> {
     })
 }
 
-/// `[environment]`: background and ambient radiance, black by default.
+/// `[environment]`: background and ambient radiance, black by default, or an
+/// environment map (`map`, relative to the scene file's folder `base`, with
+/// `rotation` in degrees about +y and a radiance `scale`) instead of the background.
 pub fn environment(
     source: &Source<'_>,
     raw: Option<Spanned<RawEnvironment>>,
+    base: &Path,
+    options: &LoadOptions<'_>,
 ) -> Result<Environment, SceneError> {
     let span = raw.as_ref().map(Spanned::span);
     let raw = raw.map(Spanned::into_inner).unwrap_or_default();
     let item = source.item("environment".into(), span);
+    let map = match &raw.map {
+        Some(file) => {
+            if raw.background.is_some() {
+                return Err(item.fail(
+                    "give either background or map: the map is the radiance of rays that hit nothing",
+                ));
+            }
+            let rotation_degrees = item.number("rotation", raw.rotation.unwrap_or(0.0))?;
+            let scale = item.colour_or("scale", raw.scale, ColourRange::Radiance, DVec3::ONE)?;
+            let image = environment_image(&item, file, base, options)?;
+            // The GPU holds radiance and the sampling tables in f32.
+            let brightest = image
+                .texels
+                .iter()
+                .map(|t| {
+                    (DVec3::new(f64::from(t[0]), f64::from(t[1]), f64::from(t[2])) * scale)
+                        .max_element()
+                })
+                .fold(0.0, f64::max);
+            if brightest > f64::from(f32::MAX) {
+                return Err(item.fail(format_args!(
+                    "map `{file}` times scale reaches {brightest:e}, beyond the largest f32 \
+                     ({:e}); lower scale",
+                    f32::MAX
+                )));
+            }
+            Some(Arc::new(EnvironmentMap {
+                image,
+                rotation_degrees,
+                scale,
+            }))
+        }
+        None => {
+            if raw.rotation.is_some() || raw.scale.is_some() {
+                return Err(item.fail("rotation and scale apply to a map; there is no map"));
+            }
+            None
+        }
+    };
     Ok(Environment {
+        map,
         background: item.colour_or(
             "background",
             raw.background,
@@ -114,4 +166,34 @@ pub fn environment(
         )?,
         ambient: item.colour_or("ambient", raw.ambient, ColourRange::Radiance, DVec3::ZERO)?,
     })
+}
+
+/// The environment map's image `file` (relative to `base`, confined to it in a
+/// sandbox): readable, finite (checked by [`load_image`]) and without a negative
+/// channel (a radiance cannot be negative). Errors name the file and the texel.
+fn environment_image(
+    item: &Item<'_>,
+    file: &str,
+    base: &Path,
+    options: &LoadOptions<'_>,
+) -> Result<Image, SceneError> {
+    let path = if options.sandbox {
+        confined_path(base, file).map_err(|e| item.fail(format_args!("map {e}")))?
+    } else {
+        base.join(file)
+    };
+    let fail =
+        |message: String| item.fail(format_args!("map `{file}` ({}): {message}", path.display()));
+    let image = load_image(&path).map_err(fail)?;
+    for (i, texel) in image.texels.iter().enumerate() {
+        for (channel, value) in ["r", "g", "b"].into_iter().zip(texel.iter().copied()) {
+            if value < 0.0 {
+                let (x, y) = (i as u32 % image.width, i as u32 / image.width);
+                return Err(fail(format!(
+                    "texel ({x}, {y}) has {channel} = {value}; texels must be >= 0 (a radiance cannot be negative)"
+                )));
+            }
+        }
+    }
+    Ok(image)
 }

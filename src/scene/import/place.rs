@@ -147,6 +147,7 @@ impl ImportedModel {
             environment: Environment {
                 background: DVec3::splat(MODEL_BACKGROUND),
                 ambient: DVec3::ZERO,
+                map: None,
             },
             materials: Vec::new(),
             material_names: Vec::new(),
