@@ -698,7 +698,8 @@ fn path_start_emitter(path: ptr<function, PathState>, trace: ptr<function, Trace
 
 // The emitter sample is visible when the first thing its ray meets is that emitter
 // (its emitting side faces the ray: the sample was drawn only there); then it adds
-// f·L·cos θ / pdf, times the event's weight, weighted by the power heuristic against
+// f·L·cos θ / pdf (L times the emission texture at the shadow ray's hit, when the
+// emitter has one), times the event's weight, weighted by the power heuristic against
 // the BRDF sampler when the path goes on. The sample is drawn again from the same
 // numbers. Twin of sample_emitter.
 fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
@@ -714,7 +715,18 @@ fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
             weight = power_heuristic(sample.pdf, pdf_brdf(material, n, wo, sample.wi));
         }
         let cos_i = dot(n, sample.wi);
-        add_contribution(path, (*path).direct * (f * emitter.radiance * (cos_i * weight / sample.pdf)));
+        var radiance = emitter.radiance;
+        //#if TEXTURES
+        // A textured emitter's radiance at the point the shadow ray reaches (the
+        // sampled point), looked up at that hit's texture coordinates.
+        let light_hit = hit_record_in(trace.best_prim, trace.best_instance,
+                                      Ray((*path).shadow_origin, sample.wi), trace.best_t);
+        let light_material = materials[light_hit.material];
+        if light_material.emission_layer != NO_IMAGE {
+            radiance = shading_emission(light_material, light_hit.position, light_hit.normal, light_hit.uv);
+        }
+        //#endif
+        add_contribution(path, (*path).direct * (f * radiance * (cos_i * weight / sample.pdf)));
     }
     (*path).phase = PHASE_POP;
 }

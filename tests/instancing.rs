@@ -385,7 +385,7 @@ fn path_tracing_samples_emissive_instances() {
     let parts =
         SceneGeometry::from_parts(&[], &instanced.meshes, gpu_render::accel::BuildMethod::Sah);
     assert_eq!(parts.instances.len(), 2);
-    let lights = gpu_render::accel::AreaLights::new(&parts, &instanced.materials);
+    let lights = gpu_render::accel::AreaLights::new(&parts, &instanced.materials, &instanced.images);
     assert_eq!(lights.entries().len(), 2 * mesh.triangles.len());
     let flat = make(
         transforms

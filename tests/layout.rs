@@ -145,6 +145,10 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 metallic_roughness_height,
                 metallic_roughness_wrap,
                 two_sided,
+                emission_layer,
+                emission_width,
+                emission_height,
+                emission_wrap,
                 _pad0,
                 _pad1,
                 _pad2,
@@ -218,7 +222,9 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 albedo,
                 metallic,
                 direct,
-                brdf_pdf
+                brdf_pdf,
+                emission,
+                _pad0
             }),
         ),
         (

@@ -54,7 +54,7 @@ impl PreparedScene {
     pub fn with_geometry(scene: &Scene, geometry: SceneGeometry) -> Self {
         let scene = scene.in_lighting_space();
         let area_lights = match scene.render.integrator {
-            Integrator::Path => AreaLights::new(&geometry, &scene.materials),
+            Integrator::Path => AreaLights::new(&geometry, &scene.materials, &scene.images),
             Integrator::Whitted => AreaLights::default(),
         };
         Self {

@@ -8,7 +8,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::accel::SceneGeometry;
 use crate::accel::{AreaLights, EmitterEntry, EmitterEntryShape};
-use crate::scene::Material;
+use crate::scene::{Image, Material};
 
 /// `FrameUniforms.flags`: trace with the path integrator (`FLAG_PATH` in WGSL).
 pub const FLAG_PATH: u32 = 4;
@@ -107,11 +107,15 @@ pub fn emitter_record(entry: &EmitterEntry) -> GpuEmitter {
     record
 }
 
-/// The emitter records of `geometry` with `materials` (in the lighting space), as the
-/// CPU's [`AreaLights::new`] finds them; [`GpuEmitter::NONE`] alone when there are
-/// none.
-pub fn emitter_records(geometry: &SceneGeometry, materials: &[Material]) -> Vec<GpuEmitter> {
-    let mut records: Vec<GpuEmitter> = AreaLights::new(geometry, materials)
+/// The emitter records of `geometry` with `materials` (in the lighting space) and the
+/// scene's `images`, as the CPU's [`AreaLights::new`] finds them; [`GpuEmitter::NONE`]
+/// alone when there are none.
+pub fn emitter_records(
+    geometry: &SceneGeometry,
+    materials: &[Material],
+    images: &[Image],
+) -> Vec<GpuEmitter> {
+    let mut records: Vec<GpuEmitter> = AreaLights::new(geometry, materials, images)
         .entries()
         .iter()
         .map(emitter_record)
@@ -167,7 +171,7 @@ mod tests {
             },
         ];
         let geometry = SceneGeometry::from_shapes(&shapes, BuildMethod::Sah);
-        let records = emitter_records(&geometry, &materials);
+        let records = emitter_records(&geometry, &materials, &[]);
         // The lamp sphere, the square's two triangles, the triangle.
         assert_eq!(records.len(), 4, "{records:?}");
         assert!(records.windows(2).all(|w| w[0].prim <= w[1].prim));
@@ -182,6 +186,6 @@ mod tests {
         // Every piece of a flat emitter has the same density per unit area.
         assert!((records[1].area_density - records[3].area_density).abs() < 1e-6);
         let dark = [materials[0], materials[0]];
-        assert_eq!(emitter_records(&geometry, &dark), vec![GpuEmitter::NONE]);
+        assert_eq!(emitter_records(&geometry, &dark, &[]), vec![GpuEmitter::NONE]);
     }
 }

@@ -93,7 +93,11 @@ impl ShaderFeatures {
             textures: scene
                 .materials
                 .iter()
-                .any(|m| m.albedo_texture.is_some() || m.metallic_roughness_texture.is_some()),
+                .any(|m| {
+                    m.albedo_texture.is_some()
+                        || m.metallic_roughness_texture.is_some()
+                        || m.emission_texture.is_some()
+                }),
             mesh_attributes: scene
                 .meshes
                 .iter()

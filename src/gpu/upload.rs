@@ -289,6 +289,7 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
     let (brdf_map_layer, brdf_map_size, _) = image(material.brdf_map);
     let (metallic_roughness_layer, metallic_roughness_width, metallic_roughness_height) =
         image(material.metallic_roughness_texture);
+    let (emission_layer, emission_width, emission_height) = image(material.emission_texture);
     GpuMaterial {
         diffuse: vec3(material.diffuse),
         shininess: material.shininess as f32,
@@ -332,6 +333,11 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
         metallic_roughness_wrap: wrap_code(material.metallic_roughness_wrap[0])
             | wrap_code(material.metallic_roughness_wrap[1]) << 8,
         two_sided: u32::from(material.two_sided),
+        emission_layer,
+        emission_width,
+        emission_height,
+        emission_wrap: wrap_code(material.emission_wrap[0])
+            | wrap_code(material.emission_wrap[1]) << 8,
         _pad0: 0,
         _pad1: 0,
         _pad2: 0,

@@ -56,19 +56,19 @@ impl ImportedModel {
     /// Adds the model to `scene` under `placement`: one [`Mesh`] per imported mesh
     /// (instances composed with the placement), its materials (named
     /// `<file stem>/<material>`) unless the placement overrides them, and the base
-    /// colour textures they use (as UV-mapped albedo textures with the file's wrap
-    /// modes). Returns warnings for what the renderers do not model: emissive textures
-    /// (the constant emission is kept).
+    /// colour, metallic/roughness and emission textures they use (UV-mapped, with the
+    /// file's wrap modes). Returns warnings for what the renderers do not model (none
+    /// at present; the list is kept for the callers that report them).
     pub fn add_to_scene(&self, scene: &mut Scene, placement: &ModelPlacement) -> Vec<String> {
-        let mut warnings = Vec::new();
+        let warnings = Vec::new();
         let stem = self
             .path
             .file_stem()
             .map_or_else(|| "model".into(), |s| s.to_string_lossy().into_owned());
         let material_base = scene.materials.len() as u32;
         if placement.material.is_none() {
-            // Only the images a base colour or metallic/roughness texture uses travel
-            // to the GPU, each once.
+            // Only the images a base colour, metallic/roughness or emission texture
+            // uses travel to the GPU, each once.
             let mut image_index = vec![None; self.images.len()];
             let mut scene_image = |scene: &mut Scene, image: u32| {
                 *image_index[image as usize].get_or_insert_with(|| {
@@ -98,13 +98,15 @@ impl ImportedModel {
                     material.texture_mapping = TextureMapping::Uv;
                     material.metallic_roughness_wrap = [texture_wrap(wrap_u), texture_wrap(wrap_v)];
                 }
-                if imported.emissive_texture.is_some() {
-                    warnings.push(format!(
-                        "{}: material `{}`: its emissive texture is not used (the renderers \
-                         take the material's constant emission)",
-                        self.path.display(),
-                        imported.name
-                    ));
+                if let Some(TextureRef {
+                    image,
+                    wrap_u,
+                    wrap_v,
+                }) = imported.emissive_texture
+                {
+                    material.emission_texture = Some(scene_image(scene, image));
+                    material.texture_mapping = TextureMapping::Uv;
+                    material.emission_wrap = [texture_wrap(wrap_u), texture_wrap(wrap_v)];
                 }
                 scene.materials.push(material);
                 scene
