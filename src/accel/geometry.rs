@@ -348,10 +348,11 @@ impl SceneGeometry {
             }
             let stored =
                 InstancedMesh::new(&meshes[group[0]], method, &mut self.degenerate_triangles);
-            let Some(root) = stored.bvh.root_bounds() else {
+            let hull = stored.hull_points();
+            if hull.is_empty() {
                 // Every triangle degenerate: nothing to place.
                 continue;
-            };
+            }
             let mesh_index = self.instanced_meshes.len() as u32;
             for &i in &group {
                 for transform in &meshes[i].instances {
@@ -359,7 +360,7 @@ impl SceneGeometry {
                         mesh_index,
                         transform,
                         meshes[i].material,
-                        root,
+                        &hull,
                     ));
                 }
             }
