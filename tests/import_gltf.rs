@@ -484,7 +484,7 @@ fn materials_map_with_their_textures_and_wrap_modes() {
         meshes: vec![],
         images: vec![],
     };
-    let warnings = model.add_to_scene(
+    model.add_to_scene(
         &mut scene,
         &gpu_render::scene::import::ModelPlacement::IDENTITY,
     );
@@ -513,7 +513,6 @@ fn materials_map_with_their_textures_and_wrap_modes() {
     );
     assert_eq!(placed.texture_mapping, gpu_render::scene::TextureMapping::Uv);
     assert_eq!(scene.images.len(), 3, "each image once");
-    assert!(warnings.is_empty(), "{warnings:?}");
 }
 
 #[test]
