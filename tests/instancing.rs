@@ -489,3 +489,48 @@ fn a_hundred_copies_cost_one_copy_and_a_hundred_instance_records() {
         "on the device 100 copies take {hundred} bytes, one {one}"
     );
 }
+
+/// The limitation that remains: a mesh whose material emits is flattened however many
+/// times it is placed (the GPU path integrator's emitter list names the surface a ray
+/// hits by primitive alone), so its copies cost the GPU scene bytes of that many
+/// placements, plus one emitter record (80 bytes) per triangle and copy for the path
+/// integrator. Prints the figures that docs/models.md quotes.
+#[test]
+fn emissive_copies_are_flattened_and_cost_a_copy_each() {
+    let mesh = blob(64, 96);
+    let lamp = Material {
+        emission: DVec3::splat(2.0),
+        ..Material::lambert(DVec3::splat(0.5))
+    };
+    let scene = |copies: usize| {
+        let mut s = base_scene(
+            64,
+            vec![Mesh {
+                instances: (0..copies)
+                    .map(|i| DMat4::from_translation(DVec3::new(2.0 * i as f64, 0.0, 0.0)))
+                    .collect(),
+                material: 0,
+                ..mesh.clone()
+            }],
+        );
+        s.materials[0] = lamp;
+        s
+    };
+    let (one, ten) = (record_bytes(&scene(1)), record_bytes(&scene(10)));
+    let triangles = mesh.triangles.len();
+    let emitters = gpu_render::gpu::area_lights::emitter_records(
+        &SceneGeometry::new(&scene(10)),
+        &scene(10).materials,
+        &[],
+    );
+    eprintln!(
+        "{triangles} emissive triangles: 1 copy {one} bytes, 10 copies {ten} bytes ({:.2}x), \
+         {} emitter records ({} bytes)",
+        ten as f64 / one as f64,
+        emitters.len(),
+        std::mem::size_of_val(emitters.as_slice())
+    );
+    assert!(SceneGeometry::new(&scene(10)).instances.is_empty());
+    assert!(ten as f64 > 8.0 * one as f64, "10 copies take {ten} bytes, one {one}");
+    assert_eq!(emitters.len(), 10 * triangles);
+}
