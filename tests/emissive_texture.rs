@@ -66,7 +66,8 @@ fn quad_light_gltf() -> String {
         bin.extend_from_slice(bytes);
         views.len() - 1
     };
-    let f32s = |values: &[f32]| -> Vec<u8> { values.iter().flat_map(|v| v.to_le_bytes()).collect() };
+    let f32s =
+        |values: &[f32]| -> Vec<u8> { values.iter().flat_map(|v| v.to_le_bytes()).collect() };
     let positions: Vec<f32> = CORNERS.iter().flatten().copied().collect();
     let uvs: Vec<f32> = CORNERS
         .iter()
@@ -354,13 +355,21 @@ fn emissive_textures_render_alike_on_both_backends() {
     }
     // The camera sees the light's underside: some pixels show each half.
     let cpu = gpu_render::cpu::render(&whitted, None).image;
-    let shows = |value: f32| cpu.pixels.iter().filter(|p| (p[1] - value).abs() < 1e-4).count();
+    let shows = |value: f32| {
+        cpu.pixels
+            .iter()
+            .filter(|p| (p[1] - value).abs() < 1e-4)
+            .count()
+    };
     assert!(shows(STRENGTH as f32) > 20, "the bright half is not seen");
     let Some(gpu) = common::gpu::headless_gpu() else {
         return;
     };
     let renderer = common::gpu::renderer(&gpu);
-    for (label, s) in [("emissive-texture-whitted", &whitted), ("emissive-texture-path", &path)] {
+    for (label, s) in [
+        ("emissive-texture-whitted", &whitted),
+        ("emissive-texture-path", &path),
+    ] {
         let expected = gpu_render::cpu::render(s, None).image;
         let actual = renderer
             .render(&gpu.device, &gpu.queue, s, None)

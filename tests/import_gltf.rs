@@ -511,7 +511,10 @@ fn materials_map_with_their_textures_and_wrap_modes() {
         placed.emission_wrap,
         [gpu_render::scene::TextureWrap::Repeat; 2]
     );
-    assert_eq!(placed.texture_mapping, gpu_render::scene::TextureMapping::Uv);
+    assert_eq!(
+        placed.texture_mapping,
+        gpu_render::scene::TextureMapping::Uv
+    );
     assert_eq!(scene.images.len(), 3, "each image once");
 }
 

@@ -410,7 +410,10 @@ fn map_ke_loads_an_emission_texture_that_the_scene_keeps() {
         placed.emission_wrap,
         [gpu_render::scene::TextureWrap::ClampToEdge; 2]
     );
-    assert_eq!(placed.texture_mapping, gpu_render::scene::TextureMapping::Uv);
+    assert_eq!(
+        placed.texture_mapping,
+        gpu_render::scene::TextureMapping::Uv
+    );
 }
 
 #[test]

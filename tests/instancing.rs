@@ -385,7 +385,8 @@ fn path_tracing_samples_emissive_instances() {
     let parts =
         SceneGeometry::from_parts(&[], &instanced.meshes, gpu_render::accel::BuildMethod::Sah);
     assert_eq!(parts.instances.len(), 2);
-    let lights = gpu_render::accel::AreaLights::new(&parts, &instanced.materials, &instanced.images);
+    let lights =
+        gpu_render::accel::AreaLights::new(&parts, &instanced.materials, &instanced.images);
     assert_eq!(lights.entries().len(), 2 * mesh.triangles.len());
     let flat = make(
         transforms
@@ -531,6 +532,9 @@ fn emissive_copies_are_flattened_and_cost_a_copy_each() {
         std::mem::size_of_val(emitters.as_slice())
     );
     assert!(SceneGeometry::new(&scene(10)).instances.is_empty());
-    assert!(ten as f64 > 8.0 * one as f64, "10 copies take {ten} bytes, one {one}");
+    assert!(
+        ten as f64 > 8.0 * one as f64,
+        "10 copies take {ten} bytes, one {one}"
+    );
     assert_eq!(emitters.len(), 10 * triangles);
 }

@@ -148,7 +148,11 @@ fn a_model_placed_several_times_is_held_once_per_material() {
     let scene = load_scene(&path).expect("the scene loads");
     let model = gpu_render::scene::import::import_model(&dir.dir.path().join("vase.gltf"))
         .expect("the vase imports");
-    assert_eq!(scene.meshes.len(), 3 * model.meshes.len(), "one copy per (material, smooth)");
+    assert_eq!(
+        scene.meshes.len(),
+        3 * model.meshes.len(),
+        "one copy per (material, smooth)"
+    );
     let placed: usize = scene.meshes.iter().map(|m| m.instances.len()).sum();
     let per_placement: usize = model.meshes.iter().map(|m| m.instances.len()).sum();
     assert_eq!(placed, 4 * per_placement);

@@ -67,9 +67,7 @@ impl AreaLights {
             power_scale: materials
                 .iter()
                 .map(|m| match m.emission_texture {
-                    Some(image) => images
-                        .get(image as usize)
-                        .map_or(DVec3::ONE, mean_texel),
+                    Some(image) => images.get(image as usize).map_or(DVec3::ONE, mean_texel),
                     None => DVec3::ONE,
                 })
                 .collect(),

@@ -414,7 +414,9 @@ mod tests {
             let a = std::f64::consts::TAU * k as f64 / n as f64;
             positions.push(DVec3::new(a.cos(), a.sin(), 0.0));
         }
-        let triangles = (0..n as u32).map(|k| [0, 1 + k, 1 + (k + 1) % n as u32]).collect();
+        let triangles = (0..n as u32)
+            .map(|k| [0, 1 + k, 1 + (k + 1) % n as u32])
+            .collect();
         let disc = Mesh {
             name: "disc".into(),
             positions: positions.clone(),
@@ -456,7 +458,10 @@ mod tests {
             assert!(width <= loose, "axis {axis}");
         }
         let loose_y = f64::from(corners.bounds.max[1] - corners.bounds.min[1]);
-        assert!(loose_y > 1.3 * (hi.y - lo.y), "the corners' box is tight too: the test cannot tell");
+        assert!(
+            loose_y > 1.3 * (hi.y - lo.y),
+            "the corners' box is tight too: the test cannot tell"
+        );
     }
 
     /// The eight corners of a box.
@@ -464,7 +469,11 @@ mod tests {
         (0..8)
             .map(|c: usize| {
                 let pick = |axis: usize| {
-                    f64::from(if (c >> axis) & 1 == 1 { b.max[axis] } else { b.min[axis] })
+                    f64::from(if (c >> axis) & 1 == 1 {
+                        b.max[axis]
+                    } else {
+                        b.min[axis]
+                    })
                 };
                 DVec3::new(pick(0), pick(1), pick(2))
             })

@@ -381,12 +381,10 @@ fn sample_emitter(
     };
     // Visible when the first thing the ray meets is the emitter itself, on its
     // emitting side.
-    let Some(light_hit) = intersect_scene(&scene.geometry, &shadow, f64::INFINITY)
-        .filter(|hit| {
-            hit.key() == emitter.key
-                && emits_towards(hit, wi, scene.materials[hit.material as usize].two_sided)
-        })
-    else {
+    let Some(light_hit) = intersect_scene(&scene.geometry, &shadow, f64::INFINITY).filter(|hit| {
+        hit.key() == emitter.key
+            && emits_towards(hit, wi, scene.materials[hit.material as usize].two_sided)
+    }) else {
         return (DVec3::ZERO, 1);
     };
     // The radiance of the sampled point: the emitter's own, times its emission texture

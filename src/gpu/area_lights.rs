@@ -186,6 +186,9 @@ mod tests {
         // Every piece of a flat emitter has the same density per unit area.
         assert!((records[1].area_density - records[3].area_density).abs() < 1e-6);
         let dark = [materials[0], materials[0]];
-        assert_eq!(emitter_records(&geometry, &dark, &[]), vec![GpuEmitter::NONE]);
+        assert_eq!(
+            emitter_records(&geometry, &dark, &[]),
+            vec![GpuEmitter::NONE]
+        );
     }
 }

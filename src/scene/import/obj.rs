@@ -544,8 +544,14 @@ impl Libraries {
                     format!("the material library could not be read: {e}"),
                 )
             })?;
-        for (material, MtlLines { line, map_kd_at, map_ke_at }) in
-            materials.iter().cloned().zip(lines)
+        for (
+            material,
+            MtlLines {
+                line,
+                map_kd_at,
+                map_ke_at,
+            },
+        ) in materials.iter().cloned().zip(lines)
         {
             self.index
                 .insert(material.name.clone(), self.materials.len());
