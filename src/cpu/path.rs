@@ -331,9 +331,9 @@ fn add(radiance: &mut DVec3, contribution: DVec3) {
 /// Next-event estimation of one emitter (chosen with probability `selection`) from
 /// `origin`: a sample on it, `f · L · cos θ / pdf` if nothing blocks it (`L` the
 /// emitter's radiance at the point the shadow ray reaches, [`shading_emission`]),
-/// weighted by
-/// the power heuristic against the BRDF's sampler when `mis` (the path goes on, so
-/// that a BRDF sample could find the same light). Returns it and the rays traced.
+/// weighted by the power heuristic against the BRDF's sampler when `mis` (the path
+/// goes on, so that a BRDF sample could find the same light). Returns it and the rays
+/// traced.
 #[allow(clippy::too_many_arguments)]
 fn sample_emitter(
     scene: &PreparedScene,
