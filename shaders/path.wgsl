@@ -442,32 +442,41 @@ fn choose_emitter(u: f32, count: u32) -> u32 {
     return min(low, count - 1u);
 }
 
-// The first emitter record of primitive `prim`, or NO_PRIM when it is no sampled
-// emitter (CPU: AreaLights::first_of); binary search over the records' ascending prims.
-fn first_emitter_of(prim: u32) -> u32 {
+// Whether emitter record `index` comes before the surface (instance, prim) in the
+// records' order: ascending instance (NO_INSTANCE, the scene's own, last), then prim.
+fn emitter_before(index: u32, prim: u32, instance: u32) -> bool {
+    let e = emitters[index];
+    return e.instance < instance || (e.instance == instance && e.prim < prim);
+}
+
+// The first emitter record of primitive `prim` in instance `instance` (NO_INSTANCE for
+// the scene's own), or NO_PRIM when it is no sampled emitter (CPU:
+// AreaLights::first_of); binary search over the records' ascending (instance, prim).
+fn first_emitter_of(prim: u32, instance: u32) -> u32 {
     let count = emitter_count();
     var low = 0u;
     var high = count;
     for (var step = 0u; step < 32u && low < high; step += 1u) {
         let middle = (low + high) / 2u;
-        if emitters[middle].prim < prim {
+        if emitter_before(middle, prim, instance) {
             low = middle + 1u;
         } else {
             high = middle;
         }
     }
-    if low < count && emitters[low].prim == prim {
+    if low < count && emitters[low].prim == prim && emitters[low].instance == instance {
         return low;
     }
     return NO_PRIM;
 }
 
 // The density per steradian with which next-event estimation from `point` samples the
-// direction towards `hit` (0 if `hit` is on no sampled emitter): a sphere's cone
+// direction towards `hit`, made in instance `instance` (0 if `hit` is on no sampled
+// emitter): a sphere's cone
 // density times its selection probability, a flat emitter's selection / area per unit
 // area converted to solid angle. Twin of AreaLights::pdf.
-fn emitter_pdf(point: vec3<f32>, hit: Hit) -> f32 {
-    let index = first_emitter_of(hit.prim);
+fn emitter_pdf(point: vec3<f32>, hit: Hit, instance: u32) -> f32 {
+    let index = first_emitter_of(hit.prim, instance);
     if index == NO_PRIM {
         return 0.0;
     }
@@ -579,7 +588,7 @@ fn path_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) 
     if max_component(material.emission) > 0.0 && emits_towards(hit, ray.direction, material.two_sided != 0u) {
         var weight = 1.0;
         if (*path).depth > 0u && (*path).brdf_pdf > 0.0 {
-            weight = power_heuristic((*path).brdf_pdf, emitter_pdf((*path).shadow_origin, hit));
+            weight = power_heuristic((*path).brdf_pdf, emitter_pdf((*path).shadow_origin, hit, trace.best_instance));
         }
         add_contribution(path, (*path).weight * material.emission * weight);
     }
@@ -705,7 +714,7 @@ fn path_start_emitter(path: ptr<function, PathState>, trace: ptr<function, Trace
 fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
     let sample = path_emitter_sample(path);
     let emitter = emitters[sample.emitter];
-    if sample.found && trace.best_prim == emitter.prim {
+    if sample.found && trace.best_prim == emitter.prim && trace.best_instance == emitter.instance {
         let material = lit_material(path);
         let n = (*path).normal;
         let wo = -(*path).direction;

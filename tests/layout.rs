@@ -265,7 +265,11 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 normal,
                 selection,
                 radiance,
-                area_density
+                area_density,
+                instance,
+                _pad0,
+                _pad1,
+                _pad2
             }),
         ),
         (

@@ -75,6 +75,35 @@ impl AreaLights {
         };
         let emission = |material: u32| materials[material as usize].emission;
         let two_sided = |material: u32| materials[material as usize].two_sided;
+        // Emissive instanced meshes first (the order of hit keys, which the GPU's
+        // binary search by surface needs): each instance's triangles moved to world
+        // space for sampling (the BVH keeps the mesh once; the emitter list has every
+        // copy).
+        for (i, instance) in geometry.instances.iter().enumerate() {
+            let radiance = emission(instance.material);
+            if radiance.max_element() <= 0.0 {
+                continue;
+            }
+            let mesh = &geometry.instanced_meshes[instance.mesh as usize];
+            for j in 0..mesh.triangles.len() {
+                let (t, _) = instance.world_triangle(mesh, j);
+                let [a, b, c] = t.vertices;
+                let normal = (b - a).cross(c - a).normalize_or_zero();
+                if normal != DVec3::ZERO {
+                    let key = HitKey {
+                        prim: PrimRef::new(PrimKind::Triangle, j as u32),
+                        instance: Some(i as u32),
+                    };
+                    lights.push_triangle(
+                        t.vertices,
+                        normal,
+                        (instance.material, two_sided(instance.material)),
+                        key,
+                        radiance,
+                    );
+                }
+            }
+        }
         for (i, s) in geometry.spheres.iter().enumerate() {
             let radiance = emission(s.material);
             if radiance.max_element() > 0.0 {
@@ -125,33 +154,6 @@ impl AreaLights {
                     prim,
                     radiance,
                 );
-            }
-        }
-        // Emissive instanced meshes: each instance's triangles moved to world space for
-        // sampling (the BVH keeps the mesh once; the emitter list has every copy).
-        for (i, instance) in geometry.instances.iter().enumerate() {
-            let radiance = emission(instance.material);
-            if radiance.max_element() <= 0.0 {
-                continue;
-            }
-            let mesh = &geometry.instanced_meshes[instance.mesh as usize];
-            for j in 0..mesh.triangles.len() {
-                let (t, _) = instance.world_triangle(mesh, j);
-                let [a, b, c] = t.vertices;
-                let normal = (b - a).cross(c - a).normalize_or_zero();
-                if normal != DVec3::ZERO {
-                    let key = HitKey {
-                        prim: PrimRef::new(PrimKind::Triangle, j as u32),
-                        instance: Some(i as u32),
-                    };
-                    lights.push_triangle(
-                        t.vertices,
-                        normal,
-                        (instance.material, two_sided(instance.material)),
-                        key,
-                        radiance,
-                    );
-                }
             }
         }
         lights
@@ -212,8 +214,10 @@ impl AreaLights {
         self.emitters.is_empty()
     }
 
-    /// The emitters in selection order, each with its cumulative and own selection
-    /// probabilities (for the GPU twin's upload, `crate::gpu::area_lights`).
+    /// The emitters in selection order, which is ascending hit-key order (instances'
+    /// triangles first, by instance and triangle, then the scene's own primitives),
+    /// each with its cumulative and own selection probabilities (for the GPU twin's
+    /// upload, `crate::gpu::area_lights`).
     pub fn entries(&self) -> Vec<EmitterEntry> {
         self.emitters
             .iter()
@@ -243,9 +247,8 @@ impl AreaLights {
                 };
                 EmitterEntry {
                     shape,
-                    // Scene geometry flattens emissive meshes, so an entry's surface
-                    // is one of the scene's own (`SceneGeometry::with_method`).
                     prim: emitter.key.prim,
+                    instance: emitter.key.instance,
                     radiance: emitter.radiance,
                     cdf: self.cdf[index] / self.total,
                     selection: (self.cdf[index] - below) / self.total,
@@ -308,8 +311,11 @@ pub enum EmitterEntryShape {
 pub struct EmitterEntry {
     /// Its shape.
     pub shape: EmitterEntryShape,
-    /// The primitive a ray hits on it.
+    /// The primitive a ray hits on it (for an instance's triangle: its index in the
+    /// instanced mesh).
     pub prim: PrimRef,
+    /// The instance it belongs to ([`super::SceneGeometry::instances`]), if any.
+    pub instance: Option<u32>,
     /// Its radiance.
     pub radiance: DVec3,
     /// The selection probability of it and every emitter before it.

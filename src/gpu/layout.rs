@@ -482,6 +482,9 @@ pub const WRAP_CLAMP_TO_EDGE: u32 = 2;
 pub const NO_ATTRIBUTES: u32 = u32::MAX;
 /// `texture_layer` / `brdf_map_layer` value meaning "no image".
 pub const NO_IMAGE: u32 = u32::MAX;
+/// The instance of the scene's own primitives in a hit or an emitter record
+/// (`NO_INSTANCE` in WGSL).
+pub const NO_INSTANCE: u32 = u32::MAX;
 /// `Light.kind` value for a point light.
 pub const LIGHT_POINT: u32 = 0;
 /// `Light.kind` value for a directional light.

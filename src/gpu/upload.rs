@@ -187,6 +187,47 @@ impl SceneRecords {
     }
 }
 
+/// Where the instanced meshes land in the GPU's buffers, as
+/// [`SceneRecords::new`] lays them out: after the scene's own triangles and tree, each
+/// mesh's triangles and tree in turn, then [`INSTANCE_RECORD_NODES`] node records per
+/// instance.
+#[derive(Debug, Clone)]
+pub struct InstanceLayout {
+    /// Per instanced mesh: the index of its first triangle in the triangle buffer.
+    first_triangle: Vec<u32>,
+    /// The node index of the first instance's records.
+    first_record: u32,
+}
+
+impl InstanceLayout {
+    /// The layout of `geometry`'s instanced meshes and instances.
+    pub fn new(geometry: &SceneGeometry) -> Self {
+        let index = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+        let mut triangles = geometry.triangles.len();
+        let mut nodes = geometry.bvh.nodes.len();
+        let mut first_triangle = Vec::with_capacity(geometry.instanced_meshes.len());
+        for mesh in &geometry.instanced_meshes {
+            first_triangle.push(index(triangles));
+            triangles += mesh.triangles.len();
+            nodes += mesh.bvh.nodes.len();
+        }
+        Self {
+            first_triangle,
+            first_record: index(nodes),
+        }
+    }
+
+    /// The names a GPU hit on triangle `triangle` of instance `instance`'s mesh
+    /// carries: its `PrimRef` in the triangle buffer and the node index of the
+    /// instance's records.
+    pub fn surface(&self, geometry: &SceneGeometry, instance: u32, triangle: usize) -> (u32, u32) {
+        let mesh = geometry.instances[instance as usize].mesh as usize;
+        let prim = self.first_triangle[mesh] + triangle as u32;
+        let node = self.first_record + INSTANCE_RECORD_NODES as u32 * instance;
+        (PrimRef::new(PrimKind::Triangle, prim).0, node)
+    }
+}
+
 /// Node records per instance in [`SceneRecords::bvh_nodes`].
 pub const INSTANCE_RECORD_NODES: usize = 4;
 
