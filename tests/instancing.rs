@@ -550,6 +550,9 @@ fn emissive_copies_are_instanced_with_an_emitter_record_per_triangle_and_copy() 
         std::mem::size_of_val(emitters.as_slice())
     );
     assert_eq!(SceneGeometry::new(&scene(10)).instances.len(), 10);
-    assert!((ten as f64) < 1.1 * one as f64, "10 copies take {ten} bytes, one {one}");
+    assert!(
+        (ten as f64) < 1.1 * one as f64,
+        "10 copies take {ten} bytes, one {one}"
+    );
     assert_eq!(emitters.len(), 10 * triangles);
 }

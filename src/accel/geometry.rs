@@ -311,11 +311,7 @@ impl SceneGeometry {
     /// ([`SceneGeometry::add_mesh`]), the others stored once as an [`InstancedMesh`]
     /// with one [`Instance`] per placement (of every mesh sharing that geometry, each
     /// with its mesh's material).
-    fn add_meshes(
-        &mut self,
-        meshes: &[Mesh],
-        method: BuildMethod,
-    ) {
+    fn add_meshes(&mut self, meshes: &[Mesh], method: BuildMethod) {
         for group in mesh_groups(meshes) {
             let placements: usize = group.iter().map(|&i| meshes[i].instances.len()).sum();
             if placements <= 1 {
