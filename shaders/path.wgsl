@@ -456,32 +456,41 @@ fn choose_emitter(u: f32, count: u32) -> u32 {
     return min(low, count - 1u);
 }
 
-// The first emitter record of primitive `prim`, or NO_PRIM when it is no sampled
-// emitter (CPU: AreaLights::first_of); binary search over the records' ascending prims.
-fn first_emitter_of(prim: u32) -> u32 {
+// Whether emitter record `index` comes before the surface (instance, prim) in the
+// records' order: ascending instance (NO_INSTANCE, the scene's own, last), then prim.
+fn emitter_before(index: u32, prim: u32, instance: u32) -> bool {
+    let e = emitters[index];
+    return e.instance < instance || (e.instance == instance && e.prim < prim);
+}
+
+// The first emitter record of primitive `prim` in instance `instance` (NO_INSTANCE for
+// the scene's own), or NO_PRIM when it is no sampled emitter (CPU:
+// AreaLights::first_of); binary search over the records' ascending (instance, prim).
+fn first_emitter_of(prim: u32, instance: u32) -> u32 {
     let count = emitter_count();
     var low = 0u;
     var high = count;
     for (var step = 0u; step < 32u && low < high; step += 1u) {
         let middle = (low + high) / 2u;
-        if emitters[middle].prim < prim {
+        if emitter_before(middle, prim, instance) {
             low = middle + 1u;
         } else {
             high = middle;
         }
     }
-    if low < count && emitters[low].prim == prim {
+    if low < count && emitters[low].prim == prim && emitters[low].instance == instance {
         return low;
     }
     return NO_PRIM;
 }
 
 // The density per steradian with which next-event estimation from `point` samples the
-// direction towards `hit` (0 if `hit` is on no sampled emitter): a sphere's cone
+// direction towards `hit`, made in instance `instance` (0 if `hit` is on no sampled
+// emitter): a sphere's cone
 // density times its selection probability, a flat emitter's selection / area per unit
 // area converted to solid angle. Twin of AreaLights::pdf.
-fn emitter_pdf(point: vec3<f32>, hit: Hit) -> f32 {
-    let index = first_emitter_of(hit.prim);
+fn emitter_pdf(point: vec3<f32>, hit: Hit, instance: u32) -> f32 {
+    let index = first_emitter_of(hit.prim, instance);
     if index == NO_PRIM {
         return 0.0;
     }
@@ -633,7 +642,7 @@ fn path_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) 
         var weight = 1.0;
         if (*path).depth > 0u && (*path).brdf_pdf > 0.0 {
             weight = power_heuristic((*path).brdf_pdf,
-                                     (1.0 - environment_selection()) * emitter_pdf((*path).shadow_origin, hit));
+                                     (1.0 - environment_selection()) * emitter_pdf((*path).shadow_origin, hit, trace.best_instance));
         }
         add_contribution(path, (*path).weight * material.emission * weight);
     }
@@ -754,15 +763,17 @@ fn path_start_emitter(path: ptr<function, PathState>, trace: ptr<function, Trace
 
 // The emitter sample is visible when the first thing its ray meets is that emitter
 // (its emitting side faces the ray: the sample was drawn only there), the environment's
-// when its ray meets nothing; then it adds f·L·cos θ / pdf, times the event's weight,
-// weighted by the power heuristic against the BRDF sampler when the path goes on. The
-// sample is drawn again from the same numbers. Twin of sample_emitter and
+// when its ray meets nothing; then it adds f·L·cos θ / pdf (L times the emission
+// texture at the shadow ray's hit, when the emitter has one), times the event's
+// weight, weighted by the power heuristic against the BRDF sampler when the path goes
+// on. The sample is drawn again from the same numbers. Twin of sample_emitter and
 // sample_environment.
 fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
     let sample = path_emitter_sample(path);
     var visible = trace.best_prim == NO_PRIM;
     if sample.emitter != ENVIRONMENT_EMITTER {
-        visible = trace.best_prim == emitters[sample.emitter].prim;
+        let emitter = emitters[sample.emitter];
+        visible = trace.best_prim == emitter.prim && trace.best_instance == emitter.instance;
     }
     if sample.found && visible {
         let material = lit_material(path);
@@ -774,7 +785,20 @@ fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
             weight = power_heuristic(sample.pdf, pdf_brdf(material, n, wo, sample.wi));
         }
         let cos_i = dot(n, sample.wi);
-        add_contribution(path, (*path).direct * (f * sample.radiance * (cos_i * weight / sample.pdf)));
+        var radiance = sample.radiance;
+        //#if TEXTURES
+        // A textured emitter's radiance at the point the shadow ray reaches (the
+        // sampled point), looked up at that hit's texture coordinates.
+        if sample.emitter != ENVIRONMENT_EMITTER {
+            let light_hit = hit_record_in(trace.best_prim, trace.best_instance,
+                                          Ray((*path).shadow_origin, sample.wi), trace.best_t);
+            let light_material = materials[light_hit.material];
+            if light_material.emission_layer != NO_IMAGE {
+                radiance = shading_emission(light_material, light_hit.position, light_hit.normal, light_hit.uv);
+            }
+        }
+        //#endif
+        add_contribution(path, (*path).direct * (f * radiance * (cos_i * weight / sample.pdf)));
     }
     (*path).phase = PHASE_POP;
 }

@@ -46,6 +46,11 @@ struct Emitter {
     radiance: vec3<f32>,
     // Triangle: selection / area, its density per unit area.
     area_density: f32,
+    // The instance a ray hits it in, or NO_INSTANCE for the scene's own primitives.
+    instance: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // The header of the environment buffer (binding 20, shaders/environment.wgsl): the

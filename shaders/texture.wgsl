@@ -98,13 +98,15 @@ fn sample_brdf_map(layer: u32, size: u32, theta_i: f32, theta_r: f32) -> vec3<f3
 }
 //#endif
 
-// The material at a hit: its albedo from shading_albedo, and its metalness and
-// perceptual roughness times the blue and green channels of the metallic/roughness
-// texture where there is one (glTF 2.0 §3.9.2), looked up at the albedo texture's
-// coordinates. Twin of shading_material (src/cpu/texture.rs).
+// The material at a hit: its albedo from shading_albedo, its emission from
+// shading_emission, and its metalness and perceptual roughness times the blue and green
+// channels of the metallic/roughness texture where there is one (glTF 2.0 §3.9.2),
+// looked up at the albedo texture's coordinates. Twin of shading_material
+// (src/cpu/texture.rs).
 fn shading_material(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> Material {
     var shaded = material;
     shaded.diffuse = shading_albedo(material, position, normal, uv);
+    shaded.emission = shading_emission(material, position, normal, uv);
     //#if TEXTURES
     if material.metallic_roughness_layer != NO_IMAGE {
         let st = texture_coordinates(material, position, normal, uv);
@@ -131,4 +133,20 @@ fn shading_albedo(material: Material, position: vec3<f32>, normal: vec3<f32>, uv
     }
     //#endif
     return material.diffuse;
+}
+
+// The emitted radiance at a point at `position` with geometric normal `normal` and mesh
+// texture coordinates `uv`: material.emission, times the emission texture where there
+// is one (glTF 2.0 §3.9.3: emissiveFactor times the texel), at the albedo texture's
+// coordinates. Twin of shading_emission (src/cpu/texture.rs).
+fn shading_emission(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> vec3<f32> {
+    //#if TEXTURES
+    if material.emission_layer != NO_IMAGE {
+        let st = texture_coordinates(material, position, normal, uv);
+        let wrap = vec2<u32>(material.emission_wrap & 0xffu, (material.emission_wrap >> 8u) & 0xffu);
+        return material.emission * sample_texture(material.emission_layer, material.emission_width,
+                                                  material.emission_height, st, wrap);
+    }
+    //#endif
+    return material.emission;
 }

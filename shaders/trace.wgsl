@@ -278,6 +278,7 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
         (*path).albedo = material.diffuse;
         (*path).roughness = material.roughness;
         (*path).metallic = material.metallic;
+        (*path).emission = material.emission;
         (*path).material = hit.material;
         (*path).normal = n;
         (*path).base = response.base;
@@ -330,8 +331,7 @@ fn next_light(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) ->
             return path_start_emitter(path, trace);
         }
         //#endif
-        let emission = materials[(*path).material].emission;
-        add_contribution(path, (*path).weight * (emission + (*path).direct * (*path).base));
+        add_contribution(path, (*path).weight * ((*path).emission + (*path).direct * (*path).base));
         (*path).phase = PHASE_POP;
         return false;
     }

@@ -154,6 +154,12 @@ struct Material {
     metallic_roughness_wrap: u32,
     // 1 when flat shapes of this material emit from both sides (path integrator).
     two_sided: u32,
+    // The emission texture (a colour multiplying `emission`), or NO_IMAGE; its wrap
+    // modes as u in bits 0-7 and v in bits 8-15.
+    emission_layer: u32,
+    emission_width: u32,
+    emission_height: u32,
+    emission_wrap: u32,
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
@@ -265,6 +271,10 @@ struct PathState {
     // Path integrator: the density of the BRDF sample that made the current ray, or
     // NO_BRDF_PDF (shaders/path.wgsl).
     brdf_pdf: f32,
+    // Whitted: the emission of the hit being lit (emission texture applied), added with
+    // its direct light after the last light.
+    emission: vec3<f32>,
+    _pad0: u32,
 }
 
 // One pending reflected or refracted ray on a slot's bounce stack.

@@ -466,8 +466,8 @@ fn materials_map_with_their_textures_and_wrap_modes() {
     assert_eq!(default.kind, MaterialKind::Pbr);
     assert_eq!((default.diffuse, default.metallic), (DVec3::ONE, 0.0));
 
-    // Placed in a scene, the base colour and metallic/roughness textures travel with
-    // the material (each image once); only the emissive one is left, with a warning.
+    // Placed in a scene, the base colour, metallic/roughness and emissive textures
+    // travel with the material (each image once), with their wrap modes.
     let mut scene = gpu_render::scene::Scene {
         render: Default::default(),
         camera: gpu_render::scene::Camera {
@@ -484,7 +484,7 @@ fn materials_map_with_their_textures_and_wrap_modes() {
         meshes: vec![],
         images: vec![],
     };
-    let warnings = model.add_to_scene(
+    model.add_to_scene(
         &mut scene,
         &gpu_render::scene::import::ModelPlacement::IDENTITY,
     );
@@ -499,9 +499,23 @@ fn materials_map_with_their_textures_and_wrap_modes() {
         [gpu_render::scene::TextureWrap::Repeat; 2]
     );
     assert!(placed.albedo_texture.is_some_and(|a| a != mr));
-    assert_eq!(scene.images.len(), 2, "the emissive image stays behind");
-    assert_eq!(warnings.len(), 1, "{warnings:?}");
-    assert!(warnings[0].contains("emissive texture"), "{warnings:?}");
+    let emission = placed
+        .emission_texture
+        .expect("the emissive texture is placed");
+    let texel = scene.images[emission as usize].texel(0, 0);
+    assert!(
+        (texel[1] - srgb_decode(128.0 / 255.0) as f32).abs() < 1e-6,
+        "{texel:?}"
+    );
+    assert_eq!(
+        placed.emission_wrap,
+        [gpu_render::scene::TextureWrap::Repeat; 2]
+    );
+    assert_eq!(
+        placed.texture_mapping,
+        gpu_render::scene::TextureMapping::Uv
+    );
+    assert_eq!(scene.images.len(), 3, "each image once");
 }
 
 #[test]

@@ -352,6 +352,71 @@ fn map_kd_loads_an_srgb_texture_linearised_with_its_wrap_mode() {
 }
 
 #[test]
+fn map_ke_loads_an_emission_texture_that_the_scene_keeps() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    write_png(
+        &dir.path().join("glow.png"),
+        2,
+        1,
+        &[[0, 0, 0, 255], [255, 128, 255, 255]],
+    );
+    std::fs::write(
+        dir.path().join("lamp.mtl"),
+        "newmtl lamp\nKd 0 0 0\nKe 2 2 2\nmap_Ke -clamp on glow.png\nillum 1\n",
+    )
+    .expect("mtl");
+    std::fs::write(
+        dir.path().join("lamp.obj"),
+        "mtllib lamp.mtl\nusemtl lamp\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n",
+    )
+    .expect("obj");
+    let model = import_obj(&dir.path().join("lamp.obj")).expect("imports");
+    assert!(
+        !model.warnings.iter().any(|w| w.contains("map_Ke")),
+        "{:?}",
+        model.warnings
+    );
+    let material = &model.materials[0];
+    assert_eq!(material.material.emission, DVec3::splat(2.0));
+    let texture = material.emissive_texture.expect("an emission texture");
+    assert_eq!(texture.wrap_u, WrapMode::ClampToEdge);
+    let image = &model.images[texture.image as usize];
+    assert!((image.texel(1, 0)[1] - srgb_decode(128.0 / 255.0) as f32).abs() < 1e-6);
+
+    // Placed in a scene, it becomes the material's UV-mapped emission texture.
+    let mut scene = gpu_render::scene::Scene {
+        render: Default::default(),
+        camera: gpu_render::scene::Camera {
+            eye: DVec3::Z,
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y_degrees: 40.0,
+        },
+        environment: Default::default(),
+        materials: vec![],
+        material_names: vec![],
+        lights: vec![],
+        shapes: vec![],
+        meshes: vec![],
+        images: vec![],
+    };
+    model.add_to_scene(
+        &mut scene,
+        &gpu_render::scene::import::ModelPlacement::IDENTITY,
+    );
+    let placed = scene.materials[0];
+    assert_eq!(placed.emission_texture, Some(0));
+    assert_eq!(
+        placed.emission_wrap,
+        [gpu_render::scene::TextureWrap::ClampToEdge; 2]
+    );
+    assert_eq!(
+        placed.texture_mapping,
+        gpu_render::scene::TextureMapping::Uv
+    );
+}
+
+#[test]
 fn degenerate_triangles_are_skipped_and_counted() {
     let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\nf 1 1 3\n";
     let model = imported(&[("thin.obj", obj)]);
@@ -478,6 +543,10 @@ const BAD_MTL: &[(&str, &str)] = &[
     (
         "newmtl a\nmap_Kd\n",
         "lib.mtl:2:1: `map_Kd` needs a file name",
+    ),
+    (
+        "newmtl a\nKe 1 1 1\nmap_Ke missing.png\n",
+        "lib.mtl:3:1: material 'a': map_Ke: the texture",
     ),
     (
         "newmtl a\nmap_Kd missing.png\n",

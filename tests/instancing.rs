@@ -379,14 +379,13 @@ fn path_tracing_samples_emissive_instances() {
         instances: transforms.to_vec(),
         ..mesh.clone()
     }]);
-    // A scene's emissive meshes are flattened (the GPU's emitter list names surfaces
-    // by primitive alone); geometry built from parts instances them, and the CPU's
-    // lights then hold every placement's triangles.
-    assert!(SceneGeometry::new(&instanced).instances.is_empty());
-    let parts =
-        SceneGeometry::from_parts(&[], &instanced.meshes, gpu_render::accel::BuildMethod::Sah);
+    // Emissive meshes placed twice are instanced too, and the lights hold every
+    // placement's triangles.
+    let parts = SceneGeometry::new(&instanced);
     assert_eq!(parts.instances.len(), 2);
-    let lights = gpu_render::accel::AreaLights::new(&parts, &instanced.materials);
+    assert!(parts.triangles.is_empty(), "nothing flattened");
+    let lights =
+        gpu_render::accel::AreaLights::new(&parts, &instanced.materials, &instanced.images);
     assert_eq!(lights.entries().len(), 2 * mesh.triangles.len());
     let flat = make(
         transforms
@@ -421,6 +420,26 @@ fn path_tracing_samples_emissive_instances() {
         ..FLAT_TOLERANCE
     };
     assert_images_match("instancing-path-emitters", &b, &a, tolerance);
+
+    // The GPU samples the instances' triangles as the CPU does: same emitter records
+    // (named by the GPU's triangle and instance record indices), same images.
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let renderer = common::gpu::renderer(&gpu);
+    let gpu_image = renderer
+        .render(&gpu.device, &gpu.queue, &instanced, None)
+        .unwrap_or_else(|e| panic!("GPU render failed: {e}"));
+    assert_images_match(
+        "instancing-path-emitters-gpu",
+        &a,
+        &gpu_image.image,
+        // A path whose sample lands exactly on an edge may branch differently: 2%.
+        Tolerance {
+            outlier_fraction: 0.02,
+            ..GPU_TOLERANCE
+        },
+    );
 }
 
 /// Bytes of every record list the GPU receives for `scene`.
@@ -489,4 +508,52 @@ fn a_hundred_copies_cost_one_copy_and_a_hundred_instance_records() {
         hundred <= one + 100 * per_instance + one / 50,
         "on the device 100 copies take {hundred} bytes, one {one}"
     );
+}
+
+/// A mesh whose material emits is instanced like any other: its copies cost the GPU
+/// scene bytes of one placement and an instance record each, plus, for the path
+/// integrator, one emitter record (96 bytes) per triangle and copy (next-event
+/// estimation samples each placement's triangles in world space). Prints the figures
+/// that docs/models.md quotes.
+#[test]
+fn emissive_copies_are_instanced_with_an_emitter_record_per_triangle_and_copy() {
+    let mesh = blob(64, 96);
+    let lamp = Material {
+        emission: DVec3::splat(2.0),
+        ..Material::lambert(DVec3::splat(0.5))
+    };
+    let scene = |copies: usize| {
+        let mut s = base_scene(
+            64,
+            vec![Mesh {
+                instances: (0..copies)
+                    .map(|i| DMat4::from_translation(DVec3::new(2.0 * i as f64, 0.0, 0.0)))
+                    .collect(),
+                material: 0,
+                ..mesh.clone()
+            }],
+        );
+        s.materials[0] = lamp;
+        s
+    };
+    let (one, ten) = (record_bytes(&scene(1)), record_bytes(&scene(10)));
+    let triangles = mesh.triangles.len();
+    let emitters = gpu_render::gpu::area_lights::emitter_records(
+        &SceneGeometry::new(&scene(10)),
+        &scene(10).materials,
+        &[],
+    );
+    eprintln!(
+        "{triangles} emissive triangles: 1 copy {one} bytes, 10 copies {ten} bytes ({:.3}x), \
+         {} emitter records ({} bytes)",
+        ten as f64 / one as f64,
+        emitters.len(),
+        std::mem::size_of_val(emitters.as_slice())
+    );
+    assert_eq!(SceneGeometry::new(&scene(10)).instances.len(), 10);
+    assert!(
+        (ten as f64) < 1.1 * one as f64,
+        "10 copies take {ten} bytes, one {one}"
+    );
+    assert_eq!(emitters.len(), 10 * triangles);
 }

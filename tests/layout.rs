@@ -146,6 +146,10 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 metallic_roughness_height,
                 metallic_roughness_wrap,
                 two_sided,
+                emission_layer,
+                emission_width,
+                emission_height,
+                emission_wrap,
                 _pad0,
                 _pad1,
                 _pad2,
@@ -219,7 +223,9 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 albedo,
                 metallic,
                 direct,
-                brdf_pdf
+                brdf_pdf,
+                emission,
+                _pad0
             }),
         ),
         (
@@ -260,7 +266,11 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 normal,
                 selection,
                 radiance,
-                area_density
+                area_density,
+                instance,
+                _pad0,
+                _pad1,
+                _pad2
             }),
         ),
         (

@@ -7,7 +7,8 @@
 use glam::DVec3;
 
 use super::{HitKey, PrimKind, PrimRef, SceneGeometry};
-use crate::scene::{Material, project_to_plane};
+use crate::cpu::texture::mean_texel;
+use crate::scene::{Image, Material, project_to_plane};
 
 /// Relative luminance of a linear Rec. 709 colour (ITU-R BT.709 weights).
 pub fn luminance(c: DVec3) -> f64 {
@@ -29,7 +30,8 @@ pub(crate) enum EmitterShape {
 }
 
 /// One emitter: its shape, the surface a ray hits on it (an instanced mesh's triangle
-/// with its instance), and its radiance.
+/// with its instance), and its material's constant radiance (`Material::emission`; an
+/// emission texture modulates it at the sampled point).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Emitter {
     pub(crate) shape: EmitterShape,
@@ -40,8 +42,10 @@ pub(crate) struct Emitter {
 /// The emissive spheres, polygons and triangles of a scene and the distribution by
 /// which next-event estimation picks one: in proportion to luminance times area (its
 /// power, up to π), so that every point of the flat emitters has the same density per
-/// unit area. Infinite planes are never sampled: their emission is found by BRDF
-/// sampling alone.
+/// unit area. An emitter whose material has an emission texture counts with its
+/// emission times the texture's mean texel ([`mean_texel`]); the radiance it adds is
+/// looked up at the sampled point. Infinite planes are never sampled: their emission
+/// is found by BRDF sampling alone.
 #[derive(Debug, Clone, Default)]
 pub struct AreaLights {
     emitters: Vec<Emitter>,
@@ -50,61 +54,31 @@ pub struct AreaLights {
     /// Cumulative selection weights.
     cdf: Vec<f64>,
     total: f64,
+    /// Per material: the mean texel of its emission texture (1 without one), which
+    /// scales its emitters' selection weights.
+    power_scale: Vec<DVec3>,
 }
 
 impl AreaLights {
-    /// The emitters of `geometry` with `materials` (in the lighting space).
-    pub fn new(geometry: &SceneGeometry, materials: &[Material]) -> Self {
-        let mut lights = Self::default();
+    /// The emitters of `geometry` with `materials` (in the lighting space) and the
+    /// scene's `images` (for the mean of emission textures).
+    pub fn new(geometry: &SceneGeometry, materials: &[Material], images: &[Image]) -> Self {
+        let mut lights = Self {
+            power_scale: materials
+                .iter()
+                .map(|m| match m.emission_texture {
+                    Some(image) => images.get(image as usize).map_or(DVec3::ONE, mean_texel),
+                    None => DVec3::ONE,
+                })
+                .collect(),
+            ..Self::default()
+        };
         let emission = |material: u32| materials[material as usize].emission;
         let two_sided = |material: u32| materials[material as usize].two_sided;
-        for (i, s) in geometry.spheres.iter().enumerate() {
-            let radiance = emission(s.material);
-            if radiance.max_element() > 0.0 {
-                let area = 4.0 * std::f64::consts::PI * s.radius * s.radius;
-                lights.push(
-                    Emitter {
-                        shape: EmitterShape::Sphere {
-                            center: s.center,
-                            radius: s.radius,
-                        },
-                        key: HitKey::world(PrimRef::new(PrimKind::Sphere, i as u32)),
-                        radiance,
-                    },
-                    area,
-                );
-            }
-        }
-        for (i, p) in geometry.polygons.iter().enumerate() {
-            let radiance = emission(p.material);
-            if radiance.max_element() <= 0.0 || p.plane.normal == DVec3::ZERO {
-                continue;
-            }
-            let prim = HitKey::world(PrimRef::new(PrimKind::Polygon, i as u32));
-            for vertices in polygon_triangles(&p.vertices, p.plane.dropped_axis) {
-                lights.push_triangle(
-                    vertices,
-                    p.plane.normal,
-                    two_sided(p.material),
-                    prim,
-                    radiance,
-                );
-            }
-        }
-        for (i, t) in geometry.triangles.iter().enumerate() {
-            let radiance = emission(t.material);
-            if radiance.max_element() <= 0.0 {
-                continue;
-            }
-            let [a, b, c] = t.vertices;
-            let normal = (b - a).cross(c - a).normalize_or_zero();
-            if normal != DVec3::ZERO {
-                let prim = HitKey::world(PrimRef::new(PrimKind::Triangle, i as u32));
-                lights.push_triangle(t.vertices, normal, two_sided(t.material), prim, radiance);
-            }
-        }
-        // Emissive instanced meshes: each instance's triangles moved to world space for
-        // sampling (the BVH keeps the mesh once; the emitter list has every copy).
+        // Emissive instanced meshes first (the order of hit keys, which the GPU's
+        // binary search by surface needs): each instance's triangles moved to world
+        // space for sampling (the BVH keeps the mesh once; the emitter list has every
+        // copy).
         for (i, instance) in geometry.instances.iter().enumerate() {
             let radiance = emission(instance.material);
             if radiance.max_element() <= 0.0 {
@@ -123,21 +97,75 @@ impl AreaLights {
                     lights.push_triangle(
                         t.vertices,
                         normal,
-                        two_sided(instance.material),
+                        (instance.material, two_sided(instance.material)),
                         key,
                         radiance,
                     );
                 }
             }
         }
+        for (i, s) in geometry.spheres.iter().enumerate() {
+            let radiance = emission(s.material);
+            if radiance.max_element() > 0.0 {
+                let area = 4.0 * std::f64::consts::PI * s.radius * s.radius;
+                lights.push(
+                    Emitter {
+                        shape: EmitterShape::Sphere {
+                            center: s.center,
+                            radius: s.radius,
+                        },
+                        key: HitKey::world(PrimRef::new(PrimKind::Sphere, i as u32)),
+                        radiance,
+                    },
+                    area,
+                    s.material,
+                );
+            }
+        }
+        for (i, p) in geometry.polygons.iter().enumerate() {
+            let radiance = emission(p.material);
+            if radiance.max_element() <= 0.0 || p.plane.normal == DVec3::ZERO {
+                continue;
+            }
+            let prim = HitKey::world(PrimRef::new(PrimKind::Polygon, i as u32));
+            for vertices in polygon_triangles(&p.vertices, p.plane.dropped_axis) {
+                lights.push_triangle(
+                    vertices,
+                    p.plane.normal,
+                    (p.material, two_sided(p.material)),
+                    prim,
+                    radiance,
+                );
+            }
+        }
+        for (i, t) in geometry.triangles.iter().enumerate() {
+            let radiance = emission(t.material);
+            if radiance.max_element() <= 0.0 {
+                continue;
+            }
+            let [a, b, c] = t.vertices;
+            let normal = (b - a).cross(c - a).normalize_or_zero();
+            if normal != DVec3::ZERO {
+                let prim = HitKey::world(PrimRef::new(PrimKind::Triangle, i as u32));
+                lights.push_triangle(
+                    t.vertices,
+                    normal,
+                    (t.material, two_sided(t.material)),
+                    prim,
+                    radiance,
+                );
+            }
+        }
         lights
     }
 
+    /// Adds a flat emitter; `material` is its material index and whether that emits
+    /// from both sides.
     fn push_triangle(
         &mut self,
         vertices: [DVec3; 3],
         normal: DVec3,
-        two_sided: bool,
+        (material, two_sided): (u32, bool),
         key: HitKey,
         radiance: DVec3,
     ) {
@@ -155,12 +183,21 @@ impl AreaLights {
                     radiance,
                 },
                 area,
+                material,
             );
         }
     }
 
-    fn push(&mut self, emitter: Emitter, area: f64) {
-        let weight = luminance(emitter.radiance).max(1e-12 * emitter.radiance.max_element()) * area;
+    /// Adds an emitter of `area` and material index `material`, weighted by the
+    /// luminance of its radiance times the mean of its emission texture, times `area`.
+    fn push(&mut self, emitter: Emitter, area: f64, material: u32) {
+        let power = emitter.radiance
+            * self
+                .power_scale
+                .get(material as usize)
+                .copied()
+                .unwrap_or(DVec3::ONE);
+        let weight = luminance(power).max(1e-12 * power.max_element()) * area;
         if !(weight > 0.0 && weight.is_finite()) {
             return;
         }
@@ -177,8 +214,10 @@ impl AreaLights {
         self.emitters.is_empty()
     }
 
-    /// The emitters in selection order, each with its cumulative and own selection
-    /// probabilities (for the GPU twin's upload, `crate::gpu::area_lights`).
+    /// The emitters in selection order, which is ascending hit-key order (instances'
+    /// triangles first, by instance and triangle, then the scene's own primitives),
+    /// each with its cumulative and own selection probabilities (for the GPU twin's
+    /// upload, `crate::gpu::area_lights`).
     pub fn entries(&self) -> Vec<EmitterEntry> {
         self.emitters
             .iter()
@@ -208,9 +247,8 @@ impl AreaLights {
                 };
                 EmitterEntry {
                     shape,
-                    // Scene geometry flattens emissive meshes, so an entry's surface
-                    // is one of the scene's own (`SceneGeometry::with_method`).
                     prim: emitter.key.prim,
+                    instance: emitter.key.instance,
                     radiance: emitter.radiance,
                     cdf: self.cdf[index] / self.total,
                     selection: (self.cdf[index] - below) / self.total,
@@ -273,8 +311,11 @@ pub enum EmitterEntryShape {
 pub struct EmitterEntry {
     /// Its shape.
     pub shape: EmitterEntryShape,
-    /// The primitive a ray hits on it.
+    /// The primitive a ray hits on it (for an instance's triangle: its index in the
+    /// instanced mesh).
     pub prim: PrimRef,
+    /// The instance it belongs to ([`super::SceneGeometry::instances`]), if any.
+    pub instance: Option<u32>,
     /// Its radiance.
     pub radiance: DVec3,
     /// The selection probability of it and every emitter before it.

@@ -174,18 +174,11 @@ impl SceneGeometry {
         Self::with_method(scene, BuildMethod::Sah)
     }
 
-    /// The geometry of `scene` with a BVH built by `method`. Meshes with an emissive
-    /// material are flattened even where placed more than once: the GPU's emitter
-    /// list names the surfaces a ray hits by primitive alone (`crate::gpu`'s
-    /// `area_lights`), and lights are small.
+    /// The geometry of `scene` with a BVH built by `method`; every mesh placed more
+    /// than once is instanced, emissive or not (next-event estimation samples each
+    /// instance's triangles, [`super::AreaLights`]).
     pub fn with_method(scene: &Scene, method: BuildMethod) -> Self {
-        let emissive = |material: u32| {
-            scene
-                .materials
-                .get(material as usize)
-                .is_some_and(|m| m.emission.max_element() > 0.0)
-        };
-        Self::build(&scene.shapes, &scene.meshes, method, &emissive)
+        Self::from_parts(&scene.shapes, &scene.meshes, method)
     }
 
     /// The geometry of `shapes` (validated, as in a [`Scene`]) with a BVH built by
@@ -197,17 +190,6 @@ impl SceneGeometry {
     /// The geometry of `shapes` and `meshes` (validated, as in a [`Scene`]) with a BVH
     /// built by `method`; every mesh placed more than once is instanced.
     pub fn from_parts(shapes: &[Shape], meshes: &[Mesh], method: BuildMethod) -> Self {
-        Self::build(shapes, meshes, method, &|_| false)
-    }
-
-    /// [`SceneGeometry::from_parts`], flattening the meshes whose material
-    /// `flattened` names.
-    fn build(
-        shapes: &[Shape],
-        meshes: &[Mesh],
-        method: BuildMethod,
-        flattened: &dyn Fn(u32) -> bool,
-    ) -> Self {
         let mut geometry = Self {
             spheres: Vec::new(),
             planes: Vec::new(),
@@ -276,7 +258,7 @@ impl SceneGeometry {
         for (plane, vertices, material) in large_polygons {
             triangulate_polygon(&plane, vertices, material, &mut geometry.triangles);
         }
-        geometry.add_meshes(meshes, method, flattened);
+        geometry.add_meshes(meshes, method);
         geometry.offset_scale = geometry.ray_offset_scale();
         let bounds = geometry.bounded_primitives();
         geometry.bvh = Bvh::build(&bounds, method);
@@ -328,19 +310,9 @@ impl SceneGeometry {
     /// Adds `meshes`: those whose geometry is placed once as world-space triangles
     /// ([`SceneGeometry::add_mesh`]), the others stored once as an [`InstancedMesh`]
     /// with one [`Instance`] per placement (of every mesh sharing that geometry, each
-    /// with its mesh's material); meshes whose material `flattened` names are always
-    /// flattened.
-    fn add_meshes(
-        &mut self,
-        meshes: &[Mesh],
-        method: BuildMethod,
-        flattened: &dyn Fn(u32) -> bool,
-    ) {
+    /// with its mesh's material).
+    fn add_meshes(&mut self, meshes: &[Mesh], method: BuildMethod) {
         for group in mesh_groups(meshes) {
-            let (flat, group): (Vec<usize>, Vec<usize>) = group
-                .into_iter()
-                .partition(|&i| flattened(meshes[i].material));
-            flat.iter().for_each(|&i| self.add_mesh(&meshes[i]));
             let placements: usize = group.iter().map(|&i| meshes[i].instances.len()).sum();
             if placements <= 1 {
                 group.iter().for_each(|&i| self.add_mesh(&meshes[i]));
@@ -348,10 +320,11 @@ impl SceneGeometry {
             }
             let stored =
                 InstancedMesh::new(&meshes[group[0]], method, &mut self.degenerate_triangles);
-            let Some(root) = stored.bvh.root_bounds() else {
+            let hull = stored.hull_points();
+            if hull.is_empty() {
                 // Every triangle degenerate: nothing to place.
                 continue;
-            };
+            }
             let mesh_index = self.instanced_meshes.len() as u32;
             for &i in &group {
                 for transform in &meshes[i].instances {
@@ -359,7 +332,7 @@ impl SceneGeometry {
                         mesh_index,
                         transform,
                         meshes[i].material,
-                        root,
+                        &hull,
                     ));
                 }
             }

@@ -93,30 +93,26 @@ pub struct Instance {
     pub mirrored: bool,
     /// Material index of every triangle of this placement.
     pub material: u32,
-    /// The conservative world box: the mesh BVH's root box, transformed.
+    /// The world box: around the mesh's [`InstancedMesh::hull_points`] moved to world
+    /// space (as tight as the transformed vertices near the root of the mesh's tree,
+    /// and never smaller than the transformed mesh).
     pub bounds: Aabb32,
 }
 
 impl Instance {
     /// The instance of `mesh` under `transform` (finite and invertible, as validated
-    /// meshes' instances are) with `material`; `object_bounds` is the mesh BVH's root
-    /// box.
-    pub fn new(mesh: u32, transform: &DMat4, material: u32, object_bounds: Aabb32) -> Self {
+    /// meshes' instances are) with `material`; `hull_points` are the mesh's
+    /// [`InstancedMesh::hull_points`] (at least one), whose convex hull contains it.
+    pub fn new(mesh: u32, transform: &DMat4, material: u32, hull_points: &[DVec3]) -> Self {
         let object_to_world = DAffine3::from_mat4(*transform);
         let world_to_object = object_to_world.inverse();
         let linear = object_to_world.matrix3;
+        // An affine map keeps convex hulls: the box around the moved points holds the
+        // moved mesh.
         let mut lo = DVec3::INFINITY;
         let mut hi = DVec3::NEG_INFINITY;
-        for corner in 0..8 {
-            let pick = |axis: usize| {
-                let bit = (corner >> axis) & 1 == 1;
-                f64::from(if bit {
-                    object_bounds.max[axis]
-                } else {
-                    object_bounds.min[axis]
-                })
-            };
-            let p = object_to_world.transform_point3(DVec3::new(pick(0), pick(1), pick(2)));
+        for p in hull_points {
+            let p = object_to_world.transform_point3(*p);
             lo = lo.min(p);
             hi = hi.max(p);
         }
@@ -172,7 +168,67 @@ impl Instance {
     }
 }
 
+/// The most nodes of a mesh's tree whose boxes stand for their subtrees in
+/// [`InstancedMesh::hull_points`].
+pub const MAX_HULL_NODES: usize = 512;
+
 impl InstancedMesh {
+    /// Points whose convex hull contains every triangle of the mesh, from which each
+    /// instance's world box is made: the tree is opened level by level from the root
+    /// while at most [`MAX_HULL_NODES`] nodes stand, and each standing node gives the
+    /// vertices of its triangles if it is a leaf, else its box's eight corners. A
+    /// rotated instance's box is then about as tight as the box of its moved vertices
+    /// (the eight corners of the mesh's root box, moved, make a box up to √3 times as
+    /// wide under rotation), at a cost per instance that does not grow with the mesh.
+    pub fn hull_points(&self) -> Vec<DVec3> {
+        let nodes = &self.bvh.nodes;
+        if nodes.is_empty() {
+            return Vec::new();
+        }
+        let mut standing = vec![0usize];
+        loop {
+            let inner = standing.iter().filter(|&&i| !nodes[i].is_leaf()).count();
+            if inner == 0 || standing.len() + inner > MAX_HULL_NODES {
+                break;
+            }
+            standing = standing
+                .iter()
+                .flat_map(|&i| {
+                    let node = &nodes[i];
+                    let first = node.first as usize;
+                    if node.is_leaf() {
+                        [i, usize::MAX]
+                    } else {
+                        [first, first + 1]
+                    }
+                })
+                .filter(|&i| i != usize::MAX)
+                .collect();
+        }
+        let mut points = Vec::new();
+        for i in standing {
+            let node = &nodes[i];
+            if node.is_leaf() {
+                let prims = &self.bvh.prims[node.first as usize..][..node.count as usize];
+                for prim in prims {
+                    points.extend_from_slice(&self.triangles[prim.index()].vertices);
+                }
+            } else {
+                for corner in 0..8 {
+                    let pick = |axis: usize| {
+                        f64::from(if (corner >> axis) & 1 == 1 {
+                            node.max[axis]
+                        } else {
+                            node.min[axis]
+                        })
+                    };
+                    points.push(DVec3::new(pick(0), pick(1), pick(2)));
+                }
+            }
+        }
+        points
+    }
+
     /// The mesh stored once: its triangles with area in object space (the others are
     /// counted into `degenerate`), their attributes, and the BVH over them.
     pub fn new(mesh: &Mesh, method: BuildMethod, degenerate: &mut usize) -> Self {
@@ -329,9 +385,8 @@ mod tests {
         let mut degenerate = 0;
         let mesh = InstancedMesh::new(&quad(vec![]), BuildMethod::Sah, &mut degenerate);
         assert_eq!(degenerate, 0);
-        let root = mesh.bvh.root_bounds().expect("two triangles");
         let mirror = DMat4::from_scale(DVec3::new(-2.0, 1.0, 1.0));
-        let instance = Instance::new(0, &mirror, 5, root);
+        let instance = Instance::new(0, &mirror, 5, &mesh.hull_points());
         assert!(instance.mirrored);
         let (triangle, attributes) = instance.world_triangle(&mesh, 0);
         assert_eq!(triangle.material, 5);
@@ -345,5 +400,83 @@ mod tests {
         let normals = attributes.and_then(|a| a.normals).expect("normals");
         assert!(normals.iter().all(|n| (*n - DVec3::Z).length() < 1e-15));
         assert!(instance.bounds.min[0] <= -2.0 && instance.bounds.max[0] >= 0.0);
+    }
+
+    /// A ring of triangles around the z axis (a round mesh, whose box a rotation about
+    /// z leaves unchanged) tipped 45° about x and turned 45° about z: the instance's box is
+    /// the box of its moved vertices (within the f32 padding), and holds every one of
+    /// them, where the moved corners of the mesh's box would be √2 wider along y.
+    #[test]
+    fn instance_boxes_are_as_tight_as_their_moved_vertices() {
+        let n = 400;
+        let mut positions = vec![DVec3::ZERO];
+        for k in 0..n {
+            let a = std::f64::consts::TAU * k as f64 / n as f64;
+            positions.push(DVec3::new(a.cos(), a.sin(), 0.0));
+        }
+        let triangles = (0..n as u32)
+            .map(|k| [0, 1 + k, 1 + (k + 1) % n as u32])
+            .collect();
+        let disc = Mesh {
+            name: "disc".into(),
+            positions: positions.clone(),
+            normals: None,
+            uvs: None,
+            triangles,
+            material: 0,
+            instances: vec![],
+        };
+        let mut degenerate = 0;
+        let mesh = InstancedMesh::new(&disc, BuildMethod::Sah, &mut degenerate);
+        let hull = mesh.hull_points();
+        let transform = DMat4::from_rotation_z(std::f64::consts::FRAC_PI_4)
+            * DMat4::from_rotation_x(std::f64::consts::FRAC_PI_4)
+            * DMat4::from_scale(DVec3::new(2.0, 2.0, 1.0));
+        let instance = Instance::new(0, &transform, 0, &hull);
+        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for p in &positions {
+            let q = transform.transform_point3(*p);
+            (lo, hi) = (lo.min(q), hi.max(q));
+            for axis in 0..3 {
+                assert!(
+                    f64::from(instance.bounds.min[axis]) <= q[axis]
+                        && q[axis] <= f64::from(instance.bounds.max[axis]),
+                    "{q} outside the box"
+                );
+            }
+        }
+        let root = mesh.bvh.root_bounds().expect("a tree");
+        let corners = Instance::new(0, &transform, 0, &corner_points(root));
+        for axis in 0..3 {
+            let width = f64::from(instance.bounds.max[axis] - instance.bounds.min[axis]);
+            let tight = hi[axis] - lo[axis];
+            assert!(
+                width <= tight * (1.0 + 1e-4) + 1e-5,
+                "axis {axis}: box {width} wide for vertices {tight} wide"
+            );
+            let loose = f64::from(corners.bounds.max[axis] - corners.bounds.min[axis]);
+            assert!(width <= loose, "axis {axis}");
+        }
+        let loose_y = f64::from(corners.bounds.max[1] - corners.bounds.min[1]);
+        assert!(
+            loose_y > 1.3 * (hi.y - lo.y),
+            "the corners' box is tight too: the test cannot tell"
+        );
+    }
+
+    /// The eight corners of a box.
+    fn corner_points(b: Aabb32) -> Vec<DVec3> {
+        (0..8)
+            .map(|c: usize| {
+                let pick = |axis: usize| {
+                    f64::from(if (c >> axis) & 1 == 1 {
+                        b.max[axis]
+                    } else {
+                        b.min[axis]
+                    })
+                };
+                DVec3::new(pick(0), pick(1), pick(2))
+            })
+            .collect()
     }
 }

@@ -30,7 +30,7 @@ use super::sample::{
     sample_triangle_barycentrics,
 };
 use super::tabulated::{pdf_tabulated, sample_tabulated};
-use super::texture::shading_material;
+use super::texture::{shading_emission, shading_material};
 use super::trace::{
     PreparedScene, direct_light, finite_radiance, keep_on_side, shading_frame_normal,
 };
@@ -392,9 +392,11 @@ fn add(radiance: &mut DVec3, contribution: DVec3) {
 }
 
 /// Next-event estimation of one emitter (chosen with probability `selection`) from
-/// `origin`: a sample on it, `f · L · cos θ / pdf` if nothing blocks it, weighted by
-/// the power heuristic against the BRDF's sampler when `mis` (the path goes on, so
-/// that a BRDF sample could find the same light). Returns it and the rays traced.
+/// `origin`: a sample on it, `f · L · cos θ / pdf` if nothing blocks it (`L` the
+/// emitter's radiance at the point the shadow ray reaches, [`shading_emission`]),
+/// weighted by the power heuristic against the BRDF's sampler when `mis` (the path
+/// goes on, so that a BRDF sample could find the same light). Returns it and the rays
+/// traced.
 #[allow(clippy::too_many_arguments)]
 fn sample_emitter(
     scene: &PreparedScene,
@@ -442,20 +444,29 @@ fn sample_emitter(
     };
     // Visible when the first thing the ray meets is the emitter itself, on its
     // emitting side.
-    let visible = intersect_scene(&scene.geometry, &shadow, f64::INFINITY).is_some_and(|hit| {
+    let Some(light_hit) = intersect_scene(&scene.geometry, &shadow, f64::INFINITY).filter(|hit| {
         hit.key() == emitter.key
-            && emits_towards(&hit, wi, scene.materials[hit.material as usize].two_sided)
-    });
-    if !visible {
+            && emits_towards(hit, wi, scene.materials[hit.material as usize].two_sided)
+    }) else {
         return (DVec3::ZERO, 1);
-    }
+    };
+    // The radiance of the sampled point: the emitter's own, times its emission texture
+    // at the point where the shadow ray meets it (that point, found with the texture
+    // coordinates of its barycentrics as every hit is).
+    let radiance = shading_emission(
+        &scene.materials[light_hit.material as usize],
+        &scene.images,
+        light_hit.position,
+        light_hit.normal,
+        light_hit.uv,
+    );
     let f = eval_brdf(material, &scene.images, n, wi, wo);
     let weight = if mis {
         power_heuristic(pdf, pdf_brdf(material, &scene.brdf_map_cdfs, n, wo, wi))
     } else {
         1.0
     };
-    (f * emitter.radiance * (cos_i * weight / pdf), 1)
+    (f * radiance * (cos_i * weight / pdf), 1)
 }
 
 /// Next-event estimation of the environment map (chosen with its selection

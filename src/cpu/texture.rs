@@ -141,9 +141,10 @@ pub fn shading_metallic_roughness(
     }
 }
 
-/// The material at a hit: [`shading_albedo`] as its albedo, and
-/// [`shading_metallic_roughness`] as its metalness and roughness. Twin of
-/// `shading_material` in `shaders/texture.wgsl`.
+/// The material at a hit: [`shading_albedo`] as its albedo,
+/// [`shading_metallic_roughness`] as its metalness and roughness, and
+/// [`shading_emission`] as its emission. Twin of `shading_material` in
+/// `shaders/texture.wgsl`.
 pub fn shading_material(
     material: &Material,
     images: &[Image],
@@ -155,7 +156,43 @@ pub fn shading_material(
     shaded.diffuse = shading_albedo(material, images, position, normal, uv);
     (shaded.metallic, shaded.roughness) =
         shading_metallic_roughness(material, images, position, normal, uv);
+    shaded.emission = shading_emission(material, images, position, normal, uv);
     shaded
+}
+
+/// The emitted radiance at a point at `position` with geometric normal `normal` and
+/// mesh texture coordinates `uv`: `material.emission`, times the emission texture
+/// where there is one (glTF 2.0 §3.9.3: the emissive colour is `emissiveFactor` times
+/// the texel), at the albedo texture's coordinates. Every place that evaluates emission
+/// calls it: a ray's hit and the point next-event estimation sampled on an emitter.
+/// Twin of `shading_emission` in `shaders/texture.wgsl`.
+pub fn shading_emission(
+    material: &Material,
+    images: &[Image],
+    position: DVec3,
+    normal: DVec3,
+    uv: DVec2,
+) -> DVec3 {
+    match material.emission_texture {
+        Some(index) => {
+            let (u, v) = texture_coordinates(material, position, normal, uv);
+            let image = &images[index as usize];
+            material.emission * sample_texture(image, u, v, material.emission_wrap)
+        }
+        None => material.emission,
+    }
+}
+
+/// The mean texel of an image (per channel, over every texel): the mean of a texture
+/// over its whole area. Next-event estimation picks a textured emitter by its material's
+/// emission times this mean ([`crate::accel::AreaLights`]): the power of the emitter if
+/// its UVs cover the image once uniformly, and an unbiased choice whatever they are
+/// (the sampled point's own texel weights its contribution).
+pub fn mean_texel(image: &Image) -> DVec3 {
+    let sum = image.texels.iter().fold(DVec3::ZERO, |sum, t| {
+        sum + DVec3::new(f64::from(t[0]), f64::from(t[1]), f64::from(t[2]))
+    });
+    sum / image.texels.len().max(1) as f64
 }
 
 /// The albedo at a hit at `position` with geometric normal `normal` and mesh texture

@@ -61,7 +61,7 @@ impl PreparedScene {
         let scene = scene.in_lighting_space();
         let (area_lights, brdf_map_cdfs) = match scene.render.integrator {
             Integrator::Path => (
-                AreaLights::new(&geometry, &scene.materials),
+                AreaLights::new(&geometry, &scene.materials, &scene.images),
                 BrdfMapCdfs::new(&scene.images, &scene.materials),
             ),
             Integrator::Whitted => (AreaLights::default(), BrdfMapCdfs::default()),

@@ -8,7 +8,9 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::accel::SceneGeometry;
 use crate::accel::{AreaLights, EmitterEntry, EmitterEntryShape};
-use crate::scene::Material;
+use crate::gpu::layout::NO_INSTANCE;
+use crate::gpu::upload::InstanceLayout;
+use crate::scene::{Image, Material};
 
 /// `FrameUniforms.flags`: trace with the path integrator (`FLAG_PATH` in WGSL).
 pub const FLAG_PATH: u32 = 4;
@@ -25,7 +27,8 @@ pub const EMITTER_NONE: u32 = 2;
 pub const EMITTER_TWO_SIDED_TRIANGLE: u32 = 3;
 
 /// One emitter (`Emitter` in WGSL), in the CPU's selection order, which is ascending
-/// [`crate::accel::PrimRef`] order.
+/// (instance, [`crate::accel::PrimRef`]) order, the scene's own primitives (instance
+/// `NO_INSTANCE`) last.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuEmitter {
@@ -49,6 +52,14 @@ pub struct GpuEmitter {
     pub radiance: [f32; 3],
     /// Triangle: selection probability over area (its density per unit area).
     pub area_density: f32,
+    /// The instance a ray hits it in, or `NO_INSTANCE` for the scene's own primitives.
+    pub instance: u32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
 }
 
 impl GpuEmitter {
@@ -65,6 +76,10 @@ impl GpuEmitter {
         selection: 0.0,
         radiance: [0.0; 3],
         area_density: 0.0,
+        instance: NO_INSTANCE,
+        _pad0: 0,
+        _pad1: 0,
+        _pad2: 0,
     };
 }
 
@@ -76,6 +91,7 @@ fn vec3(v: glam::DVec3) -> [f32; 3] {
 pub fn emitter_record(entry: &EmitterEntry) -> GpuEmitter {
     let mut record = GpuEmitter {
         prim: entry.prim.0,
+        instance: entry.instance.unwrap_or(NO_INSTANCE),
         cdf: entry.cdf as f32,
         selection: entry.selection as f32,
         radiance: vec3(entry.radiance),
@@ -107,14 +123,28 @@ pub fn emitter_record(entry: &EmitterEntry) -> GpuEmitter {
     record
 }
 
-/// The emitter records of `geometry` with `materials` (in the lighting space), as the
-/// CPU's [`AreaLights::new`] finds them; [`GpuEmitter::NONE`] alone when there are
-/// none.
-pub fn emitter_records(geometry: &SceneGeometry, materials: &[Material]) -> Vec<GpuEmitter> {
-    let mut records: Vec<GpuEmitter> = AreaLights::new(geometry, materials)
+/// The emitter records of `geometry` with `materials` (in the lighting space) and the
+/// scene's `images`, as the CPU's [`AreaLights::new`] finds them; [`GpuEmitter::NONE`]
+/// alone when there are none.
+pub fn emitter_records(
+    geometry: &SceneGeometry,
+    materials: &[Material],
+    images: &[Image],
+) -> Vec<GpuEmitter> {
+    let layout = InstanceLayout::new(geometry);
+    let mut records: Vec<GpuEmitter> = AreaLights::new(geometry, materials, images)
         .entries()
         .iter()
-        .map(emitter_record)
+        .map(|entry| {
+            let mut record = emitter_record(entry);
+            if let Some(instance) = entry.instance {
+                // The names the GPU's hits carry: the triangle's place in the
+                // triangle buffer and the node index of the instance's records.
+                (record.prim, record.instance) =
+                    layout.surface(geometry, instance, entry.prim.index());
+            }
+            record
+        })
         .collect();
     if let Some(last) = records.last_mut() {
         // The last cumulative probability is 1 exactly, whatever the rounding.
@@ -167,7 +197,7 @@ mod tests {
             },
         ];
         let geometry = SceneGeometry::from_shapes(&shapes, BuildMethod::Sah);
-        let records = emitter_records(&geometry, &materials);
+        let records = emitter_records(&geometry, &materials, &[]);
         // The lamp sphere, the square's two triangles, the triangle.
         assert_eq!(records.len(), 4, "{records:?}");
         assert!(records.windows(2).all(|w| w[0].prim <= w[1].prim));
@@ -182,6 +212,9 @@ mod tests {
         // Every piece of a flat emitter has the same density per unit area.
         assert!((records[1].area_density - records[3].area_density).abs() < 1e-6);
         let dark = [materials[0], materials[0]];
-        assert_eq!(emitter_records(&geometry, &dark), vec![GpuEmitter::NONE]);
+        assert_eq!(
+            emitter_records(&geometry, &dark, &[]),
+            vec![GpuEmitter::NONE]
+        );
     }
 }

@@ -94,10 +94,11 @@ impl ShaderFeatures {
             oren_nayar: has_kind(MaterialKind::OrenNayar),
             tabulated: has_kind(MaterialKind::Tabulated),
             pbr: has_kind(MaterialKind::Pbr),
-            textures: scene
-                .materials
-                .iter()
-                .any(|m| m.albedo_texture.is_some() || m.metallic_roughness_texture.is_some()),
+            textures: scene.materials.iter().any(|m| {
+                m.albedo_texture.is_some()
+                    || m.metallic_roughness_texture.is_some()
+                    || m.emission_texture.is_some()
+            }),
             mesh_attributes: scene
                 .meshes
                 .iter()

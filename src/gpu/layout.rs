@@ -184,6 +184,11 @@ pub struct GpuPathState {
     /// Path integrator: the density of the BRDF sample that made the current ray
     /// (negative when none did).
     pub brdf_pdf: f32,
+    /// Whitted: the emission of the hit being lit (emission texture applied), added
+    /// with its direct light.
+    pub emission: [f32; 3],
+    /// Padding.
+    pub _pad0: u32,
 }
 
 /// One pending ray on a slot's bounce stack (`StackEntry` in WGSL).
@@ -368,6 +373,14 @@ pub struct GpuMaterial {
     pub metallic_roughness_wrap: u32,
     /// 1 when flat shapes of this material emit from both sides (path integrator).
     pub two_sided: u32,
+    /// Layer of the emission texture in the image array, or [`NO_IMAGE`].
+    pub emission_layer: u32,
+    /// Width of the emission texture in texels.
+    pub emission_width: u32,
+    /// Height of the emission texture in texels.
+    pub emission_height: u32,
+    /// Its wrap modes: the `WRAP_*` code along `u` in bits 0-7, along `v` in bits 8-15.
+    pub emission_wrap: u32,
     /// Padding.
     pub _pad0: u32,
     /// Padding.
@@ -469,6 +482,9 @@ pub const WRAP_CLAMP_TO_EDGE: u32 = 2;
 pub const NO_ATTRIBUTES: u32 = u32::MAX;
 /// `texture_layer` / `brdf_map_layer` value meaning "no image".
 pub const NO_IMAGE: u32 = u32::MAX;
+/// The instance of the scene's own primitives in a hit or an emitter record
+/// (`NO_INSTANCE` in WGSL).
+pub const NO_INSTANCE: u32 = u32::MAX;
 /// `Light.kind` value for a point light.
 pub const LIGHT_POINT: u32 = 0;
 /// `Light.kind` value for a directional light.

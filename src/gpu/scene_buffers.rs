@@ -127,7 +127,7 @@ pub(crate) fn upload_scene(
         // The integrator is a flag of the trace: every trace of the scene keeps it.
         frame.flags |= FLAG_PATH;
         frame.stack_size = frame.stack_size.max(1);
-        emitter_records(geometry, &shaded.materials)
+        emitter_records(geometry, &shaded.materials, &shaded.images)
     } else {
         vec![GpuEmitter::NONE]
     };

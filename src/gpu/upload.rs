@@ -187,6 +187,47 @@ impl SceneRecords {
     }
 }
 
+/// Where the instanced meshes land in the GPU's buffers, as
+/// [`SceneRecords::new`] lays them out: after the scene's own triangles and tree, each
+/// mesh's triangles and tree in turn, then [`INSTANCE_RECORD_NODES`] node records per
+/// instance.
+#[derive(Debug, Clone)]
+pub struct InstanceLayout {
+    /// Per instanced mesh: the index of its first triangle in the triangle buffer.
+    first_triangle: Vec<u32>,
+    /// The node index of the first instance's records.
+    first_record: u32,
+}
+
+impl InstanceLayout {
+    /// The layout of `geometry`'s instanced meshes and instances.
+    pub fn new(geometry: &SceneGeometry) -> Self {
+        let index = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+        let mut triangles = geometry.triangles.len();
+        let mut nodes = geometry.bvh.nodes.len();
+        let mut first_triangle = Vec::with_capacity(geometry.instanced_meshes.len());
+        for mesh in &geometry.instanced_meshes {
+            first_triangle.push(index(triangles));
+            triangles += mesh.triangles.len();
+            nodes += mesh.bvh.nodes.len();
+        }
+        Self {
+            first_triangle,
+            first_record: index(nodes),
+        }
+    }
+
+    /// The names a GPU hit on triangle `triangle` of instance `instance`'s mesh
+    /// carries: its `PrimRef` in the triangle buffer and the node index of the
+    /// instance's records.
+    pub fn surface(&self, geometry: &SceneGeometry, instance: u32, triangle: usize) -> (u32, u32) {
+        let mesh = geometry.instances[instance as usize].mesh as usize;
+        let prim = self.first_triangle[mesh] + triangle as u32;
+        let node = self.first_record + INSTANCE_RECORD_NODES as u32 * instance;
+        (PrimRef::new(PrimKind::Triangle, prim).0, node)
+    }
+}
+
 /// Node records per instance in [`SceneRecords::bvh_nodes`].
 pub const INSTANCE_RECORD_NODES: usize = 4;
 
@@ -289,6 +330,7 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
     let (brdf_map_layer, brdf_map_size, _) = image(material.brdf_map);
     let (metallic_roughness_layer, metallic_roughness_width, metallic_roughness_height) =
         image(material.metallic_roughness_texture);
+    let (emission_layer, emission_width, emission_height) = image(material.emission_texture);
     GpuMaterial {
         diffuse: vec3(material.diffuse),
         shininess: material.shininess as f32,
@@ -332,6 +374,11 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
         metallic_roughness_wrap: wrap_code(material.metallic_roughness_wrap[0])
             | wrap_code(material.metallic_roughness_wrap[1]) << 8,
         two_sided: u32::from(material.two_sided),
+        emission_layer,
+        emission_width,
+        emission_height,
+        emission_wrap: wrap_code(material.emission_wrap[0])
+            | wrap_code(material.emission_wrap[1]) << 8,
         _pad0: 0,
         _pad1: 0,
         _pad2: 0,

@@ -309,6 +309,13 @@ pub struct Material {
     pub metallic_roughness_texture: Option<u32>,
     /// Wrap modes of the metallic/roughness texture along `u` and `v`.
     pub metallic_roughness_wrap: [TextureWrap; 2],
+    /// Index into [`Scene::images`] of a colour texture multiplying `emission`
+    /// (glTF's `emissiveTexture`, OBJ's `map_Ke`), looked up with the albedo
+    /// texture's coordinates (`texture_mapping`) wherever emission is evaluated,
+    /// if any.
+    pub emission_texture: Option<u32>,
+    /// Wrap modes of the emission texture along `u` and `v`.
+    pub emission_wrap: [TextureWrap; 2],
     /// Whether flat shapes (polygons, triangles, meshes) of this material emit
     /// `emission` from both sides; by default only from the side their normal points
     /// to (spheres always emit on both). The path integrator's rule: Whitted shows
@@ -345,6 +352,8 @@ impl Material {
             brdf_map: None,
             metallic_roughness_texture: None,
             metallic_roughness_wrap: [TextureWrap::Repeat; 2],
+            emission_texture: None,
+            emission_wrap: [TextureWrap::Repeat; 2],
             two_sided: false,
         }
     }

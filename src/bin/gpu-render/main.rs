@@ -349,9 +349,9 @@ pub fn load_model(
         );
     }
     let model = scene::import::import_model(path)?;
-    let (scene, warnings) = model.into_scene(render);
+    let scene = model.into_scene(render);
     if !quiet {
-        for warning in model.warnings.iter().chain(&warnings) {
+        for warning in &model.warnings {
             eprintln!("warning: {warning}");
         }
         if model.camera.is_none() {

@@ -352,10 +352,19 @@ fn build_scene(
     // Each shape's object index and span, for the warnings that judge shapes together.
     let mut shape_items = Vec::with_capacity(raw.objects.len());
     let mut models = Vec::new();
+    let mut model_cache = objects::ModelCache::new();
     for (i, object) in raw.objects.into_iter().enumerate() {
         checked();
         if object.get_ref().kind.as_deref() == Some("model") {
-            models.push(objects::model(source, &table, i, object, base, options)?);
+            models.push(objects::model(
+                source,
+                &table,
+                i,
+                object,
+                base,
+                options,
+                &mut model_cache,
+            )?);
         } else {
             let span = object.span();
             let shape = objects::object(source, &table, i, object)?;
@@ -400,14 +409,20 @@ fn build_scene(
         meshes: vec![],
         images: images.into_images(),
     };
-    for placed in models {
-        let warnings = placed.model.add_to_scene(&mut scene, &placed.placement);
-        if let Some(warn) = options.warning {
-            let item = source.item(placed.name, Some(placed.span));
-            for message in warnings {
-                warn(&item.warning(message));
-            }
+    // Each model file once, with all its placements (in file order of first use): its
+    // geometry is held once per distinct material override.
+    let mut done = vec![false; models.len()];
+    for first in 0..models.len() {
+        if done[first] {
+            continue;
         }
+        let model = &models[first].model;
+        let placements: Vec<_> = (first..models.len())
+            .filter(|&k| std::rc::Rc::ptr_eq(&models[k].model, model))
+            .inspect(|&k| done[k] = true)
+            .map(|k| models[k].placement)
+            .collect();
+        model.add_placements_to_scene(&mut scene, &placements);
     }
     Ok(SceneFile { scene, camera_path })
 }

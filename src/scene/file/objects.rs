@@ -92,20 +92,21 @@ pub fn object(
     }
 }
 
+/// The model files a scene file has imported so far, each once, by its canonical path
+/// (the path as joined where it cannot be canonicalised).
+pub type ModelCache = std::collections::HashMap<std::path::PathBuf, std::rc::Rc<ImportedModel>>;
+
 /// A `type = "model"` object, read and placed but not yet added to the scene.
 pub struct PlacedModel {
-    /// The model as imported.
-    pub model: ImportedModel,
+    /// The model as imported, shared by every object that places the same file.
+    pub model: std::rc::Rc<ImportedModel>,
     /// Where it stands, and the material that replaces its own, if any.
     pub placement: ModelPlacement,
-    /// The object's name and place in the scene file, for warnings.
-    pub name: String,
-    /// Byte range of the object in the scene file.
-    pub span: std::ops::Range<usize>,
 }
 
 /// Model object `index` (0-based, in file order): its file imported (relative to the
-/// scene file's folder `base`), its transform checked.
+/// scene file's folder `base`) unless `cache` has it already (then its warnings are
+/// not repeated), its transform checked.
 pub fn model(
     source: &Source<'_>,
     materials: &MaterialTable<'_>,
@@ -113,6 +114,7 @@ pub fn model(
     raw: Spanned<RawObject>,
     base: &std::path::Path,
     options: &LoadOptions<'_>,
+    cache: &mut ModelCache,
 ) -> Result<PlacedModel, SceneError> {
     let span = raw.span();
     let raw = raw.into_inner();
@@ -155,13 +157,23 @@ pub fn model(
     let transform = ModelPlacement::trs(translate, rotate, scale);
     // The importer's error names the model file and its element; this names the scene
     // object that asked for it.
-    let model = import_model(&base.join(file))
-        .map_err(|err| item.fail(format_args!("file `{file}`: {err}")))?;
-    if let Some(warn) = options.warning {
-        for message in &model.warnings {
-            warn(&item.warning(message));
+    let path = base.join(file);
+    let key = std::fs::canonicalize(&path).unwrap_or_else(|_| path.clone());
+    let model = match cache.get(&key) {
+        Some(model) => model.clone(),
+        None => {
+            let model = import_model(&path)
+                .map_err(|err| item.fail(format_args!("file `{file}`: {err}")))?;
+            if let Some(warn) = options.warning {
+                for message in &model.warnings {
+                    warn(&item.warning(message));
+                }
+            }
+            let model = std::rc::Rc::new(model);
+            cache.insert(key, model.clone());
+            model
         }
-    }
+    };
     Ok(PlacedModel {
         model,
         placement: ModelPlacement {
@@ -169,8 +181,6 @@ pub fn model(
             material,
             smooth: raw.smooth.unwrap_or(true),
         },
-        name,
-        span,
     })
 }
 

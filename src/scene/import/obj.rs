@@ -470,6 +470,8 @@ struct SourceMaterial {
     line: usize,
     /// `map_Kd` line and column, when it has one.
     map_kd_at: Option<(usize, usize)>,
+    /// `map_Ke` line and column, when it has one.
+    map_ke_at: Option<(usize, usize)>,
 }
 
 /// The material libraries loaded while `tobj` reads the OBJ file.
@@ -542,7 +544,15 @@ impl Libraries {
                     format!("the material library could not be read: {e}"),
                 )
             })?;
-        for (material, (line, map_kd_at)) in materials.iter().cloned().zip(lines) {
+        for (
+            material,
+            MtlLines {
+                line,
+                map_kd_at,
+                map_ke_at,
+            },
+        ) in materials.iter().cloned().zip(lines)
+        {
             self.index
                 .insert(material.name.clone(), self.materials.len());
             self.materials.push(SourceMaterial {
@@ -550,6 +560,7 @@ impl Libraries {
                 library: library.to_path_buf(),
                 line,
                 map_kd_at,
+                map_ke_at,
             });
         }
         Ok((materials, names))
@@ -574,14 +585,18 @@ const MTL_SCALARS: &[&str] = &[
     "sharpness",
 ];
 
+/// Where a material of an MTL library is defined: the line of its `newmtl`, and the line
+/// and column of its `map_Kd` and `map_Ke`, when it has them.
+struct MtlLines {
+    line: usize,
+    map_kd_at: Option<(usize, usize)>,
+    map_ke_at: Option<(usize, usize)>,
+}
+
 /// Checks every line of an MTL library and returns the text for `tobj` (colours with one
 /// number spelled out as three, unsupported forms blanked) and, per material in order,
-/// the line of its `newmtl` and of its `map_Kd`.
-#[allow(clippy::type_complexity)]
-fn scan_mtl(
-    text: &str,
-    path: &Path,
-) -> Result<(String, Vec<(usize, Option<(usize, usize)>)>), SceneError> {
+/// where it is defined.
+fn scan_mtl(text: &str, path: &Path) -> Result<(String, Vec<MtlLines>), SceneError> {
     let mut clean = String::with_capacity(text.len());
     let mut lines = Vec::new();
     for (index, line) in text.lines().enumerate() {
@@ -599,7 +614,11 @@ fn scan_mtl(
             if values.is_empty() {
                 return Err(at(path, n, column, "`newmtl` needs a material name"));
             }
-            lines.push((n, None));
+            lines.push(MtlLines {
+                line: n,
+                map_kd_at: None,
+                map_ke_at: None,
+            });
         } else if MTL_COLOURS.contains(&keyword) {
             if values
                 .first()
@@ -672,9 +691,10 @@ fn scan_mtl(
                     format!("`{keyword}` needs a file name"),
                 ));
             }
-            if keyword == "map_Kd" {
+            if keyword == "map_Kd" || keyword == "map_Ke" {
                 match lines.last_mut() {
-                    Some(last) => last.1 = Some((n, column)),
+                    Some(last) if keyword == "map_Kd" => last.map_kd_at = Some((n, column)),
+                    Some(last) => last.map_ke_at = Some((n, column)),
                     None => kept.clear(),
                 }
             }
@@ -725,38 +745,47 @@ fn map_material(
     let mut warn = |message: String| warnings.push(format!("{place}: {message}"));
     let colour = |c: Option<[f64; 3]>| c.map(|[r, g, b]| DVec3::new(r, g, b));
 
-    let base_color_texture = match (&m.diffuse_texture, source.map_kd_at) {
-        (Some(spec), Some((line, column))) => {
-            let (file, wrap, ignored) = texture_options(spec);
-            if !ignored.is_empty() {
-                warn(format!(
-                    "map_Kd options {} are not supported; ignored",
-                    ignored.join(" ")
-                ));
-            }
-            let directory = source.library.parent().unwrap_or(Path::new(""));
-            let mut file_path = directory.join(&file);
-            if !file_path.exists() && file.contains('\\') {
-                file_path = directory.join(file.replace('\\', "/"));
-            }
-            let image = textures
-                .file(&file_path, Encoding::Color, budget)
-                .map_err(|e| {
-                    at(
-                        &source.library,
-                        line,
-                        column,
-                        format!("material '{}': map_Kd: {e}", m.name),
-                    )
-                })?;
-            Some(TextureRef {
-                image,
-                wrap_u: wrap,
-                wrap_v: wrap,
-            })
+    // A colour texture statement (`map_Kd`, `map_Ke`) at `at`, loaded relative to the
+    // library's directory.
+    let mut colour_texture = |key: &str,
+                              spec: Option<&String>,
+                              at_line: Option<(usize, usize)>|
+     -> Result<Option<TextureRef>, SceneError> {
+        let (Some(spec), Some((line, column))) = (spec, at_line) else {
+            return Ok(None);
+        };
+        let (file, wrap, ignored) = texture_options(spec);
+        if !ignored.is_empty() {
+            warn(format!(
+                "{key} options {} are not supported; ignored",
+                ignored.join(" ")
+            ));
         }
-        _ => None,
+        let directory = source.library.parent().unwrap_or(Path::new(""));
+        let mut file_path = directory.join(&file);
+        if !file_path.exists() && file.contains('\\') {
+            file_path = directory.join(file.replace('\\', "/"));
+        }
+        let image = textures
+            .file(&file_path, Encoding::Color, budget)
+            .map_err(|e| {
+                at(
+                    &source.library,
+                    line,
+                    column,
+                    format!("material '{}': {key}: {e}", m.name),
+                )
+            })?;
+        Ok(Some(TextureRef {
+            image,
+            wrap_u: wrap,
+            wrap_v: wrap,
+        }))
     };
+    let base_color_texture =
+        colour_texture("map_Kd", m.diffuse_texture.as_ref(), source.map_kd_at)?;
+    let emissive_texture =
+        colour_texture("map_Ke", m.unknown_param.get("map_Ke"), source.map_ke_at)?;
     for (key, present) in [
         ("map_Ks", m.specular_texture.is_some()),
         ("map_Ka", m.ambient_texture.is_some()),
@@ -772,7 +801,8 @@ fn map_material(
         .unknown_param
         .keys()
         .filter(|k| {
-            k.starts_with("map_") || matches!(k.as_str(), "disp" | "decal" | "refl" | "norm")
+            (k.starts_with("map_") && k.as_str() != "map_Ke")
+                || matches!(k.as_str(), "disp" | "decal" | "refl" | "norm")
         })
         .collect();
     others.sort();
@@ -906,7 +936,7 @@ fn map_material(
         material,
         base_color_texture,
         metallic_roughness_texture: None,
-        emissive_texture: None,
+        emissive_texture,
     })
 }
 

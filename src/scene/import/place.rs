@@ -56,90 +56,114 @@ impl ImportedModel {
     /// Adds the model to `scene` under `placement`: one [`Mesh`] per imported mesh
     /// (instances composed with the placement), its materials (named
     /// `<file stem>/<material>`) unless the placement overrides them, and the base
-    /// colour textures they use (as UV-mapped albedo textures with the file's wrap
-    /// modes). Returns warnings for what the renderers do not model: emissive textures
-    /// (the constant emission is kept).
-    pub fn add_to_scene(&self, scene: &mut Scene, placement: &ModelPlacement) -> Vec<String> {
-        let mut warnings = Vec::new();
+    /// colour, metallic/roughness and emission textures they use (UV-mapped, with the
+    /// file's wrap modes). [`ImportedModel::add_placements_to_scene`] with one
+    /// placement.
+    pub fn add_to_scene(&self, scene: &mut Scene, placement: &ModelPlacement) {
+        self.add_placements_to_scene(scene, std::slice::from_ref(placement));
+    }
+
+    /// Adds the model to `scene` under every one of `placements`, holding its geometry
+    /// once per distinct (material override, `smooth`) pair rather than once per
+    /// placement: each imported mesh becomes one [`Mesh`] per such pair, whose
+    /// instances are those of the file composed with each of its placements' transforms
+    /// (in placement order), so that a model file placed many times costs the host
+    /// memory of one copy (the GPU and the BVH hold it once in any case, as an
+    /// instanced mesh). The model's materials (named `<file stem>/<material>`) and the
+    /// textures they use join the scene once, for the placements that keep them.
+    pub fn add_placements_to_scene(&self, scene: &mut Scene, placements: &[ModelPlacement]) {
         let stem = self
             .path
             .file_stem()
             .map_or_else(|| "model".into(), |s| s.to_string_lossy().into_owned());
         let material_base = scene.materials.len() as u32;
-        if placement.material.is_none() {
-            // Only the images a base colour or metallic/roughness texture uses travel
-            // to the GPU, each once.
-            let mut image_index = vec![None; self.images.len()];
-            let mut scene_image = |scene: &mut Scene, image: u32| {
-                *image_index[image as usize].get_or_insert_with(|| {
-                    scene.images.push(self.images[image as usize].clone());
-                    scene.images.len() as u32 - 1
-                })
-            };
-            for imported in &self.materials {
-                let mut material: Material = imported.material;
-                if let Some(TextureRef {
-                    image,
-                    wrap_u,
-                    wrap_v,
-                }) = imported.base_color_texture
-                {
-                    material.albedo_texture = Some(scene_image(scene, image));
-                    material.texture_mapping = TextureMapping::Uv;
-                    material.texture_wrap = [texture_wrap(wrap_u), texture_wrap(wrap_v)];
-                }
-                if let Some(TextureRef {
-                    image,
-                    wrap_u,
-                    wrap_v,
-                }) = imported.metallic_roughness_texture
-                {
-                    material.metallic_roughness_texture = Some(scene_image(scene, image));
-                    material.texture_mapping = TextureMapping::Uv;
-                    material.metallic_roughness_wrap = [texture_wrap(wrap_u), texture_wrap(wrap_v)];
-                }
-                if imported.emissive_texture.is_some() {
-                    warnings.push(format!(
-                        "{}: material `{}`: its emissive texture is not used (the renderers \
-                         take the material's constant emission)",
-                        self.path.display(),
-                        imported.name
-                    ));
-                }
-                scene.materials.push(material);
-                scene
-                    .material_names
-                    .push(format!("{stem}/{}", imported.name));
+        if placements.iter().any(|p| p.material.is_none()) {
+            self.add_materials(scene, &stem);
+        }
+        // The distinct (material override, smooth) pairs, in order of first use.
+        let mut kinds: Vec<(Option<u32>, bool)> = Vec::new();
+        for p in placements {
+            if !kinds.contains(&(p.material, p.smooth)) {
+                kinds.push((p.material, p.smooth));
             }
         }
-        for mesh in &self.meshes {
-            scene.meshes.push(Mesh {
-                name: format!("{stem}/{}", mesh.name),
-                positions: mesh.positions.clone(),
-                normals: if placement.smooth {
-                    mesh.normals.clone()
-                } else {
-                    None
-                },
-                uvs: mesh.uvs.clone(),
-                triangles: mesh.triangles.clone(),
-                material: placement.material.unwrap_or(material_base + mesh.material),
-                instances: mesh
-                    .instances
-                    .iter()
-                    .map(|m| placement.transform * *m)
-                    .collect(),
-            });
+        for (material, smooth) in kinds {
+            let transforms: Vec<DMat4> = placements
+                .iter()
+                .filter(|p| (p.material, p.smooth) == (material, smooth))
+                .map(|p| p.transform)
+                .collect();
+            for mesh in &self.meshes {
+                scene.meshes.push(Mesh {
+                    name: format!("{stem}/{}", mesh.name),
+                    positions: mesh.positions.clone(),
+                    normals: if smooth { mesh.normals.clone() } else { None },
+                    uvs: mesh.uvs.clone(),
+                    triangles: mesh.triangles.clone(),
+                    material: material.unwrap_or(material_base + mesh.material),
+                    instances: transforms
+                        .iter()
+                        .flat_map(|t| mesh.instances.iter().map(move |m| *t * *m))
+                        .collect(),
+                });
+            }
         }
-        warnings
+    }
+
+    /// Adds the model's materials to `scene` (named `<stem>/<material>`, in the
+    /// model's order) with the images their textures use, each image once.
+    fn add_materials(&self, scene: &mut Scene, stem: &str) {
+        let mut image_index = vec![None; self.images.len()];
+        let mut scene_image = |scene: &mut Scene, image: u32| {
+            *image_index[image as usize].get_or_insert_with(|| {
+                scene.images.push(self.images[image as usize].clone());
+                scene.images.len() as u32 - 1
+            })
+        };
+        for imported in &self.materials {
+            let mut material: Material = imported.material;
+            if let Some(TextureRef {
+                image,
+                wrap_u,
+                wrap_v,
+            }) = imported.base_color_texture
+            {
+                material.albedo_texture = Some(scene_image(scene, image));
+                material.texture_mapping = TextureMapping::Uv;
+                material.texture_wrap = [texture_wrap(wrap_u), texture_wrap(wrap_v)];
+            }
+            if let Some(TextureRef {
+                image,
+                wrap_u,
+                wrap_v,
+            }) = imported.metallic_roughness_texture
+            {
+                material.metallic_roughness_texture = Some(scene_image(scene, image));
+                material.texture_mapping = TextureMapping::Uv;
+                material.metallic_roughness_wrap = [texture_wrap(wrap_u), texture_wrap(wrap_v)];
+            }
+            if let Some(TextureRef {
+                image,
+                wrap_u,
+                wrap_v,
+            }) = imported.emissive_texture
+            {
+                material.emission_texture = Some(scene_image(scene, image));
+                material.texture_mapping = TextureMapping::Uv;
+                material.emission_wrap = [texture_wrap(wrap_u), texture_wrap(wrap_v)];
+            }
+            scene.materials.push(material);
+            scene
+                .material_names
+                .push(format!("{stem}/{}", imported.name));
+        }
     }
 
     /// A scene of this model alone, as the command line renders a model file: the
     /// model's own camera (or [`super::default_camera`] framing it, for `render`'s
     /// aspect ratio), its own lights (or [`super::default_lights`]), a dark grey
-    /// background, and the given render settings. Returns the scene and the warnings
-    /// of [`ImportedModel::add_to_scene`].
-    pub fn into_scene(&self, render: RenderSettings) -> (Scene, Vec<String>) {
+    /// background, and the given render settings.
+    pub fn into_scene(&self, render: RenderSettings) -> Scene {
         let aspect = f64::from(render.width) / f64::from(render.height);
         let mut scene = Scene {
             render,
@@ -156,8 +180,8 @@ impl ImportedModel {
             meshes: Vec::new(),
             images: Vec::new(),
         };
-        let warnings = self.add_to_scene(&mut scene, &ModelPlacement::IDENTITY);
-        (scene, warnings)
+        self.add_to_scene(&mut scene, &ModelPlacement::IDENTITY);
+        scene
     }
 }
 
