@@ -265,6 +265,12 @@ struct PathState {
     // Path integrator: the density of the BRDF sample that made the current ray, or
     // NO_BRDF_PDF (shaders/path.wgsl).
     brdf_pdf: f32,
+    // Welford's sum of squared deviations of the pixel's sample luminances so far
+    // (shaders/noise.wgsl).
+    luminance_m2: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // One pending reflected or refracted ray on a slot's bounce stack.

@@ -218,7 +218,11 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 albedo,
                 metallic,
                 direct,
-                brdf_pdf
+                brdf_pdf,
+                luminance_m2,
+                _pad0,
+                _pad1,
+                _pad2
             }),
         ),
         (

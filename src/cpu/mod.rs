@@ -18,7 +18,10 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 use std::time::Instant;
 
+use glam::DVec3;
+
 use crate::film::{LinearImage, ProgressFn, RenderStats, Rendered};
+use crate::noise::NoiseEstimate;
 use crate::scene::Scene;
 pub use trace::{PreparedScene, trace_pixel};
 
@@ -115,12 +118,16 @@ fn trace_window(
     let region_width = columns.end - columns.start;
     let region_height = rows.end - rows.start;
     let mut image = LinearImage::new(region_width, region_height);
-    let pending: Vec<(u32, &mut [[f32; 4]])> = image
+    // Each pixel's radiance sum and luminance M2, for the noise estimate.
+    let mut sums = vec![(DVec3::ZERO, 0.0); image.pixels.len()];
+    let pending: Vec<(u32, &mut [[f32; 4]], &mut [(DVec3, f64)])> = image
         .pixels
         .chunks_mut(region_width as usize)
+        .zip(sums.chunks_mut(region_width as usize))
         .zip(rows.clone())
-        .map(|(row, y)| (y, row))
+        .map(|((row, sums), y)| (y, row, sums))
         .collect();
+    let samples = prepared.settings.samples_per_pixel;
     let queue = Mutex::new(pending);
     let rays = AtomicU64::new(0);
     let rows_done = AtomicU32::new(0);
@@ -133,9 +140,11 @@ fn trace_window(
                         .lock()
                         .unwrap_or_else(std::sync::PoisonError::into_inner)
                         .pop();
-                    let Some((y, row)) = next else { break };
+                    let Some((y, row, row_sums)) = next else {
+                        break;
+                    };
                     let mut row_rays = 0;
-                    for (x, pixel) in columns.clone().zip(row.iter_mut()) {
+                    for ((x, pixel), sum) in columns.clone().zip(row.iter_mut()).zip(row_sums) {
                         let result = trace_pixel(prepared, x, y);
                         *pixel = [
                             result.radiance.x as f32,
@@ -143,6 +152,7 @@ fn trace_window(
                             result.radiance.z as f32,
                             1.0,
                         ];
+                        *sum = (result.radiance * f64::from(samples), result.luminance_m2);
                         row_rays += result.rays;
                     }
                     rays.fetch_add(row_rays, Ordering::Relaxed);
@@ -154,8 +164,10 @@ fn trace_window(
             });
         }
     });
+    let noise = NoiseEstimate::from_sums(region_width, region_height, samples, sums);
     Rendered {
         image,
+        noise,
         stats: RenderStats {
             rays_traced: rays.into_inner(),
             elapsed: started.elapsed(),

@@ -184,6 +184,15 @@ pub struct GpuPathState {
     /// Path integrator: the density of the BRDF sample that made the current ray
     /// (negative when none did).
     pub brdf_pdf: f32,
+    /// Welford's sum of squared deviations of the pixel's sample luminances so far
+    /// ([`crate::noise::luminance_m2_step`]).
+    pub luminance_m2: f32,
+    /// Padding to the WGSL struct's 16-byte size multiple.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
 }
 
 /// One pending ray on a slot's bounce stack (`StackEntry` in WGSL).
