@@ -130,8 +130,9 @@ pub type ProgressFn<'a> = &'a (dyn Fn(u32, u32) + Sync);
 pub struct Rendered {
     /// The linear float image.
     pub image: LinearImage,
-    /// Each pixel's standard error, from the spread of its samples.
-    pub noise: NoiseEstimate,
+    /// Each pixel's standard error, from the spread of its samples, where asked for
+    /// ([`crate::cpu::render_with_noise`]).
+    pub noise: Option<NoiseEstimate>,
     /// Ray count and times.
     pub stats: RenderStats,
 }

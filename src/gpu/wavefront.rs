@@ -258,15 +258,15 @@ impl SlotBuffers {
     ) -> Result<NoiseEstimate, GpuError> {
         let pixels = u64::from(width) * u64::from(height);
         let bytes = read_buffer(device, queue, &self.accumulation, pixels * 16, timeout)?;
-        let sums: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&bytes);
+        let float = |b: &[u8]| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
         Ok(NoiseEstimate::from_sums(
             width,
             height,
             samples,
-            sums.iter().map(|s| {
+            bytes.chunks_exact(16).map(|s| {
                 (
-                    glam::DVec3::new(f64::from(s[0]), f64::from(s[1]), f64::from(s[2])),
-                    f64::from(s[3]),
+                    glam::DVec3::new(float(&s[0..4]), float(&s[4..8]), float(&s[8..12])),
+                    float(&s[12..16]),
                 )
             }),
         ))
