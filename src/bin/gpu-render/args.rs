@@ -369,6 +369,12 @@ pub struct RenderArgs {
     #[arg(long, conflicts_with = "lighting", help_heading = "Render settings")]
     pub compare_gamma: bool,
 
+    /// Also write each pixel's standard error (of its mean luminance, estimated from
+    /// the spread of its samples) as a grey linear EXR, and print the estimated noise
+    /// left in the summary. `{frame}` and `{tile}` expand as in the output name.
+    #[arg(long, value_name = "PATH.exr", conflicts_with = "compare_gamma")]
+    pub standard_error: Option<PathBuf>,
+
     /// Where and how to trace.
     #[command(flatten)]
     pub device: DeviceArgs,

@@ -146,11 +146,18 @@ impl GpuRenderer {
         }
         let limits = device.limits();
         // A tile must fit one texture and one display dispatch's workgroup count.
-        let tile_limit = limits.max_texture_dimension_2d.min(
+        let mut tile_limit = limits.max_texture_dimension_2d.min(
             limits
                 .max_compute_workgroups_per_dimension
                 .saturating_mul(WORKGROUP_SIZE),
         );
+        if self.noise_estimate {
+            // And the noise estimate's sums, 16 bytes per pixel, one storage binding.
+            let binding = u64::from(limits.max_storage_buffer_binding_size)
+                .min(limits.max_buffer_size);
+            let side = ((binding / 16) as f64).sqrt() as u32;
+            tile_limit = tile_limit.min(side.max(1));
+        }
         let (x0, y0) = (region.columns.start, region.rows.start);
         let tiles = image_tiles(width, height, tile_limit)
             .into_iter()
