@@ -150,20 +150,27 @@ impl NoiseEstimate {
     }
 }
 
-/// Relative RMSE of `image` against `reference` over every pixel and RGB channel:
-/// `√(mean (x − r)²) / mean r`. The error measure of the time-to-1% figures
-/// (`docs/quality.md`). Infinite for a black reference.
+/// Relative RMSE of `image`'s luminance against `reference`'s:
+/// `√(mean over pixels (Y − Y_ref)²) / mean over pixels Y_ref`, with `Y` the
+/// [`sample_luminance`] of a pixel. The error measure of the tradeoff's time-to-1%
+/// figures (`docs/quality.md`), and the one [`NoiseEstimate::relative_error`]
+/// predicts. Infinite for a black reference.
 pub fn relative_rmse(reference: &LinearImage, image: &LinearImage) -> f64 {
+    let luminance = |p: &[f32; 4]| {
+        sample_luminance(DVec3::new(
+            f64::from(p[0]),
+            f64::from(p[1]),
+            f64::from(p[2]),
+        ))
+    };
     let mut squares = 0.0;
     let mut total = 0.0;
     for (r, x) in reference.pixels.iter().zip(&image.pixels) {
-        for c in 0..3 {
-            let d = f64::from(x[c]) - f64::from(r[c]);
-            squares += d * d;
-            total += f64::from(r[c]);
-        }
+        let (r, x) = (luminance(r), luminance(x));
+        squares += (x - r) * (x - r);
+        total += r;
     }
-    let count = (3 * reference.pixels.len().max(1)) as f64;
+    let count = reference.pixels.len().max(1) as f64;
     let mean = total / count;
     if mean > 0.0 {
         (squares / count).sqrt() / mean
@@ -212,8 +219,8 @@ mod tests {
         reference.pixels.iter_mut().for_each(|p| *p = [2.0, 2.0, 2.0, 1.0]);
         let mut image = reference.clone();
         image.pixels.iter_mut().for_each(|p| p[0] = 2.2);
-        // One channel in three off by 0.2: RMSE √(0.04/3), mean 2.
-        let expected = (0.04f64 / 3.0).sqrt() / 2.0;
+        // Red off by 0.2 in every pixel: luminance off by 0.2126 · 0.2, mean 2.
+        let expected = 0.2126 * 0.2 / 2.0;
         assert!((relative_rmse(&reference, &image) - expected).abs() < 1e-6);
         assert_eq!(relative_rmse(&reference, &reference), 0.0);
     }
