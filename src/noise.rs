@@ -197,7 +197,10 @@ mod tests {
         }
         let mean = values.iter().sum::<f64>() / values.len() as f64;
         let two_pass: f64 = values.iter().map(|v| (v - mean) * (v - mean)).sum();
-        assert!((m2 - two_pass).abs() < 1e-12 * two_pass, "{m2} vs {two_pass}");
+        assert!(
+            (m2 - two_pass).abs() < 1e-12 * two_pass,
+            "{m2} vs {two_pass}"
+        );
         let n = values.len() as f64;
         let se = standard_error(m2, values.len() as u32);
         assert!((se - (two_pass / (n - 1.0) / n).sqrt()).abs() < 1e-12);
@@ -216,7 +219,10 @@ mod tests {
     #[test]
     fn relative_rmse_of_a_uniform_offset() {
         let mut reference = LinearImage::new(4, 2);
-        reference.pixels.iter_mut().for_each(|p| *p = [2.0, 2.0, 2.0, 1.0]);
+        reference
+            .pixels
+            .iter_mut()
+            .for_each(|p| *p = [2.0, 2.0, 2.0, 1.0]);
         let mut image = reference.clone();
         image.pixels.iter_mut().for_each(|p| p[0] = 2.2);
         // Red off by 0.2 in every pixel: luminance off by 0.2126 · 0.2, mean 2.

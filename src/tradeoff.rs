@@ -71,7 +71,12 @@ pub fn default_sweep(integrator: Integrator) -> Vec<Knobs> {
 
 /// Every combination of `samples`, `depths` and `cutoffs` for `integrator`, samples
 /// outermost.
-pub fn sweep(integrator: Integrator, samples: &[u32], depths: &[u32], cutoffs: &[f64]) -> Vec<Knobs> {
+pub fn sweep(
+    integrator: Integrator,
+    samples: &[u32],
+    depths: &[u32],
+    cutoffs: &[f64],
+) -> Vec<Knobs> {
     let mut knobs = Vec::new();
     for &samples_per_pixel in samples {
         for &max_depth in depths {
@@ -143,7 +148,7 @@ pub fn time_to_error(
     let spp = f64::from(largest.knobs.samples_per_pixel);
     let fitted = (largest.relative_error / before.relative_error).ln()
         / (spp / f64::from(before.knobs.samples_per_pixel)).ln();
-    if !(fitted < 0.0) {
+    if fitted.is_nan() || fitted >= 0.0 {
         return None;
     }
     if let Some(m) = series.iter().find(|m| m.relative_error <= target) {
@@ -491,7 +496,10 @@ mod tests {
         let t = time_to_error(&series, Integrator::Path, 0.01, 64).expect("a fit");
         assert!(!t.measured);
         assert!((t.exponent + 0.5).abs() < 1e-9, "{t:?}");
-        assert!((t.samples_per_pixel - 40_000.0).abs() < 1e-6 * 40_000.0, "{t:?}");
+        assert!(
+            (t.samples_per_pixel - 40_000.0).abs() < 1e-6 * 40_000.0,
+            "{t:?}"
+        );
         assert!((t.seconds - 4_000.0).abs() < 1e-6 * 4_000.0, "{t:?}");
         // Faster than 1/√spp (stratified edges): the path integrator's is taken as
         // −1/2, Whitted's as it is (spp^-1: 0.01 at 200 spp).
@@ -516,7 +524,10 @@ mod tests {
             .collect();
         let whitted = time_to_error(&whitted, Integrator::Whitted, 0.01, 64).expect("a fit");
         assert!((whitted.exponent + 1.0).abs() < 1e-12);
-        assert!((whitted.samples_per_pixel - 200.0).abs() < 1e-6, "{whitted:?}");
+        assert!(
+            (whitted.samples_per_pixel - 200.0).abs() < 1e-6,
+            "{whitted:?}"
+        );
         // Reached at 64 spp (error 0.25 <= 0.3): measured, the first that did.
         let reached = time_to_error(&series, Integrator::Path, 0.3, 64).expect("a fit");
         assert!(reached.measured);
@@ -576,6 +587,10 @@ mod tests {
         }
         let csv = to_csv(&points, &front);
         assert_eq!(csv.lines().count(), 3);
-        assert!(csv.lines().nth(2).is_some_and(|l| l.starts_with("whitted,") && l.ends_with(",true")));
+        assert!(
+            csv.lines()
+                .nth(2)
+                .is_some_and(|l| l.starts_with("whitted,") && l.ends_with(",true"))
+        );
     }
 }

@@ -921,9 +921,14 @@ fn standard_error_is_written_beside_the_image_and_summarised() {
         "summary:\n{}",
         run.stderr
     );
-    let se = image::open(ws.path("se.exr")).expect("open se.exr").to_rgba32f();
+    let se = image::open(ws.path("se.exr"))
+        .expect("open se.exr")
+        .to_rgba32f();
     assert_eq!(se.dimensions(), (16, 8));
-    assert!(se.pixels().all(|p| p[0].is_finite() && p[0] >= 0.0 && p[0] == p[1]));
+    assert!(
+        se.pixels()
+            .all(|p| p[0].is_finite() && p[0] >= 0.0 && p[0] == p[1])
+    );
     // The black background's samples are all equal; the sphere's silhouette is not.
     assert_eq!(se.get_pixel(0, 0)[0], 0.0);
     assert!(se.pixels().any(|p| p[0] > 1e-3), "no pixel has noise");

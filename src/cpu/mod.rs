@@ -171,7 +171,11 @@ fn trace_window(
         .mean_luminance
         .chunks_mut(region_width as usize)
         .zip(estimate.standard_error.chunks_mut(region_width as usize));
-    type Row<'a> = (u32, &'a mut [[f32; 4]], Option<(&'a mut [f32], &'a mut [f32])>);
+    type Row<'a> = (
+        u32,
+        &'a mut [[f32; 4]],
+        Option<(&'a mut [f32], &'a mut [f32])>,
+    );
     let pending: Vec<Row<'_>> = image
         .pixels
         .chunks_mut(region_width as usize)

@@ -147,13 +147,8 @@ pub fn trace_pixel(scene: &PreparedScene, x: u32, y: u32) -> PixelResult {
         };
         let before = sum;
         sum += radiance;
-        luminance_m2 = luminance_m2_step(
-            luminance_m2,
-            before,
-            sum,
-            sample_luminance(radiance),
-            index,
-        );
+        luminance_m2 =
+            luminance_m2_step(luminance_m2, before, sum, sample_luminance(radiance), index);
         rays += sample_rays;
     }
     let radiance = sum / f64::from(settings.samples_per_pixel);

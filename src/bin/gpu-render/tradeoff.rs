@@ -67,7 +67,11 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
             max_depth: args.reference_depth,
             min_ray_weight: 0.0,
         };
-        series.push((knobs, with_knobs(&scene, knobs)?, sweep_of(args, integrator)));
+        series.push((
+            knobs,
+            with_knobs(&scene, knobs)?,
+            sweep_of(args, integrator),
+        ));
     }
     let mut outputs = vec![
         "tradeoff.csv".to_owned(),
@@ -212,7 +216,13 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
             scene.render.height,
             backend.describe()
         );
-        plot_png(&args.out_dir.join(file), &title, &measurements, &front, axis)?;
+        plot_png(
+            &args.out_dir.join(file),
+            &title,
+            &measurements,
+            &front,
+            axis,
+        )?;
     }
     eprintln!(
         "wrote {}, tradeoff.png, tradeoff-relative.png and the references in {}",

@@ -10,11 +10,11 @@ use std::time::Duration;
 use super::{GpuRenderer, TraceRegion, create_texture};
 use crate::film::{LinearImage, ProgressFn, RenderStats};
 use crate::gpu::GpuError;
-use crate::noise::NoiseEstimate;
 use crate::gpu::pipelines::{DISPLAY_FORMAT, LINEAR_FORMAT};
 use crate::gpu::readback::{read_texture, submit_and_wait};
 use crate::gpu::scene_buffers::PreparedScene;
 use crate::gpu::shaders::WORKGROUP_SIZE;
+use crate::noise::NoiseEstimate;
 use crate::scene::Scene;
 
 /// The result of [`GpuRenderer::render`], and of [`GpuRenderer::render_region`] (whose
@@ -153,7 +153,8 @@ impl GpuRenderer {
         );
         if self.noise_estimate {
             // And the noise estimate's sums, 16 bytes per pixel, one storage binding.
-            let binding = u64::from(limits.max_storage_buffer_binding_size)
+            let binding = limits
+                .max_storage_buffer_binding_size
                 .min(limits.max_buffer_size);
             let side = ((binding / 16) as f64).sqrt() as u32;
             tile_limit = tile_limit.min(side.max(1));
@@ -199,8 +200,12 @@ impl GpuRenderer {
                     &traced.display_rgba8[row * tile_width * 4..(row + 1) * tile_width * 4],
                 );
                 if let (Some(whole), Some(part)) = (&mut noise, &traced.noise) {
-                    let (to, from) = (start..start + tile_width, row * tile_width..(row + 1) * tile_width);
-                    whole.mean_luminance[to.clone()].copy_from_slice(&part.mean_luminance[from.clone()]);
+                    let (to, from) = (
+                        start..start + tile_width,
+                        row * tile_width..(row + 1) * tile_width,
+                    );
+                    whole.mean_luminance[to.clone()]
+                        .copy_from_slice(&part.mean_luminance[from.clone()]);
                     whole.standard_error[to].copy_from_slice(&part.standard_error[from]);
                 }
             }
