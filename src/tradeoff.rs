@@ -100,8 +100,9 @@ pub struct TimeToError {
     pub seconds: f64,
     /// Samples per pixel it takes.
     pub samples_per_pixel: f64,
-    /// Whether a measured setting reached the error (`false`: extrapolated along the
-    /// fitted power law).
+    /// Whether a measured setting reached the error, so that the figure is
+    /// interpolated between two measured settings (`false`: extrapolated past the
+    /// largest).
     pub measured: bool,
     /// The exponent `k` of `error ∝ spp^k` through the two largest settings (−1/2
     /// for independent noise); where extrapolated, the one used.
@@ -111,8 +112,9 @@ pub struct TimeToError {
 /// The time `integrator`'s spp series takes to reach relative error `target`: the
 /// measurements at its deepest depth without a cutoff, at most `max_spp` samples
 /// (keep the reference at least 16 times the samples, so that its own noise moves the
-/// measured errors by at most about 3%). The fastest one at or under `target` if any
-/// reached it; else the power law `error ∝ spp^k` through the two largest settings,
+/// measured errors by at most about 3%). If a setting reached `target`, the power law
+/// through it and the setting before gives the samples where the error crossed it,
+/// at the reaching setting's time per sample (measured); else the power law `error ∝ spp^k` through the two largest settings,
 /// extended from the largest to `target` with its time per sample. Stratified camera
 /// samples make an error fall faster than `1/√spp` while edges dominate it; the path
 /// integrator's independent path samples then leave `1/√spp`, so its `k` is taken
@@ -151,12 +153,32 @@ pub fn time_to_error(
     if fitted.is_nan() || fitted >= 0.0 {
         return None;
     }
-    if let Some(m) = series.iter().find(|m| m.relative_error <= target) {
+    if let Some(reached) = series.iter().position(|m| m.relative_error <= target) {
+        let m = series[reached];
+        let spp = f64::from(m.knobs.samples_per_pixel);
+        let Some(previous) = reached.checked_sub(1).map(|i| series[i]) else {
+            return Some(TimeToError {
+                seconds: m.seconds,
+                samples_per_pixel: spp,
+                measured: true,
+                exponent: fitted,
+            });
+        };
+        // Between the last setting above the target and the first at or under it,
+        // along the power law through the two.
+        let previous_spp = f64::from(previous.knobs.samples_per_pixel);
+        let exponent =
+            (m.relative_error / previous.relative_error).ln() / (spp / previous_spp).ln();
+        let samples = if exponent < 0.0 {
+            (previous_spp * (target / previous.relative_error).powf(1.0 / exponent)).min(spp)
+        } else {
+            spp
+        };
         return Some(TimeToError {
-            seconds: m.seconds,
-            samples_per_pixel: f64::from(m.knobs.samples_per_pixel),
+            seconds: m.seconds / spp * samples,
+            samples_per_pixel: samples,
             measured: true,
-            exponent: fitted,
+            exponent,
         });
     }
     let exponent = match integrator {
@@ -528,10 +550,21 @@ mod tests {
             (whitted.samples_per_pixel - 200.0).abs() < 1e-6,
             "{whitted:?}"
         );
-        // Reached at 64 spp (error 0.25 <= 0.3): measured, the first that did.
+        // Crossed between 16 (0.5) and 64 spp (0.25): 2/√n = 0.3 at n = 44.4.
         let reached = time_to_error(&series, Integrator::Path, 0.3, 64).expect("a fit");
         assert!(reached.measured);
-        assert_eq!(reached.samples_per_pixel, 64.0);
+        let crossing = (2.0f64 / 0.3).powi(2);
+        assert!(
+            (reached.samples_per_pixel - crossing).abs() < 1e-9,
+            "{reached:?}"
+        );
+        assert!(
+            (reached.seconds - 0.1 * crossing).abs() < 1e-9,
+            "{reached:?}"
+        );
+        // Reached by the first setting: its own figure.
+        let first = time_to_error(&series, Integrator::Path, 3.0, 64).expect("a fit");
+        assert_eq!(first.samples_per_pixel, 1.0);
         // Settings above max_spp are left out; one setting is no fit.
         assert!(time_to_error(&series, Integrator::Path, 0.01, 1).is_none());
         assert!(time_to_error(&series, Integrator::Whitted, 0.01, 64).is_none());

@@ -190,7 +190,7 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
                 t.seconds,
                 t.samples_per_pixel,
                 if t.measured {
-                    "measured"
+                    "interpolated between measured settings"
                 } else {
                     "extrapolated along the fit"
                 },
