@@ -385,6 +385,7 @@ pub fn plot_png(
             .y_desc(axis.label())
             .x_labels(10)
             .x_label_formatter(&|seconds| format_seconds(*seconds))
+            .y_label_formatter(&|error| format_error(*error))
             .light_line_style(RGBColor(235, 235, 235))
             .label_style(("sans-serif", 14))
             .draw()
@@ -462,6 +463,15 @@ pub fn plot_png(
         .collect();
     output::write_png_rgba8(path, width, height, rgba)?;
     Ok(())
+}
+
+/// An error as a short axis label with two significant digits: "0.030", "0.0085".
+fn format_error(error: f64) -> String {
+    if !(error > 0.0 && error.is_finite()) {
+        return format!("{error}");
+    }
+    let digits = (-error.log10().floor()).max(0.0) as usize + 1;
+    format!("{error:.digits$}")
 }
 
 /// Seconds as a short axis label: "0.05", "0.5", "2".
@@ -568,6 +578,14 @@ mod tests {
         // Settings above max_spp are left out; one setting is no fit.
         assert!(time_to_error(&series, Integrator::Path, 0.01, 1).is_none());
         assert!(time_to_error(&series, Integrator::Whitted, 0.01, 64).is_none());
+    }
+
+    #[test]
+    fn error_labels_are_short() {
+        assert_eq!(format_error(0.03), "0.030");
+        assert_eq!(format_error(0.0085), "0.0085");
+        assert_eq!(format_error(0.5), "0.50");
+        assert_eq!(format_error(2.0), "2.0");
     }
 
     #[test]
