@@ -186,7 +186,7 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
     for (name, time) in &summaries {
         match time {
             Some(t) => println!(
-                "{name:>8}: {:.3} s, {:.0} spp ({}; error ∝ spp^{:.2})",
+                "{name:>8}: {:.3} s, {:.1} spp ({}; error ∝ spp^{:.2})",
                 t.seconds,
                 t.samples_per_pixel,
                 if t.measured {
