@@ -38,7 +38,8 @@ struct FrameUniforms {
     _pad1: u32,
 }
 
-// FrameUniforms.flags: also store each finished pixel's sample sum in `accumulation`.
+// FrameUniforms.flags: also store each finished pixel's sample sum and luminance m2 in
+// `accumulation`.
 const FLAG_STORE_SUM: u32 = 1u;
 // FrameUniforms.flags, for tests: traversals leave their loop early without reaching
 // an exit, as a driver that cuts loops makes them do.

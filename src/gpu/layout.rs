@@ -83,8 +83,8 @@ pub struct FrameUniforms {
     pub _pad1: u32,
 }
 
-/// `FrameUniforms.flags`: store each finished pixel's sample sum in the accumulation
-/// buffer.
+/// `FrameUniforms.flags`: store each finished pixel's sample sum and luminance m2
+/// (its noise estimate, [`crate::noise`]) in the accumulation buffer.
 pub const FLAG_STORE_SUM: u32 = 1;
 /// `FrameUniforms.flags`, for tests: traversals leave their loop without reaching an
 /// exit, as a driver that cuts loops makes them do.
