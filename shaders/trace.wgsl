@@ -30,8 +30,9 @@
 @group(0) @binding(7) var<storage, read> lights: array<Light>;
 @group(0) @binding(8) var linear_output: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(9) var<storage, read_write> counters: Counters;
-// Each finished pixel's sample sum (when frame.flags has FLAG_STORE_SUM), and the sum
-// a pixel starts from when frame.first_sample > 0: progressive rendering.
+// Each finished pixel's sample sum in xyz and its luminance m2 in w (shaders/noise.wgsl)
+// when frame.flags has FLAG_STORE_SUM, and the sums a pixel starts from when
+// frame.first_sample > 0: progressive rendering.
 @group(0) @binding(10) var<storage, read_write> accumulation: array<vec4<f32>>;
 // binding 11: `images` (shaders/texture.wgsl).
 @group(0) @binding(12) var<storage, read> bvh_nodes: array<BvhNode>;
@@ -392,11 +393,15 @@ fn start_sample(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) 
     (*path).phase = PHASE_CLOSEST;
 }
 
-// Adds the finished sample to the pixel's sum; after the last sample of the range,
+// Adds the finished sample to the pixel's sum and its luminance to the pixel's m2
+// (the noise estimate); after the last sample of the range,
 // writes the pixel (the mean over frame.end_sample samples, black if not finite),
 // counts its rays and moves on to the next pixel.
 fn end_sample(path: ptr<function, PathState>) {
+    let before = (*path).pixel_sum;
     (*path).pixel_sum += (*path).radiance;
+    (*path).luminance_m2 = luminance_m2_step((*path).luminance_m2, before, (*path).pixel_sum,
+                                             sample_luminance((*path).radiance), (*path).sample);
     (*path).sample += 1u;
     if (*path).sample < frame.end_sample {
         (*path).phase = PHASE_START_SAMPLE;
@@ -408,7 +413,7 @@ fn end_sample(path: ptr<function, PathState>) {
         mean = vec3<f32>(0.0);
     }
     if (frame.flags & FLAG_STORE_SUM) != 0u {
-        accumulation[(*path).pixel] = vec4<f32>((*path).pixel_sum, 0.0);
+        accumulation[(*path).pixel] = vec4<f32>((*path).pixel_sum, (*path).luminance_m2);
     }
     let xy = pixel_position((*path).pixel);
     textureStore(linear_output, vec2<u32>(xy.x - frame.target_x, xy.y - frame.target_y),
@@ -433,8 +438,11 @@ fn fetch_pixel(path: ptr<function, PathState>) {
     (*path).sample = frame.first_sample;
     (*path).rays = 0u;
     (*path).pixel_sum = vec3<f32>(0.0);
+    (*path).luminance_m2 = 0.0;
     if frame.first_sample > 0u {
-        (*path).pixel_sum = accumulation[pixel].xyz;
+        let sums = accumulation[pixel];
+        (*path).pixel_sum = sums.xyz;
+        (*path).luminance_m2 = sums.w;
     }
     (*path).phase = PHASE_START_SAMPLE;
 }

@@ -38,7 +38,8 @@ struct FrameUniforms {
     _pad1: u32,
 }
 
-// FrameUniforms.flags: also store each finished pixel's sample sum in `accumulation`.
+// FrameUniforms.flags: also store each finished pixel's sample sum and luminance m2 in
+// `accumulation`.
 const FLAG_STORE_SUM: u32 = 1u;
 // FrameUniforms.flags, for tests: traversals leave their loop early without reaching
 // an exit, as a driver that cuts loops makes them do.
@@ -274,7 +275,9 @@ struct PathState {
     // Whitted: the emission of the hit being lit (emission texture applied), added with
     // its direct light after the last light.
     emission: vec3<f32>,
-    _pad0: u32,
+    // Welford's sum of squared deviations of the pixel's sample luminances so far
+    // (shaders/noise.wgsl).
+    luminance_m2: f32,
 }
 
 // One pending reflected or refracted ray on a slot's bounce stack.

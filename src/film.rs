@@ -3,6 +3,7 @@
 use std::time::Duration;
 
 use crate::color::{quantize_unorm8, srgb_encode};
+use crate::noise::NoiseEstimate;
 
 /// A linear-light RGBA image in 32-bit float, row-major, top row first.
 #[derive(Debug, Clone, PartialEq)]
@@ -124,11 +125,14 @@ fn per_second(count: u64, seconds: f64) -> f64 {
 /// A callback told how many image rows are done out of how many, as a render proceeds.
 pub type ProgressFn<'a> = &'a (dyn Fn(u32, u32) + Sync);
 
-/// A finished render: the linear image and its statistics.
+/// A finished render: the linear image, its noise estimate and its statistics.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Rendered {
     /// The linear float image.
     pub image: LinearImage,
+    /// Each pixel's standard error, from the spread of its samples, where asked for
+    /// ([`crate::cpu::render_with_noise`]).
+    pub noise: Option<NoiseEstimate>,
     /// Ray count and times.
     pub stats: RenderStats,
 }

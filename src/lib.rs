@@ -10,6 +10,7 @@
 //!   curve, and the image a render produces.
 //! - [`cpu`]: the reference tracer (f64).
 //! - [`gpu`]: the wgpu backend, built from the caller's `Device` and `Queue`.
+//! - [`noise`]: the per-pixel noise estimate (standard error of each pixel's mean).
 //! - [`output`]: writing PNG, EXR and HDR files atomically.
 //! - `plausibility` (with the default `cli` feature): the lecture's three rules checked
 //!   on a tabulated BRDF map, for `gpu-render brdf-check`.
@@ -27,6 +28,7 @@ pub mod color;
 pub mod cpu;
 pub mod film;
 pub mod gpu;
+pub mod noise;
 pub mod output;
 #[cfg(feature = "cli")]
 pub mod plausibility;

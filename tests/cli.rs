@@ -896,3 +896,58 @@ fn a_sphere_beyond_the_gpus_precision_is_warned_about_and_auto_renders_on_the_cp
     assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
     assert!(!run.stderr.contains("warning"), "{}", run.stderr);
 }
+
+#[test]
+fn standard_error_is_written_beside_the_image_and_summarised() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.exr"),
+        "--standard-error",
+        &ws.arg("se.exr"),
+        "--backend",
+        "cpu",
+        "--width",
+        "16",
+        "--height",
+        "8",
+        "--spp",
+        "4",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(
+        run.stderr.contains("estimated noise ") && run.stderr.contains("% (relative RMSE"),
+        "summary:\n{}",
+        run.stderr
+    );
+    let se = image::open(ws.path("se.exr"))
+        .expect("open se.exr")
+        .to_rgba32f();
+    assert_eq!(se.dimensions(), (16, 8));
+    assert!(
+        se.pixels()
+            .all(|p| p[0].is_finite() && p[0] >= 0.0 && p[0] == p[1])
+    );
+    // The black background's samples are all equal; the sphere's silhouette is not.
+    assert_eq!(se.get_pixel(0, 0)[0], 0.0);
+    assert!(se.pixels().any(|p| p[0] > 1e-3), "no pixel has noise");
+}
+
+#[test]
+fn standard_error_must_be_another_exr() {
+    let ws = Workspace::new(TINY_SCENE);
+    for (name, needle) in [("se.png", ".exr"), ("out.exr", "another file")] {
+        let run = gpu_render(&[
+            &ws.arg("scene.toml"),
+            "-o",
+            &ws.arg("out.exr"),
+            "--standard-error",
+            &ws.arg(name),
+            "--backend",
+            "cpu",
+        ]);
+        assert_fails_with(&run, &["--standard-error", needle]);
+        assert!(!ws.path("out.exr").exists(), "{name}: rendered anyway");
+    }
+}

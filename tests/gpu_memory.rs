@@ -56,9 +56,12 @@ fn scene(samples_per_pixel: u32) -> Scene {
 
 /// The most bytes the device's allocator held while `samples` samples per pixel were
 /// traced, read after every submission through the progress callback.
-fn peak_allocated(gpu: &gpu_render::gpu::HeadlessGpu, samples: u32) -> Option<u64> {
+/// With `noise`, the render also keeps and reads back each pixel's noise estimate.
+fn peak_allocated(gpu: &gpu_render::gpu::HeadlessGpu, samples: u32, noise: bool) -> Option<u64> {
     // A small budget, so that even the short render takes several submissions.
-    let renderer = common::gpu::renderer(gpu).with_iteration_budget(256);
+    let renderer = common::gpu::renderer(gpu)
+        .with_iteration_budget(256)
+        .with_noise_estimate(noise);
     let peak = Mutex::new(None);
     let progress = |_: u32, _: u32| {
         if let Some(report) = gpu.device.generate_allocator_report() {
@@ -74,10 +77,20 @@ fn peak_allocated(gpu: &gpu_render::gpu::HeadlessGpu, samples: u32) -> Option<u6
 
 #[test]
 fn gpu_memory_does_not_grow_with_samples() {
+    assert_memory_does_not_grow_with_samples(false);
+}
+
+/// The noise estimate's sums are one `vec4` per pixel, whatever the samples.
+#[test]
+fn gpu_memory_of_the_noise_estimate_does_not_grow_with_samples() {
+    assert_memory_does_not_grow_with_samples(true);
+}
+
+fn assert_memory_does_not_grow_with_samples(noise: bool) {
     let Some(gpu) = common::gpu::headless_gpu() else {
         return;
     };
-    let Some(few) = peak_allocated(&gpu, 4) else {
+    let Some(few) = peak_allocated(&gpu, 4, noise) else {
         // Only Vulkan, DX12 and Metal report their allocations; CI runs on Vulkan.
         assert!(
             std::env::var_os("CI").is_none(),
@@ -87,8 +100,8 @@ fn gpu_memory_does_not_grow_with_samples() {
         eprintln!("note: no allocator report on {}", gpu.adapter_info().name);
         return;
     };
-    let many = peak_allocated(&gpu, 16_384).expect("a report, as before");
-    eprintln!("peak allocated: {few} bytes at 4 spp, {many} bytes at 16384 spp");
+    let many = peak_allocated(&gpu, 16_384, noise).expect("a report, as before");
+    eprintln!("noise {noise}: peak allocated: {few} bytes at 4 spp, {many} bytes at 16384 spp");
     assert!(few > 0);
     // 4096 times the samples: within 64 KiB (the queue's staging chunks for the
     // uniforms come and go), where the old engine's buffer per sample grew to 1.29 GB.

@@ -12,6 +12,7 @@ use super::traverse::{intersect_scene, occluded};
 use crate::accel::SceneGeometry;
 use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight};
 use crate::camera::{CameraFrame, SamplePattern};
+use crate::noise::{luminance_m2_step, sample_luminance};
 pub use crate::scene::MediumStack;
 use crate::scene::{Image, Integrator, Light, Material, RenderSettings, Scene};
 
@@ -141,12 +142,16 @@ pub struct PixelResult {
     pub radiance: DVec3,
     /// Rays traced for this pixel.
     pub rays: u64,
+    /// Welford's sum of squared deviations of the samples' luminance
+    /// ([`crate::noise::luminance_m2_step`]), for the pixel's noise estimate.
+    pub luminance_m2: f64,
 }
 
 /// Traces every sample of pixel (`x`, `y`) and averages them (box filter).
 pub fn trace_pixel(scene: &PreparedScene, x: u32, y: u32) -> PixelResult {
     let settings = &scene.settings;
     let mut sum = DVec3::ZERO;
+    let mut luminance_m2 = 0.0;
     let mut rays = 0;
     for index in 0..settings.samples_per_pixel {
         let (dx, dy) = scene.samples.offset(x, y, index);
@@ -164,7 +169,10 @@ pub fn trace_pixel(scene: &PreparedScene, x: u32, y: u32) -> PixelResult {
             Integrator::Whitted => trace_radiance(scene, primary),
             Integrator::Path => path_radiance(scene, primary, y * settings.width + x, index),
         };
+        let before = sum;
         sum += radiance;
+        luminance_m2 =
+            luminance_m2_step(luminance_m2, before, sum, sample_luminance(radiance), index);
         rays += sample_rays;
     }
     let radiance = sum / f64::from(settings.samples_per_pixel);
@@ -177,6 +185,7 @@ pub fn trace_pixel(scene: &PreparedScene, x: u32, y: u32) -> PixelResult {
             DVec3::ZERO
         },
         rays,
+        luminance_m2,
     }
 }
 

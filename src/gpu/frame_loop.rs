@@ -21,6 +21,7 @@ use super::wavefront::{Schedule, default_schedule, encode_rounds, iteration_budg
 use super::{GpuError, RenderError};
 use crate::accel::SceneGeometry;
 use crate::film::LinearImage;
+use crate::noise::NoiseEstimate;
 use crate::scene::{Camera, Scene, view_problem};
 
 /// Where [`Renderer::encode_samples`] writes the few bytes a trace pass needs: a
@@ -538,5 +539,42 @@ impl Renderer {
             samples: film.samples(),
             rays_traced: film.rays_traced(),
         })
+    }
+
+    /// Waits for every sample asked of `film` ([`Renderer::finish`]) and reads its
+    /// noise estimate back (blocking): each pixel's standard error from the spread of
+    /// its [`Film::samples`] samples, kept beside the sample sums in the film's
+    /// accumulation buffer (16 bytes per pixel, whatever the sample count). The
+    /// summary [`NoiseEstimate::relative_error`] says how much noise remains.
+    ///
+    /// ```no_run
+    /// # use gpu_render::gpu::{Film, GpuScene, Renderer};
+    /// # fn demo(device: &wgpu::Device, queue: &wgpu::Queue, renderer: &Renderer,
+    /// #         scene: &GpuScene, film: &mut Film) -> Result<(), gpu_render::gpu::RenderError> {
+    /// let noise = renderer.read_noise(device, queue, scene, film)?;
+    /// if let Some(relative) = noise.relative_error() {
+    ///     println!("{} spp, about {:.2}% noise left", noise.samples, relative * 100.0);
+    /// }
+    /// # Ok(())
+    /// # }
+    /// ```
+    ///
+    /// Errors: as [`Renderer::finish`]; [`RenderError::Readback`] or
+    /// [`RenderError::DeviceLost`] if the readback fails.
+    pub fn read_noise(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &GpuScene,
+        film: &mut Film,
+    ) -> Result<NoiseEstimate, RenderError> {
+        self.finish(device, queue, scene, film)?;
+        Ok(film.slots.read_noise(
+            device,
+            queue,
+            (film.width(), film.height()),
+            film.samples(),
+            None,
+        )?)
     }
 }

@@ -83,8 +83,8 @@ pub struct FrameUniforms {
     pub _pad1: u32,
 }
 
-/// `FrameUniforms.flags`: store each finished pixel's sample sum in the accumulation
-/// buffer.
+/// `FrameUniforms.flags`: store each finished pixel's sample sum and luminance m2
+/// (its noise estimate, [`crate::noise`]) in the accumulation buffer.
 pub const FLAG_STORE_SUM: u32 = 1;
 /// `FrameUniforms.flags`, for tests: traversals leave their loop without reaching an
 /// exit, as a driver that cuts loops makes them do.
@@ -187,8 +187,9 @@ pub struct GpuPathState {
     /// Whitted: the emission of the hit being lit (emission texture applied), added
     /// with its direct light.
     pub emission: [f32; 3],
-    /// Padding.
-    pub _pad0: u32,
+    /// Welford's sum of squared deviations of the pixel's sample luminances so far
+    /// ([`crate::noise::luminance_m2_step`]).
+    pub luminance_m2: f32,
 }
 
 /// One pending ray on a slot's bounce stack (`StackEntry` in WGSL).

@@ -225,6 +225,42 @@ pub fn read_texture(
     Ok(out)
 }
 
+/// Reads the first `size` bytes of `buffer` (usage `COPY_SRC`, `size` a multiple of
+/// 4) through a staging buffer of at most 64 MiB, in bands. Each wait is bounded by
+/// `timeout`.
+///
+/// Errors: [`GpuError::Readback`], [`GpuError::DeviceLost`], [`GpuError::OutOfMemory`].
+pub(crate) fn read_buffer(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    buffer: &wgpu::Buffer,
+    size: u64,
+    timeout: Option<Duration>,
+) -> Result<Vec<u8>, GpuError> {
+    let band = READBACK_BAND_BYTES.min(size).max(4);
+    let staging = capture(device, "readback buffer", Caught::Resource, || {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("gpu-render buffer readback"),
+            size: band,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        })
+    })?;
+    let mut out = Vec::with_capacity(size as usize);
+    let mut offset = 0;
+    while offset < size {
+        let bytes = band.min(size - offset);
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("gpu-render buffer readback copy"),
+        });
+        encoder.copy_buffer_to_buffer(buffer, offset, &staging, 0, bytes);
+        submit_and_wait(device, queue, encoder, "readback copy", timeout)?;
+        out.extend_from_slice(&map_read(device, &staging, bytes, timeout)?);
+        offset += bytes;
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::align_up;

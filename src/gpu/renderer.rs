@@ -30,6 +30,7 @@ use super::wavefront::{
 };
 use crate::accel::SceneGeometry;
 use crate::film::RenderStats;
+use crate::noise::NoiseEstimate;
 use crate::scene::Scene;
 
 mod blocking;
@@ -57,6 +58,7 @@ pub struct GpuRenderer {
     slot_count: Option<u32>,
     schedule: Option<Schedule>,
     simulate_loop_cut: bool,
+    noise_estimate: bool,
 }
 
 /// A rectangle of image pixels traced into one target texture, and where it lands
@@ -115,6 +117,7 @@ impl GpuRenderer {
             slot_count: None,
             schedule: None,
             simulate_loop_cut: false,
+            noise_estimate: false,
         })
     }
 
@@ -173,6 +176,16 @@ impl GpuRenderer {
     /// fails with [`GpuError::TraceIncomplete`] instead of returning a short image.
     pub fn with_simulated_loop_cut(mut self, simulate: bool) -> Self {
         self.simulate_loop_cut = simulate;
+        self
+    }
+
+    /// With `true`, [`GpuRenderer::render`] and [`GpuRenderer::render_region`] also
+    /// return each pixel's noise estimate ([`GpuRendered::noise`]): the trace keeps
+    /// every pixel's sample sum and luminance m2 in an accumulation buffer of 16 bytes
+    /// per pixel of the tile (whatever the sample count) and reads it back. The image
+    /// does not change.
+    pub fn with_noise_estimate(mut self, estimate: bool) -> Self {
+        self.noise_estimate = estimate;
         self
     }
 
@@ -250,6 +263,22 @@ impl GpuRenderer {
         region: &TraceRegion,
         progress: Option<&dyn Fn(u64, u64)>,
     ) -> Result<RenderStats, GpuError> {
+        self.trace_region_into(device, queue, prepared, target, region, progress, false)
+            .map(|(stats, _)| stats)
+    }
+
+    /// [`GpuRenderer::trace_into`], and with `noise` the region's noise estimate.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn trace_region_into(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        prepared: &PreparedScene,
+        target: &wgpu::TextureView,
+        region: &TraceRegion,
+        progress: Option<&dyn Fn(u64, u64)>,
+        noise: bool,
+    ) -> Result<(RenderStats, Option<NoiseEstimate>), GpuError> {
         let (width, height) = region.size();
         if region.columns.end > prepared.width() || region.rows.end > prepared.height() {
             return Err(GpuError::Validation(format!(
@@ -270,7 +299,7 @@ impl GpuRenderer {
         }
         let pixels = u64::from(width) * u64::from(height);
         if pixels == 0 {
-            return Ok(RenderStats::default());
+            return Ok((RenderStats::default(), None));
         }
         check_texture(
             target,
@@ -284,7 +313,9 @@ impl GpuRenderer {
         let pipelines = self.trace_pipelines(device, &prepared.features)?;
         let slot_count =
             SlotBuffers::slot_count(device, self.slot_count, pixels, prepared.stack_size);
-        let slots = SlotBuffers::new(device, slot_count, prepared.stack_size, 0)?;
+        // The sums are kept only for the noise estimate (16 bytes per region pixel).
+        let sums = if noise { pixels } else { 0 };
+        let slots = SlotBuffers::new(device, slot_count, prepared.stack_size, sums)?;
         let bind_group = slots.bind_group(
             device,
             &self.pipelines.trace_bind_group_layout,
@@ -308,6 +339,11 @@ impl GpuRenderer {
                     super::layout::FLAG_SIMULATE_LOOP_CUT
                 } else {
                     0
+                }
+                | if noise {
+                    super::layout::FLAG_STORE_SUM
+                } else {
+                    0
                 },
             ..prepared.frame
         };
@@ -329,11 +365,23 @@ impl GpuRenderer {
             self.poll_timeout,
             &report,
         )?;
-        Ok(RenderStats {
+        let stats = RenderStats {
             rays_traced: outcome.rays,
             elapsed: outcome.elapsed,
             gpu_time: outcome.gpu_time,
-        })
+        };
+        let estimate = if noise {
+            Some(slots.read_noise(
+                device,
+                queue,
+                (width, height),
+                prepared.samples_per_pixel(),
+                self.poll_timeout,
+            )?)
+        } else {
+            None
+        };
+        Ok((stats, estimate))
     }
 
     /// Records the display pass into `encoder`: reads `linear` (an `Rgba32Float`

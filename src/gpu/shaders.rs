@@ -29,6 +29,9 @@ pub const BXDF_EVAL_ENTRY_POINT: &str = "eval_brdfs";
 pub const TRAVERSE_WGSL: &str = include_str!("../../shaders/traverse.wgsl");
 /// The wavefront kernels (`shade_paths`, `trace_rays`) and their bindings.
 pub const TRACE_WGSL: &str = include_str!("../../shaders/trace.wgsl");
+/// `shaders/noise.wgsl`: the per-pixel noise estimate's running sums (twin of
+/// [`crate::noise`]).
+pub const NOISE_WGSL: &str = include_str!("../../shaders/noise.wgsl");
 /// The path integrator's records and constants (`Emitter`, `FLAG_PATH`), twins of
 /// [`super::area_lights`].
 pub const PATH_TYPES_WGSL: &str = include_str!("../../shaders/path_types.wgsl");
@@ -58,8 +61,8 @@ pub const WORKGROUP_SIZE: u32 = 8;
 
 /// The complete trace module specialised to `features` (see [`super::features`]): the
 /// constants shared with the Rust side (`MAX_BVH_DEPTH`, `MAX_POLYGON_VERTICES`), then
-/// types, path types, sampling, intersect, texture, bxdf, environment, traverse, trace,
-/// path and the tabulated BRDF sampler.
+/// types, path types, sampling, intersect, texture, bxdf, environment, traverse, noise,
+/// trace, path and the tabulated BRDF sampler.
 ///
 /// Errors: a message if the sources' feature directives are malformed.
 ///
@@ -80,6 +83,7 @@ pub fn trace_shader_source(features: &ShaderFeatures) -> Result<String, String> 
         BXDF_WGSL,
         ENVIRONMENT_WGSL,
         TRAVERSE_WGSL,
+        NOISE_WGSL,
         TRACE_WGSL,
         PATH_WGSL,
         TABULATED_WGSL,

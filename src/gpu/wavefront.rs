@@ -17,10 +17,11 @@ use super::layout::{
     GpuTraceRay,
 };
 use super::pipelines::{TracePipelines, binding};
-use super::readback::{Caught, capture, map_read, submit_and_wait};
+use super::readback::{Caught, capture, map_read, read_buffer, submit_and_wait};
 use super::scene_buffers::PreparedScene;
 use super::shaders::SLOT_WORKGROUP_SIZE;
 use crate::accel::MAX_BVH_DEPTH;
+use crate::noise::NoiseEstimate;
 
 /// llvmpipe's (and so lavapipe's) limit on the loop iterations of one shader
 /// invocation: `LP_MAX_TGSI_LOOP_ITERATIONS` in Mesa's gallivm. Past it every loop of
@@ -219,7 +220,7 @@ impl SlotBuffers {
             accumulation: storage(
                 "gpu-render accumulation",
                 accumulation_pixels * 16,
-                wgpu::BufferUsages::empty(),
+                wgpu::BufferUsages::COPY_SRC,
             ),
             readback: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("gpu-render counter readback"),
@@ -243,6 +244,32 @@ impl SlotBuffers {
                 )
             }),
         })
+    }
+
+    /// Reads the accumulation of `width × height` region pixels after `samples`
+    /// samples back as their noise estimate (blocking).
+    pub fn read_noise(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        (width, height): (u32, u32),
+        samples: u32,
+        timeout: Option<Duration>,
+    ) -> Result<NoiseEstimate, GpuError> {
+        let pixels = u64::from(width) * u64::from(height);
+        let bytes = read_buffer(device, queue, &self.accumulation, pixels * 16, timeout)?;
+        let float = |b: &[u8]| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        Ok(NoiseEstimate::from_sums(
+            width,
+            height,
+            samples,
+            bytes.chunks_exact(16).map(|s| {
+                (
+                    glam::DVec3::new(float(&s[0..4]), float(&s[4..8]), float(&s[8..12])),
+                    float(&s[12..16]),
+                )
+            }),
+        ))
     }
 
     /// The bind group of the trace kernels for `scene`, writing into `target`, built

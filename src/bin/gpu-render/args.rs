@@ -137,6 +137,41 @@ pub struct TradeoffArgs {
     )]
     pub reference_depth: u32,
 
+    /// Samples per pixel of the path integrator's converged reference.
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 1024,
+        allow_negative_numbers = true,
+        value_parser = parse_in_range::<1, MAX_SAMPLES_PER_PIXEL>
+    )]
+    pub path_reference_spp: u32,
+
+    /// The integrators to sweep, each a series of its own against its own converged
+    /// reference, on one chart [default: the scene's].
+    #[arg(long, value_enum, value_name = "LIST", value_delimiter = ',')]
+    pub integrators: Vec<IntegratorArg>,
+
+    /// Samples per pixel to sweep, instead of each integrator's default list.
+    #[arg(
+        long,
+        value_name = "LIST",
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        value_parser = parse_in_range::<1, MAX_SAMPLES_PER_PIXEL>
+    )]
+    pub spp: Vec<u32>,
+
+    /// Maximum depths to sweep, instead of each integrator's default list.
+    #[arg(
+        long,
+        value_name = "LIST",
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        value_parser = parse_in_range::<0, MAX_DEPTH_LIMIT>
+    )]
+    pub depths: Vec<u32>,
+
     /// Timed runs per setting; the fastest counts.
     #[arg(
         long,
@@ -369,6 +404,12 @@ pub struct RenderArgs {
     #[arg(long, conflicts_with = "lighting", help_heading = "Render settings")]
     pub compare_gamma: bool,
 
+    /// Also write each pixel's standard error (of its mean luminance, estimated from
+    /// the spread of its samples) as a grey linear EXR, and print the estimated noise
+    /// left in the summary. `{frame}` and `{tile}` expand as in the output name.
+    #[arg(long, value_name = "PATH.exr", conflicts_with = "compare_gamma")]
+    pub standard_error: Option<PathBuf>,
+
     /// Where and how to trace.
     #[command(flatten)]
     pub device: DeviceArgs,
@@ -507,8 +548,8 @@ pub struct SettingsArgs {
         help_heading = "Render settings"
     )]
     pub lighting: Option<LightingArg>,
-    /// Light transport: Whitted ray tracing or Monte Carlo path tracing (CPU
-    /// reference only for now) [default: the scene's, else whitted].
+    /// Light transport: Whitted ray tracing or Monte Carlo path tracing [default: the
+    /// scene's, else whitted].
     #[arg(
         long,
         value_enum,

@@ -6,6 +6,7 @@ use anyhow::{Context, Result, bail};
 use gpu_render::cpu;
 use gpu_render::film::{LinearImage, ProgressFn, RenderStats, Rendered};
 use gpu_render::gpu::{self, AdapterChoice, GpuRenderer, HeadlessGpu, TraceRegion};
+use gpu_render::noise::NoiseEstimate;
 use gpu_render::scene::{Integrator, Scene};
 use gpu_render::tiles::PixelWindow;
 
@@ -19,6 +20,9 @@ pub struct Frame {
     pub display_rgba8: Vec<u8>,
     /// Ray count and tracing time.
     pub stats: RenderStats,
+    /// Each pixel's noise estimate, where the backend was opened with
+    /// [`GpuOptions::noise`].
+    pub noise: Option<NoiseEstimate>,
 }
 
 impl Frame {
@@ -31,6 +35,7 @@ impl Frame {
             image: rendered.image,
             display_rgba8,
             stats: rendered.stats,
+            noise: rendered.noise,
         }
     }
 }
@@ -42,6 +47,8 @@ pub struct GpuOptions {
     pub iteration_budget: Option<u32>,
     /// `--gpu-timeout`.
     pub timeout: Option<std::time::Duration>,
+    /// Estimate each pixel's noise (`--standard-error`); on either backend.
+    pub noise: bool,
 }
 
 /// An opened backend, ready to render any number of scenes.
@@ -59,6 +66,8 @@ pub enum Backend {
     Cpu {
         /// Why `--backend auto` chose it, for the summary (`None` when asked for).
         reason: Option<String>,
+        /// Whether renders estimate each pixel's noise.
+        noise: bool,
     },
 }
 
@@ -80,13 +89,17 @@ impl Backend {
             Some(AdapterArg::List) => bail!("--adapter list does not select an adapter"),
         };
         match choice {
-            BackendArg::Cpu => Ok(Backend::Cpu { reason: None }),
+            BackendArg::Cpu => Ok(Backend::Cpu {
+                reason: None,
+                noise: options.noise,
+            }),
             BackendArg::Gpu => Self::open_gpu(&adapter_choice, options),
             BackendArg::Auto if adapter.is_some() => Self::open_gpu(&adapter_choice, options),
             BackendArg::Auto => match HeadlessGpu::new(&adapter_choice) {
                 Ok(gpu) => match auto_rule(&gpu.adapter_info(), scene) {
                     Some(reason) => Ok(Backend::Cpu {
                         reason: Some(reason),
+                        noise: options.noise,
                     }),
                     None => Self::with_device(gpu, options),
                 },
@@ -96,6 +109,7 @@ impl Backend {
                     }
                     Ok(Backend::Cpu {
                         reason: Some("no GPU adapter".into()),
+                        noise: options.noise,
                     })
                 }
             },
@@ -125,6 +139,7 @@ impl Backend {
         if let Some(timeout) = options.timeout {
             renderer = renderer.with_poll_timeout(timeout);
         }
+        renderer = renderer.with_noise_estimate(options.noise);
         Ok(Backend::Gpu {
             gpu: Box::new(gpu),
             renderer,
@@ -137,9 +152,10 @@ impl Backend {
     pub fn describe(&self) -> String {
         match self {
             Backend::Gpu { adapter_name, .. } => format!("GPU ({adapter_name})"),
-            Backend::Cpu { reason: None } => "CPU reference".to_owned(),
+            Backend::Cpu { reason: None, .. } => "CPU reference".to_owned(),
             Backend::Cpu {
                 reason: Some(reason),
+                ..
             } => format!("CPU reference (auto: {reason})"),
         }
     }
@@ -185,10 +201,16 @@ impl Backend {
                     image: rendered.image,
                     display_rgba8: rendered.display_rgba8,
                     stats: rendered.stats,
+                    noise: rendered.noise,
                 })
             }
-            Backend::Cpu { .. } => {
-                let rendered = cpu::render_region(
+            Backend::Cpu { noise, .. } => {
+                let render = if *noise {
+                    cpu::render_region_with_noise
+                } else {
+                    cpu::render_region
+                };
+                let rendered = render(
                     scene,
                     window.columns.clone(),
                     window.rows.clone(),
@@ -210,9 +232,17 @@ impl Backend {
                     image: rendered.image,
                     display_rgba8: rendered.display_rgba8,
                     stats: rendered.stats,
+                    noise: rendered.noise,
                 })
             }
-            Backend::Cpu { .. } => Ok(Frame::from_cpu(cpu::render(scene, Some(progress)), scene)),
+            Backend::Cpu { noise, .. } => {
+                let rendered = if *noise {
+                    cpu::render_with_noise(scene, Some(progress))
+                } else {
+                    cpu::render(scene, Some(progress))
+                };
+                Ok(Frame::from_cpu(rendered, scene))
+            }
         }
     }
 }

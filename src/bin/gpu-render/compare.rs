@@ -35,6 +35,8 @@ pub fn side_by_side(left: &Frame, right: &Frame) -> Result<Frame> {
         image,
         display_rgba8,
         stats: crate::summary::add_stats(left.stats, right.stats),
+        // --compare-gamma and --standard-error exclude each other.
+        noise: None,
     })
 }
 
@@ -52,6 +54,7 @@ mod tests {
             image,
             display_rgba8: vec![byte; 16],
             stats: RenderStats::default(),
+            noise: None,
         }
     }
 

@@ -61,6 +61,7 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
     let options = GpuOptions {
         iteration_budget: args.device.iteration_budget,
         timeout: args.device.gpu_timeout,
+        noise: false,
     };
     let backend = Backend::open(
         args.device.backend,

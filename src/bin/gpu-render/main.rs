@@ -22,11 +22,11 @@ mod tradeoff;
 mod view;
 
 use std::borrow::Cow;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{Result, anyhow, bail};
+use anyhow::{Context, Result, anyhow, bail};
 use clap::{CommandFactory, Parser, error::ErrorKind};
 use gpu_render::output::{self, HDR_MAX, OutputFormat, Written};
 use gpu_render::scene::{
@@ -198,12 +198,18 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
     if named_by_frame {
         output::check_output_path(&output_path)?;
     }
+    let standard_error_path = args
+        .standard_error
+        .as_deref()
+        .map(|pattern| standard_error_path(pattern, frame, tile, &output_path, scene_path, &scene))
+        .transpose()?;
     check_inputs_survive(&output_path, scene_path, &scene)?;
     let window = piece_window(args, &scene.render)?;
 
     let gpu_options = GpuOptions {
         iteration_budget: args.device.iteration_budget,
         timeout: args.device.gpu_timeout,
+        noise: standard_error_path.is_some(),
     };
     let backend = Backend::open(
         args.device.backend,
@@ -218,6 +224,7 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
         format,
         args.compare_gamma,
         window.as_ref(),
+        standard_error_path.is_some(),
         args.max_memory,
     )?;
     let piece_name = window.as_ref().map(|window| match args.tile {
@@ -275,6 +282,13 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
         }
         None => output::write_image(&output_path, &rendered.image, &rendered.display_rgba8)?,
     };
+    if let Some(path) = &standard_error_path {
+        let noise = rendered
+            .noise
+            .as_ref()
+            .context("the backend returned no noise estimate")?;
+        output::write_image(path, &noise.standard_error_image(), &[])?;
+    }
 
     if !args.quiet {
         warn_clamped(&output_path, written);
@@ -287,6 +301,7 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
             wall,
             stats: rendered.stats,
             output: &output_path,
+            noise: rendered.noise.as_ref(),
         };
         eprintln!("{summary}");
     }
@@ -382,6 +397,33 @@ fn check_inputs_survive(output_path: &Path, scene_path: &Path, scene: &Scene) ->
     Ok(())
 }
 
+/// The path `--standard-error` names for this render (`{frame}` and `{tile}`
+/// expanded): an `.exr` that is neither the image written nor an input.
+fn standard_error_path(
+    pattern: &Path,
+    frame: Option<(u32, u32)>,
+    tile: Option<(u32, u32)>,
+    output_path: &Path,
+    scene_path: &Path,
+    scene: &Scene,
+) -> Result<PathBuf> {
+    let path = naming::expand(pattern, frame, tile)?;
+    if output::check_output_path(&path)? != OutputFormat::Exr {
+        bail!(
+            "{}: --standard-error writes a linear float image, so it must be an .exr",
+            path.display()
+        );
+    }
+    if path == output_path {
+        bail!(
+            "{}: --standard-error must name another file than the image (-o)",
+            path.display()
+        );
+    }
+    check_inputs_survive(&path, scene_path, scene)?;
+    Ok(path)
+}
+
 /// Refuses, before rendering, a render whose estimated peak memory is above the cap.
 fn check_memory(
     scene: &Scene,
@@ -389,16 +431,20 @@ fn check_memory(
     format: OutputFormat,
     compare_gamma: bool,
     window: Option<&PixelWindow>,
+    noise: bool,
     max_memory_gib: f64,
 ) -> Result<()> {
     let kind = match backend {
         Backend::Gpu { .. } => BackendKind::Gpu,
         Backend::Cpu { .. } => BackendKind::Cpu,
     };
-    let estimate = match window {
+    let mut estimate = match window {
         Some(window) => Estimate::for_tile(scene, kind, window.pixels()),
         None => Estimate::new(scene, kind, format, compare_gamma),
     };
+    if noise {
+        estimate = estimate.with_noise_estimate(kind);
+    }
     let cap = max_memory_gib * f64::from(1u32 << 30);
     if estimate.total as f64 > cap {
         let s = &scene.render;

@@ -51,6 +51,19 @@ fn bytes_per_pixel(backend: BackendKind, format: OutputFormat, compare_gamma: bo
     }
 }
 
+/// Bytes per pixel a `--standard-error` render adds, counted from what it holds, an
+/// upper bound: the estimate's two `f32` per pixel (8), its grey image for the EXR
+/// (16) and an encoder's copy of it (16); on the GPU also the accumulation buffer of
+/// one `vec4<f32>` per pixel (16) and its readback (16). Measured (`minimal.toml`,
+/// 2 spp, growth of the peak from 2048² to 4096², 2026-12-01): 24 on the CPU; on
+/// lavapipe no more than without the estimate (its smaller tiles hold less).
+fn noise_bytes_per_pixel(backend: BackendKind) -> u64 {
+    match backend {
+        BackendKind::Cpu => 40,
+        BackendKind::Gpu => 72,
+    }
+}
+
 /// An estimate of a render's peak memory, with its parts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Estimate {
@@ -89,6 +102,17 @@ impl Estimate {
 }
 
 impl Estimate {
+    /// The estimate with the noise estimate's bytes per pixel added
+    /// (`--standard-error`).
+    pub fn with_noise_estimate(self, backend: BackendKind) -> Self {
+        let extra = noise_bytes_per_pixel(backend);
+        Self {
+            per_pixel: self.per_pixel + extra,
+            total: self.total + self.pixels * extra,
+            ..self
+        }
+    }
+
     /// The estimate for rendering `pixels` of `scene`'s image as a tile (`--tile`,
     /// `--crop`): the `.exr` figure per pixel of the window, plus the tile's eight
     /// channels as the `exr` encoder holds them (32 bytes per pixel) and as much
@@ -221,6 +245,14 @@ mod tests {
                 "{backend:?} {format} {compare} {side}: estimate {estimate}, measured {measured}"
             );
         }
+    }
+
+    #[test]
+    fn the_noise_estimate_adds_its_bytes_per_pixel() {
+        let plain = Estimate::new(&scene(64, 32), BackendKind::Cpu, OutputFormat::Exr, false);
+        let noisy = plain.with_noise_estimate(BackendKind::Cpu);
+        assert_eq!(noisy.total - plain.total, 64 * 32 * 40);
+        assert_eq!(noisy.per_pixel, plain.per_pixel + 40);
     }
 
     #[test]

@@ -4,6 +4,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use gpu_render::film::RenderStats;
+use gpu_render::noise::NoiseEstimate;
 use gpu_render::scene::RenderSettings;
 
 /// What the summary line reports.
@@ -25,6 +26,8 @@ pub struct Summary<'a> {
     pub stats: RenderStats,
     /// The file written.
     pub output: &'a Path,
+    /// The noise estimate, with `--standard-error`.
+    pub noise: Option<&'a NoiseEstimate>,
 }
 
 impl std::fmt::Display for Summary<'_> {
@@ -45,9 +48,17 @@ impl std::fmt::Display for Summary<'_> {
         // ray rate is per that time, and the line says which it is.
         let (trace, source) = self.stats.trace_seconds();
         let (rays_per_second, _) = self.stats.trace_rays_per_second();
+        let noise = match self.noise.map(NoiseEstimate::relative_error) {
+            None => String::new(),
+            Some(Some(relative)) => format!(
+                ", estimated noise {:.2}% (relative RMSE of luminance)",
+                relative * 100.0
+            ),
+            Some(None) => ", estimated noise unknown (needs 2 spp and light)".to_owned(),
+        };
         write!(
             f,
-            "rendered {passes}{piece}{}x{}{frame}, {} spp, max depth {} on {} in {:.2} s: {} rays, trace {:.2} s ({source}), {:.1} Mrays/s -> {}",
+            "rendered {passes}{piece}{}x{}{frame}, {} spp, max depth {} on {} in {:.2} s: {} rays, trace {:.2} s ({source}), {:.1} Mrays/s{noise} -> {}",
             s.width,
             s.height,
             s.samples_per_pixel,
@@ -118,6 +129,7 @@ mod tests {
                 gpu_time: None,
             },
             output: Path::new("out.png"),
+            noise: None,
         };
         assert_eq!(
             summary.to_string(),
@@ -144,6 +156,24 @@ mod tests {
                 "rendered tile 1/4 (x 0..32, y 6..12 (32x6)) of 32x24 (frame 7), 4 spp"
             ),
             "{tile}"
+        );
+        // One pixel, mean luminance 2, standard error 0.05: 2.5% noise.
+        let estimate = NoiseEstimate {
+            width: 1,
+            height: 1,
+            samples: 4,
+            mean_luminance: vec![2.0],
+            standard_error: vec![0.05],
+        };
+        let noisy = Summary {
+            noise: Some(&estimate),
+            ..summary
+        };
+        assert!(
+            noisy.to_string().ends_with(
+                "3.0 Mrays/s, estimated noise 2.50% (relative RMSE of luminance) -> out.png"
+            ),
+            "{noisy}"
         );
     }
 

@@ -14,6 +14,7 @@ use crate::gpu::pipelines::{DISPLAY_FORMAT, LINEAR_FORMAT};
 use crate::gpu::readback::{read_texture, submit_and_wait};
 use crate::gpu::scene_buffers::PreparedScene;
 use crate::gpu::shaders::WORKGROUP_SIZE;
+use crate::noise::NoiseEstimate;
 use crate::scene::Scene;
 
 /// The result of [`GpuRenderer::render`], and of [`GpuRenderer::render_region`] (whose
@@ -28,6 +29,8 @@ pub struct GpuRendered {
     /// Rays traced, the wall time of tracing and, where the device has timestamp
     /// queries, its GPU time.
     pub stats: RenderStats,
+    /// Each pixel's noise estimate, with [`GpuRenderer::with_noise_estimate`].
+    pub noise: Option<NoiseEstimate>,
 }
 
 /// The tiles [`GpuRenderer::render`] traces an image of `width × height` in: one tile
@@ -143,11 +146,19 @@ impl GpuRenderer {
         }
         let limits = device.limits();
         // A tile must fit one texture and one display dispatch's workgroup count.
-        let tile_limit = limits.max_texture_dimension_2d.min(
+        let mut tile_limit = limits.max_texture_dimension_2d.min(
             limits
                 .max_compute_workgroups_per_dimension
                 .saturating_mul(WORKGROUP_SIZE),
         );
+        if self.noise_estimate {
+            // And the noise estimate's sums, 16 bytes per pixel, one storage binding.
+            let binding = limits
+                .max_storage_buffer_binding_size
+                .min(limits.max_buffer_size);
+            let side = ((binding / 16) as f64).sqrt() as u32;
+            tile_limit = tile_limit.min(side.max(1));
+        }
         let (x0, y0) = (region.columns.start, region.rows.start);
         let tiles = image_tiles(width, height, tile_limit)
             .into_iter()
@@ -167,6 +178,13 @@ impl GpuRenderer {
         };
         let mut stats = RenderStats::default();
         let mut gpu_time = Some(Duration::ZERO);
+        let mut noise = self.noise_estimate.then(|| NoiseEstimate {
+            width,
+            height,
+            samples: prepared.samples_per_pixel(),
+            mean_luminance: vec![0.0; width as usize * height as usize],
+            standard_error: vec![0.0; width as usize * height as usize],
+        });
         for tile in tiles {
             let traced = self.render_tile(device, queue, prepared, &tile, &report)?;
             stats.rays_traced += traced.stats.rays_traced;
@@ -181,6 +199,15 @@ impl GpuRenderer {
                 display_rgba8[start * 4..(start + tile_width) * 4].copy_from_slice(
                     &traced.display_rgba8[row * tile_width * 4..(row + 1) * tile_width * 4],
                 );
+                if let (Some(whole), Some(part)) = (&mut noise, &traced.noise) {
+                    let (to, from) = (
+                        start..start + tile_width,
+                        row * tile_width..(row + 1) * tile_width,
+                    );
+                    whole.mean_luminance[to.clone()]
+                        .copy_from_slice(&part.mean_luminance[from.clone()]);
+                    whole.standard_error[to].copy_from_slice(&part.standard_error[from]);
+                }
             }
         }
         stats.gpu_time = gpu_time;
@@ -192,6 +219,7 @@ impl GpuRenderer {
             },
             display_rgba8,
             stats,
+            noise,
         })
     }
 
@@ -232,13 +260,14 @@ impl GpuRenderer {
             let before = last.swap(done, Ordering::Relaxed);
             report(done - before);
         };
-        let stats = self.trace_into(
+        let (stats, noise) = self.trace_region_into(
             device,
             queue,
             prepared,
             &linear_view,
             tile,
             Some(&tile_progress),
+            self.noise_estimate,
         )?;
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("gpu-render display pass"),
@@ -263,6 +292,7 @@ impl GpuRenderer {
             },
             display_rgba8,
             stats,
+            noise,
         })
     }
 
