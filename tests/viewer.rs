@@ -156,11 +156,34 @@ fn the_screenshot_matches_the_headless_render_of_the_same_samples() {
 
     let mut render = gpu_render(None);
     render
-        .args(["scenes/showcase.toml", "--backend", "gpu", "-q", "-o"])
+        .args(["scenes/showcase.toml", "--backend", "gpu", "-o"])
         .arg(&reference)
+        .arg("--standard-error")
+        .arg(dir.join("headless-se.exr"))
         .args(size);
-    let (status, stderr) = run(render);
-    assert_eq!(status, Some(0), "the headless render failed:\n{stderr}");
+    let (status, headless_stderr) = run(render);
+    assert_eq!(
+        status,
+        Some(0),
+        "the headless render failed:\n{headless_stderr}"
+    );
+    // The same samples give the same noise estimate, worded alike.
+    let noise = |text: &str| {
+        text.split("estimated noise ")
+            .nth(1)
+            .and_then(|rest| rest.split('%').next())
+            .map(str::to_owned)
+    };
+    let shown_noise = noise(&stderr);
+    assert!(
+        shown_noise.is_some(),
+        "the viewer's summary gives the estimated noise:\n{stderr}"
+    );
+    assert_eq!(
+        shown_noise,
+        noise(&headless_stderr),
+        "the viewer and the headless render estimate the same noise:\n{stderr}\n{headless_stderr}"
+    );
 
     let shown = load_rgba(&screenshot);
     let expected = load_rgba(&reference);

@@ -163,6 +163,7 @@ impl ApplicationHandler for App<'_> {
             {
                 match event.logical_key.as_ref() {
                     Key::Character(c) if c.eq_ignore_ascii_case("s") => viewer.save(),
+                    Key::Character(c) if c.eq_ignore_ascii_case("n") => viewer.show_noise(),
                     Key::Named(NamedKey::Escape) => {
                         event_loop.exit();
                         Ok(())
@@ -408,10 +409,11 @@ impl Viewer {
             }
         }
         self.wait_in_flight()?;
+        let noise = self.noise_text()?;
         let seconds = elapsed.as_secs_f64();
         eprintln!(
             "viewer: {} frames in {seconds:.2} s: {:.2} frames/s at {}x{}, {} samples per \
-             frame; {} samples per pixel, {:.1} Mrays/s",
+             frame; {} samples per pixel, {:.1} Mrays/s, {noise}",
             self.frames_drawn - 1,
             f64::from(self.frames_drawn - 1) / seconds.max(1e-9),
             self.config.width,
@@ -620,6 +622,33 @@ impl Viewer {
         self.title_written = None;
         self.update_title();
         Ok(())
+    }
+
+    /// `N`: shows the film's estimated noise in the title (a blocking readback of the
+    /// per-pixel sums, so on demand rather than every frame).
+    fn show_noise(&mut self) -> Result<()> {
+        self.wait_in_flight()?;
+        let noise = self.noise_text()?;
+        self.status = Some(format!("{} spp: {noise}", self.film.samples()));
+        self.title_written = None;
+        self.update_title();
+        Ok(())
+    }
+
+    /// The film's estimated noise as the CLI's summary line words it: the relative RMSE
+    /// of luminance that the per-pixel standard errors predict (`docs/quality.md`).
+    fn noise_text(&mut self) -> Result<String> {
+        let estimate = self
+            .renderer
+            .read_noise(&self.device, &self.queue, &self.scene, &mut self.film)
+            .context("cannot read the film's noise estimate back")?;
+        Ok(match estimate.relative_error() {
+            Some(relative) => format!(
+                "estimated noise {:.2}% (relative RMSE of luminance)",
+                relative * 100.0
+            ),
+            None => "estimated noise unknown (needs 2 spp and light)".to_owned(),
+        })
     }
 
     /// Reads the offscreen image (what the window shows) back and writes it as an
