@@ -19,7 +19,7 @@ mod common;
 
 use std::sync::Arc;
 
-use common::compare::{Tolerance, assert_images_match};
+use common::compare::Tolerance;
 use glam::DVec3;
 use gpu_render::gpu::{GpuRenderer, HeadlessGpu};
 use gpu_render::scene::{Integrator, Material, MaterialKind, RenderOverrides, Scene, Shape};
@@ -49,29 +49,7 @@ fn env_materials(integrator: Integrator, width: u32, samples: u32) -> Scene {
 }
 
 fn compare(gpu: &HeadlessGpu, renderer: &GpuRenderer, label: &str, scene: &Scene) {
-    let cpu = gpu_render::cpu::render(scene, None);
-    let gpu_image = renderer
-        .render(&gpu.device, &gpu.queue, scene, None)
-        .unwrap_or_else(|e| panic!("{label}: GPU render failed: {e}"));
-    let comparison = assert_images_match(label, &cpu.image, &gpu_image.image, TOLERANCE);
-    eprintln!(
-        "{label}: {} of {} pixels outside tolerance, max |Δ| {:.2e}, RMSE {:.2e}; rays CPU {}, \
-         GPU {}",
-        comparison.outliers,
-        comparison.pixels,
-        comparison.max_abs_error,
-        comparison.rmse,
-        cpu.stats.rays_traced,
-        gpu_image.stats.rays_traced
-    );
-    let (c, g) = (
-        cpu.stats.rays_traced as f64,
-        gpu_image.stats.rays_traced as f64,
-    );
-    assert!(
-        (c - g).abs() <= 0.01 * c,
-        "{label}: ray counts differ: CPU {c}, GPU {g}"
-    );
+    common::twins::assert_backends_agree(gpu, renderer, label, scene, TOLERANCE);
 }
 
 #[test]

@@ -11,8 +11,9 @@
 
 mod common;
 
+use common::twins::assert_ray_counts_agree;
+
 use common::compare::{Tolerance, assert_images_match};
-use gpu_render::film::RenderStats;
 use gpu_render::scene::{LightingSpace, RenderOverrides, Scene, load_scene};
 
 const TOLERANCE: Tolerance = Tolerance {
@@ -20,15 +21,6 @@ const TOLERANCE: Tolerance = Tolerance {
     relative: 5e-3,
     outlier_fraction: 0.005,
 };
-
-/// Both backends count the rays they trace; their counts must agree within `fraction`.
-fn assert_ray_counts_agree(label: &str, cpu: &RenderStats, gpu: &RenderStats, fraction: f64) {
-    let (c, g) = (cpu.rays_traced as f64, gpu.rays_traced as f64);
-    assert!(
-        (c - g).abs() <= fraction * c,
-        "{label}: ray counts differ: CPU {c}, GPU {g}"
-    );
-}
 
 fn reduced(scene: Scene, lighting_space: LightingSpace) -> Scene {
     let overrides = RenderOverrides {

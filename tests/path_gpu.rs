@@ -17,9 +17,8 @@
 
 mod common;
 
-use common::compare::{Tolerance, assert_images_match};
+use common::compare::Tolerance;
 use glam::DVec3;
-use gpu_render::film::RenderStats;
 use gpu_render::gpu::{GpuError, GpuRenderer, Renderer, RendererOptions, Schedule};
 use gpu_render::scene::{
     Camera, Environment, Integrator, Material, MaterialKind, RenderOverrides, RenderSettings,
@@ -35,15 +34,6 @@ const TOLERANCE: Tolerance = Tolerance {
     outlier_fraction: OUTLIERS,
 };
 
-/// Both backends count the rays they trace; their counts must agree within `fraction`.
-fn assert_ray_counts_agree(label: &str, cpu: &RenderStats, gpu: &RenderStats, fraction: f64) {
-    let (c, g) = (cpu.rays_traced as f64, gpu.rays_traced as f64);
-    assert!(
-        (c - g).abs() <= fraction * c,
-        "{label}: ray counts differ: CPU {c}, GPU {g}"
-    );
-}
-
 /// A shipped scene, path-traced, `width` pixels wide with `samples` per pixel.
 fn shipped(name: &str, width: u32, samples: u32) -> Scene {
     let overrides = RenderOverrides {
@@ -56,30 +46,7 @@ fn shipped(name: &str, width: u32, samples: u32) -> Scene {
 
 /// Renders `scene` on both backends and compares them.
 fn compare(gpu: &gpu_render::gpu::HeadlessGpu, renderer: &GpuRenderer, label: &str, scene: &Scene) {
-    let cpu = gpu_render::cpu::render(scene, None);
-    let gpu_image = renderer
-        .render(&gpu.device, &gpu.queue, scene, None)
-        .unwrap_or_else(|e| panic!("{label}: GPU render failed: {e}"));
-    assert!(
-        gpu_image
-            .image
-            .pixels
-            .iter()
-            .all(|p| p.iter().all(|c| c.is_finite())),
-        "{label}: the GPU image has non-finite pixels"
-    );
-    let comparison = assert_images_match(label, &cpu.image, &gpu_image.image, TOLERANCE);
-    eprintln!(
-        "{label}: {} of {} pixels outside tolerance, max |Δ| {:.2e}, RMSE {:.2e}; rays CPU {}, \
-         GPU {}",
-        comparison.outliers,
-        comparison.pixels,
-        comparison.max_abs_error,
-        comparison.rmse,
-        cpu.stats.rays_traced,
-        gpu_image.stats.rays_traced
-    );
-    assert_ray_counts_agree(label, &cpu.stats, &gpu_image.stats, 0.01);
+    common::twins::assert_backends_agree(gpu, renderer, label, scene, TOLERANCE);
 }
 
 /// A closed emissive sphere around the camera with `material` inside: the white

@@ -7,3 +7,4 @@ pub mod gpu;
 pub mod process;
 pub mod reference;
 pub mod scenes;
+pub mod twins;
