@@ -21,7 +21,6 @@ mod common;
 
 use std::path::Path;
 
-use glam::DVec3;
 use gpu_render::cpu::intersect::Ray;
 use gpu_render::cpu::trace::PreparedScene;
 use gpu_render::cpu::traverse::intersect_scene;
@@ -59,9 +58,7 @@ fn an_environment_lit_scene_agrees_with_mitsuba_within_its_statistical_error() {
         .to_rgb32f();
     assert_eq!(reference.dimensions(), (WIDTH, HEIGHT));
 
-    let mut z_values = Vec::new();
-    let (mut our_total, mut reference_total) = (DVec3::ZERO, DVec3::ZERO);
-    let mut total_variance = DVec3::ZERO;
+    let mut gathered = common::reference::ReferenceComparison::default();
     let mut background_values = 0;
     for (i, (mean, variance)) in ours.iter().enumerate() {
         let r = reference.get_pixel(i as u32 % WIDTH, i as u32 / WIDTH);
@@ -70,16 +67,18 @@ fn an_environment_lit_scene_agrees_with_mitsuba_within_its_statistical_error() {
         for c in 0..3 {
             let expected = f64::from(r[c]);
             let statistical = variance[c] / f64::from(SAMPLES) + variance[c] / REFERENCE_SAMPLES;
-            our_total[c] += mean[c];
-            reference_total[c] += expected;
-            total_variance[c] += statistical;
+            gathered.our_total[c] += mean[c];
+            gathered.reference_total[c] += expected;
+            gathered.total_variance[c] += statistical;
             let b = if background {
                 INTERPOLATION * expected
             } else {
                 0.0
             };
             if statistical > 0.0 {
-                z_values.push((mean[c] - expected) / (statistical + b * b).sqrt());
+                gathered
+                    .z_values
+                    .push((mean[c] - expected) / (statistical + b * b).sqrt());
             } else {
                 // The sky seen inside one texel: no variance, so only the lookup
                 // differs.
@@ -95,37 +94,5 @@ fn an_environment_lit_scene_agrees_with_mitsuba_within_its_statistical_error() {
         background_values > 300,
         "{background_values} background values"
     );
-    let n = z_values.len() as f64;
-    let outliers = z_values.iter().filter(|z| z.abs() > 4.0).count();
-    let difference = our_total - reference_total;
-    let standard_error = DVec3::new(
-        total_variance.x.sqrt(),
-        total_variance.y.sqrt(),
-        total_variance.z.sqrt(),
-    );
-    let relative = difference / reference_total;
-    eprintln!(
-        "{} values: {outliers} with |z| > 4; image means differ by {relative:.5} \
-         (relative), {:.2} standard errors",
-        z_values.len(),
-        (difference / standard_error).abs().max_element()
-    );
-    assert!(
-        outliers as f64 <= 0.005 * n,
-        "{outliers} of {n} pixel values differ from Mitsuba by more than 4 standard errors"
-    );
-    for c in 0..3 {
-        assert!(
-            difference[c].abs() <= 4.0 * standard_error[c],
-            "channel {c}: biased against Mitsuba: the image sums differ by {} with a \
-             standard error of {}",
-            difference[c],
-            standard_error[c]
-        );
-        assert!(
-            relative[c].abs() <= 0.005,
-            "channel {c}: the image mean differs from Mitsuba's by {:.3}%",
-            100.0 * relative[c]
-        );
-    }
+    gathered.assert_agrees();
 }

@@ -15,7 +15,6 @@ mod common;
 
 use std::path::Path;
 
-use glam::DVec3;
 use gpu_render::cpu::trace::PreparedScene;
 use gpu_render::scene::load_scene;
 
@@ -37,19 +36,17 @@ fn the_cornell_box_agrees_with_mitsuba_within_its_statistical_error() {
         .to_rgb32f();
     assert_eq!(reference.dimensions(), (SIZE, SIZE));
 
-    let mut z_values = Vec::new();
-    let (mut our_total, mut reference_total) = (DVec3::ZERO, DVec3::ZERO);
-    let mut total_variance = DVec3::ZERO;
+    let mut gathered = common::reference::ReferenceComparison::default();
     for (i, (mean, variance)) in ours.iter().enumerate() {
         let r = reference.get_pixel(i as u32 % SIZE, i as u32 / SIZE);
         for c in 0..3 {
             let expected = f64::from(r[c]);
             let error = (variance[c] / f64::from(SAMPLES) + variance[c] / REFERENCE_SAMPLES).sqrt();
-            our_total[c] += mean[c];
-            reference_total[c] += expected;
-            total_variance[c] += error * error;
+            gathered.our_total[c] += mean[c];
+            gathered.reference_total[c] += expected;
+            gathered.total_variance[c] += error * error;
             if error > 0.0 {
-                z_values.push((mean[c] - expected) / error);
+                gathered.z_values.push((mean[c] - expected) / error);
             } else {
                 // A pixel without variance (the lamp seen directly) must agree exactly,
                 // to f32.
@@ -61,37 +58,5 @@ fn the_cornell_box_agrees_with_mitsuba_within_its_statistical_error() {
             }
         }
     }
-    let n = z_values.len() as f64;
-    let outliers = z_values.iter().filter(|z| z.abs() > 4.0).count();
-    let difference = our_total - reference_total;
-    let standard_error = DVec3::new(
-        total_variance.x.sqrt(),
-        total_variance.y.sqrt(),
-        total_variance.z.sqrt(),
-    );
-    let relative = difference / reference_total;
-    eprintln!(
-        "{} values: {outliers} with |z| > 4; image means differ by {relative:.5} \
-         (relative), {:.2} standard errors",
-        z_values.len(),
-        (difference / standard_error).abs().max_element()
-    );
-    assert!(
-        outliers as f64 <= 0.005 * n,
-        "{outliers} of {n} pixel values differ from Mitsuba by more than 4 standard errors"
-    );
-    for c in 0..3 {
-        assert!(
-            difference[c].abs() <= 4.0 * standard_error[c],
-            "channel {c}: biased against Mitsuba: the image sums differ by {} with a \
-             standard error of {}",
-            difference[c],
-            standard_error[c]
-        );
-        assert!(
-            relative[c].abs() <= 0.005,
-            "channel {c}: the image mean differs from Mitsuba's by {:.3}%",
-            100.0 * relative[c]
-        );
-    }
+    gathered.assert_agrees();
 }

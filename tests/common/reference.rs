@@ -57,3 +57,60 @@ pub fn render_with_variance(
             .collect()
     })
 }
+
+/// What a comparison with an independent reference gathered over the pixel values:
+/// each value's z score, and per channel the two image sums and the variance of their
+/// difference.
+#[derive(Debug, Default)]
+pub struct ReferenceComparison {
+    /// `(ours − reference) / σ` of every value with a variance.
+    pub z_values: Vec<f64>,
+    /// Our image's sum per channel.
+    pub our_total: DVec3,
+    /// The reference's sum per channel.
+    pub reference_total: DVec3,
+    /// The variance of `our_total − reference_total` per channel.
+    pub total_variance: DVec3,
+}
+
+impl ReferenceComparison {
+    /// Asserts the stated agreement with the reference: at most 0.5% of the values
+    /// beyond 4 standard errors, and each channel's image sum within 4 standard
+    /// errors and 0.5% of the reference's. Prints the figures.
+    pub fn assert_agrees(&self) {
+        let n = self.z_values.len() as f64;
+        let outliers = self.z_values.iter().filter(|z| z.abs() > 4.0).count();
+        let difference = self.our_total - self.reference_total;
+        let standard_error = DVec3::new(
+            self.total_variance.x.sqrt(),
+            self.total_variance.y.sqrt(),
+            self.total_variance.z.sqrt(),
+        );
+        let relative = difference / self.reference_total;
+        eprintln!(
+            "{} values: {outliers} with |z| > 4; image means differ by {relative:.5} \
+             (relative), {:.2} standard errors",
+            self.z_values.len(),
+            (difference / standard_error).abs().max_element()
+        );
+        assert!(
+            outliers as f64 <= 0.005 * n,
+            "{outliers} of {n} pixel values differ from the reference by more than 4 \
+             standard errors"
+        );
+        for c in 0..3 {
+            assert!(
+                difference[c].abs() <= 4.0 * standard_error[c],
+                "channel {c}: biased against the reference: the image sums differ by {} \
+                 with a standard error of {}",
+                difference[c],
+                standard_error[c]
+            );
+            assert!(
+                relative[c].abs() <= 0.005,
+                "channel {c}: the image mean differs from the reference's by {:.3}%",
+                100.0 * relative[c]
+            );
+        }
+    }
+}
