@@ -18,7 +18,7 @@ use gpu_render::scene::{
     Shape, TextureMapping,
 };
 
-use common::compare::{Tolerance, assert_images_match};
+use common::compare::Tolerance;
 
 /// The light: a 1.2 × 0.9 rectangle at height 1.2 facing down, `u` running along x
 /// from its left edge (x = −0.4) to its right (x = 0.8), `v` along z.
@@ -327,11 +327,7 @@ fn a_textured_emitter_is_chosen_by_its_texture_s_mean() {
 
 /// The shipped scenes' tolerance (tests/gpu_vs_cpu.rs): f32 against f64, with 0.5% of
 /// the pixels (the quad's edges and the texture's) allowed to land on either side.
-const TOLERANCE: Tolerance = Tolerance {
-    absolute: 1e-3,
-    relative: 5e-3,
-    outlier_fraction: 0.005,
-};
+const TOLERANCE: Tolerance = common::twins::TWIN_TOLERANCE;
 
 /// The GPU renders the textured light and the floor it lights as the CPU reference
 /// does, per pixel, with both integrators (Whitted with a directional light, so that the
@@ -370,10 +366,6 @@ fn emissive_textures_render_alike_on_both_backends() {
         ("emissive-texture-whitted", &whitted),
         ("emissive-texture-path", &path),
     ] {
-        let expected = gpu_render::cpu::render(s, None).image;
-        let actual = renderer
-            .render(&gpu.device, &gpu.queue, s, None)
-            .unwrap_or_else(|e| panic!("{label}: GPU render failed: {e}"));
-        assert_images_match(label, &expected, &actual.image, TOLERANCE);
+        common::twins::assert_backends_agree(&gpu, &renderer, label, s, TOLERANCE);
     }
 }

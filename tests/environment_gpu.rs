@@ -24,14 +24,7 @@ use glam::DVec3;
 use gpu_render::gpu::{GpuRenderer, HeadlessGpu};
 use gpu_render::scene::{Integrator, Material, MaterialKind, RenderOverrides, Scene, Shape};
 
-/// The largest fraction of pixels allowed outside the per-channel tolerance.
-const OUTLIERS: f64 = 0.005;
-
-const TOLERANCE: Tolerance = Tolerance {
-    absolute: 1e-3,
-    relative: 5e-3,
-    outlier_fraction: OUTLIERS,
-};
+const TOLERANCE: Tolerance = common::twins::TWIN_TOLERANCE;
 
 /// `scenes/env-materials.toml` with `integrator`, `width` pixels wide, `samples` per
 /// pixel.

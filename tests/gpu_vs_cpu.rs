@@ -16,11 +16,7 @@ use common::twins::assert_ray_counts_agree;
 use common::compare::{Tolerance, assert_images_match};
 use gpu_render::scene::{LightingSpace, RenderOverrides, Scene, load_scene};
 
-const TOLERANCE: Tolerance = Tolerance {
-    absolute: 1e-3,
-    relative: 5e-3,
-    outlier_fraction: 0.005,
-};
+const TOLERANCE: Tolerance = common::twins::TWIN_TOLERANCE;
 
 fn reduced(scene: Scene, lighting_space: LightingSpace) -> Scene {
     let overrides = RenderOverrides {

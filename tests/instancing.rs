@@ -40,11 +40,7 @@ const FLAT_TOLERANCE: Tolerance = Tolerance {
 };
 
 /// GPU against CPU: the tolerance of `tests/gpu_vs_cpu.rs`.
-const GPU_TOLERANCE: Tolerance = Tolerance {
-    absolute: 1e-3,
-    relative: 5e-3,
-    outlier_fraction: 0.005,
-};
+const GPU_TOLERANCE: Tolerance = common::twins::TWIN_TOLERANCE;
 
 /// The placements: translated, rotated, non-uniformly scaled, mirrored (with a
 /// rotation, so that the mirror shows), each with its material.

@@ -7,7 +7,7 @@
 //! `tests/gpu_vs_cpu.rs`. A pixel may still fail where one of its paths takes another
 //! branch in f32 than in f64 (a ray grazing an edge, an event or roulette number within
 //! rounding of its threshold), and from then on draws other numbers: at most
-//! [`OUTLIERS`] of the pixels may (measured on lavapipe, 2026-12-01: none does on any
+//! 0.5% of the pixels (`common::twins::TWIN_TOLERANCE`) may (measured on lavapipe, 2026-12-01: none does on any
 //! of these scenes; the largest difference is 2.1e-3, on a bright Cornell box pixel,
 //! RMSE at most 2.7e-5). On failure both images and their difference are
 //! written under `target/test-output/`.
@@ -25,14 +25,7 @@ use gpu_render::scene::{
     Scene, Shape,
 };
 
-/// The largest fraction of pixels allowed outside the per-channel tolerance.
-const OUTLIERS: f64 = 0.005;
-
-const TOLERANCE: Tolerance = Tolerance {
-    absolute: 1e-3,
-    relative: 5e-3,
-    outlier_fraction: OUTLIERS,
-};
+const TOLERANCE: Tolerance = common::twins::TWIN_TOLERANCE;
 
 /// A shipped scene, path-traced, `width` pixels wide with `samples` per pixel.
 fn shipped(name: &str, width: u32, samples: u32) -> Scene {

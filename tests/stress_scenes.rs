@@ -19,11 +19,7 @@ use gpu_render::scene::{
 
 /// The tolerance of `tests/gpu_vs_cpu.rs`: f32 against f64, with 0.5% of pixels
 /// allowed to differ where a sample grazes an edge.
-const TOLERANCE: Tolerance = Tolerance {
-    absolute: 1e-3,
-    relative: 5e-3,
-    outlier_fraction: 0.005,
-};
+const TOLERANCE: Tolerance = common::twins::TWIN_TOLERANCE;
 
 fn settings(width: u32, height: u32, samples: u32, depth: u32) -> RenderSettings {
     RenderSettings {

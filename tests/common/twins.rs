@@ -9,6 +9,16 @@ use gpu_render::scene::Scene;
 
 use super::compare::{Comparison, Tolerance, assert_images_match};
 
+/// The GPU-against-CPU tolerance of the twin tests: a channel passes within `1e-3 +
+/// 5e-3·|cpu|` (f32 against f64), and 0.5% of the pixels may fail it (a sample that
+/// grazes an edge, or a branch taken the other way within rounding, lands on either
+/// side).
+pub const TWIN_TOLERANCE: Tolerance = Tolerance {
+    absolute: 1e-3,
+    relative: 5e-3,
+    outlier_fraction: 0.005,
+};
+
 /// Both backends count the rays they trace; their counts must agree within `fraction`
 /// of the CPU's.
 pub fn assert_ray_counts_agree(label: &str, cpu: &RenderStats, gpu: &RenderStats, fraction: f64) {
