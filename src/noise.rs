@@ -19,17 +19,14 @@
 
 use glam::DVec3;
 
+use crate::accel::luminance;
 use crate::film::LinearImage;
 
 /// Luminance weights of linear Rec. 709 / sRGB primaries (ITU-R BT.709-6, item 3.3;
-/// IEC 61966-2-1): `Y = 0.2126 R + 0.7152 G + 0.0722 B`. Twin of `LUMINANCE_WEIGHTS`
-/// in `shaders/noise.wgsl`.
+/// IEC 61966-2-1): `Y = 0.2126 R + 0.7152 G + 0.0722 B`, the weights of
+/// [`crate::accel::luminance`], which the estimate uses. Twin of `LUMINANCE_WEIGHTS` in
+/// `shaders/noise.wgsl`.
 pub const LUMINANCE_WEIGHTS: [f64; 3] = [0.2126, 0.7152, 0.0722];
-
-/// The luminance of a linear RGB radiance ([`LUMINANCE_WEIGHTS`]).
-pub fn sample_luminance(rgb: DVec3) -> f64 {
-    rgb.dot(DVec3::from_array(LUMINANCE_WEIGHTS))
-}
 
 /// Welford's update of a pixel's `m2` for its sample number `index` (0-based) of
 /// luminance `luminance`: `sum_before` is the radiance sum of the samples before it,
@@ -45,9 +42,9 @@ pub fn luminance_m2_step(
     let mean_before = if index == 0 {
         0.0
     } else {
-        sample_luminance(sum_before) / f64::from(index)
+        crate::accel::luminance(sum_before) / f64::from(index)
     };
-    let mean_after = sample_luminance(sum_after) / (f64::from(index) + 1.0);
+    let mean_after = crate::accel::luminance(sum_after) / (f64::from(index) + 1.0);
     m2 + (luminance - mean_before) * (luminance - mean_after)
 }
 
@@ -73,7 +70,7 @@ pub struct NoiseEstimate {
     pub height: u32,
     /// Samples per pixel the estimate is over.
     pub samples: u32,
-    /// `width * height` mean luminances ([`sample_luminance`] of the mean radiance).
+    /// `width * height` mean luminances ([`luminance`] of the mean radiance).
     pub mean_luminance: Vec<f32>,
     /// `width * height` standard errors of the mean luminance ([`standard_error`]);
     /// infinite below two samples.
@@ -94,7 +91,7 @@ impl NoiseEstimate {
             .into_iter()
             .map(|(sum, m2)| {
                 (
-                    (sample_luminance(sum) / n) as f32,
+                    (luminance(sum) / n) as f32,
                     self::standard_error(m2, samples) as f32,
                 )
             })
@@ -152,12 +149,12 @@ impl NoiseEstimate {
 
 /// Relative RMSE of `image`'s luminance against `reference`'s:
 /// `√(mean over pixels (Y − Y_ref)²) / mean over pixels Y_ref`, with `Y` the
-/// [`sample_luminance`] of a pixel. The error measure of the tradeoff's time-to-1%
+/// [`luminance`] of a pixel. The error measure of the tradeoff's time-to-1%
 /// figures (`docs/quality.md`), and the one [`NoiseEstimate::relative_error`]
 /// predicts. Infinite for a black reference.
 pub fn relative_rmse(reference: &LinearImage, image: &LinearImage) -> f64 {
     let luminance = |p: &[f32; 4]| {
-        sample_luminance(DVec3::new(
+        luminance(DVec3::new(
             f64::from(p[0]),
             f64::from(p[1]),
             f64::from(p[2]),
@@ -193,7 +190,7 @@ mod tests {
             let rgb = DVec3::splat(v);
             let before = sum;
             sum += rgb;
-            m2 = luminance_m2_step(m2, before, sum, sample_luminance(rgb), i as u32);
+            m2 = luminance_m2_step(m2, before, sum, luminance(rgb), i as u32);
         }
         let mean = values.iter().sum::<f64>() / values.len() as f64;
         let two_pass: f64 = values.iter().map(|v| (v - mean) * (v - mean)).sum();
@@ -208,7 +205,13 @@ mod tests {
 
     #[test]
     fn grey_has_its_own_luminance_and_one_sample_is_unknown() {
-        assert!((sample_luminance(DVec3::splat(0.25)) - 0.25).abs() < 1e-12);
+        assert!((luminance(DVec3::splat(0.25)) - 0.25).abs() < 1e-12);
+        // The weights the WGSL twin is checked against are the function's.
+        for (i, weight) in LUMINANCE_WEIGHTS.iter().enumerate() {
+            let mut primary = DVec3::ZERO;
+            primary[i] = 1.0;
+            assert_eq!(luminance(primary), *weight);
+        }
         assert!(standard_error(1.0, 1).is_infinite());
         assert!(standard_error(f64::NAN, 8).is_infinite());
         assert_eq!(standard_error(-1e-20, 8), 0.0);

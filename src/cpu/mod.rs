@@ -20,7 +20,7 @@ use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 use std::time::Instant;
 
 use crate::film::{LinearImage, ProgressFn, RenderStats, Rendered};
-use crate::noise::{NoiseEstimate, sample_luminance, standard_error};
+use crate::noise::{NoiseEstimate, standard_error};
 use crate::scene::Scene;
 pub use trace::{PreparedScene, trace_pixel};
 
@@ -208,7 +208,7 @@ fn trace_window(
                             1.0,
                         ];
                         if let Some((mean, error)) = &mut row_noise {
-                            mean[i] = sample_luminance(result.radiance) as f32;
+                            mean[i] = crate::accel::luminance(result.radiance) as f32;
                             error[i] = standard_error(result.luminance_m2, samples) as f32;
                         }
                         row_rays += result.rays;

@@ -12,7 +12,7 @@ use super::traverse::{intersect_scene, occluded};
 use crate::accel::SceneGeometry;
 use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight};
 use crate::camera::{CameraFrame, SamplePattern};
-use crate::noise::{luminance_m2_step, sample_luminance};
+use crate::noise::luminance_m2_step;
 pub use crate::scene::MediumStack;
 use crate::scene::{Image, Integrator, Light, Material, RenderSettings, Scene};
 
@@ -171,8 +171,13 @@ pub fn trace_pixel(scene: &PreparedScene, x: u32, y: u32) -> PixelResult {
         };
         let before = sum;
         sum += radiance;
-        luminance_m2 =
-            luminance_m2_step(luminance_m2, before, sum, sample_luminance(radiance), index);
+        luminance_m2 = luminance_m2_step(
+            luminance_m2,
+            before,
+            sum,
+            crate::accel::luminance(radiance),
+            index,
+        );
         rays += sample_rays;
     }
     let radiance = sum / f64::from(settings.samples_per_pixel);
