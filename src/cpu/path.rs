@@ -460,13 +460,10 @@ fn sample_emitter(
         light_hit.normal,
         light_hit.uv,
     );
-    let f = eval_brdf(material, &scene.images, n, wi, wo);
-    let weight = if mis {
-        power_heuristic(pdf, pdf_brdf(material, &scene.brdf_map_cdfs, n, wo, wi))
-    } else {
-        1.0
-    };
-    (f * radiance * (cos_i * weight / pdf), 1)
+    (
+        light_sample_contribution(scene, material, n, wo, wi, pdf, radiance, mis),
+        1,
+    )
 }
 
 /// Next-event estimation of the environment map (chosen with its selection
@@ -500,13 +497,36 @@ fn sample_environment(
     if occluded(&scene.geometry, &shadow, f64::INFINITY) {
         return (DVec3::ZERO, 1);
     }
+    (
+        light_sample_contribution(scene, material, n, wo, wi, pdf, sample.radiance, mis),
+        1,
+    )
+}
+
+/// `f · L · cos θ / pdf` of a visible light sample in direction `wi` of density `pdf`
+/// (an emitter's or the environment's, its selection included) and radiance `L`,
+/// weighted by the power heuristic against the BRDF's sampler when `mis`. The shared
+/// end of [`sample_emitter`] and [`sample_environment`] (one function on the GPU,
+/// `path_consume_emitter`).
+#[allow(clippy::too_many_arguments)]
+fn light_sample_contribution(
+    scene: &PreparedScene,
+    material: &Material,
+    n: DVec3,
+    wo: DVec3,
+    wi: DVec3,
+    pdf: f64,
+    radiance: DVec3,
+    mis: bool,
+) -> DVec3 {
+    let cos_i = n.dot(wi);
     let f = eval_brdf(material, &scene.images, n, wi, wo);
     let weight = if mis {
         power_heuristic(pdf, pdf_brdf(material, &scene.brdf_map_cdfs, n, wo, wi))
     } else {
         1.0
     };
-    (f * sample.radiance * (cos_i * weight / pdf), 1)
+    f * radiance * (cos_i * weight / pdf)
 }
 
 #[cfg(test)]
