@@ -57,6 +57,10 @@ struct Args {
     /// The GPU schedule: `fused` or `wavefront` (default: the adapter's).
     #[arg(long)]
     schedule: Option<String>,
+    /// Keep the scene records in storage buffers, not in uniform buffers where they
+    /// fit on a CPU device (`GpuRenderer::with_uniform_records(false)`).
+    #[arg(long)]
+    storage_records: bool,
     /// Print the BVH's build figures and the nodes and primitives a camera ray and a
     /// shadow ray (to the first light) visit on average, counted by the CPU traversal
     /// at one ray per pixel.
@@ -371,7 +375,7 @@ fn main() -> Result<()> {
     }
     instancing_figures(&scene);
     let gpu = HeadlessGpu::new(&AdapterChoice::Default).context("no GPU adapter")?;
-    let mut renderer = GpuRenderer::new(&gpu.device)?;
+    let mut renderer = GpuRenderer::new(&gpu.device)?.with_uniform_records(!args.storage_records);
     match args.schedule.as_deref() {
         None => {}
         Some("fused") => renderer = renderer.with_schedule(Schedule::Fused),
@@ -402,10 +406,15 @@ fn main() -> Result<()> {
     let primitives = gpu_render::accel::SceneGeometry::new(&scene).bounded_count();
     println!(
         "GPU scene buffers: {} bytes for {primitives} bounded primitives ({:.1} bytes each, \
-         BVH included); BVH built in {:.1} ms",
+         BVH included); BVH built in {:.1} ms; records in {} buffers",
         prepared.scene_bytes(),
         prepared.scene_bytes() as f64 / primitives.max(1) as f64,
-        prepared.bvh_stats().build_time.as_secs_f64() * 1e3
+        prepared.bvh_stats().build_time.as_secs_f64() * 1e3,
+        if prepared.features().uniform_records {
+            "uniform"
+        } else {
+            "storage"
+        }
     );
     drop(prepared);
     if !args.gpu_only {

@@ -20,14 +20,14 @@
 // dispatches or budgets it took.
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
-@group(0) @binding(1) var<storage, read> spheres: array<Sphere>;
+// binding 1: `spheres`, a storage or a uniform array, declared by src/gpu/uniform_records.rs.
 @group(0) @binding(2) var<storage, read> planes: array<Plane>;
-@group(0) @binding(3) var<storage, read> polygons: array<Polygon>;
+// binding 3: `polygons`, a storage or a uniform array, declared by src/gpu/uniform_records.rs.
 // Each polygon vertex projected for the inside test (the plane's dropped axis removed).
 @group(0) @binding(4) var<storage, read> polygon_points: array<vec2<f32>>;
-@group(0) @binding(5) var<storage, read> triangles: array<Triangle>;
-@group(0) @binding(6) var<storage, read> materials: array<Material>;
-@group(0) @binding(7) var<storage, read> lights: array<Light>;
+// binding 5: `triangles`, a storage or a uniform array, declared by src/gpu/uniform_records.rs.
+// binding 6: `materials`, a storage or a uniform array, declared by src/gpu/uniform_records.rs.
+// binding 7: `lights`, a storage or a uniform array, declared by src/gpu/uniform_records.rs.
 @group(0) @binding(8) var linear_output: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(9) var<storage, read_write> counters: Counters;
 // Each finished pixel's sample sum in xyz and its luminance m2 in w (shaders/noise.wgsl)
@@ -35,7 +35,7 @@
 // frame.first_sample > 0: progressive rendering.
 @group(0) @binding(10) var<storage, read_write> accumulation: array<vec4<f32>>;
 // binding 11: `images` (shaders/texture.wgsl).
-@group(0) @binding(12) var<storage, read> bvh_nodes: array<BvhNode>;
+// binding 12: `bvh_nodes`, a storage or a uniform array, declared by src/gpu/uniform_records.rs.
 @group(0) @binding(13) var<storage, read> bvh_prims: array<u32>;
 @group(0) @binding(14) var<storage, read_write> paths: array<PathState>;
 // Each slot's bounce stack of frame.stack_size entries (interleaved across slots).

@@ -49,10 +49,17 @@ pub struct ShaderFeatures {
     /// An environment map as the background and, for the path integrator, a light
     /// (`ENVIRONMENT_MAP`, `shaders/environment.wgsl`).
     pub environment_map: bool,
+    /// The records every traversal step reads (BVH nodes, spheres, polygons,
+    /// triangles, materials, lights) are uniform arrays of a fixed length rather than
+    /// storage buffers: chosen at upload for small scenes on CPU devices (see
+    /// `src/gpu/uniform_records.rs`), never by [`ShaderFeatures::for_scene`]. Not a
+    /// directive: the bindings' declarations differ, not the code.
+    pub uniform_records: bool,
 }
 
 impl ShaderFeatures {
-    /// Every feature: the general module that renders any scene.
+    /// Every feature: the general module that renders any scene (with storage buffers
+    /// for the records, which hold scenes of any size).
     pub const ALL: Self = Self {
         spheres: true,
         planes: true,
@@ -69,6 +76,7 @@ impl ShaderFeatures {
         instances: true,
         path: true,
         environment_map: true,
+        uniform_records: false,
     };
 
     /// Exactly the features `scene` uses.
@@ -106,6 +114,7 @@ impl ShaderFeatures {
             instances: crate::accel::instance::has_instances(&scene.meshes),
             path: scene.render.integrator == crate::scene::Integrator::Path,
             environment_map: scene.environment.map.is_some(),
+            uniform_records: false,
         }
     }
 
@@ -119,11 +128,14 @@ impl ShaderFeatures {
 
     /// A short label for pipeline names, listing the features that are on.
     pub fn label(&self) -> String {
-        let on: Vec<String> = FEATURE_NAMES
+        let mut on: Vec<String> = FEATURE_NAMES
             .iter()
             .filter(|(_, is_on)| is_on(self))
             .map(|(name, _)| name.to_lowercase())
             .collect();
+        if self.uniform_records {
+            on.push("uniform_records".into());
+        }
         if on.is_empty() {
             "none".into()
         } else {

@@ -59,6 +59,10 @@ pub struct RendererOptions {
     /// Trace shaders specialised to each scene's features (`true`, faster) or the
     /// general shader.
     pub specialise: bool,
+    /// On CPU devices, bind the records of scenes small enough as uniform buffers
+    /// (`true`, faster there) or always as storage buffers. The image does not depend
+    /// on it.
+    pub uniform_records: bool,
 }
 
 impl Default for RendererOptions {
@@ -70,6 +74,7 @@ impl Default for RendererOptions {
             iteration_budget: None,
             max_rounds_per_call: 64,
             specialise: true,
+            uniform_records: true,
         }
     }
 }
@@ -189,11 +194,18 @@ impl Renderer {
         scene: &Scene,
     ) -> Result<GpuScene, RenderError> {
         let geometry = SceneGeometry::new(scene);
-        let prepared = upload_scene(device, queue, scene, &geometry, self.options.specialise)
-            .map_err(|e| match e {
-                GpuError::Validation(_) | GpuError::DeviceLimit { .. } => RenderError::Scene(e),
-                other => RenderError::Wgpu(other),
-            })?;
+        let prepared = upload_scene(
+            device,
+            queue,
+            scene,
+            &geometry,
+            self.options.specialise,
+            self.options.uniform_records,
+        )
+        .map_err(|e| match e {
+            GpuError::Validation(_) | GpuError::DeviceLimit { .. } => RenderError::Scene(e),
+            other => RenderError::Wgpu(other),
+        })?;
         let pipelines = self
             .pipelines
             .trace(device, &prepared.features)
@@ -250,7 +262,8 @@ impl Renderer {
             .slots
             .bind_group(
                 device,
-                &self.pipelines.trace_bind_group_layout,
+                self.pipelines
+                    .trace_bind_group_layout(&scene.prepared.features),
                 &scene.prepared,
                 &film.view,
             )
@@ -302,7 +315,8 @@ impl Renderer {
             // resource are the renderer's own, made to match.
             let bind_group = film.slots.bind_group_unchecked(
                 device,
-                &self.pipelines.trace_bind_group_layout,
+                self.pipelines
+                    .trace_bind_group_layout(&scene.prepared.features),
                 &scene.prepared,
                 &film.view,
             );

@@ -13,7 +13,8 @@
 //! - `wavefront`: the path slots and the schedule of the two trace kernels.
 //! - `pipelines`, `display`: the pipelines and the display pass.
 //! - [`upload`]: pure conversion of a [`crate::scene::Scene`] into the GPU records.
-//! - [`shaders`]: composition of the WGSL sources, specialised by [`features`].
+//! - [`shaders`]: composition of the WGSL sources, specialised by [`features`];
+//!   `uniform_records`: the scene records CPU devices read from uniform buffers.
 //! - [`layout`]: the `#[repr(C)]` records shared with `shaders/types.wgsl`.
 //!
 //! ```no_run
@@ -45,6 +46,7 @@ mod render_error;
 pub mod renderer;
 mod scene_buffers;
 pub mod shaders;
+mod uniform_records;
 pub mod upload;
 mod wavefront;
 

@@ -11,6 +11,7 @@ use super::shaders::{
     DISPLAY_ENTRY_POINT, FUSED_ENTRY_POINT, SHADE_ENTRY_POINT, TRACE_ENTRY_POINT,
     display_shader_source, trace_shader_source,
 };
+use super::uniform_records::is_uniform_record;
 
 /// Format of the linear radiance texture the trace writes.
 pub const LINEAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -62,11 +63,76 @@ pub struct TracePipelines {
     pub fused: wgpu::ComputePipeline,
 }
 
+/// The bind group and pipeline layout of the trace modules of one kind of record
+/// binding (see [`ShaderFeatures::uniform_records`]).
+#[derive(Debug)]
+struct TraceLayout {
+    bind_group: wgpu::BindGroupLayout,
+    pipeline: wgpu::PipelineLayout,
+}
+
+impl TraceLayout {
+    fn new(device: &wgpu::Device, uniform_records: bool) -> Result<Self, GpuError> {
+        use binding::*;
+        // The records every traversal step reads: storage or uniform arrays.
+        let record = |binding: u32| {
+            if uniform_records && is_uniform_record(binding) {
+                uniform_entry(binding)
+            } else {
+                storage_entry(binding, true)
+            }
+        };
+        // Explicit layouts: an automatic layout would drop bindings a shader leaves
+        // unused, and the bind groups would no longer match it.
+        let bind_group = capture(device, "trace bind group layout", Caught::Resource, || {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(if uniform_records {
+                    "gpu-render trace bindings (uniform records)"
+                } else {
+                    "gpu-render trace bindings"
+                }),
+                entries: &[
+                    uniform_entry(FRAME),
+                    record(SPHERES),
+                    storage_entry(PLANES, true),
+                    record(POLYGONS),
+                    storage_entry(POLYGON_POINTS, true),
+                    record(TRIANGLES),
+                    record(MATERIALS),
+                    record(LIGHTS),
+                    storage_texture_entry(LINEAR_OUTPUT, LINEAR_FORMAT),
+                    storage_entry(COUNTERS, false),
+                    storage_entry(ACCUMULATION, false),
+                    float_texture_entry(IMAGES, wgpu::TextureViewDimension::D2Array),
+                    record(BVH_NODES),
+                    storage_entry(BVH_PRIMS, true),
+                    storage_entry(PATHS, false),
+                    storage_entry(RAY_STACK, false),
+                    storage_entry(TRACES, false),
+                    storage_entry(TRAVERSAL_STACK, false),
+                    storage_entry(TRIANGLE_ATTRIBUTES, true),
+                    storage_entry(EMITTERS, true),
+                    storage_entry(ENVIRONMENT, true),
+                ],
+            })
+        })?;
+        let pipeline = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("gpu-render trace layout"),
+            bind_group_layouts: &[Some(&bind_group)],
+            immediate_size: 0,
+        });
+        Ok(Self {
+            bind_group,
+            pipeline,
+        })
+    }
+}
+
 /// Every layout and pipeline the renderer uses on one device.
 #[derive(Debug)]
 pub(crate) struct Pipelines {
-    pub trace_bind_group_layout: wgpu::BindGroupLayout,
-    trace_pipeline_layout: wgpu::PipelineLayout,
+    /// With storage records, then with uniform records.
+    trace_layouts: [TraceLayout; 2],
     pub display_bind_group_layout: wgpu::BindGroupLayout,
     pub display: wgpu::ComputePipeline,
     /// Trace pipelines by feature set, built on first use.
@@ -134,44 +200,10 @@ fn float_texture_entry(
 impl Pipelines {
     /// Builds the layouts and the display pipeline (trace pipelines come on demand).
     pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
-        use binding::*;
-        // Explicit layouts: an automatic layout would drop bindings a shader leaves
-        // unused, and the bind groups would no longer match it.
-        let trace_bind_group_layout =
-            capture(device, "trace bind group layout", Caught::Resource, || {
-                device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                    label: Some("gpu-render trace bindings"),
-                    entries: &[
-                        uniform_entry(FRAME),
-                        storage_entry(SPHERES, true),
-                        storage_entry(PLANES, true),
-                        storage_entry(POLYGONS, true),
-                        storage_entry(POLYGON_POINTS, true),
-                        storage_entry(TRIANGLES, true),
-                        storage_entry(MATERIALS, true),
-                        storage_entry(LIGHTS, true),
-                        storage_texture_entry(LINEAR_OUTPUT, LINEAR_FORMAT),
-                        storage_entry(COUNTERS, false),
-                        storage_entry(ACCUMULATION, false),
-                        float_texture_entry(IMAGES, wgpu::TextureViewDimension::D2Array),
-                        storage_entry(BVH_NODES, true),
-                        storage_entry(BVH_PRIMS, true),
-                        storage_entry(PATHS, false),
-                        storage_entry(RAY_STACK, false),
-                        storage_entry(TRACES, false),
-                        storage_entry(TRAVERSAL_STACK, false),
-                        storage_entry(TRIANGLE_ATTRIBUTES, true),
-                        storage_entry(EMITTERS, true),
-                        storage_entry(ENVIRONMENT, true),
-                    ],
-                })
-            })?;
-        let trace_pipeline_layout =
-            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("gpu-render trace layout"),
-                bind_group_layouts: &[Some(&trace_bind_group_layout)],
-                immediate_size: 0,
-            });
+        let trace_layouts = [
+            TraceLayout::new(device, false)?,
+            TraceLayout::new(device, true)?,
+        ];
         let display_bind_group_layout =
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("gpu-render display bindings"),
@@ -196,8 +228,7 @@ impl Pipelines {
         )?
         .remove(0);
         Ok(Self {
-            trace_bind_group_layout,
-            trace_pipeline_layout,
+            trace_layouts,
             display_bind_group_layout,
             display,
             trace: Mutex::new(HashMap::new()),
@@ -219,7 +250,7 @@ impl Pipelines {
             device,
             &format!("trace ({})", features.label()),
             source,
-            &self.trace_pipeline_layout,
+            &self.trace_layouts[usize::from(features.uniform_records)].pipeline,
             &[SHADE_ENTRY_POINT, TRACE_ENTRY_POINT, FUSED_ENTRY_POINT],
         )?;
         let pipelines = TracePipelines {
@@ -229,6 +260,12 @@ impl Pipelines {
         };
         cache.insert(*features, pipelines.clone());
         Ok(pipelines)
+    }
+
+    /// The bind group layout of the trace modules for `features` (their record
+    /// bindings are storage or uniform buffers).
+    pub fn trace_bind_group_layout(&self, features: &ShaderFeatures) -> &wgpu::BindGroupLayout {
+        &self.trace_layouts[usize::from(features.uniform_records)].bind_group
     }
 
     /// How many trace modules have been built so far.

@@ -54,6 +54,7 @@ pub struct GpuRenderer {
     pipelines: Pipelines,
     poll_timeout: Option<Duration>,
     specialise: bool,
+    uniform_records: bool,
     iteration_budget: Option<u32>,
     slot_count: Option<u32>,
     schedule: Option<Schedule>,
@@ -113,6 +114,7 @@ impl GpuRenderer {
             pipelines: Pipelines::new(device)?,
             poll_timeout: None,
             specialise: true,
+            uniform_records: true,
             iteration_budget: None,
             slot_count: None,
             schedule: None,
@@ -144,6 +146,15 @@ impl GpuRenderer {
     /// `true`, is faster to run and to compile.
     pub fn with_specialisation(mut self, specialise: bool) -> Self {
         self.specialise = specialise;
+        self
+    }
+
+    /// With `false`, scenes keep their records in storage buffers on every device,
+    /// instead of uniform buffers where they fit on CPU devices (see
+    /// [`ShaderFeatures::uniform_records`]). For measurements and tests; the image is
+    /// the same.
+    pub fn with_uniform_records(mut self, uniform_records: bool) -> Self {
+        self.uniform_records = uniform_records;
         self
     }
 
@@ -242,7 +253,14 @@ impl GpuRenderer {
         scene: &Scene,
         geometry: &SceneGeometry,
     ) -> Result<PreparedScene, GpuError> {
-        upload_scene(device, queue, scene, geometry, self.specialise)
+        upload_scene(
+            device,
+            queue,
+            scene,
+            geometry,
+            self.specialise,
+            self.uniform_records,
+        )
     }
 
     /// Traces the pixels of `region` of `prepared` into `target` (an `Rgba32Float`
@@ -318,7 +336,7 @@ impl GpuRenderer {
         let slots = SlotBuffers::new(device, slot_count, prepared.stack_size, sums)?;
         let bind_group = slots.bind_group(
             device,
-            &self.pipelines.trace_bind_group_layout,
+            self.pipelines.trace_bind_group_layout(&prepared.features),
             prepared,
             target,
         )?;

@@ -1,12 +1,15 @@
-//! A scene uploaded to one device: its storage buffers (primitives, BVH, materials,
-//! lights), its image array and its trace constants.
+//! A scene uploaded to one device: its buffers (primitives, BVH, materials, lights; the
+//! records every traversal step reads in uniform buffers where `super::uniform_records`
+//! says), its image array and its trace constants.
 
 use super::GpuError;
 use super::area_lights::{EMITTER_NONE, FLAG_PATH, GpuEmitter, emitter_records};
 use super::environment::environment_buffer;
 use super::features::ShaderFeatures;
 use super::layout::FrameUniforms;
+use super::pipelines::binding;
 use super::readback::{Caught, capture};
+use super::uniform_records;
 use super::upload::{SceneRecords, frame_uniforms, image_layers};
 use crate::accel::{BrdfMapCdfs, BvhStats, EnvironmentLight, MAX_PLANES, SceneGeometry};
 use crate::scene::{Integrator, Scene};
@@ -103,13 +106,16 @@ impl PreparedScene {
 }
 
 /// Uploads `scene` (as loaded: it is converted to its lighting space here) with its
-/// `geometry` (built from the lighting-space-independent shapes).
+/// `geometry` (built from the lighting-space-independent shapes). With
+/// `allow_uniform_records`, a scene whose records fit is bound with uniform records
+/// where the device prefers them (see `super::uniform_records`).
 pub(crate) fn upload_scene(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     scene: &Scene,
     geometry: &SceneGeometry,
     specialise: bool,
+    allow_uniform_records: bool,
 ) -> Result<PreparedScene, GpuError> {
     scene.render.check().map_err(GpuError::Validation)?;
     if geometry.planes.len() > MAX_PLANES {
@@ -148,9 +154,16 @@ pub(crate) fn upload_scene(
         .max_storage_buffer_binding_size
         .min(limits.max_buffer_size);
     let padded = records.padded();
+    let uniform_records = allow_uniform_records
+        && uniform_records::preferred(&device.adapter_info())
+        && uniform_records::fits(&padded, &limits);
     let mut scene_bytes = 0;
-    let mut upload = |what: &str, bytes: &[u8]| -> Result<wgpu::Buffer, GpuError> {
-        let size = bytes.len() as u64;
+    let mut upload = |what: &str, binding: u32, bytes: &[u8]| -> Result<wgpu::Buffer, GpuError> {
+        // A uniform record array is bound whole: its buffer has the array's length.
+        let uniform_bytes = uniform_records
+            .then(|| uniform_records::padded_bytes(binding))
+            .flatten();
+        let size = uniform_bytes.unwrap_or(bytes.len() as u64);
         if size > max_binding {
             return Err(GpuError::DeviceLimit {
                 what: format!("{what} buffer bytes"),
@@ -163,7 +176,11 @@ pub(crate) fn upload_scene(
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(what),
                 size,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                usage: if uniform_bytes.is_some() {
+                    wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST
+                } else {
+                    wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST
+                },
                 mapped_at_creation: false,
             })
         })?;
@@ -173,24 +190,62 @@ pub(crate) fn upload_scene(
         Ok(buffer)
     };
     let buffers = SceneBuffers {
-        spheres: upload("sphere", bytemuck::cast_slice(&padded.spheres))?,
-        planes: upload("plane", bytemuck::cast_slice(&padded.planes))?,
-        polygons: upload("polygon", bytemuck::cast_slice(&padded.polygons))?,
+        spheres: upload(
+            "sphere",
+            binding::SPHERES,
+            bytemuck::cast_slice(&padded.spheres),
+        )?,
+        planes: upload(
+            "plane",
+            binding::PLANES,
+            bytemuck::cast_slice(&padded.planes),
+        )?,
+        polygons: upload(
+            "polygon",
+            binding::POLYGONS,
+            bytemuck::cast_slice(&padded.polygons),
+        )?,
         polygon_points: upload(
             "polygon point",
+            binding::POLYGON_POINTS,
             bytemuck::cast_slice(&padded.polygon_points),
         )?,
-        triangles: upload("triangle", bytemuck::cast_slice(&padded.triangles))?,
-        materials: upload("material", bytemuck::cast_slice(&padded.materials))?,
-        lights: upload("light", bytemuck::cast_slice(&padded.lights))?,
-        bvh_nodes: upload("BVH node", bytemuck::cast_slice(&padded.bvh_nodes))?,
-        bvh_prims: upload("BVH primitive", bytemuck::cast_slice(&padded.bvh_prims))?,
+        triangles: upload(
+            "triangle",
+            binding::TRIANGLES,
+            bytemuck::cast_slice(&padded.triangles),
+        )?,
+        materials: upload(
+            "material",
+            binding::MATERIALS,
+            bytemuck::cast_slice(&padded.materials),
+        )?,
+        lights: upload(
+            "light",
+            binding::LIGHTS,
+            bytemuck::cast_slice(&padded.lights),
+        )?,
+        bvh_nodes: upload(
+            "BVH node",
+            binding::BVH_NODES,
+            bytemuck::cast_slice(&padded.bvh_nodes),
+        )?,
+        bvh_prims: upload(
+            "BVH primitive",
+            binding::BVH_PRIMS,
+            bytemuck::cast_slice(&padded.bvh_prims),
+        )?,
         triangle_attributes: upload(
             "triangle attribute",
+            binding::TRIANGLE_ATTRIBUTES,
             bytemuck::cast_slice(&padded.triangle_attributes),
         )?,
-        emitters: upload("emitter", bytemuck::cast_slice(&emitters))?,
-        environment: upload("environment map", &environment)?,
+        emitters: upload(
+            "emitter",
+            binding::EMITTERS,
+            bytemuck::cast_slice(&emitters),
+        )?,
+        environment: upload("environment map", binding::ENVIRONMENT, &environment)?,
     };
     let (images, image_bytes) = upload_images(device, queue, &shaded, &limits)?;
     Ok(PreparedScene {
@@ -201,10 +256,13 @@ pub(crate) fn upload_scene(
         } else {
             scene.render.stack_size
         },
-        features: if specialise {
-            ShaderFeatures::for_scene(scene)
-        } else {
-            ShaderFeatures::ALL
+        features: ShaderFeatures {
+            uniform_records,
+            ..if specialise {
+                ShaderFeatures::for_scene(scene)
+            } else {
+                ShaderFeatures::ALL
+            }
         },
         encode_srgb: scene.display_encodes_srgb(),
         buffers,

@@ -60,7 +60,8 @@ pub const DISPLAY_ENTRY_POINT: &str = "encode_display";
 pub const WORKGROUP_SIZE: u32 = 8;
 
 /// The complete trace module specialised to `features` (see [`super::features`]): the
-/// constants shared with the Rust side (`MAX_BVH_DEPTH`, `MAX_POLYGON_VERTICES`), then
+/// constants shared with the Rust side (`MAX_BVH_DEPTH`, `MAX_POLYGON_VERTICES`), the
+/// record bindings (storage or uniform arrays, as `features.uniform_records` says), then
 /// types, path types, sampling, intersect, texture, bxdf, environment, traverse, noise,
 /// trace, path and the tabulated BRDF sampler.
 ///
@@ -93,6 +94,9 @@ pub fn trace_shader_source(features: &ShaderFeatures) -> Result<String, String> 
         crate::accel::MAX_BVH_DEPTH,
         crate::accel::MAX_POLYGON_VERTICES
     );
+    source.push_str(&super::uniform_records::declarations(
+        features.uniform_records,
+    ));
     for part in parts {
         source.push_str(&specialise(part, features)?);
     }

@@ -1,0 +1,190 @@
+//! Binding the scene records every traversal step reads as uniform buffers, on CPU
+//! devices.
+//!
+//! llvmpipe (Mesa 25.0) loads an element of a storage buffer whose index differs from
+//! lane to lane of a SIMD vector one lane at a time, each lane behind a branch on its
+//! execution mask and another on the buffer's bounds (`emit_load_mem` in gallivm's
+//! `lp_bld_nir_soa.c`); an element of a uniform buffer it gathers without branches. The
+//! BVH nodes, spheres, polygons, triangles, materials and lights are read at every
+//! traversal and shading step, so where each of them fits in one uniform binding
+//! ([`UNIFORM_RECORD_BYTES`]) and the device is a CPU, they are bound as uniform arrays
+//! of a fixed length (the binding padded to it), which makes the trace of
+//! `scenes/showcase.toml` about 28% shorter on lavapipe (BENCHMARKS.md, "Uniform
+//! records"). On GPUs, uniform (constant) memory serialises lanes that read different
+//! addresses, so those keep storage buffers.
+//!
+//! The WGSL declarations of these bindings are composed here ([`declarations`]) rather
+//! than written in `shaders/trace.wgsl`, since their address space and array type are
+//! what differs; the code that reads them is the same.
+
+use std::mem::size_of;
+
+use super::layout::{GpuLight, GpuMaterial, GpuPolygon, GpuSphere, GpuTriangle};
+use super::pipelines::binding;
+use super::upload::SceneRecords;
+use crate::accel::BvhNode;
+
+/// The bytes of each uniform record binding: the least `maxUniformBufferRange` Vulkan
+/// guarantees is 16 KiB, lavapipe's is 64 KiB; [`fits`] checks the device's.
+pub const UNIFORM_RECORD_BYTES: u64 = 65536;
+
+/// One record array that may be bound as a uniform buffer.
+struct RecordBinding {
+    binding: u32,
+    name: &'static str,
+    wgsl_type: &'static str,
+    stride: usize,
+}
+
+/// The record arrays bound as uniform buffers, in binding order. Not the planes
+/// (every ray reads them all, in the same order, so their index is the same in every
+/// lane), nor the polygon points and primitive references (their strides, 8 and 4
+/// bytes, are not the 16-byte array stride of the uniform address space).
+const RECORDS: [RecordBinding; 6] = [
+    RecordBinding {
+        binding: binding::SPHERES,
+        name: "spheres",
+        wgsl_type: "Sphere",
+        stride: size_of::<GpuSphere>(),
+    },
+    RecordBinding {
+        binding: binding::POLYGONS,
+        name: "polygons",
+        wgsl_type: "Polygon",
+        stride: size_of::<GpuPolygon>(),
+    },
+    RecordBinding {
+        binding: binding::TRIANGLES,
+        name: "triangles",
+        wgsl_type: "Triangle",
+        stride: size_of::<GpuTriangle>(),
+    },
+    RecordBinding {
+        binding: binding::MATERIALS,
+        name: "materials",
+        wgsl_type: "Material",
+        stride: size_of::<GpuMaterial>(),
+    },
+    RecordBinding {
+        binding: binding::LIGHTS,
+        name: "lights",
+        wgsl_type: "Light",
+        stride: size_of::<GpuLight>(),
+    },
+    RecordBinding {
+        binding: binding::BVH_NODES,
+        name: "bvh_nodes",
+        wgsl_type: "BvhNode",
+        stride: size_of::<BvhNode>(),
+    },
+];
+
+/// How many records of `stride` bytes one uniform binding holds.
+const fn capacity(stride: usize) -> usize {
+    UNIFORM_RECORD_BYTES as usize / stride
+}
+
+/// Whether `binding` is one of the record bindings that [`declarations`] makes
+/// uniform.
+pub(crate) fn is_uniform_record(binding: u32) -> bool {
+    RECORDS.iter().any(|r| r.binding == binding)
+}
+
+/// The bytes the buffer of record binding `binding` is padded to when it is bound as
+/// a uniform array (its capacity times its stride), or `None` for other bindings.
+pub(crate) fn padded_bytes(binding: u32) -> Option<u64> {
+    RECORDS
+        .iter()
+        .find(|r| r.binding == binding)
+        .map(|r| (capacity(r.stride) * r.stride) as u64)
+}
+
+/// The WGSL declarations of the record bindings: storage arrays, or with `uniform`
+/// uniform arrays of their capacity.
+pub(crate) fn declarations(uniform: bool) -> String {
+    RECORDS
+        .iter()
+        .map(|r| {
+            if uniform {
+                format!(
+                    "@group(0) @binding({}) var<uniform> {}: array<{}, {}>;\n",
+                    r.binding,
+                    r.name,
+                    r.wgsl_type,
+                    capacity(r.stride)
+                )
+            } else {
+                format!(
+                    "@group(0) @binding({}) var<storage, read> {}: array<{}>;\n",
+                    r.binding, r.name, r.wgsl_type
+                )
+            }
+        })
+        .collect()
+}
+
+/// Whether every record array of `records` fits in its uniform binding on a device
+/// with `limits`.
+pub(crate) fn fits(records: &SceneRecords, limits: &wgpu::Limits) -> bool {
+    let lengths = [
+        records.spheres.len(),
+        records.polygons.len(),
+        records.triangles.len(),
+        records.materials.len(),
+        records.lights.len(),
+        records.bvh_nodes.len(),
+    ];
+    u64::from(limits.max_uniform_buffer_binding_size) >= UNIFORM_RECORD_BYTES
+        && limits.max_uniform_buffers_per_shader_stage as usize > RECORDS.len()
+        && RECORDS
+            .iter()
+            .zip(lengths)
+            .all(|(r, length)| length <= capacity(r.stride))
+}
+
+/// Whether a scene whose records [`fits`] binds them as uniform arrays on the device
+/// `info` describes: on CPU devices only (see the module's documentation).
+pub(crate) fn preferred(info: &wgpu::AdapterInfo) -> bool {
+    info.device_type == wgpu::DeviceType::Cpu
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_uniform_record_has_a_16_byte_stride_and_fits_whole() {
+        for r in &RECORDS {
+            assert_eq!(r.stride % 16, 0, "{}", r.name);
+            assert!(capacity(r.stride) > 0, "{}", r.name);
+            assert!(padded_bytes(r.binding).unwrap_or(0) <= UNIFORM_RECORD_BYTES);
+        }
+        assert!(padded_bytes(binding::PLANES).is_none());
+        assert!(!is_uniform_record(binding::BVH_PRIMS));
+    }
+
+    #[test]
+    fn declarations_give_the_address_space_and_the_capacity() {
+        assert!(
+            declarations(false)
+                .contains("@group(0) @binding(12) var<storage, read> bvh_nodes: array<BvhNode>;\n")
+        );
+        assert!(
+            declarations(true)
+                .contains("@group(0) @binding(12) var<uniform> bvh_nodes: array<BvhNode, 2048>;\n")
+        );
+    }
+
+    #[test]
+    fn declarations_name_each_record_binding_once() {
+        for uniform in [false, true] {
+            let text = declarations(uniform);
+            for r in &RECORDS {
+                assert_eq!(
+                    text.matches(&format!("@binding({}) ", r.binding)).count(),
+                    1
+                );
+            }
+        }
+    }
+}
