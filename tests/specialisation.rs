@@ -91,6 +91,23 @@ fn only_a_scene_with_an_environment_map_gets_its_code() {
 }
 
 #[test]
+fn modules_with_uniform_records_validate_and_differ_only_in_their_bindings() {
+    for features in [
+        ShaderFeatures::ALL,
+        ShaderFeatures::for_scene(&scene("showcase.toml")),
+    ] {
+        let uniform = ShaderFeatures {
+            uniform_records: true,
+            ..features
+        };
+        assert_eq!(function_names(&uniform), function_names(&features));
+        let source = trace_shader_source(&uniform).expect("well-formed directives");
+        assert!(source.contains("var<uniform> bvh_nodes: array<BvhNode, 2048>;"));
+        assert!(!source.contains("var<storage, read> bvh_nodes"));
+    }
+}
+
+#[test]
 fn every_feature_alone_and_every_feature_left_out_validates() {
     let none = ShaderFeatures {
         spheres: false,
@@ -108,6 +125,7 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         instances: false,
         path: false,
         environment_map: false,
+        uniform_records: false,
     };
     type Toggle = fn(&mut ShaderFeatures, bool);
     let toggles: [Toggle; 15] = [

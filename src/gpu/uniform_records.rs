@@ -134,7 +134,7 @@ pub(crate) fn fits(records: &SceneRecords, limits: &wgpu::Limits) -> bool {
         records.lights.len(),
         records.bvh_nodes.len(),
     ];
-    u64::from(limits.max_uniform_buffer_binding_size) >= UNIFORM_RECORD_BYTES
+    limits.max_uniform_buffer_binding_size >= UNIFORM_RECORD_BYTES
         && limits.max_uniform_buffers_per_shader_stage as usize > RECORDS.len()
         && RECORDS
             .iter()
