@@ -328,9 +328,9 @@ fn point_in_polygon(p: vec3<f32>, polygon: Polygon) -> bool {
     let point = project_to_plane(p, polygon.dropped_axis);
     var inside = false;
     let last = polygon.first_vertex + polygon.vertex_count - 1u;
-    var previous = polygon_points[last];
+    var previous = polygon_point(last);
     for (var i = 0u; i < polygon.vertex_count; i += 1u) {
-        let current = polygon_points[polygon.first_vertex + i];
+        let current = polygon_point(polygon.first_vertex + i);
         if (current.y > point.y) != (previous.y > point.y) {
             let crossing_u = current.x
                 + (point.y - current.y) * (previous.x - current.x) / (previous.y - current.y);

@@ -23,8 +23,9 @@
 // binding 1: `spheres`, a storage or a uniform array, declared by src/gpu/uniform_records.rs.
 @group(0) @binding(2) var<storage, read> planes: array<Plane>;
 // binding 3: `polygons`, a storage or a uniform array, declared by src/gpu/uniform_records.rs.
-// Each polygon vertex projected for the inside test (the plane's dropped axis removed).
-@group(0) @binding(4) var<storage, read> polygon_points: array<vec2<f32>>;
+// binding 4: `polygon_points`, each polygon vertex projected for the inside test (the
+// plane's dropped axis removed), read by polygon_point(i); declared by
+// src/gpu/uniform_records.rs.
 // binding 5: `triangles`, a storage or a uniform array, declared by src/gpu/uniform_records.rs.
 // binding 6: `materials`, a storage or a uniform array, declared by src/gpu/uniform_records.rs.
 // binding 7: `lights`, a storage or a uniform array, declared by src/gpu/uniform_records.rs.
@@ -36,7 +37,7 @@
 @group(0) @binding(10) var<storage, read_write> accumulation: array<vec4<f32>>;
 // binding 11: `images` (shaders/texture.wgsl).
 // binding 12: `bvh_nodes`, a storage or a uniform array, declared by src/gpu/uniform_records.rs.
-@group(0) @binding(13) var<storage, read> bvh_prims: array<u32>;
+// binding 13: `bvh_prims`, read by prim_ref(i); declared by src/gpu/uniform_records.rs.
 @group(0) @binding(14) var<storage, read_write> paths: array<PathState>;
 // Each slot's bounce stack of frame.stack_size entries (interleaved across slots).
 @group(0) @binding(15) var<storage, read_write> ray_stack: array<StackEntry>;

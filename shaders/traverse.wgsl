@@ -273,7 +273,7 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
             }
             steps += 1u;
             iterations += 1u;
-            let prim = bvh_prims[cursor];
+            let prim = prim_ref(cursor);
             cursor += 1u;
             //#if INSTANCES
             if prim_kind(prim) == PRIM_INSTANCE {

@@ -32,6 +32,8 @@ const KERNELS: &str = r"
 @group(0) @binding(9) var<storage, read_write> counters: Counters;
 @group(0) @binding(12) var<storage, read> bvh_nodes: array<BvhNode>;
 @group(0) @binding(13) var<storage, read> bvh_prims: array<u32>;
+fn prim_ref(i: u32) -> u32 { return bvh_prims[i]; }
+fn polygon_point(i: u32) -> vec2<f32> { return polygon_points[i]; }
 @group(0) @binding(17) var<storage, read_write> traversal_stack: array<u32>;
 @group(0) @binding(18) var<storage, read> test_rays: array<vec4<f32>>;
 @group(0) @binding(19) var<storage, read_write> results: array<vec2<u32>>;

@@ -5,8 +5,9 @@
 //! lane to lane of a SIMD vector one lane at a time, each lane behind a branch on its
 //! execution mask and another on the buffer's bounds (`emit_load_mem` in gallivm's
 //! `lp_bld_nir_soa.c`); an element of a uniform buffer it gathers without branches. The
-//! BVH nodes, spheres, polygons, triangles, materials and lights are read at every
-//! traversal and shading step, so where each of them fits in one uniform binding
+//! BVH nodes and primitive references, spheres, polygons and their points, triangles,
+//! materials and lights are read at every traversal and shading step, so where each of
+//! them fits in one uniform binding
 //! ([`UNIFORM_RECORD_BYTES`]) and the device is a CPU, they are bound as uniform arrays
 //! of a fixed length (the binding padded to it), which makes the trace of
 //! `scenes/showcase.toml` about 28% shorter on lavapipe (BENCHMARKS.md, "Uniform
@@ -36,10 +37,9 @@ struct RecordBinding {
     stride: usize,
 }
 
-/// The record arrays bound as uniform buffers, in binding order. Not the planes
-/// (every ray reads them all, in the same order, so their index is the same in every
-/// lane), nor the polygon points and primitive references (their strides, 8 and 4
-/// bytes, are not the 16-byte array stride of the uniform address space).
+/// The record arrays bound as uniform buffers, in binding order (besides the packed
+/// ones, [`PACKED`]). Not the planes: every ray reads them all, in the same order, so
+/// their index is the same in every lane.
 const RECORDS: [RecordBinding; 6] = [
     RecordBinding {
         binding: binding::SPHERES,
@@ -79,6 +79,46 @@ const RECORDS: [RecordBinding; 6] = [
     },
 ];
 
+/// An array of 4- or 8-byte elements, which a uniform array holds packed four or two
+/// to a `vec4` (its array stride must be 16 bytes), read through an accessor function
+/// that both declarations define.
+struct PackedBinding {
+    binding: u32,
+    name: &'static str,
+    /// The storage array's element type.
+    element: &'static str,
+    /// The uniform array's element type, a `vec4`.
+    packed: &'static str,
+    /// Elements per `vec4`.
+    per_vec4: usize,
+    /// The accessor: `fn {accessor}(i: u32) -> {element}`.
+    accessor: &'static str,
+    /// The accessor's body for the packed array, reading element `i`.
+    packed_read: &'static str,
+}
+
+/// The primitive references (4 bytes) and the polygons' projected points (8 bytes).
+const PACKED: [PackedBinding; 2] = [
+    PackedBinding {
+        binding: binding::POLYGON_POINTS,
+        name: "polygon_points",
+        element: "vec2<f32>",
+        packed: "vec4<f32>",
+        per_vec4: 2,
+        accessor: "polygon_point",
+        packed_read: "let pair = polygon_points[i >> 1u]; return select(pair.xy, pair.zw, (i & 1u) == 1u);",
+    },
+    PackedBinding {
+        binding: binding::BVH_PRIMS,
+        name: "bvh_prims",
+        element: "u32",
+        packed: "vec4<u32>",
+        per_vec4: 4,
+        accessor: "prim_ref",
+        packed_read: "return bvh_prims[i >> 2u][i & 3u];",
+    },
+];
+
 /// How many records of `stride` bytes one uniform binding holds.
 const fn capacity(stride: usize) -> usize {
     UNIFORM_RECORD_BYTES as usize / stride
@@ -87,7 +127,7 @@ const fn capacity(stride: usize) -> usize {
 /// Whether `binding` is one of the record bindings that [`declarations`] makes
 /// uniform.
 pub(crate) fn is_uniform_record(binding: u32) -> bool {
-    RECORDS.iter().any(|r| r.binding == binding)
+    RECORDS.iter().any(|r| r.binding == binding) || PACKED.iter().any(|p| p.binding == binding)
 }
 
 /// The bytes the buffer of record binding `binding` is padded to when it is bound as
@@ -97,11 +137,39 @@ pub(crate) fn padded_bytes(binding: u32) -> Option<u64> {
         .iter()
         .find(|r| r.binding == binding)
         .map(|r| (capacity(r.stride) * r.stride) as u64)
+        .or_else(|| {
+            PACKED
+                .iter()
+                .any(|p| p.binding == binding)
+                .then_some(UNIFORM_RECORD_BYTES)
+        })
 }
 
 /// The WGSL declarations of the record bindings: storage arrays, or with `uniform`
-/// uniform arrays of their capacity.
+/// uniform arrays of their capacity; and the accessors of the packed ones,
+/// `polygon_point(i)` and `prim_ref(i)`.
 pub(crate) fn declarations(uniform: bool) -> String {
+    let packed = PACKED.iter().map(|p| {
+        if uniform {
+            format!(
+                "@group(0) @binding({}) var<uniform> {}: array<{}, {}>;\n\
+                 fn {}(i: u32) -> {} {{ {} }}\n",
+                p.binding,
+                p.name,
+                p.packed,
+                UNIFORM_RECORD_BYTES / 16,
+                p.accessor,
+                p.element,
+                p.packed_read
+            )
+        } else {
+            format!(
+                "@group(0) @binding({}) var<storage, read> {}: array<{}>;\n\
+                 fn {}(i: u32) -> {} {{ return {}[i]; }}\n",
+                p.binding, p.name, p.element, p.accessor, p.element, p.name
+            )
+        }
+    });
     RECORDS
         .iter()
         .map(|r| {
@@ -120,6 +188,7 @@ pub(crate) fn declarations(uniform: bool) -> String {
                 )
             }
         })
+        .chain(packed)
         .collect()
 }
 
@@ -134,12 +203,17 @@ pub(crate) fn fits(records: &SceneRecords, limits: &wgpu::Limits) -> bool {
         records.lights.len(),
         records.bvh_nodes.len(),
     ];
+    let packed_lengths = [records.polygon_points.len(), records.bvh_prims.len()];
     limits.max_uniform_buffer_binding_size >= UNIFORM_RECORD_BYTES
-        && limits.max_uniform_buffers_per_shader_stage as usize > RECORDS.len()
+        && limits.max_uniform_buffers_per_shader_stage as usize > RECORDS.len() + PACKED.len()
         && RECORDS
             .iter()
             .zip(lengths)
             .all(|(r, length)| length <= capacity(r.stride))
+        && PACKED
+            .iter()
+            .zip(packed_lengths)
+            .all(|(p, length)| length <= UNIFORM_RECORD_BYTES as usize / 16 * p.per_vec4)
 }
 
 /// Whether a scene whose records [`fits`] binds them as uniform arrays on the device
@@ -160,7 +234,8 @@ mod tests {
             assert!(padded_bytes(r.binding).unwrap_or(0) <= UNIFORM_RECORD_BYTES);
         }
         assert!(padded_bytes(binding::PLANES).is_none());
-        assert!(!is_uniform_record(binding::BVH_PRIMS));
+        assert!(!is_uniform_record(binding::PLANES));
+        assert_eq!(padded_bytes(binding::BVH_PRIMS), Some(UNIFORM_RECORD_BYTES));
     }
 
     #[test]
@@ -179,12 +254,12 @@ mod tests {
     fn declarations_name_each_record_binding_once() {
         for uniform in [false, true] {
             let text = declarations(uniform);
-            for r in &RECORDS {
-                assert_eq!(
-                    text.matches(&format!("@binding({}) ", r.binding)).count(),
-                    1
-                );
+            let bindings = RECORDS.iter().map(|r| r.binding);
+            for binding in bindings.chain(PACKED.iter().map(|p| p.binding)) {
+                assert_eq!(text.matches(&format!("@binding({binding}) ")).count(), 1);
             }
+            assert!(text.contains("fn prim_ref(i: u32) -> u32 {"));
+            assert!(text.contains("fn polygon_point(i: u32) -> vec2<f32> {"));
         }
     }
 }
