@@ -61,6 +61,9 @@ struct Args {
     /// fit on a CPU device (`GpuRenderer::with_uniform_records(false)`).
     #[arg(long)]
     storage_records: bool,
+    /// Path slots of the GPU trace (default: the adapter's, `default_slot_count`).
+    #[arg(long)]
+    slots: Option<u32>,
     /// Print the BVH's build figures and the nodes and primitives a camera ray and a
     /// shadow ray (to the first light) visit on average, counted by the CPU traversal
     /// at one ray per pixel.
@@ -376,6 +379,9 @@ fn main() -> Result<()> {
     instancing_figures(&scene);
     let gpu = HeadlessGpu::new(&AdapterChoice::Default).context("no GPU adapter")?;
     let mut renderer = GpuRenderer::new(&gpu.device)?.with_uniform_records(!args.storage_records);
+    if let Some(slots) = args.slots {
+        renderer = renderer.with_slot_count(slots);
+    }
     match args.schedule.as_deref() {
         None => {}
         Some("fused") => renderer = renderer.with_schedule(Schedule::Fused),
