@@ -164,7 +164,8 @@ pub(crate) fn upload_scene(
             .then(|| uniform_records::padded_bytes(binding))
             .flatten();
         let size = uniform_bytes.unwrap_or(bytes.len() as u64);
-        if size > max_binding {
+        // A uniform record array fits its binding (`uniform_records::fits`).
+        if uniform_bytes.is_none() && size > max_binding {
             return Err(GpuError::DeviceLimit {
                 what: format!("{what} buffer bytes"),
                 value: size,
