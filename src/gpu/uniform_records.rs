@@ -106,7 +106,7 @@ const PACKED: [PackedBinding; 2] = [
         packed: "vec4<f32>",
         per_vec4: 2,
         accessor: "polygon_point",
-        packed_read: "let pair = polygon_points[i >> 1u]; return select(pair.xy, pair.zw, (i & 1u) == 1u);",
+        packed_read: "let c = (i & 1u) * 2u; return vec2<f32>(polygon_points[i >> 1u][c], polygon_points[i >> 1u][c + 1u]);",
     },
     PackedBinding {
         binding: binding::BVH_PRIMS,
