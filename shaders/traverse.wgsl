@@ -221,6 +221,13 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
                 let candidate = traversal_stack[traversal_stack_index(slot, stack_len)];
                 if slab_enter(candidate, ray.origin, inverse, best_t) != NO_HIT {
                     node = candidate;
+                    // A leaf is opened in the same step.
+                    let count = bvh_nodes[node].count;
+                    if count > 0u {
+                        cursor = bvh_nodes[node].first;
+                        leaf_end = cursor + count;
+                        node = NO_NODE;
+                    }
                 }
                 continue;
             }
@@ -256,6 +263,15 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
                 node = b;
             } else {
                 node = NO_NODE;
+            }
+            if node != NO_NODE {
+                // The child descended into, if a leaf, is opened in the same step.
+                let count = bvh_nodes[node].count;
+                if count > 0u {
+                    cursor = bvh_nodes[node].first;
+                    leaf_end = cursor + count;
+                    node = NO_NODE;
+                }
             }
         }
         // Test the leaf's primitives.
