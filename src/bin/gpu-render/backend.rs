@@ -253,7 +253,7 @@ impl Backend {
 /// is used only where it measured faster than the CPU reference: llvmpipe from Mesa 25
 /// (whose loops have no limit, `gpu::driver_loop_limit`) on scenes without polygons
 /// and without glass (2.1x on the direct-light scene, 1.2x on spheres and planes);
-/// polygons and refraction make it slower (0.79x on `glass.toml`, 0.81x on the
+/// polygons and refraction make it slower (0.86x on `glass.toml`, 0.89x on the
 /// showcase at 1920x1080, with the records in uniform buffers, `gpu::ShaderFeatures::
 /// uniform_records`), and so is every scene on older Mesa, and every path-traced scene (the
 /// Cornell box: `BENCHMARKS.md`, "Path tracing on the GPU"). On any device, a scene with a sphere
