@@ -86,6 +86,18 @@ fn object_ray(instance: Instance, ray: Ray) -> Ray {
 }
 //#endif
 
+// Opens node `*node` if it is a leaf: its primitives become the range [*cursor,
+// *leaf_end) and *node becomes NO_NODE (the traversal loop descends only through inner
+// nodes). Called on every node a traversal reaches, in the step that reaches it.
+fn open_if_leaf(node: ptr<function, u32>, cursor: ptr<function, u32>, leaf_end: ptr<function, u32>) {
+    let count = bvh_nodes[*node].count;
+    if count > 0u {
+        *cursor = bvh_nodes[*node].first;
+        *leaf_end = *cursor + count;
+        *node = NO_NODE;
+    }
+}
+
 // Where level `level` of slot `slot`'s traversal stack lives: levels are interleaved
 // across slots, so the lanes of one vector touch neighbouring words.
 fn traversal_stack_index(slot: u32, level: u32) -> u32 {
@@ -158,13 +170,7 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
         stack_base = 0u;
         if frame.node_count > 0u && slab_enter(0u, ray.origin, inverse, best_t) != NO_HIT {
             node = 0u;
-            // A root that is a leaf is opened at once (the loop below only descends
-            // through inner nodes).
-            if bvh_nodes[0].count > 0u {
-                cursor = bvh_nodes[0].first;
-                leaf_end = cursor + bvh_nodes[0].count;
-                node = NO_NODE;
-            }
+            open_if_leaf(&node, &cursor, &leaf_end);
         }
         (*trace).status = TRACE_RUNNING;
     }
@@ -221,11 +227,7 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
                 node = NO_NODE;
                 if slab_enter(placed.root, ray.origin, inverse, best_t) != NO_HIT {
                     node = placed.root;
-                    if bvh_nodes[node].count > 0u {
-                        cursor = bvh_nodes[node].first;
-                        leaf_end = cursor + bvh_nodes[node].count;
-                        node = NO_NODE;
-                    }
+                    open_if_leaf(&node, &cursor, &leaf_end);
                 }
             }
             //#endif
@@ -289,13 +291,7 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
             }
         }
         if node != NO_NODE {
-            // A leaf is opened in the step that reaches it.
-            let count = bvh_nodes[node].count;
-            if count > 0u {
-                cursor = bvh_nodes[node].first;
-                leaf_end = cursor + count;
-                node = NO_NODE;
-            }
+            open_if_leaf(&node, &cursor, &leaf_end);
         }
     }
     if !exited {

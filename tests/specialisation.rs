@@ -198,13 +198,7 @@ fn specialised_and_general_modules_render_the_same_pixels() {
         let b = general
             .render(&gpu.device, &gpu.queue, &scene, None)
             .expect("general render");
-        let worst = a
-            .image
-            .pixels
-            .iter()
-            .zip(&b.image.pixels)
-            .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
-            .fold(0.0f32, f32::max);
+        let worst = common::compare::max_channel_difference(&a.image, &b.image);
         // The same arithmetic in the same order; only code the scene never runs differs.
         assert!(worst <= 1e-6, "{}: max |Δ| {worst}", path.display());
         assert_eq!(

@@ -61,13 +61,7 @@ fn shipped_scenes_render_the_same_with_uniform_and_storage_records() {
         let b = storage
             .render(&gpu.device, &gpu.queue, &scene, None)
             .expect("render, storage records");
-        let worst = a
-            .image
-            .pixels
-            .iter()
-            .zip(&b.image.pixels)
-            .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
-            .fold(0.0f32, f32::max);
+        let worst = common::compare::max_channel_difference(&a.image, &b.image);
         // The same code reading the same values; only where they are bound differs.
         assert_eq!(worst, 0.0, "{path}: max |Δ| {worst}");
         assert_eq!(a.stats.rays_traced, b.stats.rays_traced, "{path}");

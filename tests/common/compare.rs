@@ -47,6 +47,21 @@ pub fn output_dir() -> PathBuf {
     target.join("test-output")
 }
 
+/// The largest difference of one colour channel between two images of the same size
+/// (alpha left out): 0 when they are bit-identical in colour.
+pub fn max_channel_difference(a: &LinearImage, b: &LinearImage) -> f32 {
+    assert_eq!(
+        (a.width, a.height),
+        (b.width, b.height),
+        "image sizes differ"
+    );
+    a.pixels
+        .iter()
+        .zip(&b.pixels)
+        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
+        .fold(0.0f32, f32::max)
+}
+
 /// Measures the difference between `actual` and `expected`.
 pub fn measure(expected: &LinearImage, actual: &LinearImage, tolerance: Tolerance) -> Comparison {
     assert_eq!(
