@@ -1042,3 +1042,22 @@ fn camera_inside_nested_dielectrics_starts_in_the_innermost() {
         );
     }
 }
+
+/// A device that binds fewer uniform buffers per stage than uniform records need (9)
+/// builds its renderer and renders, with the records in storage buffers.
+#[test]
+fn a_device_with_few_uniform_buffers_keeps_storage_records() {
+    let Some(g) = gpu() else { return };
+    let (device, queue) = limited_device(&g.gpu, |l| wgpu::Limits {
+        max_uniform_buffers_per_shader_stage: 4,
+        ..l
+    });
+    let renderer = GpuRenderer::new(&device).expect("renderer");
+    let scene = mesh_scene(&icosphere_mesh(), DVec3::ZERO, DVec3::Y, 90.0);
+    let prepared = renderer.prepare(&device, &queue, &scene).expect("prepare");
+    assert!(!prepared.features().uniform_records);
+    let rendered = renderer
+        .render(&device, &queue, &scene, None)
+        .expect("render with storage records");
+    assert!(rendered.stats.rays_traced > 0);
+}

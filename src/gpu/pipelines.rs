@@ -11,7 +11,7 @@ use super::shaders::{
     DISPLAY_ENTRY_POINT, FUSED_ENTRY_POINT, SHADE_ENTRY_POINT, TRACE_ENTRY_POINT,
     display_shader_source, trace_shader_source,
 };
-use super::uniform_records::is_uniform_record;
+use super::uniform_records::{UNIFORM_BUFFERS, device_allows, is_uniform_record};
 
 /// Format of the linear radiance texture the trace writes.
 pub const LINEAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -131,8 +131,11 @@ impl TraceLayout {
 /// Every layout and pipeline the renderer uses on one device.
 #[derive(Debug)]
 pub(crate) struct Pipelines {
-    /// With storage records, then with uniform records.
-    trace_layouts: [TraceLayout; 2],
+    /// With storage records.
+    storage_layout: TraceLayout,
+    /// With uniform records, where the device binds enough uniform buffers
+    /// (`uniform_records::device_allows`).
+    uniform_layout: Option<TraceLayout>,
     pub display_bind_group_layout: wgpu::BindGroupLayout,
     pub display: wgpu::ComputePipeline,
     /// Trace pipelines by feature set, built on first use.
@@ -200,10 +203,12 @@ fn float_texture_entry(
 impl Pipelines {
     /// Builds the layouts and the display pipeline (trace pipelines come on demand).
     pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
-        let trace_layouts = [
-            TraceLayout::new(device, false)?,
-            TraceLayout::new(device, true)?,
-        ];
+        let storage_layout = TraceLayout::new(device, false)?;
+        let uniform_layout = if device_allows(&device.limits()) {
+            Some(TraceLayout::new(device, true)?)
+        } else {
+            None
+        };
         let display_bind_group_layout =
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("gpu-render display bindings"),
@@ -228,7 +233,8 @@ impl Pipelines {
         )?
         .remove(0);
         Ok(Self {
-            trace_layouts,
+            storage_layout,
+            uniform_layout,
             display_bind_group_layout,
             display,
             trace: Mutex::new(HashMap::new()),
@@ -245,12 +251,13 @@ impl Pipelines {
         if let Some(pipelines) = cache.get(features) {
             return Ok(pipelines.clone());
         }
+        let layout = self.trace_layout(device, features)?;
         let source = trace_shader_source(features).map_err(GpuError::Shader)?;
         let mut built = build_pipelines(
             device,
             &format!("trace ({})", features.label()),
             source,
-            &self.trace_layouts[usize::from(features.uniform_records)].pipeline,
+            &layout.pipeline,
             &[SHADE_ENTRY_POINT, TRACE_ENTRY_POINT, FUSED_ENTRY_POINT],
         )?;
         let pipelines = TracePipelines {
@@ -262,10 +269,35 @@ impl Pipelines {
         Ok(pipelines)
     }
 
-    /// The bind group layout of the trace modules for `features` (their record
-    /// bindings are storage or uniform buffers).
+    /// The layouts of the trace modules for `features` (their record bindings are
+    /// storage or uniform buffers).
+    ///
+    /// Errors: [`GpuError::DeviceLimit`] for uniform records on a device that binds too
+    /// few uniform buffers (an upload never chooses them there).
+    fn trace_layout(
+        &self,
+        device: &wgpu::Device,
+        features: &ShaderFeatures,
+    ) -> Result<&TraceLayout, GpuError> {
+        if !features.uniform_records {
+            return Ok(&self.storage_layout);
+        }
+        self.uniform_layout
+            .as_ref()
+            .ok_or_else(|| GpuError::DeviceLimit {
+                what: "uniform buffers per shader stage (for uniform records)".into(),
+                value: u64::from(UNIFORM_BUFFERS),
+                limit: u64::from(device.limits().max_uniform_buffers_per_shader_stage),
+            })
+    }
+
+    /// The bind group layout of the trace modules for a prepared scene's `features`
+    /// (uploads choose uniform records only where the device has their layout).
     pub fn trace_bind_group_layout(&self, features: &ShaderFeatures) -> &wgpu::BindGroupLayout {
-        &self.trace_layouts[usize::from(features.uniform_records)].bind_group
+        match (&self.uniform_layout, features.uniform_records) {
+            (Some(uniform), true) => &uniform.bind_group,
+            _ => &self.storage_layout.bind_group,
+        }
     }
 
     /// How many trace modules have been built so far.

@@ -119,6 +119,17 @@ const PACKED: [PackedBinding; 2] = [
     },
 ];
 
+/// The uniform buffers the trace kernels bind in one stage with uniform records: the
+/// frame's and one per record array.
+pub(crate) const UNIFORM_BUFFERS: u32 = 1 + (RECORDS.len() + PACKED.len()) as u32;
+
+/// Whether a device with `limits` can bind the records as uniform buffers at all
+/// (the trace layout with uniform records is built only then).
+pub(crate) fn device_allows(limits: &wgpu::Limits) -> bool {
+    limits.max_uniform_buffer_binding_size >= UNIFORM_RECORD_BYTES
+        && limits.max_uniform_buffers_per_shader_stage >= UNIFORM_BUFFERS
+}
+
 /// How many records of `stride` bytes one uniform binding holds.
 const fn capacity(stride: usize) -> usize {
     UNIFORM_RECORD_BYTES as usize / stride
@@ -204,8 +215,7 @@ pub(crate) fn fits(records: &SceneRecords, limits: &wgpu::Limits) -> bool {
         records.bvh_nodes.len(),
     ];
     let packed_lengths = [records.polygon_points.len(), records.bvh_prims.len()];
-    limits.max_uniform_buffer_binding_size >= UNIFORM_RECORD_BYTES
-        && limits.max_uniform_buffers_per_shader_stage as usize > RECORDS.len() + PACKED.len()
+    device_allows(limits)
         && RECORDS
             .iter()
             .zip(lengths)
