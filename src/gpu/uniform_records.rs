@@ -35,6 +35,8 @@ struct RecordBinding {
     name: &'static str,
     wgsl_type: &'static str,
     stride: usize,
+    /// The scene's records of this binding.
+    length: fn(&SceneRecords) -> usize,
 }
 
 /// The record arrays bound as uniform buffers, in binding order (besides the packed
@@ -46,36 +48,42 @@ const RECORDS: [RecordBinding; 6] = [
         name: "spheres",
         wgsl_type: "Sphere",
         stride: size_of::<GpuSphere>(),
+        length: |r| r.spheres.len(),
     },
     RecordBinding {
         binding: binding::POLYGONS,
         name: "polygons",
         wgsl_type: "Polygon",
         stride: size_of::<GpuPolygon>(),
+        length: |r| r.polygons.len(),
     },
     RecordBinding {
         binding: binding::TRIANGLES,
         name: "triangles",
         wgsl_type: "Triangle",
         stride: size_of::<GpuTriangle>(),
+        length: |r| r.triangles.len(),
     },
     RecordBinding {
         binding: binding::MATERIALS,
         name: "materials",
         wgsl_type: "Material",
         stride: size_of::<GpuMaterial>(),
+        length: |r| r.materials.len(),
     },
     RecordBinding {
         binding: binding::LIGHTS,
         name: "lights",
         wgsl_type: "Light",
         stride: size_of::<GpuLight>(),
+        length: |r| r.lights.len(),
     },
     RecordBinding {
         binding: binding::BVH_NODES,
         name: "bvh_nodes",
         wgsl_type: "BvhNode",
         stride: size_of::<BvhNode>(),
+        length: |r| r.bvh_nodes.len(),
     },
 ];
 
@@ -95,6 +103,8 @@ struct PackedBinding {
     accessor: &'static str,
     /// The accessor's body for the packed array, reading element `i`.
     packed_read: &'static str,
+    /// The scene's elements of this binding.
+    length: fn(&SceneRecords) -> usize,
 }
 
 /// The primitive references (4 bytes) and the polygons' projected points (8 bytes).
@@ -107,6 +117,7 @@ const PACKED: [PackedBinding; 2] = [
         per_vec4: 2,
         accessor: "polygon_point",
         packed_read: "let c = (i & 1u) * 2u; return vec2<f32>(polygon_points[i >> 1u][c], polygon_points[i >> 1u][c + 1u]);",
+        length: |r| r.polygon_points.len(),
     },
     PackedBinding {
         binding: binding::BVH_PRIMS,
@@ -116,6 +127,7 @@ const PACKED: [PackedBinding; 2] = [
         per_vec4: 4,
         accessor: "prim_ref",
         packed_read: "return bvh_prims[i >> 2u][i & 3u];",
+        length: |r| r.bvh_prims.len(),
     },
 ];
 
@@ -134,6 +146,9 @@ pub(crate) fn device_allows(limits: &wgpu::Limits) -> bool {
 const fn capacity(stride: usize) -> usize {
     UNIFORM_RECORD_BYTES as usize / stride
 }
+
+/// The `vec4`s of one packed uniform binding.
+const PACKED_VEC4S: usize = UNIFORM_RECORD_BYTES as usize / 16;
 
 /// Whether `binding` is one of the record bindings that [`declarations`] makes
 /// uniform.
@@ -165,13 +180,7 @@ pub(crate) fn declarations(uniform: bool) -> String {
             format!(
                 "@group(0) @binding({}) var<uniform> {}: array<{}, {}>;\n\
                  fn {}(i: u32) -> {} {{ {} }}\n",
-                p.binding,
-                p.name,
-                p.packed,
-                UNIFORM_RECORD_BYTES / 16,
-                p.accessor,
-                p.element,
-                p.packed_read
+                p.binding, p.name, p.packed, PACKED_VEC4S, p.accessor, p.element, p.packed_read
             )
         } else {
             format!(
@@ -206,24 +215,13 @@ pub(crate) fn declarations(uniform: bool) -> String {
 /// Whether every record array of `records` fits in its uniform binding on a device
 /// with `limits`.
 pub(crate) fn fits(records: &SceneRecords, limits: &wgpu::Limits) -> bool {
-    let lengths = [
-        records.spheres.len(),
-        records.polygons.len(),
-        records.triangles.len(),
-        records.materials.len(),
-        records.lights.len(),
-        records.bvh_nodes.len(),
-    ];
-    let packed_lengths = [records.polygon_points.len(), records.bvh_prims.len()];
     device_allows(limits)
         && RECORDS
             .iter()
-            .zip(lengths)
-            .all(|(r, length)| length <= capacity(r.stride))
+            .all(|r| (r.length)(records) <= capacity(r.stride))
         && PACKED
             .iter()
-            .zip(packed_lengths)
-            .all(|(p, length)| length <= UNIFORM_RECORD_BYTES as usize / 16 * p.per_vec4)
+            .all(|p| (p.length)(records) <= PACKED_VEC4S * p.per_vec4)
 }
 
 /// Whether a scene whose records [`fits`] binds them as uniform arrays on the device
