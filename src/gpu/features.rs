@@ -49,9 +49,10 @@ pub struct ShaderFeatures {
     /// An environment map as the background and, for the path integrator, a light
     /// (`ENVIRONMENT_MAP`, `shaders/environment.wgsl`).
     pub environment_map: bool,
-    /// The records every traversal step reads (BVH nodes, spheres, polygons,
-    /// triangles, materials, lights) are uniform arrays of a fixed length rather than
-    /// storage buffers: chosen at upload for small scenes on CPU devices (see
+    /// The records every traversal step reads (BVH nodes and primitive references,
+    /// spheres, polygons and their points, triangles, materials, lights) are uniform
+    /// arrays of a fixed length rather than storage buffers: chosen at upload for
+    /// small scenes on CPU devices (see
     /// `src/gpu/uniform_records.rs`), never by [`ShaderFeatures::for_scene`]. Not a
     /// directive: the bindings' declarations differ, not the code.
     pub uniform_records: bool,
