@@ -428,9 +428,19 @@ fn end_sample(path: ptr<function, PathState>) {
     (*path).phase = PHASE_FETCH_PIXEL;
 }
 
-// Takes the next pixel of the region from the shared counter, or goes idle.
-fn fetch_pixel(path: ptr<function, PathState>) {
-    let pixel = atomicAdd(&counters.next_pixel, 1u);
+// Takes the slot's next pixel of the region, or goes idle: slot s takes pixels s,
+// s + slot_count, s + 2·slot_count, ... below frame.static_pixels, so that neighbouring
+// lanes trace neighbouring pixels, and the rest from the shared counter, so that the
+// slots that finish first take the last pixels (static_pixels_for in
+// src/gpu/layout.rs).
+fn fetch_pixel(slot: u32, path: ptr<function, PathState>) {
+    var pixel = (*path).pixel + frame.slot_count;
+    if (*path).phase == PHASE_FIRST_PIXEL {
+        pixel = slot;
+    }
+    if pixel >= frame.static_pixels {
+        pixel = frame.static_pixels + atomicAdd(&counters.next_pixel, 1u);
+    }
     if pixel >= frame.region_width * frame.region_height {
         (*path).phase = PHASE_IDLE;
         return;
@@ -493,8 +503,8 @@ fn shade_step(slot: u32, path: ptr<function, PathState>, trace: ptr<function, Tr
     if (*path).phase == PHASE_END_SAMPLE {
         end_sample(path);
     }
-    if (*path).phase == PHASE_FETCH_PIXEL {
-        fetch_pixel(path);
+    if (*path).phase == PHASE_FETCH_PIXEL || (*path).phase == PHASE_FIRST_PIXEL {
+        fetch_pixel(slot, path);
     }
     if (*path).phase == PHASE_START_SAMPLE {
         start_sample(path, trace);

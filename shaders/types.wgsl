@@ -35,7 +35,7 @@ struct FrameUniforms {
     offset_scale: f32,
     min_ray_weight: f32,
     lattice_generator: u32,
-    _pad1: u32,
+    static_pixels: u32,
 }
 
 // FrameUniforms.flags: also store each finished pixel's sample sum and luminance m2 in
@@ -232,7 +232,8 @@ struct TraceRay {
 }
 
 // PathState.phase: what a path does next (see shaders/trace.wgsl).
-const PHASE_FETCH_PIXEL: u32 = 0u;
+// A zeroed slot, before its first pixel.
+const PHASE_FIRST_PIXEL: u32 = 0u;
 const PHASE_CLOSEST: u32 = 1u;
 const PHASE_SHADOW: u32 = 2u;
 const PHASE_NEXT_LIGHT: u32 = 3u;
@@ -240,6 +241,8 @@ const PHASE_POP: u32 = 4u;
 const PHASE_END_SAMPLE: u32 = 5u;
 const PHASE_START_SAMPLE: u32 = 6u;
 const PHASE_IDLE: u32 = 7u;
+// A slot whose pixel is done (PHASE_EMITTER is 8).
+const PHASE_FETCH_PIXEL: u32 = 9u;
 
 // The state of one slot's path tree between dispatches: its pixel and sample, the
 // sums, the ray being shaded (origin, direction, weight, depth, medium) and, while its

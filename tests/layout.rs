@@ -69,7 +69,7 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 offset_scale,
                 min_ray_weight,
                 lattice_generator,
-                _pad1,
+                static_pixels,
             }),
         ),
         (

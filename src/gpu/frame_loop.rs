@@ -334,8 +334,13 @@ impl Renderer {
                 flags: FLAG_STORE_SUM | scene.prepared.frame.flags,
                 ..scene.frame_for(film.width(), film.height())
             };
+            let pixels = u64::from(film.width()) * u64::from(film.height());
+            let frame = super::layout::FrameUniforms {
+                static_pixels: super::layout::static_pixels_for(&frame, pixels),
+                ..frame
+            };
             queue.write_buffer(&film.slots.uniforms, 0, bytemuck::bytes_of(&frame));
-            // Zeroed slots start at PHASE_FETCH_PIXEL with no trace pending.
+            // Zeroed slots start at PHASE_FIRST_PIXEL with no trace pending.
             encoder.clear_buffer(&film.slots.paths, 0, None);
             encoder.clear_buffer(&film.slots.traces, 0, None);
             encoder.clear_buffer(&film.slots.counters, 0, None);

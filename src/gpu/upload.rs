@@ -506,7 +506,7 @@ pub fn frame_uniforms(scene: &Scene, geometry: &SceneGeometry) -> FrameUniforms 
         offset_scale: geometry.offset_scale as f32,
         min_ray_weight: settings.min_ray_weight as f32,
         lattice_generator: crate::camera::lattice_generator(settings.samples_per_pixel),
-        _pad1: 0,
+        static_pixels: 0,
     }
 }
 

@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use super::GpuError;
 use super::layout::{
     ERROR_LOOP_CUT, ERROR_TRAVERSAL_STACK, FrameUniforms, GpuCounters, GpuPathState, GpuStackEntry,
-    GpuTraceRay,
+    GpuTraceRay, static_pixels_for,
 };
 use super::pipelines::{TracePipelines, binding};
 use super::readback::{Caught, capture, map_read, read_buffer, submit_and_wait};
@@ -374,6 +374,10 @@ pub(crate) fn trace_region(
     if pixels == 0 {
         return Ok(outcome);
     }
+    let frame = &FrameUniforms {
+        static_pixels: static_pixels_for(frame, pixels),
+        ..*frame
+    };
     queue.write_buffer(&slots.uniforms, 0, bytemuck::bytes_of(frame));
     let groups = frame.slot_count.div_ceil(SLOT_WORKGROUP_SIZE);
     let period_ns = f64::from(queue.get_timestamp_period());
@@ -387,7 +391,7 @@ pub(crate) fn trace_region(
             label: Some("gpu-render trace rounds"),
         });
         if first {
-            // Zeroed slots start at PHASE_FETCH_PIXEL with no trace pending.
+            // Zeroed slots start at PHASE_FIRST_PIXEL with no trace pending.
             encoder.clear_buffer(&slots.paths, 0, None);
             encoder.clear_buffer(&slots.traces, 0, None);
             encoder.clear_buffer(&slots.counters, 0, None);
