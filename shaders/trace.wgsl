@@ -429,10 +429,10 @@ fn end_sample(path: ptr<function, PathState>) {
 }
 
 // Takes the slot's next pixel of the region, or goes idle: slot s takes pixels s,
-// s + slot_count, s + 2·slot_count, ... below frame.static_pixels, so that neighbouring
-// lanes trace neighbouring pixels, and the rest from the shared counter, so that the
-// slots that finish first take the last pixels (static_pixels_for in
-// src/gpu/layout.rs).
+// s + slot_count, s + 2·slot_count, ... below frame.static_pixels (the first few
+// rounds), so that neighbouring lanes start on neighbouring pixels, and the rest from
+// the shared counter, so that the slots that finish first take the next pixels
+// (static_pixels_for in src/gpu/layout.rs).
 fn fetch_pixel(slot: u32, path: ptr<function, PathState>) {
     var pixel = (*path).pixel + frame.slot_count;
     if (*path).phase == PHASE_FIRST_PIXEL {
