@@ -61,6 +61,10 @@ struct Args {
     /// fit on a CPU device (`GpuRenderer::with_uniform_records(false)`).
     #[arg(long)]
     storage_records: bool,
+    /// Traversals never give way to finished lanes
+    /// (`GpuRenderer::with_refill_lanes(false)`).
+    #[arg(long)]
+    no_refill: bool,
     /// Path slots of the GPU trace (default: the adapter's, `default_slot_count`).
     #[arg(long)]
     slots: Option<u32>,
@@ -378,7 +382,9 @@ fn main() -> Result<()> {
     }
     instancing_figures(&scene);
     let gpu = HeadlessGpu::new(&AdapterChoice::Default).context("no GPU adapter")?;
-    let mut renderer = GpuRenderer::new(&gpu.device)?.with_uniform_records(!args.storage_records);
+    let mut renderer = GpuRenderer::new(&gpu.device)?
+        .with_uniform_records(!args.storage_records)
+        .with_refill_lanes(!args.no_refill);
     if let Some(slots) = args.slots {
         renderer = renderer.with_slot_count(slots);
     }

@@ -32,6 +32,7 @@ fn main() -> Result<()> {
     let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
         label: Some("application device"),
         required_limits: Renderer::required_limits(&adapter.limits()),
+        required_features: Renderer::optional_features(adapter.features()),
         ..Default::default()
     }))?;
 

@@ -4,7 +4,8 @@
 //! application reads the finished film back and saves it.
 //!
 //! The gpu-render-specific part is the 12 lines between the `gpu-render:` markers
-//! below, plus the one `required_limits` line of the device request: 13 lines.
+//! below, plus the `required_limits` and `required_features` lines of the device
+//! request: 14 lines.
 //!
 //! ```sh
 //! cargo run --release --example embed_headless -- scenes/minimal.toml embedded.png
@@ -27,6 +28,7 @@ fn main() -> Result<()> {
             .context("no GPU adapter")?;
     let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
         required_limits: Renderer::required_limits(&adapter.limits()),
+        required_features: Renderer::optional_features(adapter.features()),
         ..Default::default()
     }))?;
 

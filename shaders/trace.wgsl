@@ -545,7 +545,7 @@ fn trace_rays(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     iterations = 0u;
-    if advance_traversal(slot, &trace) {
+    if advance_traversal(slot, &trace, false) == TRAVERSAL_FINISHED {
         trace.status = TRACE_DONE;
     }
     traces[slot] = trace;
@@ -567,21 +567,31 @@ fn trace_paths(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     var trace = traces[slot];
     iterations = 0u;
+    // Whitted traversals give way to finished lanes (REFILL_LANES); the path
+    // integrator's do not, as its heavier shading step made that 3-4% slower on a
+    // Cornell box (BENCHMARKS.md, "Replacing finished rays").
+    let give_way = (frame.flags & FLAG_PATH) == 0u;
     var exited = false;
     loop {
         if trace.status == TRACE_PENDING || trace.status == TRACE_RUNNING {
-            if !advance_traversal(slot, &trace) {
+            let outcome = advance_traversal(slot, &trace, give_way);
+            if outcome == TRAVERSAL_SUSPENDED {
                 exited = true;
                 break;
             }
-            trace.status = TRACE_DONE;
+            if outcome == TRAVERSAL_FINISHED {
+                trace.status = TRACE_DONE;
+            }
         }
         if path.phase == PHASE_IDLE || iterations >= frame.iteration_budget {
             exited = true;
             break;
         }
-        iterations += 1u;
-        shade_step(slot, &path, &trace);
+        // A lane whose traversal gave way resumes it in the next pass.
+        if trace.status != TRACE_PENDING && trace.status != TRACE_RUNNING {
+            iterations += 1u;
+            shade_step(slot, &path, &trace);
+        }
     }
     if !exited {
         atomicOr(&counters.errors, ERROR_LOOP_CUT);

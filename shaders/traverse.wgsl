@@ -27,6 +27,27 @@ const MIN_DIRECTION_COMPONENT: f32 = 1e-20;
 // (Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013).
 const FAR_SLAB_SCALE: f32 = 1.0000003576;
 
+// What advance_traversal did: finished the traversal, stopped because the budget is
+// spent (or the loop was cut), or gave way to lanes whose rays have finished.
+const TRAVERSAL_FINISHED: u32 = 0u;
+const TRAVERSAL_SUSPENDED: u32 = 1u;
+const TRAVERSAL_GAVE_WAY: u32 = 2u;
+
+//#if REFILL_LANES
+// A traversal that may give way does so once at most 1/REFILL_FRACTION of the lanes of
+// its subgroup that began the call together still traverse: the others' rays have
+// finished, and they idle until the last one's does. Giving way lets them shade and
+// start their next rays while the stragglers resume in the next pass of the fused
+// kernel's loop: Aila and Laine's "replacing terminated rays" ("Understanding the
+// Efficiency of Ray Traversal on GPUs", HPG 2009, section 4). Each give-way costs the
+// shading step of the lanes that finished, run with fewer lanes, so giving way early
+// costs more than it wins: on lavapipe (8 lanes) with the Whitted integrator,
+// glass.toml traced 1.077 s without it, 1.098 s giving way at 1/2, 1.569 s at 3/4,
+// 0.979 s at 1/3 and 0.986 s at 1/5; the 1920x1080 showcase 5.953 s without, 4.753 s
+// at 1/3 (BENCHMARKS.md, "Replacing finished rays").
+const REFILL_FRACTION: u32 = 3u;
+//#endif
+
 // The largest charge of one step of the traversal loop (a polygon test charges its
 // vertices besides the step).
 //#if POLYGONS
@@ -104,10 +125,11 @@ fn traversal_stack_index(slot: u32, level: u32) -> u32 {
     return level * frame.slot_count + slot;
 }
 
-// Runs `trace`'s traversal until it finishes (true) or the iteration budget is spent
-// (false: the state is saved in `trace` and the slot's traversal stack). For an
-// any-hit trace (a shadow ray) the first hit ends it; best_prim != NO_PRIM then means
-// occluded.
+// Runs `trace`'s traversal until it finishes (TRAVERSAL_FINISHED), the iteration
+// budget is spent (TRAVERSAL_SUSPENDED) or, where `give_way` and the module has
+// REFILL_LANES, few lanes of its subgroup still traverse (TRAVERSAL_GAVE_WAY); in the
+// last two the state is saved in `trace` and the slot's traversal stack. For an any-hit
+// trace (a shadow ray) the first hit ends it; best_prim != NO_PRIM then means occluded.
 //
 // Instances (a two-level BVH, src/accel/instance.rs): a leaf primitive of kind
 // PRIM_INSTANCE is entered as one step: the leaf's position is saved, the ray moves to
@@ -115,7 +137,12 @@ fn traversal_stack_index(slot: u32, level: u32) -> u32 {
 // same stack above the depth it entered at (stack_base); when that tree is done, one
 // more step moves the ray back and resumes the leaf. A suspended traversal inside an
 // instance recomputes the object-space ray from its record when it resumes.
-fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
+fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) -> u32 {
+    //#if REFILL_LANES
+    // The lanes of this subgroup that run this call together.
+    let traversing = subgroupAdd(1u);
+    var gave_way = false;
+    //#endif
     let world_ray = Ray((*trace).origin, (*trace).direction);
     var ray = world_ray;
     var inverse = inverse_direction(ray.direction);
@@ -202,6 +229,17 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
             exited = true;
             break;
         }
+        //#if REFILL_LANES
+        // The lanes still here vote (subgroupAdd over the active lanes); the test is
+        // the same for all of them, so they leave together. The exit is charged, as it
+        // costs the loop's last iteration.
+        if give_way && steps > 0u && REFILL_FRACTION * subgroupAdd(1u) <= traversing {
+            iterations += 1u;
+            gave_way = true;
+            exited = true;
+            break;
+        }
+        //#endif
         steps += 1u;
         iterations += 1u;
         if cursor < leaf_end {
@@ -308,5 +346,13 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>) -> bool {
     (*trace).stack_base = stack_base;
     (*trace).world_cursor = world_cursor;
     (*trace).world_leaf_end = world_leaf_end;
-    return finished;
+    if finished {
+        return TRAVERSAL_FINISHED;
+    }
+    //#if REFILL_LANES
+    if gave_way {
+        return TRAVERSAL_GAVE_WAY;
+    }
+    //#endif
+    return TRAVERSAL_SUSPENDED;
 }

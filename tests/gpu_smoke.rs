@@ -11,7 +11,8 @@ use std::time::Duration;
 use glam::DVec3;
 use gpu_render::gpu::{GpuError, Schedule, TraceRegion, read_texture};
 use gpu_render::scene::{
-    Camera, Environment, Light, LightingSpace, Material, RenderSettings, Scene, Shape,
+    Camera, Environment, Light, LightingSpace, Material, RenderOverrides, RenderSettings, Scene,
+    Shape,
 };
 
 // 37 columns: 37 * 16 and 37 * 4 bytes are not multiples of 256, so both readbacks
@@ -154,7 +155,8 @@ fn linear_target(device: &wgpu::Device) -> wgpu::Texture {
 }
 
 /// The image is the same bit for bit whether it is traced whole or as three
-/// regions into one target, with one slot or many, with either schedule, and with an
+/// regions into one target, with one slot or many, with either schedule, with or
+/// without lanes giving way to finished ones, and with an
 /// iteration budget so small that every traversal is suspended and resumed many times.
 #[test]
 fn regions_slots_and_budgets_do_not_change_the_image() {
@@ -182,6 +184,12 @@ fn regions_slots_and_budgets_do_not_change_the_image() {
 
     // Three uneven bands of rows, each traced into its place in one target.
     let prepared = renderer.prepare(device, queue, &scene).expect("prepare");
+    // The reference gives way to finished lanes wherever the device can (lavapipe can).
+    let subgroups = device.features().contains(wgpu::Features::SUBGROUP);
+    assert_eq!(prepared.features().refill_lanes, subgroups);
+    if gpu.adapter.get_info().name.contains("llvmpipe") {
+        assert!(subgroups, "lavapipe offers subgroup operations");
+    }
     let target = linear_target(device);
     let view = target.create_view(&Default::default());
     let mut rays = 0;
@@ -208,6 +216,10 @@ fn regions_slots_and_budgets_do_not_change_the_image() {
             common::gpu::renderer(&gpu).with_iteration_budget(3),
         ),
         (
+            "no lane refill",
+            common::gpu::renderer(&gpu).with_refill_lanes(false),
+        ),
+        (
             "wavefront schedule",
             common::gpu::renderer(&gpu).with_schedule(Schedule::Wavefront),
         ),
@@ -226,6 +238,39 @@ fn regions_slots_and_budgets_do_not_change_the_image() {
         let image = read_texture(device, queue, &target, 16, timeout).expect("reads back");
         assert_eq!(image, reference, "{label} must not change the image");
         assert_eq!(traced.rays_traced, stats.rays_traced, "{label}: same rays");
+    }
+}
+
+/// Lanes that give way to finished ones resume where they stopped: shipped Whitted
+/// scenes (polygons and glass, meshes and instances, deep refraction) render the same
+/// pixels from the same rays with and without it.
+#[test]
+fn giving_way_to_finished_lanes_does_not_change_the_image() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let refill = common::gpu::renderer(&gpu).with_schedule(Schedule::Fused);
+    let plain = common::gpu::renderer(&gpu)
+        .with_schedule(Schedule::Fused)
+        .with_refill_lanes(false);
+    for path in ["showcase.toml", "glass.toml", "models.toml"] {
+        let scene = common::scenes::reduced(
+            common::scenes::shipped(path),
+            96,
+            RenderOverrides {
+                max_depth: Some(16),
+                ..RenderOverrides::default()
+            },
+        );
+        let a = refill
+            .render(&gpu.device, &gpu.queue, &scene, None)
+            .expect("render, lanes refilled");
+        let b = plain
+            .render(&gpu.device, &gpu.queue, &scene, None)
+            .expect("render, lanes not refilled");
+        let worst = common::compare::max_channel_difference(&a.image, &b.image);
+        assert_eq!(worst, 0.0, "{path}: max |Δ| {worst}");
+        assert_eq!(a.stats.rays_traced, b.stats.rays_traced, "{path}");
     }
 }
 

@@ -11,17 +11,31 @@ use gpu_render::scene::{RenderOverrides, Scene, load_scene};
 
 use common::scenes::shipped as scene;
 
-/// The names of the functions in the naga module built for `features`.
+/// The names of the functions in the naga module built for `features`, validated with
+/// the capabilities a device without optional features has (subgroup operations only
+/// for a module with `refill_lanes`, which needs them).
 fn function_names(features: &ShaderFeatures) -> BTreeSet<String> {
     let source = trace_shader_source(features).expect("well-formed directives");
     let module = naga::front::wgsl::parse_str(&source)
         .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
-    naga::valid::Validator::new(
-        naga::valid::ValidationFlags::all(),
-        naga::valid::Capabilities::default(),
-    )
-    .validate(&module)
-    .unwrap_or_else(|e| panic!("{:?}: {}", features, e.emit_to_string(&source)));
+    let mut validator = if features.refill_lanes {
+        let mut validator = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::SUBGROUP,
+        );
+        validator
+            .subgroup_stages(naga::valid::ShaderStages::COMPUTE)
+            .subgroup_operations(naga::valid::SubgroupOperationSet::ARITHMETIC);
+        validator
+    } else {
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::default(),
+        )
+    };
+    validator
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{:?}: {}", features, e.emit_to_string(&source)));
     module
         .functions
         .iter()
@@ -90,6 +104,31 @@ fn only_a_scene_with_an_environment_map_gets_its_code() {
     }
 }
 
+/// Only a module with `refill_lanes` uses subgroup operations (a device without
+/// wgpu::Features::SUBGROUP could not build the others otherwise), and it validates.
+#[test]
+fn only_modules_that_refill_lanes_use_subgroup_operations() {
+    for features in [
+        ShaderFeatures::ALL,
+        ShaderFeatures::for_scene(&scene("showcase.toml")),
+        ShaderFeatures::for_scene(&scene("cornell-box.toml")),
+    ] {
+        assert!(
+            !features.refill_lanes,
+            "chosen from the device, not the scene"
+        );
+        let without = trace_shader_source(&features).expect("well-formed directives");
+        assert!(!without.contains("subgroupAdd("));
+        let refill = ShaderFeatures {
+            refill_lanes: true,
+            ..features
+        };
+        assert_eq!(function_names(&refill), function_names(&features));
+        let with = trace_shader_source(&refill).expect("well-formed directives");
+        assert!(with.contains("subgroupAdd(1u)"));
+    }
+}
+
 #[test]
 fn modules_with_uniform_records_validate_and_differ_only_in_their_bindings() {
     for features in [
@@ -126,6 +165,7 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         path: false,
         environment_map: false,
         uniform_records: false,
+        refill_lanes: false,
     };
     type Toggle = fn(&mut ShaderFeatures, bool);
     let toggles: [Toggle; 15] = [

@@ -108,8 +108,8 @@ pub fn select_adapter(
 ///
 /// The device is created with the adapter's own limits (not [`wgpu::Limits::default`]),
 /// so large storage buffers and image sizes the hardware supports are usable, and with
-/// [`wgpu::Features::TIMESTAMP_QUERY`] where the adapter offers it, so that renders
-/// report GPU time ([`crate::film::RenderStats::gpu_time`]).
+/// the features of [`super::limits::optional_features`] where the adapter offers them
+/// (timestamp queries, so that renders report GPU time, and subgroup operations).
 pub struct HeadlessGpu {
     /// The instance the adapter came from.
     pub instance: wgpu::Instance,
@@ -162,9 +162,8 @@ impl HeadlessGpu {
             }
             _ => select_adapter(&adapters, choice)?,
         };
-        // Timestamp queries time the trace passes on the GPU itself (see
-        // `RenderStats::gpu_time`); request them only where the adapter offers them.
-        let required_features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+        // Timestamp queries and subgroup operations, where the adapter offers them.
+        let required_features = super::limits::optional_features(adapter.features());
         let desc = wgpu::DeviceDescriptor {
             label: Some("gpu-render headless device"),
             required_features,

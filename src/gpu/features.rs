@@ -56,6 +56,14 @@ pub struct ShaderFeatures {
     /// `src/gpu/uniform_records.rs`), never by [`ShaderFeatures::for_scene`]. Not a
     /// directive: the bindings' declarations differ, not the code.
     pub uniform_records: bool,
+    /// The fused kernel's Whitted traversals give way once few lanes of their subgroup
+    /// still traverse, so that the lanes whose rays finished shade and start their
+    /// next rays (`REFILL_LANES`; Aila and Laine's "replacing terminated rays", see
+    /// `shaders/traverse.wgsl`). Needs [`wgpu::Features::SUBGROUP`], so it is chosen
+    /// at upload from the device (see `super::scene_buffers`), never by
+    /// [`ShaderFeatures::for_scene`], and [`ShaderFeatures::ALL`] leaves it out. The
+    /// image does not depend on it.
+    pub refill_lanes: bool,
 }
 
 impl ShaderFeatures {
@@ -78,6 +86,7 @@ impl ShaderFeatures {
         path: true,
         environment_map: true,
         uniform_records: false,
+        refill_lanes: false,
     };
 
     /// Exactly the features `scene` uses.
@@ -116,6 +125,7 @@ impl ShaderFeatures {
             path: scene.render.integrator == crate::scene::Integrator::Path,
             environment_map: scene.environment.map.is_some(),
             uniform_records: false,
+            refill_lanes: false,
         }
     }
 
@@ -149,7 +159,7 @@ impl ShaderFeatures {
 type FeatureFlag = fn(&ShaderFeatures) -> bool;
 
 /// The name of each feature in the WGSL directives, with the flag it reads.
-const FEATURE_NAMES: [(&str, FeatureFlag); 15] = [
+const FEATURE_NAMES: [(&str, FeatureFlag); 16] = [
     ("SPHERES", |f| f.spheres),
     ("PLANES", |f| f.planes),
     ("POLYGONS", |f| f.polygons),
@@ -165,6 +175,7 @@ const FEATURE_NAMES: [(&str, FeatureFlag); 15] = [
     ("INSTANCES", |f| f.instances),
     ("PATH", |f| f.path),
     ("ENVIRONMENT_MAP", |f| f.environment_map),
+    ("REFILL_LANES", |f| f.refill_lanes),
 ];
 
 /// Keeps the lines of `source` whose enclosing `//#if` directives hold for `features`

@@ -63,6 +63,10 @@ pub struct RendererOptions {
     /// (`true`, faster there) or always as storage buffers. The image does not depend
     /// on it.
     pub uniform_records: bool,
+    /// Where the device has subgroup operations, let the fused kernel's traversals
+    /// give way to lanes whose rays finished (`true`, faster on lavapipe; see
+    /// [`super::ShaderFeatures::refill_lanes`]). The image does not depend on it.
+    pub refill_lanes: bool,
 }
 
 impl Default for RendererOptions {
@@ -75,6 +79,7 @@ impl Default for RendererOptions {
             max_rounds_per_call: 64,
             specialise: true,
             uniform_records: true,
+            refill_lanes: true,
         }
     }
 }
@@ -106,6 +111,7 @@ pub struct FilmImage {
 /// #               -> Result<(), Box<dyn std::error::Error>> {
 /// let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
 ///     required_limits: Renderer::required_limits(&adapter.limits()),
+///     required_features: Renderer::optional_features(adapter.features()),
 ///     ..Default::default()
 /// }))?;
 /// let renderer = Renderer::new(&device, RendererOptions::default())?;
@@ -169,6 +175,13 @@ impl Renderer {
         required_limits(adapter_limits)
     }
 
+    /// The features to request when creating a device for the renderer, where the
+    /// adapter has them ([`super::limits::optional_features`]): the renderer runs
+    /// without them, only slower.
+    pub fn optional_features(adapter_features: wgpu::Features) -> wgpu::Features {
+        super::limits::optional_features(adapter_features)
+    }
+
     /// The options the renderer was built with.
     pub fn options(&self) -> &RendererOptions {
         &self.options
@@ -201,6 +214,7 @@ impl Renderer {
             &geometry,
             self.options.specialise,
             self.options.uniform_records,
+            self.options.refill_lanes,
         )
         .map_err(|e| match e {
             GpuError::Validation(_) | GpuError::DeviceLimit { .. } => RenderError::Scene(e),

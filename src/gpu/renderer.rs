@@ -55,6 +55,7 @@ pub struct GpuRenderer {
     poll_timeout: Option<Duration>,
     specialise: bool,
     uniform_records: bool,
+    refill_lanes: bool,
     iteration_budget: Option<u32>,
     slot_count: Option<u32>,
     schedule: Option<Schedule>,
@@ -115,6 +116,7 @@ impl GpuRenderer {
             poll_timeout: None,
             specialise: true,
             uniform_records: true,
+            refill_lanes: true,
             iteration_budget: None,
             slot_count: None,
             schedule: None,
@@ -129,6 +131,12 @@ impl GpuRenderer {
     /// trace kernels bind among them).
     pub fn required_limits(adapter_limits: &wgpu::Limits) -> wgpu::Limits {
         super::limits::required_limits(adapter_limits)
+    }
+
+    /// The features to request when creating a device for this renderer, where the
+    /// adapter has them ([`super::limits::optional_features`]).
+    pub fn optional_features(adapter_features: wgpu::Features) -> wgpu::Features {
+        super::limits::optional_features(adapter_features)
     }
 
     /// Bounds every wait for the GPU (one submission of trace rounds, the display
@@ -155,6 +163,15 @@ impl GpuRenderer {
     /// the same.
     pub fn with_uniform_records(mut self, uniform_records: bool) -> Self {
         self.uniform_records = uniform_records;
+        self
+    }
+
+    /// With `false`, the fused kernel's traversals never give way to lanes whose rays
+    /// finished, even where the device has subgroup operations (see
+    /// [`ShaderFeatures::refill_lanes`]). For measurements and tests; the image is the
+    /// same.
+    pub fn with_refill_lanes(mut self, refill_lanes: bool) -> Self {
+        self.refill_lanes = refill_lanes;
         self
     }
 
@@ -260,6 +277,7 @@ impl GpuRenderer {
             geometry,
             self.specialise,
             self.uniform_records,
+            self.refill_lanes,
         )
     }
 

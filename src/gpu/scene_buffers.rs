@@ -108,7 +108,9 @@ impl PreparedScene {
 /// Uploads `scene` (as loaded: it is converted to its lighting space here) with its
 /// `geometry` (built from the lighting-space-independent shapes). With
 /// `allow_uniform_records`, a scene whose records fit is bound with uniform records
-/// where the device prefers them (see `super::uniform_records`).
+/// where the device prefers them (see `super::uniform_records`). With
+/// `allow_refill_lanes`, the trace module gives way to finished lanes
+/// ([`ShaderFeatures::refill_lanes`]) where the device has subgroup operations.
 pub(crate) fn upload_scene(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -116,6 +118,7 @@ pub(crate) fn upload_scene(
     geometry: &SceneGeometry,
     specialise: bool,
     allow_uniform_records: bool,
+    allow_refill_lanes: bool,
 ) -> Result<PreparedScene, GpuError> {
     scene.render.check().map_err(GpuError::Validation)?;
     if geometry.planes.len() > MAX_PLANES {
@@ -259,6 +262,8 @@ pub(crate) fn upload_scene(
         },
         features: ShaderFeatures {
             uniform_records,
+            refill_lanes: allow_refill_lanes
+                && device.features().contains(wgpu::Features::SUBGROUP),
             ..if specialise {
                 ShaderFeatures::for_scene(scene)
             } else {

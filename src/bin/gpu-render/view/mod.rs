@@ -298,6 +298,7 @@ impl Viewer {
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("gpu-render viewer"),
             required_limits: Renderer::required_limits(&adapter.limits()),
+            required_features: Renderer::optional_features(adapter.features()),
             ..Default::default()
         }))
         .context("cannot open the GPU device")?;
