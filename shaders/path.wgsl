@@ -587,11 +587,11 @@ fn path_emitter_sample(path: ptr<function, PathState>) -> EmitterSample {
 }
 
 // Records the path's continuation (origin, direction, throughput after the event,
-// medium) on its bounce stack unless Russian roulette ends it: after ROULETTE_DEPTH
-// bounces it survives with probability clamp(max channel, MIN_SURVIVAL, 1)
-// (dimension 7) and is divided by it. A throughput that is not finite ends the path.
+// medium) as its bounce stack's held top (hold_top: it never goes through memory)
+// unless Russian roulette ends it: after ROULETTE_DEPTH bounces it survives with
+// probability clamp(max channel, MIN_SURVIVAL, 1) (dimension 7) and is divided by it. A throughput that is not finite ends the path.
 // Twin of the end of path_radiance's loop.
-fn path_continue(slot: u32, path: ptr<function, PathState>, origin: vec3<f32>, direction: vec3<f32>, throughput: vec3<f32>, medium: MediumStack) {
+fn path_continue(path: ptr<function, PathState>, origin: vec3<f32>, direction: vec3<f32>, throughput: vec3<f32>, medium: MediumStack) {
     let depth = (*path).depth + 1u;
     var weight = throughput;
     if depth >= ROULETTE_DEPTH {
@@ -604,8 +604,7 @@ fn path_continue(slot: u32, path: ptr<function, PathState>, origin: vec3<f32>, d
     if !finite_radiance(weight) {
         return;
     }
-    ray_stack[ray_stack_index(slot, 0u)] = StackEntry(origin, depth, direction, medium.depth,
-                                                      weight, 0u, medium.iors);
+    hold_top(path, StackEntry(origin, depth, direction, medium.depth, weight, 0u, medium.iors));
     (*path).stack_len = 1u;
 }
 
@@ -614,7 +613,7 @@ fn path_continue(slot: u32, path: ptr<function, PathState>, origin: vec3<f32>, d
 // picks an event in proportion to its weight (dimension 0) and records the
 // continuation; for the base BRDF it samples the next direction (dimensions 1-3) and
 // starts gathering direct light (PHASE_NEXT_LIGHT), else it goes on to PHASE_POP.
-fn path_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) {
+fn path_closest_hit(path: ptr<function, PathState>, trace: TraceRay) {
     let ray = Ray((*path).origin, (*path).direction);
     if trace.best_prim == NO_PRIM {
         var background = frame.background;
@@ -699,7 +698,7 @@ fn path_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) 
             if pdf > 0.0 && cos_i > 0.0 && dot(ng, wi) > 0.0 {
                 let f = eval_brdf(material, n, wi, wo);
                 (*path).brdf_pdf = pdf;
-                path_continue(slot, path, offset_ray_origin(hit.position, ng, frame.offset_scale),
+                path_continue(path, offset_ray_origin(hit.position, ng, frame.offset_scale),
                               wi, event_weight * f * (cos_i / pdf), medium);
             }
         }
@@ -727,7 +726,7 @@ fn path_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) 
     }
     //#endif
     (*path).brdf_pdf = NO_BRDF_PDF;
-    path_continue(slot, path, offset_ray_origin(hit.position, side, frame.offset_scale),
+    path_continue(path, offset_ray_origin(hit.position, side, frame.offset_scale),
                   direction, (*path).weight * weight, next_medium);
 }
 

@@ -132,13 +132,24 @@ fn ray_stack_index(slot: u32, level: u32) -> u32 {
 }
 
 // Pushes a branch if it carries more than the weight cutoff and the stack has room;
-// otherwise the branch is dropped (both backends alike).
+// otherwise the branch is dropped (both backends alike). The new top is held in the
+// path state; the one it covers moves to its place in ray_stack.
 fn push_branch(slot: u32, path: ptr<function, PathState>, entry: StackEntry) {
     let cutoff = max(frame.min_ray_weight, MIN_BRANCH_WEIGHT);
     if max_component(entry.weight) > cutoff && (*path).stack_len < frame.stack_size {
-        ray_stack[ray_stack_index(slot, (*path).stack_len)] = entry;
+        if (*path).held_top != 0u {
+            ray_stack[ray_stack_index(slot, (*path).stack_len - 1u)] = (*path).held;
+        }
+        hold_top(path, entry);
         (*path).stack_len += 1u;
     }
+}
+
+// Makes `entry` the held top of the bounce stack (its level is stack_len - 1 once the
+// caller has counted it).
+fn hold_top(path: ptr<function, PathState>, entry: StackEntry) {
+    (*path).held = entry;
+    (*path).held_top = 1u;
 }
 
 // Sets up the traversal of a ray: the nearest hit in (0, t_max), or with `any_hit`
@@ -223,7 +234,7 @@ fn keep_on_side(d: vec3<f32>, side: vec3<f32>) -> vec3<f32> {
 fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) {
     //#if PATH
     if path_mode() {
-        path_closest_hit(slot, path, trace);
+        path_closest_hit(path, trace);
         return;
     }
     //#endif
@@ -356,7 +367,11 @@ fn pop_ray(slot: u32, path: ptr<function, PathState>, trace: ptr<function, Trace
         return false;
     }
     (*path).stack_len -= 1u;
-    let entry = ray_stack[ray_stack_index(slot, (*path).stack_len)];
+    var entry = (*path).held;
+    if (*path).held_top == 0u {
+        entry = ray_stack[ray_stack_index(slot, (*path).stack_len)];
+    }
+    (*path).held_top = 0u;
     (*path).origin = entry.origin;
     (*path).direction = entry.direction;
     (*path).weight = entry.weight;
@@ -389,6 +404,7 @@ fn start_sample(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) 
     (*path).medium_depth = frame.camera_medium_depth;
     (*path).medium_iors = frame.camera_medium_iors;
     (*path).stack_len = 0u;
+    (*path).held_top = 0u;
     (*path).rays += 1u;
     start_trace(trace, frame.eye, direction, bitcast<f32>(0x7f800000u), false);
     (*path).phase = PHASE_CLOSEST;

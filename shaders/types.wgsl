@@ -281,6 +281,15 @@ struct PathState {
     // Welford's sum of squared deviations of the pixel's sample luminances so far
     // (shaders/noise.wgsl).
     luminance_m2: f32,
+    // The bounce stack's top entry, kept here instead of in ray_stack while
+    // held_top != 0: a branch pushed and popped before another push (the reflected ray
+    // of a dielectric or mirror, the path integrator's continuation) never goes through
+    // memory (push_branch, pop_ray).
+    held: StackEntry,
+    held_top: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // One pending reflected or refracted ray on a slot's bounce stack.

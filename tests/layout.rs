@@ -225,7 +225,12 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 direct,
                 brdf_pdf,
                 emission,
-                luminance_m2
+                luminance_m2,
+                held,
+                held_top,
+                _pad0,
+                _pad1,
+                _pad2
             }),
         ),
         (

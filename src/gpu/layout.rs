@@ -215,6 +215,17 @@ pub struct GpuPathState {
     /// Welford's sum of squared deviations of the pixel's sample luminances so far
     /// ([`crate::noise::luminance_m2_step`]).
     pub luminance_m2: f32,
+    /// The bounce stack's top entry while `held_top` is not 0 (it is then not in the
+    /// slot's bounce stack buffer).
+    pub held: GpuStackEntry,
+    /// Whether `held` is the stack's top.
+    pub held_top: u32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
 }
 
 /// One pending ray on a slot's bounce stack (`StackEntry` in WGSL).
