@@ -589,8 +589,8 @@ fn path_emitter_sample(path: ptr<function, PathState>) -> EmitterSample {
 // Records the path's continuation (origin, direction, throughput after the event,
 // medium) as its bounce stack's held top (hold_top: it never goes through memory)
 // unless Russian roulette ends it: after ROULETTE_DEPTH bounces it survives with
-// probability clamp(max channel, MIN_SURVIVAL, 1) (dimension 7) and is divided by it. A throughput that is not finite ends the path.
-// Twin of the end of path_radiance's loop.
+// probability clamp(max channel, MIN_SURVIVAL, 1) (dimension 7) and is divided by it.
+// A throughput that is not finite ends the path. Twin of the end of path_radiance's loop.
 fn path_continue(path: ptr<function, PathState>, origin: vec3<f32>, direction: vec3<f32>, throughput: vec3<f32>, medium: MediumStack) {
     let depth = (*path).depth + 1u;
     var weight = throughput;
