@@ -56,7 +56,7 @@ fn random_number(pixel: u32, sample: u32, dimension: u32) -> f32 {
 // Random number `k` of the path's current bounce: dimension 2 + 8·depth + k of its
 // sample, for its image pixel (y·width + x).
 fn path_random(path: ptr<function, PathState>, k: u32) -> f32 {
-    let xy = pixel_position((*path).pixel);
+    let xy = image_position(path);
     let dimension = 2u + (*path).depth * DIMENSIONS_PER_BOUNCE + k;
     return random_number(xy.y * frame.width + xy.x, (*path).sample, dimension);
 }

@@ -390,10 +390,16 @@ fn pixel_position(pixel: u32) -> vec2<u32> {
                      frame.region_y + pixel / frame.region_width);
 }
 
+// The image pixel the path works on (pixel_position of its region pixel, kept by
+// fetch_pixel).
+fn image_position(path: ptr<function, PathState>) -> vec2<u32> {
+    return vec2<u32>((*path).image_x, (*path).image_y);
+}
+
 // Starts the camera ray of the path's current sample (jittered stratified, box
 // filter), inside the dielectrics around the camera.
 fn start_sample(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) {
-    let xy = pixel_position((*path).pixel);
+    let xy = image_position(path);
     let offset = sample_offset(xy.x, xy.y, (*path).sample);
     let direction = camera_ray_direction(f32(xy.x) + offset.x, f32(xy.y) + offset.y);
     (*path).radiance = vec3<f32>(0.0);
@@ -432,7 +438,7 @@ fn end_sample(path: ptr<function, PathState>) {
     if (frame.flags & FLAG_STORE_SUM) != 0u {
         accumulation[(*path).pixel] = vec4<f32>((*path).pixel_sum, (*path).luminance_m2);
     }
-    let xy = pixel_position((*path).pixel);
+    let xy = image_position(path);
     textureStore(linear_output, vec2<u32>(xy.x - frame.target_x, xy.y - frame.target_y),
                  vec4<f32>(mean, 1.0));
     // 64-bit ray count as two words: carry when the low word wraps.
@@ -462,6 +468,9 @@ fn fetch_pixel(slot: u32, path: ptr<function, PathState>) {
         return;
     }
     (*path).pixel = pixel;
+    let xy = pixel_position(pixel);
+    (*path).image_x = xy.x;
+    (*path).image_y = xy.y;
     (*path).sample = frame.first_sample;
     (*path).rays = 0u;
     (*path).pixel_sum = vec3<f32>(0.0);

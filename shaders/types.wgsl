@@ -287,9 +287,11 @@ struct PathState {
     // memory (push_branch, pop_ray).
     held: StackEntry,
     held_top: u32,
+    // The image column and row of `pixel`, worked out once per pixel (fetch_pixel):
+    // llvmpipe divides integers one lane at a time.
+    image_x: u32,
+    image_y: u32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
 }
 
 // One pending reflected or refracted ray on a slot's bounce stack.

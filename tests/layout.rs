@@ -228,9 +228,9 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 luminance_m2,
                 held,
                 held_top,
-                _pad0,
-                _pad1,
-                _pad2
+                image_x,
+                image_y,
+                _pad0
             }),
         ),
         (

@@ -220,12 +220,12 @@ pub struct GpuPathState {
     pub held: GpuStackEntry,
     /// Whether `held` is the stack's top.
     pub held_top: u32,
+    /// Image column of `pixel`.
+    pub image_x: u32,
+    /// Image row of `pixel`.
+    pub image_y: u32,
     /// Padding.
     pub _pad0: u32,
-    /// Padding.
-    pub _pad1: u32,
-    /// Padding.
-    pub _pad2: u32,
 }
 
 /// One pending ray on a slot's bounce stack (`StackEntry` in WGSL).
