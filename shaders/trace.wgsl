@@ -21,7 +21,7 @@
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
 // binding 1: `spheres`, a storage or a uniform array, declared by src/gpu/uniform_records.rs.
-@group(0) @binding(2) var<storage, read> planes: array<Plane>;
+// binding 2: `planes`, a storage or a uniform array, declared by src/gpu/uniform_records.rs.
 // binding 3: `polygons`, a storage or a uniform array, declared by src/gpu/uniform_records.rs.
 // binding 4: `polygon_points`, each polygon vertex projected for the inside test (the
 // plane's dropped axis removed), read by polygon_point(i); declared by

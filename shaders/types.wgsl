@@ -59,8 +59,11 @@ struct Plane {
     normal: vec3<f32>,
     offset: f32,
     material: u32,
-    // Not vec3<u32>: that is 16-byte aligned and would grow the struct to 48 bytes.
-    _pad: array<u32, 3>,
+    // Not vec3<u32>, which is 16-byte aligned and would grow the struct to 48 bytes, nor
+    // array<u32, 3>, whose 4-byte stride a uniform array of planes may not hold.
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 struct Polygon {

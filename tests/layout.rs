@@ -87,7 +87,9 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 normal,
                 offset,
                 material,
-                _pad
+                _pad0,
+                _pad1,
+                _pad2
             }),
         ),
         (

@@ -305,7 +305,11 @@ pub struct GpuPlane {
     /// Material index.
     pub material: u32,
     /// Padding.
-    pub _pad: [u32; 3],
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
 }
 
 /// A planar polygon whose vertices live in the polygon-vertex buffer (`Polygon` in WGSL).

@@ -94,7 +94,7 @@ impl TraceLayout {
                 entries: &[
                     uniform_entry(FRAME),
                     record(SPHERES),
-                    storage_entry(PLANES, true),
+                    record(PLANES),
                     record(POLYGONS),
                     record(POLYGON_POINTS),
                     record(TRIANGLES),

@@ -5,10 +5,10 @@
 //! lane to lane of a SIMD vector one lane at a time, each lane behind a branch on its
 //! execution mask and another on the buffer's bounds (`emit_load_mem` in gallivm's
 //! `lp_bld_nir_soa.c`); an element of a uniform buffer it gathers without branches. The
-//! BVH nodes and primitive references, spheres, polygons and their points, triangles,
-//! materials and lights are read at every traversal and shading step, so where each of
-//! them fits in one uniform binding
-//! ([`UNIFORM_RECORD_BYTES`]) and the device is a CPU, they are bound as uniform arrays
+//! BVH nodes and primitive references, planes, spheres, polygons and their points,
+//! triangles, materials and lights are read at every traversal and shading step, so
+//! where each of them fits in one uniform binding ([`UNIFORM_RECORD_BYTES`]) and the
+//! device is a CPU, they are bound as uniform arrays
 //! of a fixed length (the binding padded to it), which makes the trace of
 //! `scenes/showcase.toml` about 28% shorter on lavapipe (BENCHMARKS.md, "Uniform
 //! records"). On GPUs, uniform (constant) memory serialises lanes that read different
@@ -20,7 +20,7 @@
 
 use std::mem::size_of;
 
-use super::layout::{GpuLight, GpuMaterial, GpuPolygon, GpuSphere, GpuTriangle};
+use super::layout::{GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle};
 use super::pipelines::binding;
 use super::upload::SceneRecords;
 use crate::accel::BvhNode;
@@ -40,9 +40,18 @@ struct RecordBinding {
 }
 
 /// The record arrays bound as uniform buffers, in binding order (besides the packed
-/// ones, [`PACKED`]). Not the planes: every ray reads them all, in the same order, so
-/// their index is the same in every lane.
-const RECORDS: [RecordBinding; 6] = [
+/// ones, [`PACKED`]). The planes too: every ray reads them all in the same order, but
+/// llvmpipe does not see that the index is the same in every lane and loaded a storage
+/// plane lane by lane (`glass.toml` took 8% less CPU time with uniform planes,
+/// BENCHMARKS.md "Uniform records").
+const RECORDS: [RecordBinding; 7] = [
+    RecordBinding {
+        binding: binding::PLANES,
+        name: "planes",
+        wgsl_type: "Plane",
+        stride: size_of::<GpuPlane>(),
+        length: |r| r.planes.len(),
+    },
     RecordBinding {
         binding: binding::SPHERES,
         name: "spheres",
@@ -241,8 +250,11 @@ mod tests {
             assert!(capacity(r.stride) > 0, "{}", r.name);
             assert!(padded_bytes(r.binding).unwrap_or(0) <= UNIFORM_RECORD_BYTES);
         }
-        assert!(padded_bytes(binding::PLANES).is_none());
-        assert!(!is_uniform_record(binding::PLANES));
+        assert!(is_uniform_record(binding::PLANES));
+        assert!(padded_bytes(binding::PATHS).is_none());
+        assert!(!is_uniform_record(binding::PATHS));
+        // Every plane a scene may have fits.
+        assert!(capacity(size_of::<super::super::layout::GpuPlane>()) >= crate::accel::MAX_PLANES);
         assert_eq!(padded_bytes(binding::BVH_PRIMS), Some(UNIFORM_RECORD_BYTES));
     }
 

@@ -80,7 +80,9 @@ impl SceneRecords {
                     normal: vec3(p.normal),
                     offset: p.offset as f32,
                     material: p.material,
-                    _pad: [0; 3],
+                    _pad0: 0,
+                    _pad1: 0,
+                    _pad2: 0,
                 })
                 .collect(),
             triangles: geometry
