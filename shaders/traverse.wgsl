@@ -203,6 +203,10 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) 
     }
     var finished = false;
     var exited = false;
+    // The top of the traversal stack while it is not in traversal_stack (NO_NODE when
+    // level stack_len - 1, if any, is in memory): a node pushed and popped with no push
+    // between never goes through memory. Written back before a suspended call returns.
+    var held = NO_NODE;
     // At least one step per call, so that any budget makes progress.
     var steps = 0u;
     // One loop whose every step is either a primitive test (while the lane has a leaf
@@ -296,7 +300,11 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) 
         if node == NO_NODE {
             // Pop; a node pushed earlier may lie beyond a hit found since.
             stack_len -= 1u;
-            let candidate = traversal_stack[traversal_stack_index(slot, stack_len)];
+            var candidate = held;
+            if held == NO_NODE {
+                candidate = traversal_stack[traversal_stack_index(slot, stack_len)];
+            }
+            held = NO_NODE;
             if slab_enter(candidate, ray.origin, inverse, best_t) != NO_HIT {
                 node = candidate;
             }
@@ -314,7 +322,10 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) 
                     far = a;
                 }
                 if stack_len < MAX_BVH_DEPTH {
-                    traversal_stack[traversal_stack_index(slot, stack_len)] = far;
+                    if held != NO_NODE {
+                        traversal_stack[traversal_stack_index(slot, stack_len - 1u)] = held;
+                    }
+                    held = far;
                     stack_len += 1u;
                 } else {
                     atomicOr(&counters.errors, ERROR_TRAVERSAL_STACK);
@@ -334,6 +345,9 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) 
     }
     if !exited {
         atomicOr(&counters.errors, ERROR_LOOP_CUT);
+    }
+    if !finished && held != NO_NODE {
+        traversal_stack[traversal_stack_index(slot, stack_len - 1u)] = held;
     }
     (*trace).best_t = best_t;
     (*trace).best_prim = best_prim;

@@ -56,7 +56,7 @@ fn traverse_rays(@builtin(global_invocation_id) id: vec3<u32>) {
     var trace = test_trace(slot);
     loop {
         iterations = 0u;
-        if advance_traversal(slot, &trace) {
+        if advance_traversal(slot, &trace, false) == TRAVERSAL_FINISHED {
             break;
         }
     }
