@@ -252,14 +252,15 @@ impl Backend {
 /// device (lavapipe, llvmpipe, WARP: software on the same cores as the CPU reference)
 /// is used only where it measured faster than the CPU reference: llvmpipe from Mesa 25
 /// (whose loops have no limit, `gpu::driver_loop_limit`) on Whitted scenes without
-/// meshes, that is without models loaded from files (loose triangles are fine) (the 1920x1080 showcase 1.28x, the Whitted caustic and Cornell box
-/// 1.3x-1.6x, the direct-light scene 2.2x, with lanes refilled, `gpu::ShaderFeatures::
-/// refill_lanes`; `glass.toml`, at 0.80x, is the one such scene measured slower).
-/// Meshes make it slower (`models.toml`, OBJ and glTF tori and vases, 0.53x), and so does every scene on older Mesa,
-/// and every path-traced scene (the Cornell box: `BENCHMARKS.md`, "Path tracing on the
-/// GPU"). On any device, a scene with a sphere
-/// that only the CPU reference's f64 places precisely enough (`scene::sphere_precision`:
-/// a small sphere far from the origin seen from close by) renders on the CPU. Returns
+/// meshes, that is without models loaded from files (loose triangles are fine): the
+/// 1920x1080 showcase 1.10x, the direct-light scene 2.5x, the Whitted caustic and
+/// Cornell box 1.4x-1.6x, with lanes refilled (`gpu::ShaderFeatures::refill_lanes`);
+/// `glass.toml`, at 0.94x-0.96x, is the one such scene measured slower. Meshes make it
+/// slower (`models.toml`, OBJ and glTF tori and vases, 0.55x), and so does every scene
+/// on older Mesa, and every path-traced scene (the Cornell box: `BENCHMARKS.md`, "Path
+/// tracing on the GPU"). On any device, a scene with a sphere that only the CPU
+/// reference's f64 places precisely enough (`scene::sphere_precision`: a small sphere far
+/// from the origin seen from close by) renders on the CPU. Returns
 /// why the CPU reference is chosen instead, if it is.
 pub fn auto_rule(adapter: &wgpu::AdapterInfo, scene: &Scene) -> Option<String> {
     if let Some(radius) = sphere_only_the_cpu_places(scene) {
