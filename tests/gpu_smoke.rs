@@ -262,15 +262,8 @@ fn giving_way_to_finished_lanes_does_not_change_the_image() {
                 ..RenderOverrides::default()
             },
         );
-        let a = refill
-            .render(&gpu.device, &gpu.queue, &scene, None)
-            .expect("render, lanes refilled");
-        let b = plain
-            .render(&gpu.device, &gpu.queue, &scene, None)
-            .expect("render, lanes not refilled");
-        let worst = common::compare::max_channel_difference(&a.image, &b.image);
-        assert_eq!(worst, 0.0, "{path}: max |Δ| {worst}");
-        assert_eq!(a.stats.rays_traced, b.stats.rays_traced, "{path}");
+        let what = format!("{path}, lanes refilled and not");
+        common::gpu::assert_renders_identical(&gpu, &refill, &plain, &scene, &what);
     }
 }
 

@@ -55,16 +55,9 @@ fn shipped_scenes_render_the_same_with_uniform_and_storage_records() {
             continue;
         }
         uniform_scenes += usize::from(prepared.features().uniform_records);
-        let a = uniform
-            .render(&gpu.device, &gpu.queue, &scene, None)
-            .expect("render, uniform records");
-        let b = storage
-            .render(&gpu.device, &gpu.queue, &scene, None)
-            .expect("render, storage records");
-        let worst = common::compare::max_channel_difference(&a.image, &b.image);
         // The same code reading the same values; only where they are bound differs.
-        assert_eq!(worst, 0.0, "{path}: max |Δ| {worst}");
-        assert_eq!(a.stats.rays_traced, b.stats.rays_traced, "{path}");
+        let what = format!("{path}, uniform and storage records");
+        common::gpu::assert_renders_identical(&gpu, &uniform, &storage, &scene, &what);
     }
     if cpu_device(&gpu) {
         // These scenes are small: most of them take uniform records.

@@ -32,3 +32,27 @@ pub fn headless_gpu() -> Option<HeadlessGpu> {
 pub fn renderer(gpu: &HeadlessGpu) -> GpuRenderer {
     GpuRenderer::new(&gpu.device).unwrap_or_else(|e| panic!("GpuRenderer::new failed: {e}"))
 }
+
+/// Renders `scene` with `a` and with `b` on `gpu` and asserts the same pixels bit for
+/// bit and the same ray count: for settings that change how the work is done, never
+/// its result. `what` names the scene and the pair in a failure.
+pub fn assert_renders_identical(
+    gpu: &HeadlessGpu,
+    a: &GpuRenderer,
+    b: &GpuRenderer,
+    scene: &gpu_render::scene::Scene,
+    what: &str,
+) {
+    let first = a
+        .render(&gpu.device, &gpu.queue, scene, None)
+        .unwrap_or_else(|e| panic!("{what}, first render: {e}"));
+    let second = b
+        .render(&gpu.device, &gpu.queue, scene, None)
+        .unwrap_or_else(|e| panic!("{what}, second render: {e}"));
+    let worst = super::compare::max_channel_difference(&first.image, &second.image);
+    assert_eq!(worst, 0.0, "{what}: max |Δ| {worst}");
+    assert_eq!(
+        first.stats.rays_traced, second.stats.rays_traced,
+        "{what}: rays"
+    );
+}
