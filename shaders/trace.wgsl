@@ -152,6 +152,11 @@ fn hold_top(path: ptr<function, PathState>, entry: StackEntry) {
     (*path).held_top = 1u;
 }
 
+// Whether `trace` has a traversal to run or resume.
+fn trace_in_flight(trace: TraceRay) -> bool {
+    return trace.status == TRACE_PENDING || trace.status == TRACE_RUNNING;
+}
+
 // Sets up the traversal of a ray: the nearest hit in (0, t_max), or with `any_hit`
 // whether anything lies there.
 fn start_trace(trace: ptr<function, TraceRay>, origin: vec3<f32>, direction: vec3<f32>, t_max: f32, any_hit: bool) {
@@ -548,7 +553,7 @@ fn shade_paths(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     var trace = traces[slot];
-    if trace.status == TRACE_PENDING || trace.status == TRACE_RUNNING {
+    if trace_in_flight(trace) {
         return;
     }
     iterations = 0u;
@@ -566,7 +571,7 @@ fn trace_rays(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     var trace = traces[slot];
-    if trace.status != TRACE_PENDING && trace.status != TRACE_RUNNING {
+    if !trace_in_flight(trace) {
         return;
     }
     iterations = 0u;
@@ -598,7 +603,7 @@ fn trace_paths(@builtin(global_invocation_id) id: vec3<u32>) {
     let give_way = (frame.flags & FLAG_PATH) == 0u;
     var exited = false;
     loop {
-        if trace.status == TRACE_PENDING || trace.status == TRACE_RUNNING {
+        if trace_in_flight(trace) {
             let outcome = advance_traversal(slot, &trace, give_way);
             if outcome == TRAVERSAL_SUSPENDED {
                 exited = true;
@@ -613,7 +618,7 @@ fn trace_paths(@builtin(global_invocation_id) id: vec3<u32>) {
             break;
         }
         // A lane whose traversal gave way resumes it in the next pass.
-        if trace.status != TRACE_PENDING && trace.status != TRACE_RUNNING {
+        if !trace_in_flight(trace) {
             iterations += 1u;
             shade_step(slot, &path, &trace);
         }

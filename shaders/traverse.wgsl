@@ -139,8 +139,12 @@ fn traversal_stack_index(slot: u32, level: u32) -> u32 {
 // instance recomputes the object-space ray from its record when it resumes.
 fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) -> u32 {
     //#if REFILL_LANES
-    // The lanes of this subgroup that run this call together.
-    let traversing = subgroupAdd(1u);
+    // The lanes of this subgroup that run this call together (counted only where they
+    // may give way).
+    var traversing = 0u;
+    if give_way {
+        traversing = subgroupAdd(1u);
+    }
     var gave_way = false;
     //#endif
     let world_ray = Ray((*trace).origin, (*trace).direction);
