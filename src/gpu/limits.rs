@@ -110,7 +110,7 @@ pub fn required_limits(adapter_limits: &wgpu::Limits) -> wgpu::Limits {
 /// [`wgpu::Features::TIMESTAMP_QUERY`] times the trace passes on the GPU
 /// ([`crate::film::RenderStats::gpu_time`]), and [`wgpu::Features::SUBGROUP`] lets the
 /// fused kernel's traversals give way to finished lanes
-/// ([`super::ShaderFeatures::refill_lanes`]; the 1920x1080 showcase traced 20%
+/// ([`super::ShaderFeatures::refill_lanes`]; the 1920x1080 showcase traced 17-20%
 /// faster with it on lavapipe).
 pub fn optional_features(adapter_features: wgpu::Features) -> wgpu::Features {
     adapter_features & (wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::SUBGROUP)
