@@ -313,31 +313,56 @@ fn intersect_plane(ray: Ray, normal: vec3<f32>, offset: f32, t_max: f32) -> f32 
 // (z, x) or (x, y), picked with selects (lanes testing different polygons agree on the
 // code path).
 fn project_to_plane(p: vec3<f32>, dropped_axis: u32) -> vec2<f32> {
-    return vec2<f32>(vector_component(p, (dropped_axis + 1u) % 3u),
-                     vector_component(p, (dropped_axis + 2u) % 3u));
+    // (dropped_axis + 1) mod 3 and (dropped_axis + 2) mod 3 without an integer division
+    // (per lane on CPU devices).
+    let u_axis = select(dropped_axis + 1u, 0u, dropped_axis == 2u);
+    let v_axis = select(2u, dropped_axis - 1u, dropped_axis > 0u);
+    return vec2<f32>(vector_component(p, u_axis), vector_component(p, v_axis));
 }
 //#endif
 
 //#if POLYGONS
-// Even-odd (crossing number) inside test in the projection that drops the polygon's
-// dominant axis (Haines, "Point in Polygon Strategies", Graphics Gems IV). The vertices
-// come projected already (`polygon_points`, the same f32 coordinates).
+// Whether the edge from `previous` to `current` crosses the ray from `point` along +u:
+// one step of the even-odd (crossing number) rule (Haines, "Point in Polygon
+// Strategies", Graphics Gems IV). Branch-free, so an unrolled test stays straight-line
+// code; an edge that does not straddle the point's v (a horizontal one included, whose
+// crossing is a division by zero) never counts.
+fn edge_crosses(point: vec2<f32>, previous: vec2<f32>, current: vec2<f32>) -> bool {
+    let straddles = (current.y > point.y) != (previous.y > point.y);
+    // point.x < current.x + (point.y - current.y) (previous.x - current.x) / dy, with
+    // both sides multiplied by dy (whose sign flips the comparison): no division.
+    let dy = previous.y - current.y;
+    let left = (point.x - current.x) * dy;
+    let right = (point.y - current.y) * (previous.x - current.x);
+    return straddles & select((right < left), (left < right), (dy > 0.0));
+}
+//#endif
+
+//#if POLYGONS
+// Even-odd inside test in the projection that drops the polygon's dominant axis (Haines,
+// as above). The vertices come projected already (`polygon_points`, the same f32
+// coordinates). Triangles and quads, the common case, take a loop-free path: four edges
+// over the vertices with indices clamped to the last one, so a triangle's fourth edge
+// joins its last vertex to itself and cannot cross (the even-odd count is unchanged).
 fn point_in_polygon(p: vec3<f32>, polygon: Polygon) -> bool {
-    // Its loop's iterations count against the invocation's budget (traverse.wgsl).
+    // Its edges count against the invocation's budget (traverse.wgsl).
     iterations += polygon.vertex_count;
     let point = project_to_plane(p, polygon.dropped_axis);
+    let first = polygon.first_vertex;
+    let last = first + polygon.vertex_count - 1u;
+    if polygon.vertex_count <= 4u {
+        let p0 = polygon_point(first);
+        let p1 = polygon_point(min(first + 1u, last));
+        let p2 = polygon_point(min(first + 2u, last));
+        let p3 = polygon_point(last);
+        return (edge_crosses(point, p3, p0) != edge_crosses(point, p0, p1))
+            != (edge_crosses(point, p1, p2) != edge_crosses(point, p2, p3));
+    }
     var inside = false;
-    let last = polygon.first_vertex + polygon.vertex_count - 1u;
     var previous = polygon_point(last);
     for (var i = 0u; i < polygon.vertex_count; i += 1u) {
-        let current = polygon_point(polygon.first_vertex + i);
-        if (current.y > point.y) != (previous.y > point.y) {
-            let crossing_u = current.x
-                + (point.y - current.y) * (previous.x - current.x) / (previous.y - current.y);
-            if point.x < crossing_u {
-                inside = !inside;
-            }
-        }
+        let current = polygon_point(first + i);
+        inside = inside != edge_crosses(point, previous, current);
         previous = current;
     }
     return inside;
