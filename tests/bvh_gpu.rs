@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::geometry::{blob, mixed_shapes, random_rays, rays_through_mesh_edges};
+use common::geometry::{blob, mixed_shapes, random_rays, rays_through_mesh_edges, small_polygons};
 use glam::{DMat4, DQuat, DVec3};
 use gpu_render::accel::{BuildMethod, SceneGeometry};
 use gpu_render::cpu::intersect::Ray;
@@ -347,6 +347,18 @@ fn gpu_traversal_equals_gpu_brute_force_and_the_cpu() {
     );
     let (shapes, rays) = rays_through_mesh_edges();
     check(&gpu, shapes, rays, "mesh edges", true);
+}
+
+/// Triangles and quads, convex and concave, given as polygons take the GPU's loop-free
+/// inside test: rays aimed in, around and near the edges of each find the same hits by
+/// traversal and by brute force, and their distances agree with the f64 CPU twin.
+#[test]
+fn small_polygons_agree_with_the_cpu() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let (shapes, rays) = small_polygons(0x9a11);
+    check(&gpu, shapes, rays, "small polygons", false);
 }
 
 /// Instanced meshes (a two-level BVH): the traversal, whole and suspended after every

@@ -276,3 +276,58 @@ pub fn blob(rings: usize, segments: usize) -> Mesh {
         instances: vec![],
     }
 }
+
+/// Triangles, convex quads and concave quads ("darts") given as polygons in random
+/// planes, 60 in all, with 40 rays at each aimed at random points of its plane up to
+/// 1.4 times its radius from its centre: inside, outside and near its edges. The GPU
+/// tests polygons of up to four vertices without a loop (`shaders/intersect.wgsl`).
+pub fn small_polygons(seed: u64) -> (Vec<Shape>, Vec<Ray>) {
+    let mut rng = SplitMix(seed);
+    let mut shapes = Vec::new();
+    let mut rays = Vec::new();
+    for i in 0..60 {
+        let center = rng.point(4.0);
+        let normal = rng.direction();
+        let u = normal.any_orthonormal_vector();
+        let v = normal.cross(u);
+        let radius = 0.2 + 0.4 * rng.next_f64();
+        let corners: Vec<DVec2> = match i % 3 {
+            0 => (0..3)
+                .map(|k| {
+                    let a = std::f64::consts::TAU * (k as f64 + 0.6 * rng.next_f64()) / 3.0;
+                    DVec2::new(a.cos(), a.sin())
+                })
+                .collect(),
+            1 => (0..4)
+                .map(|k| {
+                    let a = std::f64::consts::TAU * (k as f64 + 0.6 * rng.next_f64()) / 4.0;
+                    DVec2::new(a.cos(), a.sin()) * (0.6 + 0.4 * rng.next_f64())
+                })
+                .collect(),
+            _ => vec![
+                DVec2::new(0.0, 1.0),
+                DVec2::new(-1.0, -1.0),
+                DVec2::new(0.0, -0.2 + 0.6 * rng.next_f64()),
+                DVec2::new(1.0, -1.0),
+            ],
+        };
+        let on_plane = |p: DVec2| center + (u * p.x + v * p.y) * radius;
+        shapes.push(Shape::Polygon {
+            vertices: corners.iter().map(|&p| on_plane(p)).collect(),
+            material: 0,
+        });
+        for _ in 0..40 {
+            let target = on_plane(DVec2::new(
+                2.8 * rng.next_f64() - 1.4,
+                2.8 * rng.next_f64() - 1.4,
+            ));
+            let side = if rng.next_f64() < 0.5 { 1.0 } else { -1.0 };
+            let origin = target + (normal * side + rng.point(0.5)) * 3.0;
+            rays.push(Ray {
+                origin,
+                direction: (target - origin).normalize(),
+            });
+        }
+    }
+    (shapes, rays)
+}
