@@ -278,10 +278,20 @@ pub fn blob(rings: usize, segments: usize) -> Mesh {
 }
 
 /// Triangles, convex quads and concave quads ("darts") given as polygons in random
-/// planes, 60 in all, with 40 rays at each aimed at random points of its plane up to
-/// 1.4 times its radius from its centre: inside, outside and near its edges. The GPU
-/// tests polygons of up to four vertices without a loop (`shaders/intersect.wgsl`).
+/// planes, 60 in all, with 40 rays at each aimed at random points of its plane within
+/// 1.4 radii of its centre along each of the plane's axes: inside, outside and near its
+/// edges. The GPU tests polygons of up to four vertices without a loop
+/// (`shaders/intersect.wgsl`).
 pub fn small_polygons(seed: u64) -> (Vec<Shape>, Vec<Ray>) {
+    // `n` corners at jittered angles, each at a distance in [1 - shrink, 1]: convex.
+    let jittered = |rng: &mut SplitMix, n: usize, shrink: f64| -> Vec<DVec2> {
+        (0..n)
+            .map(|k| {
+                let a = std::f64::consts::TAU * (k as f64 + 0.6 * rng.next_f64()) / n as f64;
+                DVec2::new(a.cos(), a.sin()) * (1.0 - shrink * rng.next_f64())
+            })
+            .collect()
+    };
     let mut rng = SplitMix(seed);
     let mut shapes = Vec::new();
     let mut rays = Vec::new();
@@ -291,19 +301,9 @@ pub fn small_polygons(seed: u64) -> (Vec<Shape>, Vec<Ray>) {
         let u = normal.any_orthonormal_vector();
         let v = normal.cross(u);
         let radius = 0.2 + 0.4 * rng.next_f64();
-        let corners: Vec<DVec2> = match i % 3 {
-            0 => (0..3)
-                .map(|k| {
-                    let a = std::f64::consts::TAU * (k as f64 + 0.6 * rng.next_f64()) / 3.0;
-                    DVec2::new(a.cos(), a.sin())
-                })
-                .collect(),
-            1 => (0..4)
-                .map(|k| {
-                    let a = std::f64::consts::TAU * (k as f64 + 0.6 * rng.next_f64()) / 4.0;
-                    DVec2::new(a.cos(), a.sin()) * (0.6 + 0.4 * rng.next_f64())
-                })
-                .collect(),
+        let corners = match i % 3 {
+            0 => jittered(&mut rng, 3, 0.0),
+            1 => jittered(&mut rng, 4, 0.4),
             _ => vec![
                 DVec2::new(0.0, 1.0),
                 DVec2::new(-1.0, -1.0),
