@@ -65,6 +65,9 @@ struct Args {
     /// (`GpuRenderer::with_refill_lanes(false)`).
     #[arg(long)]
     no_refill: bool,
+    /// Small scenes walk their BVH too (`GpuRenderer::with_unrolled_primitives(false)`).
+    #[arg(long)]
+    no_unrolled: bool,
     /// Path slots of the GPU trace (default: the adapter's, `default_slot_count`).
     #[arg(long)]
     slots: Option<u32>,
@@ -384,7 +387,8 @@ fn main() -> Result<()> {
     let gpu = HeadlessGpu::new(&AdapterChoice::Default).context("no GPU adapter")?;
     let mut renderer = GpuRenderer::new(&gpu.device)?
         .with_uniform_records(!args.storage_records)
-        .with_refill_lanes(!args.no_refill);
+        .with_refill_lanes(!args.no_refill)
+        .with_unrolled_primitives(!args.no_unrolled);
     if let Some(slots) = args.slots {
         renderer = renderer.with_slot_count(slots);
     }
@@ -418,7 +422,7 @@ fn main() -> Result<()> {
     let primitives = gpu_render::accel::SceneGeometry::new(&scene).bounded_count();
     println!(
         "GPU scene buffers: {} bytes for {primitives} bounded primitives ({:.1} bytes each, \
-         BVH included); BVH built in {:.1} ms; records in {} buffers",
+         BVH included); BVH built in {:.1} ms; records in {} buffers; closest hit {}",
         prepared.scene_bytes(),
         prepared.scene_bytes() as f64 / primitives.max(1) as f64,
         prepared.bvh_stats().build_time.as_secs_f64() * 1e3,
@@ -426,6 +430,11 @@ fn main() -> Result<()> {
             "uniform"
         } else {
             "storage"
+        },
+        if prepared.features().unrolled.is_some() {
+            "unrolled"
+        } else {
+            "by the BVH"
         }
     );
     drop(prepared);

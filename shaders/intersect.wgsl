@@ -347,10 +347,15 @@ fn edge_crosses(point: vec2<f32>, previous: vec2<f32>, current: vec2<f32>) -> bo
 fn point_in_polygon(p: vec3<f32>, polygon: Polygon) -> bool {
     // Its edges count against the invocation's budget (traverse.wgsl).
     iterations += polygon.vertex_count;
-    let point = project_to_plane(p, polygon.dropped_axis);
-    let first = polygon.first_vertex;
-    let last = first + polygon.vertex_count - 1u;
-    if polygon.vertex_count <= 4u {
+    return inside_polygon_points(project_to_plane(p, polygon.dropped_axis), polygon.first_vertex,
+                                 polygon.vertex_count);
+}
+
+// The even-odd test of point_in_polygon for `point`, already projected, against the
+// `count` projected vertices from `first` in polygon_points.
+fn inside_polygon_points(point: vec2<f32>, first: u32, count: u32) -> bool {
+    let last = first + count - 1u;
+    if count <= 4u {
         let p0 = polygon_point(first);
         let p1 = polygon_point(min(first + 1u, last));
         let p2 = polygon_point(min(first + 2u, last));
@@ -360,7 +365,7 @@ fn point_in_polygon(p: vec3<f32>, polygon: Polygon) -> bool {
     }
     var inside = false;
     var previous = polygon_point(last);
-    for (var i = 0u; i < polygon.vertex_count; i += 1u) {
+    for (var i = 0u; i < count; i += 1u) {
         let current = polygon_point(first + i);
         inside = inside != edge_crosses(point, previous, current);
         previous = current;

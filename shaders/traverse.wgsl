@@ -17,6 +17,17 @@
 // that ends without reaching one of its exits was cut by the driver all the same: that
 // sets ERROR_LOOP_CUT for the host, which then refuses the image.
 
+// Unrolled scenes: a scene of a few primitives (src/gpu/unrolled.rs says which) gets
+// no tree walk at all. The host writes unrolled_closest_hit, one call of the helpers
+// below per primitive with its record index (and a polygon's vertices) as literals, so
+// every record is read at a constant offset: llvmpipe loads such a record once for all
+// lanes, where a per-lane index costs a load per lane and component, and the
+// primitive's kind is known at compile time. The nearest hit, ties to the smaller
+// reference, is the tree's (which only skips primitives whose boxes the ray misses),
+// so the image is the same; glass.toml traced 34% faster (BENCHMARKS.md, "Unrolled
+// scenes"). Its work is bounded by the scene: at most
+// MAX_UNROLLED_PRIMITIVES records, charged to `iterations` like the tree's tests.
+
 // Direction components smaller than this are replaced by it (with their sign; -0
 // counts as positive) before the slab test divides by them: a ray parallel to a slab
 // gets huge but finite distances, never the NaN of 0·∞.
@@ -171,6 +182,18 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) 
     }
     //#endif
     if (*trace).status == TRACE_PENDING {
+        node = NO_NODE;
+        cursor = 0u;
+        leaf_end = 0u;
+        stack_len = 0u;
+        instance = NO_INSTANCE;
+        stack_base = 0u;
+        //#if UNROLLED
+        // A small scene's every primitive, planes included, in straight-line code with
+        // constant record indices (unrolled_closest_hit, written by the host; see
+        // "Unrolled scenes" above): the loop below finds nothing left to visit.
+        unrolled_closest_hit(ray, sheared, &best_t, &best_prim);
+        //#else
         //#if PLANES
         // Planes are unbounded: every ray tests every plane, before the tree.
         var i = 0u;
@@ -193,16 +216,11 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) 
             atomicOr(&counters.errors, ERROR_LOOP_CUT);
         }
         //#endif
-        node = NO_NODE;
-        cursor = 0u;
-        leaf_end = 0u;
-        stack_len = 0u;
-        instance = NO_INSTANCE;
-        stack_base = 0u;
         if frame.node_count > 0u && slab_enter(0u, ray.origin, inverse, best_t) != NO_HIT {
             node = 0u;
             open_if_leaf(&node, &cursor, &leaf_end);
         }
+        //#endif
         (*trace).status = TRACE_RUNNING;
     }
     var finished = false;
@@ -374,3 +392,72 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) 
     //#endif
     return TRAVERSAL_SUSPENDED;
 }
+
+//#if UNROLLED
+//#if SPHERES
+// Unrolled test of sphere record `i` (a literal) against the best hit so far.
+fn unrolled_sphere(i: u32, ray: Ray, best_t: ptr<function, f32>, best_prim: ptr<function, u32>) {
+    let prim = (PRIM_SPHERE << PRIM_KIND_SHIFT) | i;
+    iterations += 1u;
+    let sphere = spheres[i];
+    let t = intersect_sphere(ray, sphere.anchor, sphere.normal, sphere.radius,
+                             tie_limit(prim, *best_t, *best_prim));
+    if t != NO_HIT {
+        *best_t = t;
+        *best_prim = prim;
+    }
+}
+//#endif
+
+//#if PLANES
+// Unrolled test of plane record `i` (a literal).
+fn unrolled_plane(i: u32, ray: Ray, best_t: ptr<function, f32>, best_prim: ptr<function, u32>) {
+    let prim = (PRIM_PLANE << PRIM_KIND_SHIFT) | i;
+    iterations += 1u;
+    let plane = planes[i];
+    let t = intersect_plane(ray, plane.normal, plane.offset, tie_limit(prim, *best_t, *best_prim));
+    if t != NO_HIT {
+        *best_t = t;
+        *best_prim = prim;
+    }
+}
+//#endif
+
+//#if POLYGONS
+// Unrolled test of polygon record `i` whose `count` vertices start at `first` in
+// polygon_points (literals, as upload wrote them): intersect_polygon with the
+// vertices read at constant offsets.
+fn unrolled_polygon(i: u32, first: u32, count: u32, ray: Ray, best_t: ptr<function, f32>,
+                    best_prim: ptr<function, u32>) {
+    let prim = (PRIM_POLYGON << PRIM_KIND_SHIFT) | i;
+    iterations += 1u;
+    let polygon = polygons[i];
+    let t = intersect_plane(ray, polygon.normal, polygon.offset, tie_limit(prim, *best_t, *best_prim));
+    if t == NO_HIT {
+        return;
+    }
+    // The same rule and charge as point_in_polygon (shaders/intersect.wgsl).
+    iterations += count;
+    if inside_polygon_points(project_to_plane(ray_at(ray, t), polygon.dropped_axis), first, count) {
+        *best_t = t;
+        *best_prim = prim;
+    }
+}
+//#endif
+
+//#if TRIANGLES
+// Unrolled test of triangle record `i` (a literal).
+fn unrolled_triangle(i: u32, sheared: ShearedRay, best_t: ptr<function, f32>,
+                     best_prim: ptr<function, u32>) {
+    let prim = (PRIM_TRIANGLE << PRIM_KIND_SHIFT) | i;
+    iterations += 1u;
+    let triangle = triangles[i];
+    let t = intersect_triangle(sheared, triangle.v0, triangle.v1, triangle.v2,
+                               tie_limit(prim, *best_t, *best_prim));
+    if t != NO_HIT {
+        *best_t = t;
+        *best_prim = prim;
+    }
+}
+//#endif
+//#endif

@@ -166,6 +166,7 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         environment_map: false,
         uniform_records: false,
         refill_lanes: false,
+        unrolled: None,
     };
     type Toggle = fn(&mut ShaderFeatures, bool);
     let toggles: [Toggle; 15] = [

@@ -9,6 +9,7 @@
 //! to remove it. Dropping the text means a module for a scene without glass really
 //! has no refraction code, which `tests/specialisation.rs` checks on the naga module.
 
+use super::unrolled::UnrolledPrimitives;
 use crate::accel::MAX_POLYGON_VERTICES;
 use crate::scene::{MaterialKind, Scene, Shape};
 
@@ -64,6 +65,11 @@ pub struct ShaderFeatures {
     /// [`ShaderFeatures::for_scene`], and [`ShaderFeatures::ALL`] leaves it out. The
     /// image does not depend on it.
     pub refill_lanes: bool,
+    /// The closest-hit test of a small scene as straight-line code over its primitives
+    /// (`UNROLLED`; see [`super::unrolled`]), instead of the BVH's walk: chosen at
+    /// upload for small scenes on CPU devices, never by [`ShaderFeatures::for_scene`],
+    /// and [`ShaderFeatures::ALL`] leaves it out. The image does not depend on it.
+    pub unrolled: Option<UnrolledPrimitives>,
 }
 
 impl ShaderFeatures {
@@ -87,6 +93,7 @@ impl ShaderFeatures {
         environment_map: true,
         uniform_records: false,
         refill_lanes: false,
+        unrolled: None,
     };
 
     /// Exactly the features `scene` uses.
@@ -126,6 +133,7 @@ impl ShaderFeatures {
             environment_map: scene.environment.map.is_some(),
             uniform_records: false,
             refill_lanes: false,
+            unrolled: None,
         }
     }
 
@@ -159,7 +167,7 @@ impl ShaderFeatures {
 type FeatureFlag = fn(&ShaderFeatures) -> bool;
 
 /// The name of each feature in the WGSL directives, with the flag it reads.
-const FEATURE_NAMES: [(&str, FeatureFlag); 16] = [
+const FEATURE_NAMES: [(&str, FeatureFlag); 17] = [
     ("SPHERES", |f| f.spheres),
     ("PLANES", |f| f.planes),
     ("POLYGONS", |f| f.polygons),
@@ -176,6 +184,7 @@ const FEATURE_NAMES: [(&str, FeatureFlag); 16] = [
     ("PATH", |f| f.path),
     ("ENVIRONMENT_MAP", |f| f.environment_map),
     ("REFILL_LANES", |f| f.refill_lanes),
+    ("UNROLLED", |f| f.unrolled.is_some()),
 ];
 
 /// Keeps the lines of `source` whose enclosing `//#if` directives hold for `features`

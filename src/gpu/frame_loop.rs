@@ -15,7 +15,7 @@ use super::limits::{check_limits, required_limits};
 use super::pipelines::{DISPLAY_FORMAT, Pipelines};
 use super::readback::{read_texture, wait};
 use super::renderer::create_texture;
-use super::scene_buffers::upload_scene;
+use super::scene_buffers::{UploadOptions, upload_scene};
 use super::shaders::{SLOT_WORKGROUP_SIZE, WORKGROUP_SIZE};
 use super::wavefront::{Schedule, default_schedule, encode_rounds, iteration_budget_for};
 use super::{GpuError, RenderError};
@@ -67,6 +67,10 @@ pub struct RendererOptions {
     /// give way to lanes whose rays finished (`true`, faster on lavapipe; see
     /// [`super::ShaderFeatures::refill_lanes`]). The image does not depend on it.
     pub refill_lanes: bool,
+    /// On CPU devices, test the primitives of scenes small enough unrolled instead of
+    /// walking their BVH (`true`, faster there; see [`super::ShaderFeatures::unrolled`]).
+    /// The image does not depend on it.
+    pub unrolled: bool,
 }
 
 impl Default for RendererOptions {
@@ -80,6 +84,7 @@ impl Default for RendererOptions {
             specialise: true,
             uniform_records: true,
             refill_lanes: true,
+            unrolled: true,
         }
     }
 }
@@ -212,9 +217,12 @@ impl Renderer {
             queue,
             scene,
             &geometry,
-            self.options.specialise,
-            self.options.uniform_records,
-            self.options.refill_lanes,
+            UploadOptions {
+                specialise: self.options.specialise,
+                allow_uniform_records: self.options.uniform_records,
+                allow_refill_lanes: self.options.refill_lanes,
+                allow_unrolled: self.options.unrolled,
+            },
         )
         .map_err(|e| match e {
             GpuError::Validation(_) | GpuError::DeviceLimit { .. } => RenderError::Scene(e),

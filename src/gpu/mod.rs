@@ -14,7 +14,8 @@
 //! - `pipelines`, `display`: the pipelines and the display pass.
 //! - [`upload`]: pure conversion of a [`crate::scene::Scene`] into the GPU records.
 //! - [`shaders`]: composition of the WGSL sources, specialised by [`features`];
-//!   `uniform_records`: the scene records CPU devices read from uniform buffers.
+//!   `uniform_records`: the scene records CPU devices read from uniform buffers;
+//!   [`unrolled`]: small scenes' closest-hit test without the tree.
 //! - [`layout`]: the `#[repr(C)]` records shared with `shaders/types.wgsl`.
 //!
 //! ```no_run
@@ -47,6 +48,7 @@ pub mod renderer;
 mod scene_buffers;
 pub mod shaders;
 mod uniform_records;
+pub mod unrolled;
 pub mod upload;
 mod wavefront;
 

@@ -24,7 +24,7 @@ use super::display::{check_texture, encode_display};
 use super::features::ShaderFeatures;
 use super::pipelines::{LINEAR_FORMAT, Pipelines, TRACE_STORAGE_BUFFERS, TracePipelines};
 use super::readback::{Caught, capture};
-use super::scene_buffers::{PreparedScene, upload_scene};
+use super::scene_buffers::{PreparedScene, UploadOptions, upload_scene};
 use super::wavefront::{
     Schedule, SlotBuffers, default_schedule, iteration_budget_for, trace_region,
 };
@@ -56,6 +56,7 @@ pub struct GpuRenderer {
     specialise: bool,
     uniform_records: bool,
     refill_lanes: bool,
+    unrolled: bool,
     iteration_budget: Option<u32>,
     slot_count: Option<u32>,
     schedule: Option<Schedule>,
@@ -117,6 +118,7 @@ impl GpuRenderer {
             specialise: true,
             uniform_records: true,
             refill_lanes: true,
+            unrolled: true,
             iteration_budget: None,
             slot_count: None,
             schedule: None,
@@ -172,6 +174,14 @@ impl GpuRenderer {
     /// same.
     pub fn with_refill_lanes(mut self, refill_lanes: bool) -> Self {
         self.refill_lanes = refill_lanes;
+        self
+    }
+
+    /// With `false`, small scenes are traced through their BVH like any other, instead
+    /// of with their closest-hit test unrolled on CPU devices (see
+    /// [`ShaderFeatures::unrolled`]). For measurements and tests; the image is the same.
+    pub fn with_unrolled_primitives(mut self, unrolled: bool) -> Self {
+        self.unrolled = unrolled;
         self
     }
 
@@ -275,9 +285,12 @@ impl GpuRenderer {
             queue,
             scene,
             geometry,
-            self.specialise,
-            self.uniform_records,
-            self.refill_lanes,
+            UploadOptions {
+                specialise: self.specialise,
+                allow_uniform_records: self.uniform_records,
+                allow_refill_lanes: self.refill_lanes,
+                allow_unrolled: self.unrolled,
+            },
         )
     }
 

@@ -10,6 +10,7 @@ use super::layout::FrameUniforms;
 use super::pipelines::binding;
 use super::readback::{Caught, capture};
 use super::uniform_records;
+use super::unrolled::{self, UnrolledPrimitives};
 use super::upload::{SceneRecords, frame_uniforms, image_layers};
 use crate::accel::{BrdfMapCdfs, BvhStats, EnvironmentLight, MAX_PLANES, SceneGeometry};
 use crate::scene::{Integrator, Scene};
@@ -105,21 +106,41 @@ impl PreparedScene {
     }
 }
 
+/// How [`upload_scene`] may specialise a scene's trace module.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct UploadOptions {
+    /// Only the features the scene uses ([`ShaderFeatures::for_scene`]), else all.
+    pub specialise: bool,
+    /// Records in uniform buffers where the device prefers them and they fit.
+    pub allow_uniform_records: bool,
+    /// Traversals that give way, where the device has subgroup operations.
+    pub allow_refill_lanes: bool,
+    /// A small scene's closest-hit test unrolled, where the device prefers it
+    /// ([`super::unrolled`]).
+    pub allow_unrolled: bool,
+}
+
 /// Uploads `scene` (as loaded: it is converted to its lighting space here) with its
 /// `geometry` (built from the lighting-space-independent shapes). With
 /// `allow_uniform_records`, a scene whose records fit is bound with uniform records
 /// where the device prefers them (see `super::uniform_records`). With
 /// `allow_refill_lanes`, the trace module gives way to finished lanes
-/// ([`ShaderFeatures::refill_lanes`]) where the device has subgroup operations.
+/// ([`ShaderFeatures::refill_lanes`]) where the device has subgroup operations. With
+/// `allow_unrolled`, a small scene's closest-hit test is unrolled
+/// ([`ShaderFeatures::unrolled`]) where the device prefers it.
 pub(crate) fn upload_scene(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     scene: &Scene,
     geometry: &SceneGeometry,
-    specialise: bool,
-    allow_uniform_records: bool,
-    allow_refill_lanes: bool,
+    options: UploadOptions,
 ) -> Result<PreparedScene, GpuError> {
+    let UploadOptions {
+        specialise,
+        allow_uniform_records,
+        allow_refill_lanes,
+        allow_unrolled,
+    } = options;
     scene.render.check().map_err(GpuError::Validation)?;
     if geometry.planes.len() > MAX_PLANES {
         return Err(GpuError::DeviceLimit {
@@ -251,6 +272,15 @@ pub(crate) fn upload_scene(
         )?,
         environment: upload("environment map", binding::ENVIRONMENT, &environment)?,
     };
+    let unrolled = if allow_unrolled
+        && unrolled::preferred(&device.adapter_info())
+        && geometry.instances.is_empty()
+        && geometry.instanced_meshes.is_empty()
+    {
+        UnrolledPrimitives::for_scene(&records.bvh_prims, records.planes.len(), &records.polygons)
+    } else {
+        None
+    };
     let (images, image_bytes) = upload_images(device, queue, &shaded, &limits)?;
     Ok(PreparedScene {
         frame,
@@ -264,6 +294,7 @@ pub(crate) fn upload_scene(
             uniform_records,
             refill_lanes: allow_refill_lanes
                 && device.features().contains(wgpu::Features::SUBGROUP),
+            unrolled,
             ..if specialise {
                 ShaderFeatures::for_scene(scene)
             } else {

@@ -63,7 +63,8 @@ pub const WORKGROUP_SIZE: u32 = 8;
 /// constants shared with the Rust side (`MAX_BVH_DEPTH`, `MAX_POLYGON_VERTICES`), the
 /// record bindings (storage or uniform arrays, as `features.uniform_records` says), then
 /// types, path types, sampling, intersect, texture, bxdf, environment, traverse, noise,
-/// trace, path and the tabulated BRDF sampler.
+/// trace, path and the tabulated BRDF sampler, then for an unrolled scene its
+/// `unrolled_closest_hit` ([`super::unrolled`]).
 ///
 /// Errors: a message if the sources' feature directives are malformed.
 ///
@@ -99,6 +100,9 @@ pub fn trace_shader_source(features: &ShaderFeatures) -> Result<String, String> 
     ));
     for part in parts {
         source.push_str(&specialise(part, features)?);
+    }
+    if let Some(unrolled) = &features.unrolled {
+        source.push_str(&unrolled.wgsl());
     }
     Ok(source)
 }
