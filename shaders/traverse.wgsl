@@ -181,6 +181,8 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) 
         sheared = shear_ray(ray);
     }
     //#endif
+    // At least one step per call, so that any budget makes progress.
+    var steps = 0u;
     if (*trace).status == TRACE_PENDING {
         node = NO_NODE;
         cursor = 0u;
@@ -193,6 +195,8 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) 
         // constant record indices (unrolled_closest_hit, written by the host; see
         // "Unrolled scenes" above): the loop below finds nothing left to visit.
         unrolled_closest_hit(ray, sheared, &best_t, &best_prim);
+        // The traversal's one step (so that a simulated loop cut still cuts it).
+        steps = 1u;
         //#else
         //#if PLANES
         // Planes are unbounded: every ray tests every plane, before the tree.
@@ -229,8 +233,6 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) 
     // level stack_len - 1, if any, is in memory): a node pushed and popped with no push
     // between never goes through memory. Written back before a suspended call returns.
     var held = NO_NODE;
-    // At least one step per call, so that any budget makes progress.
-    var steps = 0u;
     // One loop whose every step is either a primitive test (while the lane has a leaf
     // open) or a node step (pop, or visit an inner node and open the child it descends
     // into if that is a leaf), so that a lane never waits for the others to finish a

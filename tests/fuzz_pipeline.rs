@@ -107,6 +107,57 @@ fn random_hostile_scenes_render_alike_on_both_backends() {
     }
 }
 
+/// Cases with their primitives unrolled (`gpu_render::gpu::unrolled`, on CPU devices):
+/// fewer, as each compiles a module of its own. Most are unrolled (at most seven
+/// objects; the larger polygons' triangles may pass the limit).
+const UNROLLED_CASES: u32 = 16;
+
+/// The same check with the primitives of each case tested unrolled rather than through
+/// the tree, from another seed.
+#[test]
+fn random_hostile_scenes_render_alike_unrolled() {
+    let Some(gpu) = common::gpu::headless_gpu() else {
+        return;
+    };
+    let cpu_device = gpu.adapter_info().device_type == wgpu::DeviceType::Cpu;
+    let checker = PipelineChecker::unrolled(gpu);
+    let mut runner = TestRunner::new_with_rng(
+        Config {
+            cases: UNROLLED_CASES,
+            failure_persistence: None,
+            max_shrink_iters: 64,
+            ..Config::default()
+        },
+        rng(CI_SEED + 1),
+    );
+    let unrolled = std::cell::Cell::new(0);
+    let outcome = runner.run(&pipeline::scene_text(), |text| {
+        unrolled.set(unrolled.get() + usize::from(checker.unrolls(&text)));
+        checker
+            .check(&text)
+            .map(|_| ())
+            .map_err(|failed| TestCaseError::fail(failed.reason))
+    });
+    if let Err(error) = outcome {
+        let minimal = match &error {
+            proptest::test_runner::TestError::Fail(_, text) => text.clone(),
+            other => panic!("the fuzzer stopped: {other}"),
+        };
+        let failed = checker.check(&minimal).err().unwrap_or_else(|| Failed {
+            reason: format!("{error} (passed when checked again)"),
+            images: None,
+        });
+        report_failure("fuzz-pipeline-unrolled-failure", &minimal, &failed);
+    }
+    if cpu_device {
+        assert!(
+            unrolled.get() * 2 >= UNROLLED_CASES as usize,
+            "only {} of {UNROLLED_CASES} cases were unrolled",
+            unrolled.get()
+        );
+    }
+}
+
 /// Every scene that ever failed, replayed through the same check.
 #[test]
 fn regression_corpus_renders_alike_on_both_backends() {

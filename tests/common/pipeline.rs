@@ -670,12 +670,36 @@ pub struct Failed {
 }
 
 impl PipelineChecker {
-    /// A checker on `gpu`.
+    /// A checker on `gpu`: every case with the general trace module walking the BVH,
+    /// one module for all cases (compiled once).
     pub fn new(gpu: HeadlessGpu) -> Self {
+        let renderer = GpuRenderer::new(&gpu.device)
+            .unwrap_or_else(|e| panic!("GpuRenderer::new failed: {e}"))
+            .with_specialisation(false)
+            .with_unrolled_primitives(false);
+        Self { gpu, renderer }
+    }
+
+    /// A checker on `gpu` whose cases, on CPU devices, test their primitives unrolled
+    /// (`gpu_render::gpu::unrolled`): a module of its own for every case, as each
+    /// names its primitives, so a few seconds of compiling per case on lavapipe.
+    pub fn unrolled(gpu: HeadlessGpu) -> Self {
         let renderer = GpuRenderer::new(&gpu.device)
             .unwrap_or_else(|e| panic!("GpuRenderer::new failed: {e}"))
             .with_specialisation(false);
         Self { gpu, renderer }
+    }
+
+    /// Whether `text`'s scene, prepared by this checker, tests its primitives unrolled.
+    pub fn unrolls(&self, text: &str) -> bool {
+        gpu_render::scene::parse_scene(text, std::path::Path::new("<fuzz>"))
+            .ok()
+            .and_then(|scene| {
+                self.renderer
+                    .prepare(&self.gpu.device, &self.gpu.queue, &scene)
+                    .ok()
+            })
+            .is_some_and(|prepared| prepared.features().unrolled.is_some())
     }
 
     /// Parses `text` (which must be accepted), renders it on the CPU and the GPU and
