@@ -5,6 +5,7 @@ use std::io::Write;
 use anyhow::{Context, Result, bail};
 use gpu_render::cpu;
 use gpu_render::film::{LinearImage, ProgressFn, RenderStats, Rendered};
+use gpu_render::gpu::unrolled::MAX_UNROLLED_PRIMITIVES;
 use gpu_render::gpu::{self, AdapterChoice, GpuRenderer, HeadlessGpu, TraceRegion};
 use gpu_render::noise::NoiseEstimate;
 use gpu_render::scene::{Integrator, Scene};
@@ -254,11 +255,14 @@ impl Backend {
 /// (whose loops have no limit, `gpu::driver_loop_limit`) on Whitted scenes without
 /// meshes, that is without models loaded from files (loose triangles are fine): the
 /// 1920x1080 showcase 1.10x, the direct-light scene 2.5x, the Whitted caustic and
-/// Cornell box 1.4x-1.6x, with lanes refilled (`gpu::ShaderFeatures::refill_lanes`);
-/// `glass.toml`, at 0.94x-0.96x, is the one such scene measured slower. Meshes make it
-/// slower (`models.toml`, OBJ and glTF tori and vases, 0.55x), and so does every scene
-/// on older Mesa, and every path-traced scene (the Cornell box: `BENCHMARKS.md`, "Path
-/// tracing on the GPU"). On any device, a scene with a sphere that only the CPU
+/// Cornell box 1.4x-1.6x, with lanes refilled (`gpu::ShaderFeatures::refill_lanes`),
+/// and `glass.toml` 1.6x with its primitives unrolled (`gpu::unrolled`); and on
+/// path-traced scenes of at most `gpu::unrolled::MAX_UNROLLED_PRIMITIVES` primitives
+/// without meshes, unrolled (the Cornell box 1.8x, the caustic and the environment-lit
+/// materials 1.1x). Meshes make it slower (`models.toml`, OBJ and glTF tori and vases,
+/// 0.55x), and so does every scene on older Mesa, and larger path-traced scenes (the
+/// Cornell box walking its tree, 0.8x: `BENCHMARKS.md`, "Unrolled scenes"). On
+/// any device, a scene with a sphere that only the CPU
 /// reference's f64 places precisely enough (`scene::sphere_precision`: a small sphere far
 /// from the origin seen from close by) renders on the CPU. Returns
 /// why the CPU reference is chosen instead, if it is.
@@ -275,7 +279,10 @@ pub fn auto_rule(adapter: &wgpu::AdapterInfo, scene: &Scene) -> Option<String> {
     let why = if gpu::driver_loop_limit(adapter).is_some() {
         "on this driver version the CPU reference is faster for every scene measured"
     } else if scene.render.integrator == Integrator::Path {
-        "for path-traced scenes the CPU reference is faster"
+        if scene.meshes.is_empty() && unrolled_primitives(scene) <= MAX_UNROLLED_PRIMITIVES {
+            return None;
+        }
+        "for path-traced scenes of more than a few primitives the CPU reference is faster"
     } else {
         if scene.meshes.is_empty() {
             return None;
@@ -287,6 +294,24 @@ pub fn auto_rule(adapter: &wgpu::AdapterInfo, scene: &Scene) -> Option<String> {
          uses it anyway",
         adapter.name
     ))
+}
+
+/// The primitives a scene without meshes has for an unrolled closest-hit test
+/// (`gpu::unrolled`): one per shape, a polygon of more vertices than the GPU tests
+/// directly counted as its triangles.
+fn unrolled_primitives(scene: &Scene) -> usize {
+    scene
+        .shapes
+        .iter()
+        .map(|shape| match shape {
+            gpu_render::scene::Shape::Polygon { vertices, .. }
+                if vertices.len() > gpu_render::accel::MAX_POLYGON_VERTICES =>
+            {
+                vertices.len().saturating_sub(2)
+            }
+            _ => 1,
+        })
+        .sum()
 }
 
 /// The radius of the first sphere that the GPU cannot place precisely enough seen from
@@ -411,7 +436,12 @@ mod tests {
             "[render]\nintegrator = \"path\"\n{camera}[materials.m]\ntype = \"lambert\"\n\
              albedo = 0.5\n{sphere}"
         ));
-        let reason = auto_rule(&new, &path).expect("path tracing renders on the CPU");
+        assert_eq!(auto_rule(&new, &path), None, "a small path-traced scene");
+        let mut large_path = path.clone();
+        while super::unrolled_primitives(&large_path) <= super::MAX_UNROLLED_PRIMITIVES {
+            large_path.shapes.push(path.shapes[0].clone());
+        }
+        let reason = auto_rule(&new, &large_path).expect("larger path tracing renders on the CPU");
         assert!(reason.contains("path-traced"), "{reason}");
         assert_eq!(
             auto_rule(
