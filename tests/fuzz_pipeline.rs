@@ -86,8 +86,16 @@ fn random_hostile_scenes_render_alike_on_both_backends() {
         max_shrink_iters: 256,
         ..Config::default()
     };
+    fuzz(&checker, config, seed, "fuzz-pipeline-failure", |_| {});
+}
+
+/// Runs random scenes from `seed` through `checker` under `config`; on a failure,
+/// minimises it, checks the minimal case again for its own images and reason, and
+/// reports it under `name`. `visit` sees each case before it is checked.
+fn fuzz(checker: &PipelineChecker, config: Config, seed: u64, name: &str, visit: impl Fn(&str)) {
     let mut runner = TestRunner::new_with_rng(config, rng(seed));
     let outcome = runner.run(&pipeline::scene_text(), |text| {
+        visit(&text);
         checker
             .check(&text)
             .map(|_| ())
@@ -98,19 +106,18 @@ fn random_hostile_scenes_render_alike_on_both_backends() {
             proptest::test_runner::TestError::Fail(_, text) => text.clone(),
             other => panic!("the fuzzer stopped: {other}"),
         };
-        // Re-check the minimal case for its own images and reason.
         let failed = checker.check(&minimal).err().unwrap_or_else(|| Failed {
             reason: format!("{error} (passed when checked again)"),
             images: None,
         });
-        report_failure("fuzz-pipeline-failure", &minimal, &failed);
+        report_failure(name, &minimal, &failed);
     }
 }
 
 /// Cases with their primitives unrolled (`gpu_render::gpu::unrolled`, on CPU devices):
 /// fewer, as each compiles a module of its own. Most are unrolled (at most seven
 /// objects; the larger polygons' triangles may pass the limit).
-const UNROLLED_CASES: u32 = 16;
+const UNROLLED_CASES: u32 = 8;
 
 /// The same check with the primitives of each case tested unrolled rather than through
 /// the tree, from another seed.
@@ -121,34 +128,20 @@ fn random_hostile_scenes_render_alike_unrolled() {
     };
     let cpu_device = gpu.adapter_info().device_type == wgpu::DeviceType::Cpu;
     let checker = PipelineChecker::unrolled(gpu);
-    let mut runner = TestRunner::new_with_rng(
-        Config {
-            cases: UNROLLED_CASES,
-            failure_persistence: None,
-            max_shrink_iters: 64,
-            ..Config::default()
-        },
-        rng(CI_SEED + 1),
-    );
+    let config = Config {
+        cases: UNROLLED_CASES,
+        failure_persistence: None,
+        max_shrink_iters: 64,
+        ..Config::default()
+    };
     let unrolled = std::cell::Cell::new(0);
-    let outcome = runner.run(&pipeline::scene_text(), |text| {
-        unrolled.set(unrolled.get() + usize::from(checker.unrolls(&text)));
-        checker
-            .check(&text)
-            .map(|_| ())
-            .map_err(|failed| TestCaseError::fail(failed.reason))
-    });
-    if let Err(error) = outcome {
-        let minimal = match &error {
-            proptest::test_runner::TestError::Fail(_, text) => text.clone(),
-            other => panic!("the fuzzer stopped: {other}"),
-        };
-        let failed = checker.check(&minimal).err().unwrap_or_else(|| Failed {
-            reason: format!("{error} (passed when checked again)"),
-            images: None,
-        });
-        report_failure("fuzz-pipeline-unrolled-failure", &minimal, &failed);
-    }
+    fuzz(
+        &checker,
+        config,
+        CI_SEED + 1,
+        "fuzz-pipeline-unrolled-failure",
+        |text| unrolled.set(unrolled.get() + usize::from(checker.unrolls(text))),
+    );
     if cpu_device {
         assert!(
             unrolled.get() * 2 >= UNROLLED_CASES as usize,
