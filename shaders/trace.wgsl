@@ -510,13 +510,18 @@ fn shade_step(slot: u32, path: ptr<function, PathState>, trace: ptr<function, Tr
         //#endif
     }
     if (*path).phase == PHASE_NEXT_LIGHT {
-        // Lights behind the surface cast no ray: skip them here.
+        // Lights behind the surface cast no ray: skip them here. At least one light
+        // per step, so that any budget makes progress: the step itself was charged an
+        // iteration, and a budget of 1 would otherwise spend it on nothing, forever.
         var exited = false;
+        var lights = 0u;
         loop {
-            if iterations >= frame.iteration_budget || (*path).phase != PHASE_NEXT_LIGHT {
+            if (lights > 0u && iterations >= frame.iteration_budget)
+                || (*path).phase != PHASE_NEXT_LIGHT {
                 exited = true;
                 break;
             }
+            lights += 1u;
             iterations += 1u;
             if next_light(path, trace) {
                 exited = true;

@@ -11,6 +11,8 @@
 //! - [`cpu`]: the reference tracer (f64).
 //! - [`gpu`]: the wgpu backend, built from the caller's `Device` and `Queue`.
 //! - [`noise`]: the per-pixel noise estimate (standard error of each pixel's mean).
+//! - [`input`]: opening the files a render reads (regular files only, confined in a
+//!   sandbox without a race).
 //! - [`output`]: writing PNG, EXR and HDR files atomically.
 //! - `plausibility` (with the default `cli` feature): the lecture's three rules checked
 //!   on a tabulated BRDF map, for `gpu-render brdf-check`.
@@ -28,6 +30,7 @@ pub mod color;
 pub mod cpu;
 pub mod film;
 pub mod gpu;
+pub mod input;
 pub mod noise;
 pub mod output;
 #[cfg(feature = "cli")]

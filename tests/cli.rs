@@ -56,6 +56,11 @@ impl Workspace {
     }
 
     fn assert_old_output_kept(&self) {
+        self.assert_old_output_kept_beside(&[]);
+    }
+
+    /// As [`Self::assert_old_output_kept`], with `others` (sorted) also in the folder.
+    fn assert_old_output_kept_beside(&self, others: &[&str]) {
         let now = std::fs::read(self.path("out.png")).expect("read out.png");
         assert_eq!(now, OLD_OUTPUT, "a failed run changed the existing output");
         let mut names: Vec<String> = std::fs::read_dir(self.dir.path())
@@ -63,7 +68,10 @@ impl Workspace {
             .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
             .collect();
         names.sort();
-        assert_eq!(names, ["out.png", "scene.toml"], "stray files left behind");
+        let mut expected: Vec<&str> = others.to_vec();
+        expected.extend(["out.png", "scene.toml"]);
+        expected.sort_unstable();
+        assert_eq!(names, expected, "stray files left behind");
     }
 }
 
@@ -483,6 +491,43 @@ fn albedo_textures_above_one_are_clamped_with_a_warning_unless_quiet() {
 }
 
 #[test]
+fn the_environment_map_is_never_the_output_nor_the_standard_error() {
+    let ws = Workspace::new(&format!("{TINY_SCENE}\n[environment]\nmap = \"sky.hdr\"\n"));
+    let sky = image::Rgb32FImage::from_pixel(4, 2, image::Rgb([0.5, 0.6, 0.7]));
+    image::DynamicImage::ImageRgb32F(sky)
+        .save(ws.path("sky.hdr"))
+        .expect("write the map");
+    let before = std::fs::read(ws.path("sky.hdr")).expect("read");
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("sky.hdr"),
+        "--backend",
+        "cpu",
+    ]);
+    assert_fails_with(&run, &["sky.hdr", "same file as the environment map"]);
+    std::fs::copy(ws.path("sky.hdr"), ws.path("sky.exr")).expect("copy");
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(ws.path("sky.hdr"), ws.path("link.exr")).expect("symlink");
+    #[cfg(not(unix))]
+    std::fs::copy(ws.path("sky.hdr"), ws.path("link.exr")).expect("copy");
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--standard-error",
+        &ws.arg("link.exr"),
+        "--backend",
+        "cpu",
+    ]);
+    if cfg!(unix) {
+        assert_fails_with(&run, &["link.exr", "same file as the environment map"]);
+    }
+    assert_eq!(std::fs::read(ws.path("sky.hdr")).expect("read"), before);
+    assert_eq!(std::fs::read(ws.path("out.png")).expect("read"), OLD_OUTPUT);
+}
+
+#[test]
 fn the_sandbox_refuses_textures_outside_the_scene_folder() {
     let ws =
         Workspace::new(&TINY_SCENE.replace("albedo = 0.7", "albedo_texture = \"../wood.png\""));
@@ -498,21 +543,15 @@ fn the_sandbox_refuses_textures_outside_the_scene_folder() {
     ws.assert_old_output_kept();
 }
 
+/// Runs gpu-render with `args` (`{}` replaced by the workspace's folder) and expects
+/// it to fail within 30 s (a blocking open would hang it until killed) with exit 1 and
+/// every `needle` in stderr.
 #[cfg(unix)]
-#[test]
-fn a_fifo_as_scene_is_refused_at_once() {
-    let ws = Workspace::new(TINY_SCENE);
-    let fifo = ws.path("pipe.toml");
-    let made = Command::new("mkfifo").arg(&fifo).status().expect("mkfifo");
-    assert!(made.success());
+fn assert_refused_at_once(ws: &Workspace, args: &[&str], needles: &[&str]) {
+    let dir = ws.dir.path().to_string_lossy().into_owned();
+    let args: Vec<String> = args.iter().map(|a| a.replace("{}", &dir)).collect();
     let mut child = Command::new(env!("CARGO_BIN_EXE_gpu-render"))
-        .args([
-            &ws.arg("pipe.toml"),
-            "-o",
-            &ws.arg("out.png"),
-            "--backend",
-            "cpu",
-        ])
+        .args(&args)
         .stderr(std::process::Stdio::piped())
         .spawn()
         .expect("spawn");
@@ -522,8 +561,105 @@ fn a_fifo_as_scene_is_refused_at_once() {
         use std::io::Read;
         pipe.read_to_string(&mut stderr).expect("read stderr");
     }
-    assert_eq!(status.and_then(|s| s.code()), Some(1), "{stderr}");
-    assert!(stderr.contains("a FIFO, not a regular file"), "{stderr}");
+    assert_eq!(status.and_then(|s| s.code()), Some(1), "{args:?}: {stderr}");
+    for needle in needles {
+        assert!(stderr.contains(needle), "{args:?}: {stderr} lacks {needle}");
+    }
+}
+
+#[cfg(unix)]
+fn mkfifo(path: &Path) {
+    let made = Command::new("mkfifo").arg(path).status().expect("mkfifo");
+    assert!(made.success());
+}
+
+#[cfg(unix)]
+#[test]
+fn a_fifo_as_scene_is_refused_at_once() {
+    let ws = Workspace::new(TINY_SCENE);
+    mkfifo(&ws.path("pipe.toml"));
+    assert_refused_at_once(
+        &ws,
+        &["{}/pipe.toml", "-o", "{}/out.png", "--backend", "cpu"],
+        &["a FIFO, not a regular file"],
+    );
+}
+
+/// Every file the program opens is checked, not only the scene: a FIFO as a model
+/// file, a material library, a glTF buffer, a texture, an environment map or a tile
+/// to merge is refused at once, and so is a device behind a link with a model's name.
+#[cfg(unix)]
+#[test]
+fn fifos_and_devices_are_refused_at_every_open() {
+    let triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let ws = Workspace::new(TINY_SCENE);
+    let write = |name: &str, text: &str| std::fs::write(ws.path(name), text).expect("write");
+    for fifo in [
+        "pipe.obj", "pipe.mtl", "pipe.bin", "pipe.png", "pipe.hdr", "pipe.exr",
+    ] {
+        mkfifo(&ws.path(fifo));
+    }
+    write("lib.obj", &format!("mtllib pipe.mtl\n{triangle}"));
+    write(
+        "buffer.gltf",
+        r#"{"asset": {"version": "2.0"}, "buffers": [{"uri": "pipe.bin", "byteLength": 36}],
+            "bufferViews": [{"buffer": 0, "byteLength": 36}],
+            "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                           "min": [0, 0, 0], "max": [1, 1, 0]}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+            "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0}"#,
+    );
+    write(
+        "textured.toml",
+        &TINY_SCENE.replace("albedo = 0.7", "albedo_texture = \"pipe.png\""),
+    );
+    write(
+        "sky.toml",
+        &format!("{TINY_SCENE}\n[environment]\nmap = \"pipe.hdr\"\n"),
+    );
+    std::os::unix::fs::symlink("/dev/zero", ws.path("zero.obj")).expect("symlink");
+    write("zero-lib.obj", &format!("mtllib /dev/zero\n{triangle}"));
+    let render = |input: &str| {
+        vec![
+            input.to_owned(),
+            "-o".into(),
+            "{}/out.png".into(),
+            "--backend".into(),
+            "cpu".into(),
+        ]
+    };
+    for (input, needle) in [
+        ("{}/pipe.obj", "a FIFO"),
+        ("{}/lib.obj", "a FIFO"),
+        ("{}/buffer.gltf", "a FIFO"),
+        ("{}/textured.toml", "a FIFO"),
+        ("{}/sky.toml", "a FIFO"),
+        ("{}/zero.obj", "a device"),
+        ("{}/zero-lib.obj", "a device"),
+    ] {
+        let args = render(input);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        assert_refused_at_once(&ws, &args, &[needle]);
+    }
+    assert_refused_at_once(
+        &ws,
+        &["merge", "{}/pipe.exr", "-o", "{}/out.png"],
+        &["pipe.exr", "a FIFO"],
+    );
+    ws.assert_old_output_kept_beside(&[
+        "buffer.gltf",
+        "lib.obj",
+        "pipe.bin",
+        "pipe.exr",
+        "pipe.hdr",
+        "pipe.mtl",
+        "pipe.obj",
+        "pipe.png",
+        "sky.toml",
+        "textured.toml",
+        "zero-lib.obj",
+        "zero.obj",
+    ]);
 }
 
 // ------------------------------------------------------------- flag values
@@ -619,6 +755,29 @@ fn temporaries(dir: &Path) -> Vec<(String, u64)> {
         .collect()
 }
 
+/// Whether `child` is writing an output in `dir`: a temporary file there has data, or
+/// (on Linux, where the temporary file has no name until it is complete) one of the
+/// child's open files is an unnamed file of `dir` with data.
+#[cfg(unix)]
+fn writing_in(child: &std::process::Child, dir: &Path) -> bool {
+    if temporaries(dir).iter().any(|&(_, size)| size > 0) {
+        return true;
+    }
+    let Ok(fds) = std::fs::read_dir(format!("/proc/{}/fd", child.id())) else {
+        return false;
+    };
+    let dir = dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf());
+    fds.flatten().any(|fd| {
+        let Ok(target) = std::fs::read_link(fd.path()) else {
+            return false;
+        };
+        let unnamed = target.to_string_lossy().ends_with("(deleted)");
+        unnamed
+            && target.parent() == Some(dir.as_path())
+            && std::fs::metadata(fd.path()).is_ok_and(|m| m.len() > 0)
+    })
+}
+
 /// Renders an empty 4096x4096 scene to `out.exr` (256 MiB) and sends `signal` once
 /// the temporary file has data in it: the write is in progress.
 #[cfg(unix)]
@@ -648,7 +807,7 @@ fn interrupt_a_write(signal: &str) {
         if child.try_wait().expect("wait").is_some() {
             break;
         }
-        if temporaries(ws.dir.path()).iter().any(|&(_, size)| size > 0) {
+        if writing_in(&child, ws.dir.path()) {
             send_signal(&child, signal);
             sent = true;
             break;
@@ -657,17 +816,41 @@ fn interrupt_a_write(signal: &str) {
     }
     let status = wait_at_most(&mut child, Duration::from_secs(60));
     assert!(sent, "the write finished before the signal could be sent");
-    assert_eq!(
-        status.and_then(|s| s.code()),
-        Some(130),
-        "{signal}: {status:?}"
-    );
+    if signal == "-KILL" {
+        use std::os::unix::process::ExitStatusExt;
+        assert_eq!(status.and_then(|s| s.signal()), Some(9), "{status:?}");
+    } else {
+        assert_eq!(
+            status.and_then(|s| s.code()),
+            Some(130),
+            "{signal}: {status:?}"
+        );
+    }
     assert!(
         temporaries(ws.dir.path()).is_empty(),
         "{signal} left {:?}",
         temporaries(ws.dir.path())
     );
     assert_eq!(std::fs::read(ws.path("out.exr")).expect("read"), OLD_OUTPUT);
+    // A later render into the same folder completes and leaves nothing either.
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("next.png"),
+        "--backend",
+        "cpu",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "-q",
+    ]);
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    assert!(
+        temporaries(ws.dir.path()).is_empty(),
+        "after the next render: {:?}",
+        temporaries(ws.dir.path())
+    );
 }
 
 #[cfg(unix)]
@@ -680,6 +863,14 @@ fn sigint_during_a_write_leaves_no_temporary_file_and_exits_130() {
 #[test]
 fn sigterm_during_a_write_leaves_no_temporary_file_and_exits_130() {
     interrupt_a_write("-TERM");
+}
+
+/// SIGKILL, which no handler sees (what Slurm and Kubernetes send after their grace
+/// period), leaves no temporary file either, and a render after it leaves none.
+#[cfg(unix)]
+#[test]
+fn sigkill_during_a_write_leaves_no_temporary_file_before_or_after_the_next_render() {
+    interrupt_a_write("-KILL");
 }
 
 #[cfg(unix)]

@@ -229,6 +229,26 @@ fn regions_slots_and_budgets_do_not_change_the_image() {
                 .with_schedule(Schedule::Fused)
                 .with_iteration_budget(3),
         ),
+        // The smallest budgets: a budget of 1 once made no progress at all in the
+        // fused kernel (its shading step spent the one iteration on nothing).
+        (
+            "fused schedule, budget 1",
+            common::gpu::renderer(&gpu)
+                .with_schedule(Schedule::Fused)
+                .with_iteration_budget(1),
+        ),
+        (
+            "fused schedule, budget 2",
+            common::gpu::renderer(&gpu)
+                .with_schedule(Schedule::Fused)
+                .with_iteration_budget(2),
+        ),
+        (
+            "wavefront schedule, budget 1",
+            common::gpu::renderer(&gpu)
+                .with_schedule(Schedule::Wavefront)
+                .with_iteration_budget(1),
+        ),
     ] {
         let target = linear_target(device);
         let view = target.create_view(&Default::default());

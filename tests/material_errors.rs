@@ -301,3 +301,82 @@ fn the_sandbox_keeps_textures_inside_the_scene_folder() {
         );
     }
 }
+
+/// The sandbox's check and the texture's open are one step: a texture swapped between
+/// a regular file inside the folder and a symbolic link to a file outside it, as fast
+/// as a second thread can, is never read from outside. Every load either reads the
+/// inside texel or is refused (by the link check or a missing file mid-swap).
+#[cfg(unix)]
+#[test]
+fn a_texture_swapped_for_a_link_during_the_load_is_never_read_from_outside() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+
+    let root = tempfile::tempdir().expect("tempdir");
+    let scene_dir = root.path().join("scene");
+    let secret_dir = root.path().join("secret");
+    std::fs::create_dir(&scene_dir).expect("mkdir");
+    std::fs::create_dir(&secret_dir).expect("mkdir");
+    let red = image::RgbImage::from_pixel(1, 1, image::Rgb([255, 0, 0]));
+    let blue = image::RgbImage::from_pixel(1, 1, image::Rgb([0, 0, 255]));
+    red.save(scene_dir.join("red.png")).expect("write");
+    blue.save(secret_dir.join("blue.png")).expect("write");
+    let text = "[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\n\n[materials.m]\n\
+                type = \"lambert\"\nalbedo_texture = \"tex.png\"\n";
+    let scene_path = scene_dir.join("s.toml");
+    let sandboxed = LoadOptions {
+        sandbox: true,
+        ..LoadOptions::default()
+    };
+    let stop = AtomicBool::new(false);
+    let (mut inside, mut refused) = (0, 0);
+    let mut outcomes = Vec::new();
+    std::thread::scope(|scope| {
+        scope.spawn(|| {
+            let tex = scene_dir.join("tex.png");
+            let staged = scene_dir.join("staged.png");
+            let link = scene_dir.join("link.png");
+            let _ = std::os::unix::fs::symlink(secret_dir.join("blue.png"), &link);
+            while !stop.load(Ordering::Relaxed) {
+                // A regular copy of the red texel, then the link, each renamed into place.
+                std::fs::copy(scene_dir.join("red.png"), &staged).expect("copy");
+                std::fs::rename(&staged, &tex).expect("rename");
+                let _ = std::fs::remove_file(&link);
+                std::os::unix::fs::symlink(secret_dir.join("blue.png"), &link).expect("symlink");
+                std::fs::rename(&link, &tex).expect("rename");
+            }
+        });
+        // Outcomes are judged after the swapping thread has stopped, so that a failed
+        // assertion cannot leave it running (the scope would wait for it forever).
+        for _ in 0..400 {
+            outcomes.push(
+                parse_scene_with(text, &scene_path, &sandboxed)
+                    .map(|scene| scene.images[0].texels[0]),
+            );
+        }
+        stop.store(true, Ordering::Relaxed);
+    });
+    for outcome in outcomes {
+        match outcome {
+            Ok(texel) => {
+                assert!(
+                    texel[0] > 0.9 && texel[2] < 0.1,
+                    "a texel from outside the folder was read: {texel:?}"
+                );
+                inside += 1;
+            }
+            Err(error) => {
+                let error = error.to_string();
+                assert!(
+                    error.contains("symbolic link") || error.contains("No such file"),
+                    "{error}"
+                );
+                refused += 1;
+            }
+        }
+    }
+    // Both outcomes happened, so the swap raced the loads.
+    assert!(
+        inside > 0 && refused > 0,
+        "inside {inside}, refused {refused}"
+    );
+}

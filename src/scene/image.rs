@@ -2,41 +2,66 @@
 
 use std::path::Path;
 
-use image::{DynamicImage, ImageReader};
+use std::io::Cursor;
+
+use image::{DynamicImage, ImageFormat, ImageReader};
 
 use super::Image;
 use crate::color::srgb_decode;
+use crate::input::{read_confined, read_input};
 
 /// Largest accepted image width or height in texels. Every image of a scene shares one
 /// GPU texture array whose layers are as large as the largest image, so this bounds
 /// each layer at 64 MiB of RGBA `f32`.
 pub const MAX_IMAGE_SIDE: u32 = 2048;
 
+/// Largest accepted image file in bytes: a [`MAX_IMAGE_SIDE`]² RGBA `f32` OpenEXR
+/// file without compression is 64 MiB, so this leaves room for any real encoding.
+pub const MAX_IMAGE_FILE_BYTES: u64 = 256 * 1024 * 1024;
+
 /// Reads the image at `path` into linear RGBA `f32`: 8- and 16-bit files (PNG) are
 /// taken as sRGB-encoded and linearised with the exact sRGB curve (IEC 61966-2-1);
 /// 32-bit float files (OpenEXR, Radiance HDR) are taken as linear. Fails with a
 /// message (without the path, which the caller names) when the file is missing,
-/// unreadable, not a regular file (a FIFO or a device would block or never end), not
-/// an image, empty or larger than [`MAX_IMAGE_SIDE`], or holds a non-finite value.
-/// Texels outside [0, 1] are kept as they are: a scene's materials check their range.
+/// unreadable, not a regular file (a FIFO or a device would block or never end:
+/// judged on the opened file, [`crate::input`]), not an image, empty or larger than
+/// [`MAX_IMAGE_SIDE`], or holds a non-finite value. Texels outside [0, 1] are kept as
+/// they are: a scene's materials check their range.
 pub fn load_image(path: &Path) -> Result<Image, String> {
-    let metadata = std::fs::metadata(path).map_err(|e| format!("cannot read the file: {e}"))?;
-    if let Some(kind) = not_a_regular_file(&metadata) {
-        return Err(format!(
-            "cannot read the file: it is {kind}, not a regular file"
-        ));
-    }
-    let reader = ImageReader::open(path)
-        .map_err(|e| format!("cannot read the file: {e}"))?
-        .with_guessed_format()
+    let bytes =
+        read_input(path, MAX_IMAGE_FILE_BYTES).map_err(|e| format!("cannot read the file: {e}"))?;
+    decode_image(path, &bytes)
+}
+
+/// [`load_image`] for the file `file` that a sandboxed scene in folder `dir` names:
+/// opened beneath `dir` so that no symbolic link, nor a swap of one while the file is
+/// opened, reaches outside it ([`crate::input::open_confined`]). The image's path is
+/// `dir/file`.
+pub fn load_confined_image(dir: &Path, file: &Path) -> Result<Image, String> {
+    let bytes = read_confined(dir, file, MAX_IMAGE_FILE_BYTES)
         .map_err(|e| format!("cannot read the file: {e}"))?;
-    let dimensions = reader
+    decode_image(&dir.join(file), &bytes)
+}
+
+/// Decodes the image file `bytes` (read from `path`, or embedded in a model and named
+/// `path`) as [`load_image`] does. The format comes from the bytes, or where they do
+/// not tell, from `path`'s extension.
+pub fn decode_image(path: &Path, bytes: &[u8]) -> Result<Image, String> {
+    let bytes = radiance_header(bytes);
+    let reader = || {
+        let mut reader = ImageReader::new(Cursor::new(bytes.as_ref()));
+        if let Ok(format) = ImageFormat::from_path(path) {
+            reader.set_format(format);
+        }
+        reader
+            .with_guessed_format()
+            .map_err(|e| format!("cannot read the file: {e}"))
+    };
+    let dimensions = reader()?
         .into_dimensions()
         .map_err(|e| format!("not a readable image: {e}"))?;
     check_dimensions(dimensions)?;
-    let decoded = ImageReader::open(path)
-        .and_then(|r| r.with_guessed_format())
-        .map_err(|e| format!("cannot read the file: {e}"))?
+    let decoded = reader()?
         .decode()
         .map_err(|e| format!("not a readable image: {e}"))?;
     let (width, height) = (decoded.width(), decoded.height());
@@ -81,31 +106,20 @@ pub fn load_image(path: &Path) -> Result<Image, String> {
     })
 }
 
-/// What a file that is not a regular file is ("a directory", "a FIFO", "a device",
-/// "a socket"), or `None` for a regular file. Symbolic links are followed by the
-/// caller's `metadata`.
-pub(crate) fn not_a_regular_file(metadata: &std::fs::Metadata) -> Option<&'static str> {
-    if metadata.is_file() {
-        return None;
-    }
-    if metadata.is_dir() {
-        return Some("a directory");
-    }
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        let kind = metadata.file_type();
-        if kind.is_fifo() {
-            return Some("a FIFO");
+/// A Radiance HDR file whose first line is `#?RGBE` (as Mitsuba and other programs
+/// write it) with that line spelled `#?RADIANCE`, the only one the decoder takes: both
+/// name the same format (Greg Ward, "Real Pixels", Graphics Gems II, and the Radiance
+/// reference, where the program name after `#?` is free). Other bytes as they are.
+fn radiance_header(bytes: &[u8]) -> std::borrow::Cow<'_, [u8]> {
+    const RGBE: &[u8] = b"#?RGBE\n";
+    match bytes.strip_prefix(RGBE) {
+        Some(rest) => {
+            let mut fixed = b"#?RADIANCE\n".to_vec();
+            fixed.extend_from_slice(rest);
+            std::borrow::Cow::Owned(fixed)
         }
-        if kind.is_char_device() || kind.is_block_device() {
-            return Some("a device");
-        }
-        if kind.is_socket() {
-            return Some("a socket");
-        }
+        None => std::borrow::Cow::Borrowed(bytes),
     }
-    Some("a special file")
 }
 
 fn check_dimensions((width, height): (u32, u32)) -> Result<(), String> {

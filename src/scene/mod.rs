@@ -19,7 +19,9 @@ pub use file::{
     CONDUCTOR_PRESETS, LoadOptions, LoadProgress, MAX_SCENE_FILE_BYTES, SceneFile, confined_path,
     load_scene, load_scene_file, load_scene_with, parse_scene, parse_scene_file, parse_scene_with,
 };
-pub use image::{MAX_IMAGE_SIDE, load_image};
+pub use image::{
+    MAX_IMAGE_FILE_BYTES, MAX_IMAGE_SIDE, decode_image, load_confined_image, load_image,
+};
 pub use medium::{MEDIUM_STACK_SIZE, MediumStack};
 pub use model::*;
 pub use sphere::{

@@ -549,6 +549,22 @@ impl RenderSettings {
 }
 
 impl Scene {
+    /// The image files the scene was built from, each with what it is ("image" for
+    /// textures and BRDF maps, "environment map"): the inputs besides the scene file
+    /// that a render must never write over.
+    pub fn image_files(&self) -> impl Iterator<Item = (&std::path::Path, &'static str)> {
+        let images = self
+            .images
+            .iter()
+            .map(|image| (image.path.as_path(), "image"));
+        let environment = self
+            .environment
+            .map
+            .iter()
+            .map(|map| (map.image.path.as_path(), "environment map"));
+        images.chain(environment)
+    }
+
     /// The scene as the tracers shade it. In [`LightingSpace::Linear`] that is the scene
     /// itself. In [`LightingSpace::NaiveGamma`] every colour (albedos, reflectances,
     /// transmittances, emission, background and ambient radiance) is replaced by its

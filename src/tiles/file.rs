@@ -265,7 +265,8 @@ fn sort_header_attributes(bytes: &mut [u8]) -> Result<(), String> {
 /// Errors: [`TileError::Read`] for a file that cannot be read as OpenEXR,
 /// [`TileError::NotATile`] for one without the attributes and channels of a tile.
 pub fn read_tile_header(path: &Path) -> Result<TileInfo, TileError> {
-    let meta = MetaData::read_from_file(path, false).map_err(|e| read_error(path, e))?;
+    let meta =
+        MetaData::read_from_buffered(open_tile(path)?, false).map_err(|e| read_error(path, e))?;
     let [header] = meta.headers.as_slice() else {
         return Err(not_a_tile(
             path,
@@ -308,7 +309,7 @@ pub fn read_tile(path: &Path) -> Result<Tile, TileError> {
         .all_channels()
         .first_valid_layer()
         .all_attributes()
-        .from_file(path)
+        .from_buffered(open_tile(path)?)
         .map_err(|e| read_error(path, e))?;
     let layer = image.layer_data;
     let pixels = info.window.pixels() as usize;
@@ -536,6 +537,17 @@ fn text(value: &str) -> Text {
         .map(|c| if u32::from(c) < 256 { c } else { '?' })
         .collect();
     Text::new_or_none(&latin1).unwrap_or_else(|| Text::from("?"))
+}
+
+/// The tile file at `path`, opened as an input ([`crate::input::open_input`]: a FIFO or
+/// a device is refused at once, never read from), buffered.
+fn open_tile(path: &Path) -> Result<std::io::BufReader<std::fs::File>, TileError> {
+    crate::input::open_input(path)
+        .map(std::io::BufReader::new)
+        .map_err(|e| TileError::Read {
+            path: PathBuf::from(path),
+            message: e.to_string(),
+        })
 }
 
 fn read_error(path: &Path, error: exr::error::Error) -> TileError {

@@ -385,14 +385,10 @@ pub fn load_model(
     Ok(scene)
 }
 
-/// Refuses an output that is the scene file or one of its images.
+/// Refuses an output that is the scene file or one of its images (textures, BRDF maps,
+/// the environment map).
 fn check_inputs_survive(output_path: &Path, scene_path: &Path, scene: &Scene) -> Result<()> {
-    let inputs = std::iter::once((scene_path, "scene file")).chain(
-        scene
-            .images
-            .iter()
-            .map(|image| (image.path.as_path(), "image")),
-    );
+    let inputs = std::iter::once((scene_path, "scene file")).chain(scene.image_files());
     output::check_not_an_input(output_path, inputs)?;
     Ok(())
 }

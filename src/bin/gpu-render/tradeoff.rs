@@ -85,8 +85,8 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
     );
     for name in &outputs {
         let path = args.out_dir.join(name);
-        let inputs = std::iter::once((args.scene.as_path(), "scene file"))
-            .chain(scene.images.iter().map(|i| (i.path.as_path(), "image")));
+        let inputs =
+            std::iter::once((args.scene.as_path(), "scene file")).chain(scene.image_files());
         gpu_render::output::check_not_an_input(&path, inputs)?;
     }
     std::fs::create_dir_all(&args.out_dir)

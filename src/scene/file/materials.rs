@@ -11,7 +11,7 @@ use super::paths::confined_path;
 use super::raw::RawMaterial;
 use crate::scene::{
     FresnelModel, Image, Material, MaterialKind, MicrofacetDistribution, SceneError,
-    TextureMapping, load_image,
+    TextureMapping, load_confined_image, load_image,
 };
 
 /// Largest accepted Blinn-Phong exponent.
@@ -162,7 +162,13 @@ impl<'a> ImageTable<'a> {
                 path.display()
             ))
         };
-        let mut image = load_image(&path).map_err(fail)?;
+        let mut image = if self.options.sandbox {
+            // Opened beneath the folder: the check above and the open are one step.
+            load_confined_image(self.base, Path::new(file))
+        } else {
+            load_image(&path)
+        }
+        .map_err(fail)?;
         if let Some(((x, y), channel, value)) = negative_texel(&image) {
             let why = match role {
                 ImageRole::Albedo => "a reflectance cannot be negative",

@@ -24,7 +24,6 @@ use self::objects::MaterialTable;
 pub use self::paths::confined_path;
 use self::raw::RawScene;
 pub(crate) use self::settings::view_problem;
-use super::image::not_a_regular_file;
 use super::{CameraPath, Scene, SceneError, SceneWarning};
 
 /// Largest scene file accepted, in bytes (64 MiB).
@@ -182,21 +181,18 @@ fn read_scene_file(path: &Path, options: &LoadOptions<'_>) -> Result<String, Sce
         location: None,
         message,
     };
-    let metadata =
-        std::fs::metadata(path).map_err(|e| fail(format!("cannot read the scene file: {e}")))?;
-    if let Some(kind) = not_a_regular_file(&metadata) {
-        return Err(fail(format!(
-            "cannot read the scene file: it is {kind}, not a regular file"
-        )));
+    // Opened, then judged on what was opened: a FIFO is refused without waiting for a
+    // writer, and nothing can be swapped in between the check and the read.
+    let file = crate::input::open_input(path)
+        .map_err(|e| fail(format!("cannot read the scene file: {e}")))?;
+    let length = file
+        .metadata()
+        .map_err(|e| fail(format!("cannot read the scene file: {e}")))?
+        .len();
+    if length > MAX_SCENE_FILE_BYTES {
+        return Err(fail(too_large_message(length)));
     }
-    if metadata.len() > MAX_SCENE_FILE_BYTES {
-        return Err(fail(too_large_message(metadata.len())));
-    }
-    options.report(LoadProgress::Reading {
-        bytes: metadata.len(),
-    });
-    let file =
-        std::fs::File::open(path).map_err(|e| fail(format!("cannot read the scene file: {e}")))?;
+    options.report(LoadProgress::Reading { bytes: length });
     let mut bytes = Vec::new();
     file.take(MAX_SCENE_FILE_BYTES + 1)
         .read_to_end(&mut bytes)

@@ -12,7 +12,7 @@ use super::paths::confined_path;
 use super::raw::{RawCamera, RawEnvironment, RawIntegrator, RawLighting, RawRender};
 use crate::scene::{
     Camera, Environment, EnvironmentMap, Image, Integrator, LightingSpace, RenderSettings,
-    SceneError, load_image,
+    SceneError, load_confined_image, load_image,
 };
 
 /// Default image width in pixels.
@@ -184,7 +184,13 @@ fn environment_image(
     };
     let fail =
         |message: String| item.fail(format_args!("map `{file}` ({}): {message}", path.display()));
-    let image = load_image(&path).map_err(fail)?;
+    let image = if options.sandbox {
+        // Opened beneath the folder: the check above and the open are one step.
+        load_confined_image(base, Path::new(file))
+    } else {
+        load_image(&path)
+    }
+    .map_err(fail)?;
     for (i, texel) in image.texels.iter().enumerate() {
         for (channel, value) in ["r", "g", "b"].into_iter().zip(texel.iter().copied()) {
             if value < 0.0 {

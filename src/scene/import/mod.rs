@@ -40,7 +40,6 @@ mod obj;
 mod place;
 mod texture;
 
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use glam::{DMat4, DVec2, DVec3};
@@ -322,33 +321,12 @@ fn error(path: &Path, message: impl Into<String>) -> SceneError {
     }
 }
 
-/// Reads a whole file (a model, a material library or a buffer), refusing directories
-/// and files larger than [`MAX_MODEL_FILE_BYTES`]. `what` names the file's role in the
-/// message ("the model file", "the material library lib.mtl", ...); errors are reported
-/// against `report` (the model being imported).
+/// Reads a whole file (a model, a material library or a buffer), refusing anything
+/// but a regular file (judged on the opened file: a FIFO or a device behind any name
+/// is refused at once) and files larger than [`MAX_MODEL_FILE_BYTES`]. `what` names the
+/// file's role in the message ("the model file", "the material library lib.mtl",
+/// ...); errors are reported against `report` (the model being imported).
 fn read_file(path: &Path, report: &Path, what: &str) -> Result<Vec<u8>, SceneError> {
-    let fail = |reason: String| error(report, format!("cannot read {what}: {reason}"));
-    let metadata = std::fs::metadata(path).map_err(|e| fail(e.to_string()))?;
-    if metadata.is_dir() {
-        return Err(fail("it is a directory".into()));
-    }
-    if metadata.len() > MAX_MODEL_FILE_BYTES {
-        return Err(fail(too_large(metadata.len())));
-    }
-    let file = std::fs::File::open(path).map_err(|e| fail(e.to_string()))?;
-    let mut bytes = Vec::new();
-    file.take(MAX_MODEL_FILE_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| fail(e.to_string()))?;
-    if bytes.len() as u64 > MAX_MODEL_FILE_BYTES {
-        return Err(fail(too_large(bytes.len() as u64)));
-    }
-    Ok(bytes)
-}
-
-fn too_large(bytes: u64) -> String {
-    format!(
-        "it is {bytes} bytes, more than the {MAX_MODEL_FILE_BYTES} accepted ({} MiB)",
-        MAX_MODEL_FILE_BYTES / (1024 * 1024)
-    )
+    crate::input::read_input(path, MAX_MODEL_FILE_BYTES)
+        .map_err(|e| error(report, format!("cannot read {what}: {e}")))
 }

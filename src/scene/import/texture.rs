@@ -1,12 +1,11 @@
 //! Loading a model's textures, each file once, through [`load_image`].
 
 use std::collections::HashMap;
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use super::mesh::Budget;
 use crate::color::srgb_encode;
-use crate::scene::{Image, load_image};
+use crate::scene::{Image, decode_image, load_image};
 
 /// How a texture's values are meant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -56,15 +55,8 @@ impl Textures {
         if let Some(&index) = self.loaded.get(&key) {
             return Ok(index);
         }
-        // `load_image` reads files; the embedded bytes go through a temporary file so
-        // that every texture is decoded and linearised by the one function.
-        let fail = |e: std::io::Error| format!("the texture {name} does not load: {e}");
-        let mut file = tempfile::NamedTempFile::new().map_err(fail)?;
-        file.write_all(bytes).map_err(fail)?;
-        file.flush().map_err(fail)?;
-        let mut image = load_image(file.path())
+        let image = decode_image(Path::new(name), bytes)
             .map_err(|e| format!("the texture {name} does not load: {e}"))?;
-        image.path = PathBuf::from(name);
         self.add(key, image, encoding, budget)
     }
 

@@ -60,6 +60,11 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     // Stamped before the load, so that an edit made while the window opens counts.
     let watcher = SceneWatcher::new(&args.scene);
     let scene = load_view_scene(args)?;
+    if let Some(path) = &args.screenshot {
+        let inputs =
+            std::iter::once((args.scene.as_path(), "scene file")).chain(scene.image_files());
+        output::check_not_an_input(path, inputs)?;
+    }
     let event_loop = EventLoop::new().context(
         "cannot open a window: no display server (set DISPLAY or WAYLAND_DISPLAY, or run \
          under xvfb-run)",

@@ -4,7 +4,9 @@
 //! `.exr` the linear image as 32-bit float RGBA and `.hdr` the linear image as Radiance
 //! RGBE. Every file is first written to a temporary file beside the target, flushed and
 //! synced, then renamed over the target, so a failed write never leaves a truncated or
-//! half-written file where the old one was, and no temporary file stays behind.
+//! half-written file where the old one was, and no temporary file stays behind: on
+//! Linux the temporary file has no name until it is complete, so that even a process
+//! killed with SIGKILL leaves nothing (see `temporary`).
 //!
 //! A program that handles signals calls [`cancel_pending_writes`] from its handler
 //! before it exits: that removes the temporary files of the writes in progress and
@@ -16,7 +18,6 @@
 use std::fmt;
 use std::io::{self, BufWriter, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, MutexGuard};
 
 use image::codecs::hdr::HdrEncoder;
 use image::codecs::openexr::OpenExrEncoder;
@@ -24,6 +25,11 @@ use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder, Rgb};
 
 use crate::film::LinearImage;
+
+mod temporary;
+
+use temporary::Temporary;
+pub use temporary::cancel_pending_writes;
 
 /// The largest value a Radiance HDR (RGBE) file holds: mantissa 255, exponent 2^127
 /// (`255 · 2^119 ≈ 1.69e38`). Larger channels are clamped to it.
@@ -235,7 +241,7 @@ pub fn check_output_path(path: &Path) -> Result<OutputFormat, OutputError> {
         });
     }
     // The probe proves the directory takes new files.
-    discard(create_temporary(path, dir)?);
+    Temporary::create(path, dir)?.discard();
     Ok(format)
 }
 
@@ -275,9 +281,9 @@ fn file_kind(metadata: &std::fs::Metadata) -> &'static str {
 /// `scene.png` to `-o scene.png`, or over one of its textures, would destroy the input.
 /// `inputs` pairs each path with what it is ("scene file", "texture"). An output that
 /// does not exist yet is no input.
-pub fn check_not_an_input<'a>(
+pub fn check_not_an_input<'a, 'b>(
     path: &Path,
-    inputs: impl IntoIterator<Item = (&'a Path, &'a str)>,
+    inputs: impl IntoIterator<Item = (&'a Path, &'b str)>,
 ) -> Result<(), OutputError> {
     let Ok(output) = std::fs::metadata(path) else {
         return Ok(());
@@ -450,80 +456,6 @@ fn check_buffers(
     }
 }
 
-/// The temporary files of the writes in progress, and whether they were cancelled.
-struct Pending {
-    paths: Vec<PathBuf>,
-    cancelled: bool,
-}
-
-static PENDING: Mutex<Pending> = Mutex::new(Pending {
-    paths: Vec::new(),
-    cancelled: false,
-});
-
-fn pending() -> MutexGuard<'static, Pending> {
-    PENDING
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner)
-}
-
-/// Removes the temporary file of every write in progress and makes those writes, and
-/// every later one, fail with [`OutputError::Cancelled`] instead of renaming anything
-/// into place. Meant for a signal handler that then exits: afterwards no output of
-/// this process is replaced, and none of its temporary files remains. A write whose
-/// rename already started completes first (this waits for it). Returns how many
-/// temporary files were removed.
-pub fn cancel_pending_writes() -> usize {
-    let mut pending = pending();
-    pending.cancelled = true;
-    pending
-        .paths
-        .drain(..)
-        .filter(|path| std::fs::remove_file(path).is_ok())
-        .count()
-}
-
-/// Creates a temporary file for `path` in `dir`, registered so that
-/// [`cancel_pending_writes`] can remove it. Removed when dropped.
-fn create_temporary(path: &Path, dir: &Path) -> Result<tempfile::NamedTempFile, OutputError> {
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".gpu-render-").suffix(".tmp");
-    #[cfg(unix)]
-    {
-        // Like an ordinary new file: rw for everyone, narrowed by the umask.
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    // Created and registered under the lock, so a cancellation sees it or prevents it.
-    let mut pending = pending();
-    if pending.cancelled {
-        return Err(OutputError::Cancelled {
-            path: path.to_path_buf(),
-        });
-    }
-    let temp = builder.tempfile_in(dir).map_err(|error| OutputError::Io {
-        path: path.to_path_buf(),
-        action: format!("create a temporary file in {}", dir.display()),
-        error,
-    })?;
-    pending.paths.push(temp.path().to_path_buf());
-    Ok(temp)
-}
-
-/// Forgets a temporary file (it was renamed or is about to be deleted).
-fn unregister(pending: &mut Pending, temp: &Path) {
-    pending.paths.retain(|p| p != temp);
-}
-
-/// Deletes a temporary file and forgets it, under the lock, so that no signal can
-/// arrive between the two and leave it behind.
-fn discard(temp: tempfile::NamedTempFile) {
-    let mut pending = pending();
-    unregister(&mut pending, temp.path());
-    // Best effort: a file that cannot be deleted cannot be helped here.
-    let _ = temp.close();
-}
-
 /// Why an encoder stopped.
 enum EncodeFailure {
     /// The image encoder's error, while writing this format.
@@ -631,34 +563,17 @@ fn write_atomically(
             dir: dir.to_path_buf(),
         });
     }
-    let mut temp = create_temporary(path, dir)?;
-    let result = encode_to(path, temp.as_file_mut(), encode).and_then(|()| {
-        temp.as_file()
+    let mut temp = Temporary::create(path, dir)?;
+    let result = encode_to(path, temp.file_mut(), encode).and_then(|()| {
+        temp.file()
             .sync_all()
             .map_err(io_error("sync the file to disk"))
     });
     if let Err(error) = result {
-        discard(temp);
+        temp.discard();
         return Err(error);
     }
-    let mut pending = pending();
-    if pending.cancelled {
-        drop(pending);
-        discard(temp);
-        return Err(OutputError::Cancelled {
-            path: path.to_path_buf(),
-        });
-    }
-    // Renamed under the lock: a cancellation waits for it rather than racing it.
-    unregister(&mut pending, temp.path());
-    match temp.persist(path) {
-        Ok(_) => Ok(()),
-        Err(e) => {
-            // Still under the lock: deleted before a cancellation could miss it.
-            let _ = e.file.close();
-            Err(io_error("move the finished file into place")(e.error))
-        }
-    }
+    temp.persist(path)
 }
 
 #[cfg(test)]
