@@ -87,7 +87,7 @@ ensure_lavapipe() {
     fi
 }
 
-# GNU parallel, whose recipe (distributed/parallel/render.sh) tests/recipes.rs runs.
+# GNU parallel, whose recipe (distributed/parallel/render.sh) tests/integration/recipes.rs runs.
 # Without apt (or root) it warns and carries on: that test then skips, except in CI.
 ensure_parallel() {
     if command -v parallel >/dev/null 2>&1; then
@@ -102,7 +102,7 @@ ensure_parallel() {
     fi
 }
 
-# Xvfb, the virtual X server that tests/viewer.rs starts to open the viewer's window
+# Xvfb, the virtual X server that tests/integration/viewer.rs starts to open the viewer's window
 # (and wgpu's surface on it) without a display, and the X11 client libraries winit
 # loads at run time (Xlib with its XCB bridge, xkbcommon's X11 keymaps, the cursor,
 # RandR and input extensions). Without apt (or root) it warns and carries on: those

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the round-trip fixture of tests/import_gltf.rs with a glTF exporter that is not
+"""Writes the round-trip fixture of tests/integration/import_gltf.rs with a glTF exporter that is not
 ours: Python's trimesh (tested with trimesh 5.2.0, numpy 2.4).
 
 A small scene: a box placed twice (one mesh under two nodes: instancing), one copy

@@ -9,7 +9,7 @@ MODE is a comma-separated list: material types to replace by a grey Lambert
 (`drop:polygon`), or `none`. Example:
 
     scripts/scene-variant.py scenes/glass.toml /tmp/g1.toml drop:polygon
-    cargo run --release --example bench -- /tmp/g1.toml --width 640 --height 360
+    cargo run --release -p gpu-render-tools --bin bench -- /tmp/g1.toml --width 640 --height 360
 """
 import tomllib, sys, json
 src, dst, mode = sys.argv[1], sys.argv[2], sys.argv[3]

@@ -27,6 +27,9 @@ cargo fmt --all -- --check
 section "cargo clippy (warnings are errors)"
 cargo clippy --all-targets -- -D warnings
 
+section "the tools crate compiles, lint-clean (benchmarks, probes, fuzz programs; not linked)"
+cargo clippy -p gpu-render-tools --all-targets -- -D warnings
+
 section "the library without the CLI's dependencies (cargo check --no-default-features)"
 cargo check --lib --no-default-features
 

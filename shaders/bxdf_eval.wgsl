@@ -1,5 +1,5 @@
 // Test kernel: evaluates eval_brdf for a list of cases, so that tests can compare the
-// WGSL BRDFs with their CPU twins (tests/bxdf_gpu_twin.rs). Not part of the renderer.
+// WGSL BRDFs with their CPU twins (tests/integration/bxdf_gpu_twin.rs). Not part of the renderer.
 
 struct BrdfCase {
     // Index into `eval_materials`.

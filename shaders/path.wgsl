@@ -20,7 +20,7 @@
 // - PHASE_POP then pops the continuation, or ends the sample when there is none.
 //
 // The path therefore draws the CPU's numbers for the CPU's decisions, in the CPU's
-// order of sums: the images agree per pixel within f32 rounding (tests/path_gpu.rs).
+// order of sums: the images agree per pixel within f32 rounding (tests/integration/path_gpu.rs).
 
 // The emitters of the AreaLights distribution (src/gpu/area_lights.rs), in the CPU's
 // order; one EMITTER_NONE record when the scene has none.

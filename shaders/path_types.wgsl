@@ -1,6 +1,6 @@
 // Records and constants of the path-tracing integrator (shaders/path.wgsl). Each
 // struct is the twin of the `#[repr(C)]` struct of the same name (with a `Gpu` prefix)
-// in src/gpu/area_lights.rs; tests/layout.rs checks sizes and offsets with naga's
+// in src/gpu/area_lights.rs; tests/integration/layout.rs checks sizes and offsets with naga's
 // layouter.
 
 // FrameUniforms.flags: trace with the path integrator (`integrator = "path"`) instead

@@ -1,6 +1,6 @@
 // Records shared by the tracing and display passes. Each struct is the twin of the
 // `#[repr(C)]` struct of the same name (with a `Gpu` prefix) in src/gpu/layout.rs;
-// tests/layout.rs checks sizes and offsets with naga's layouter.
+// tests/integration/layout.rs checks sizes and offsets with naga's layouter.
 
 struct FrameUniforms {
     eye: vec3<f32>,

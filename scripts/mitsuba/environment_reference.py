@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Renders an environment-lit gpu-render scene with Mitsuba 3's path tracer, as the
-independent reference of tests/environment_reference.rs: path_reference.py's scene
+independent reference of tests/integration/environment_reference.rs: path_reference.py's scene
 subset (Lambert and emissive materials, polygons, spheres) plus `[environment] map`
 with `rotation` and `scale`, as Mitsuba's `envmap` emitter.
 
@@ -13,7 +13,7 @@ Mitsuba enlarged 8 times by texel replication: Mitsuba's interpolation then blen
 only across a band about one enlarged texel wide (1/8 of one of ours) along each of
 our texel edges (smooth in our sky except at the sun's rim). The remaining
 difference on the directly seen sky, at most 0.15%, is measured and allowed for by
-tests/environment_reference.rs. The larger map is a temporary file; only the render
+tests/integration/environment_reference.rs. The larger map is a temporary file; only the render
 is committed.
 
 Run from the repository root (tested with mitsuba 3.6.4):

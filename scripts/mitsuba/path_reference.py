@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Renders a gpu-render scene file with Mitsuba 3's path tracer, as the independent
-reference of tests/path_reference.rs (the path integrator against another renderer).
+reference of tests/integration/path_reference.rs (the path integrator against another renderer).
 
 Reads the subset of the scene format the reference scenes use: [render], [camera],
 Lambert and emissive materials, polygons (as triangle fans of convex quads) and

@@ -4,7 +4,7 @@
 //!
 //! Every sampler maps uniform numbers `u ∈ [0, 1)²` to a sample and has a density
 //! function for the same measure (solid angle for directions, area for points) that
-//! `tests/sampler_chi2.rs` checks against the sampler's histogram with a chi-square
+//! `tests/integration/sampler_chi2.rs` checks against the sampler's histogram with a chi-square
 //! test, as pbrt-v4 and Mitsuba 3 do. Directions are in a local frame whose `z` is the
 //! surface normal ([`ShadingFrame`]).
 

@@ -2,7 +2,7 @@
 //! distribution (emitters chosen by power, spheres sampled by cone, triangles by area)
 //! as a storage buffer of [`GpuEmitter`] records that `shaders/path.wgsl` samples, and
 //! the constants it shares with `shaders/path_types.wgsl` (checked by
-//! `tests/layout.rs`).
+//! `tests/integration/layout.rs`).
 
 use bytemuck::{Pod, Zeroable};
 

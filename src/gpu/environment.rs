@@ -2,7 +2,7 @@
 //! rotation and scale, and its piecewise-constant sampling tables) as one storage
 //! buffer (binding 20) that `shaders/environment.wgsl` reads: an
 //! [`GpuEnvironmentHeader`] (`EnvironmentHeader` in `shaders/path_types.wgsl`, checked
-//! by `tests/layout.rs`) followed by `f32` data in this order, for a map of `w × h`
+//! by `tests/integration/layout.rs`) followed by `f32` data in this order, for a map of `w × h`
 //! texels:
 //!
 //! 1. the texels' red, green and blue, row by row from the top (`3 w h` values);

@@ -7,7 +7,7 @@
 //! `override` constants because overrides only fold branches: the code (and the
 //! registers it needs) stays in the module, and naga has no dead-function elimination
 //! to remove it. Dropping the text means a module for a scene without glass really
-//! has no refraction code, which `tests/specialisation.rs` checks on the naga module.
+//! has no refraction code, which `tests/integration/specialisation.rs` checks on the naga module.
 
 use super::unrolled::UnrolledPrimitives;
 use crate::accel::MAX_POLYGON_VERTICES;

@@ -1,5 +1,5 @@
 //! The `#[repr(C)]` records uploaded to the GPU, twins of the structs in
-//! `shaders/types.wgsl`. `tests/layout.rs` checks with naga's layouter that every size
+//! `shaders/types.wgsl`. `tests/integration/layout.rs` checks with naga's layouter that every size
 //! and field offset agrees. WGSL `vec3<f32>` is 16-byte aligned with size 12, so every
 //! `[f32; 3]` here is followed by a 4-byte scalar that fills its last lane.
 

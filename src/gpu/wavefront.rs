@@ -53,7 +53,7 @@ fn mesa_version(adapter: &wgpu::AdapterInfo) -> Option<(u32, u32)> {
 /// known: llvmpipe before Mesa 25 ends every loop of an invocation once its vector of
 /// lanes has run [`LLVMPIPE_LOOP_LIMIT`] iterations in all (measured on Mesa 22.3.6;
 /// Mesa 25.0.7 counted a loop of 10,000,000 iterations to the end:
-/// `examples/loop_probe.rs`). An llvmpipe whose version cannot be read is taken to have
+/// `tools/src/bin/loop_probe.rs`). An llvmpipe whose version cannot be read is taken to have
 /// the limit.
 pub fn driver_loop_limit(adapter: &wgpu::AdapterInfo) -> Option<u32> {
     let llvmpipe = |s: &str| s.to_lowercase().contains("llvmpipe");

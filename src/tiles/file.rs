@@ -6,7 +6,7 @@
 //! radiance as 32-bit float, and `display.A`, `display.B`, `display.G`,
 //! `display.R`, the 8-bit display image as the backend made it (on the GPU its
 //! display pass, which may differ from the CPU's encoding by one step at a rounding
-//! boundary, `tests/display_pass.rs`), as 32-bit unsigned integers of 0 to 255. The
+//! boundary, `tests/integration/display_pass.rs`), as 32-bit unsigned integers of 0 to 255. The
 //! merged PNG is then the whole render's PNG byte for byte. Compression: ZIP of 16
 //! rows (lossless).
 //!

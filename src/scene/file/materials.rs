@@ -70,7 +70,7 @@ const KINDS: &str =
 /// <https://shaderlabs.org/wiki/LabPBR_Material_Standard>), measured `n` and `k` at
 /// red, green and blue wavelengths (refractiveindex.info data); their normal-incidence
 /// reflectances agree with Real-Time Rendering, 4th ed., Table 9.2 (see
-/// `tests/bxdf_plausibility.rs`).
+/// `tests/integration/bxdf_plausibility.rs`).
 pub const CONDUCTOR_PRESETS: &[(&str, [f64; 3], [f64; 3])] = &[
     ("gold", [0.18299, 0.42108, 1.3734], [3.4242, 2.3459, 1.7704]),
     (

@@ -1,0 +1,1143 @@
+//! The `gpu-render` program end to end: bad input gives a clear error naming the
+//! culprit and exit status 1 (never a panic, never a damaged output file); a good
+//! scene gives an image of the requested size.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// A small valid scene in the documented format.
+const TINY_SCENE: &str = r#"
+[render]
+width = 32
+height = 24
+[camera]
+eye = [0.0, 0.0, 3.0]
+look_at = [0.0, 0.0, 0.0]
+[materials.white]
+type = "lambert"
+albedo = 0.7
+[[lights]]
+type = "point"
+position = [0.0, 2.0, 3.0]
+intensity = 10.0
+[[objects]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+material = "white"
+"#;
+
+/// Bytes that must survive a failed run untouched.
+const OLD_OUTPUT: &[u8] = b"an older image that a failed run must not touch";
+
+use crate::support::process::{Run, gpu_render};
+
+/// A temporary directory holding `scene.toml` with `text` and an existing `out.png`.
+struct Workspace {
+    dir: tempfile::TempDir,
+}
+
+impl Workspace {
+    fn new(scene_text: &str) -> Self {
+        let dir = tempfile::tempdir().expect("tempdir");
+        std::fs::write(dir.path().join("scene.toml"), scene_text).expect("write scene");
+        std::fs::write(dir.path().join("out.png"), OLD_OUTPUT).expect("write old output");
+        Self { dir }
+    }
+
+    fn path(&self, name: &str) -> PathBuf {
+        self.dir.path().join(name)
+    }
+
+    fn arg(&self, name: &str) -> String {
+        self.path(name).to_string_lossy().into_owned()
+    }
+
+    fn assert_old_output_kept(&self) {
+        self.assert_old_output_kept_beside(&[]);
+    }
+
+    /// As [`Self::assert_old_output_kept`], with `others` (sorted) also in the folder.
+    fn assert_old_output_kept_beside(&self, others: &[&str]) {
+        let now = std::fs::read(self.path("out.png")).expect("read out.png");
+        assert_eq!(now, OLD_OUTPUT, "a failed run changed the existing output");
+        let mut names: Vec<String> = std::fs::read_dir(self.dir.path())
+            .expect("list workspace")
+            .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        let mut expected: Vec<&str> = others.to_vec();
+        expected.extend(["out.png", "scene.toml"]);
+        expected.sort_unstable();
+        assert_eq!(names, expected, "stray files left behind");
+    }
+}
+
+/// Asserts a failed run: status 1 and every `needle` in stderr.
+fn assert_fails_with(run: &Run, needles: &[&str]) {
+    assert_eq!(
+        run.status,
+        Some(1),
+        "expected exit 1, stderr:\n{}",
+        run.stderr
+    );
+    assert!(run.stderr.starts_with("error: "), "stderr:\n{}", run.stderr);
+    for needle in needles {
+        assert!(
+            run.stderr.contains(needle),
+            "stderr lacks {needle:?}:\n{}",
+            run.stderr
+        );
+    }
+    assert!(run.stdout.is_empty(), "stdout: {}", run.stdout);
+}
+
+fn read_png_size(path: &Path) -> (u32, u32) {
+    let image = image::open(path).expect("open output image");
+    (image.width(), image.height())
+}
+
+// ---------------------------------------------------------------- bad input
+
+#[test]
+fn missing_scene_file() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[
+        &ws.arg("no-such-scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+    ]);
+    assert_fails_with(&run, &["no-such-scene.toml", "cannot read"]);
+    ws.assert_old_output_kept();
+}
+
+#[test]
+fn unknown_output_extension() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[&ws.arg("scene.toml"), "-o", &ws.arg("out.jpg")]);
+    assert_fails_with(&run, &["out.jpg", "unsupported output format", ".png"]);
+    ws.assert_old_output_kept();
+}
+
+#[test]
+fn output_into_missing_directory() {
+    let ws = Workspace::new(TINY_SCENE);
+    let target = ws.path("no-such-dir").join("out.png");
+    let run = gpu_render(&[&ws.arg("scene.toml"), "-o", &target.to_string_lossy()]);
+    assert_fails_with(&run, &["no-such-dir", "does not exist"]);
+    ws.assert_old_output_kept();
+}
+
+#[test]
+fn zero_width() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--width",
+        "0",
+    ]);
+    assert_fails_with(&run, &["--width 0", "width must be between 1 and"]);
+    ws.assert_old_output_kept();
+}
+
+#[test]
+fn compare_gamma_needs_png() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.exr"),
+        "--compare-gamma",
+    ]);
+    assert_fails_with(&run, &["out.exr", "--compare-gamma", ".png"]);
+    ws.assert_old_output_kept();
+}
+
+#[test]
+fn adapter_with_cpu_backend_is_refused() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+        "--adapter",
+        "0",
+    ]);
+    assert_fails_with(&run, &["--adapter", "--backend cpu"]);
+    ws.assert_old_output_kept();
+}
+
+#[test]
+fn usage_errors_keep_clap_status() {
+    let run = gpu_render(&["scene.toml"]);
+    assert_eq!(run.status, Some(2), "stderr:\n{}", run.stderr);
+    assert!(run.stderr.contains("--output"), "stderr:\n{}", run.stderr);
+    let run = gpu_render(&["scene.toml", "-o", "x.png", "--width", "wide"]);
+    assert_eq!(run.status, Some(2), "stderr:\n{}", run.stderr);
+    let run = gpu_render(&["--adapter", "0"]);
+    assert_eq!(run.status, Some(2), "stderr:\n{}", run.stderr);
+}
+
+#[test]
+fn help_describes_rendering() {
+    let run = gpu_render(&["--help"]);
+    assert_eq!(run.status, Some(0));
+    for needle in [
+        "SCENE",
+        "--output",
+        "--spp",
+        "--backend",
+        "--adapter",
+        ".exr",
+    ] {
+        assert!(
+            run.stdout.contains(needle),
+            "help lacks {needle}:\n{}",
+            run.stdout
+        );
+    }
+}
+
+#[test]
+fn adapter_list_exits_zero() {
+    let run = gpu_render(&["--adapter", "list"]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(!run.stdout.trim().is_empty(), "nothing listed");
+}
+
+// The tests below need the real scene parser (and, for the renders, the CPU tracer);
+// they pass once those are merged.
+
+#[test]
+fn malformed_toml() {
+    let ws = Workspace::new("[render]\nwidth = 32\nheight = = 24\n");
+    let run = gpu_render(&[&ws.arg("scene.toml"), "-o", &ws.arg("out.png")]);
+    // The parser reports file:line:col; the error is on line 3.
+    assert_fails_with(&run, &["scene.toml:3:"]);
+    ws.assert_old_output_kept();
+}
+
+#[test]
+fn undefined_material() {
+    let scene = TINY_SCENE.replace("material = \"white\"", "material = \"chalk\"");
+    let ws = Workspace::new(&scene);
+    let run = gpu_render(&[&ws.arg("scene.toml"), "-o", &ws.arg("out.png")]);
+    assert_fails_with(&run, &["scene.toml:", "chalk"]);
+    ws.assert_old_output_kept();
+}
+
+#[test]
+fn cpu_render_writes_png_of_requested_size() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+        "--width",
+        "32",
+        "--height",
+        "24",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(run.stdout.is_empty(), "stdout: {}", run.stdout);
+    assert!(run.stderr.contains("32x24"), "summary:\n{}", run.stderr);
+    assert!(run.stderr.contains("out.png"), "summary:\n{}", run.stderr);
+    assert_eq!(read_png_size(&ws.path("out.png")), (32, 24));
+}
+
+#[test]
+fn cpu_render_writes_exr_and_hdr_quietly() {
+    let ws = Workspace::new(TINY_SCENE);
+    for name in ["out.exr", "out.hdr"] {
+        let run = gpu_render(&[
+            &ws.arg("scene.toml"),
+            "-o",
+            &ws.arg(name),
+            "--backend",
+            "cpu",
+            "--width",
+            "16",
+            "--height",
+            "8",
+            "--quiet",
+        ]);
+        assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+        assert!(run.stderr.is_empty(), "quiet run printed:\n{}", run.stderr);
+        assert_eq!(read_png_size(&ws.path(name)), (16, 8));
+    }
+}
+
+#[test]
+fn compare_gamma_is_twice_as_wide() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+        "--compare-gamma",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert_eq!(read_png_size(&ws.path("out.png")), (64, 24));
+}
+
+fn shipped_path(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+#[test]
+fn brdf_check_accepts_a_plausible_map() {
+    let run = gpu_render(&["brdf-check", &shipped_path("scenes/brdf/plausible.png")]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    for rule in ["positivity:", "energy:", "reciprocity:"] {
+        let line = run
+            .stdout
+            .lines()
+            .find(|l| l.starts_with(rule))
+            .unwrap_or_else(|| panic!("no {rule} line in:\n{}", run.stdout));
+        assert!(line.contains(" ok "), "{line}");
+    }
+}
+
+#[test]
+fn brdf_check_reports_every_violated_rule() {
+    let path = shipped_path("scenes/brdf/implausible.exr");
+    let run = gpu_render(&["brdf-check", &path]);
+    assert_eq!(run.status, Some(1), "stderr:\n{}", run.stderr);
+    assert_eq!(run.stdout.matches("VIOLATED").count(), 3, "{}", run.stdout);
+    assert!(run.stderr.contains("implausible.exr"), "{}", run.stderr);
+    let missing = gpu_render(&["brdf-check", "/nonexistent/map.png"]);
+    assert_fails_with(&missing, &["/nonexistent/map.png", "cannot read"]);
+}
+
+// ------------------------------------------------- inputs, outputs and limits
+
+#[test]
+fn the_scene_file_is_never_the_output() {
+    // A scene file with an image extension, rendered onto itself.
+    let ws = Workspace::new(TINY_SCENE);
+    let scene = ws.path("scene.png");
+    std::fs::write(&scene, TINY_SCENE).expect("write scene.png");
+    let run = gpu_render(&[
+        &ws.arg("scene.png"),
+        "-o",
+        &ws.arg("scene.png"),
+        "--backend",
+        "cpu",
+    ]);
+    assert_fails_with(&run, &["scene.png", "same file as the scene file"]);
+    assert_eq!(std::fs::read_to_string(&scene).expect("read"), TINY_SCENE);
+    // Through a symbolic link too.
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(ws.path("scene.toml"), ws.path("link.png")).expect("symlink");
+        let run = gpu_render(&[
+            &ws.arg("scene.toml"),
+            "-o",
+            &ws.arg("link.png"),
+            "--backend",
+            "cpu",
+        ]);
+        assert_fails_with(&run, &["link.png", "scene.toml"]);
+        assert_eq!(
+            std::fs::read_to_string(ws.path("scene.toml")).expect("read"),
+            TINY_SCENE
+        );
+    }
+}
+
+#[test]
+fn a_texture_is_never_the_output() {
+    let ws = Workspace::new(&TINY_SCENE.replace("albedo = 0.7", "albedo_texture = \"wood.png\""));
+    image::RgbImage::from_pixel(2, 2, image::Rgb([200, 100, 50]))
+        .save(ws.path("wood.png"))
+        .expect("write the texture");
+    let before = std::fs::read(ws.path("wood.png")).expect("read");
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("wood.png"),
+        "--backend",
+        "cpu",
+    ]);
+    assert_fails_with(&run, &["wood.png", "same file as the image"]);
+    assert_eq!(std::fs::read(ws.path("wood.png")).expect("read"), before);
+}
+
+#[test]
+fn an_output_path_naming_a_directory_is_refused_before_rendering() {
+    let ws = Workspace::new(TINY_SCENE);
+    let target = format!("{}/", ws.arg("dir.png"));
+    // 4096x4096 at 64 spp would take minutes: the refusal must come first.
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &target,
+        "--backend",
+        "cpu",
+        "--width",
+        "4096",
+        "--height",
+        "4096",
+        "--spp",
+        "64",
+    ]);
+    assert_fails_with(&run, &["dir.png/", "is a directory"]);
+    ws.assert_old_output_kept();
+}
+
+#[test]
+fn a_render_beyond_the_memory_cap_is_refused_up_front_with_the_estimate() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+        "--compare-gamma",
+        "--width",
+        "16384",
+        "--height",
+        "8192",
+    ]);
+    assert_fails_with(
+        &run,
+        &[
+            "16384x8192",
+            "GiB",
+            "more than the 4 GiB allowed",
+            "--max-memory",
+        ],
+    );
+    ws.assert_old_output_kept();
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+        "--max-memory",
+        "0.01",
+    ]);
+    assert_fails_with(&run, &["more than the 0.01 GiB allowed"]);
+    ws.assert_old_output_kept();
+}
+
+#[test]
+fn hdr_output_clamps_radiance_it_cannot_hold_and_says_so() {
+    let scene = TINY_SCENE.replace(
+        "type = \"lambert\"\nalbedo = 0.7",
+        "type = \"emissive\"\nradiance = 3e38",
+    );
+    let ws = Workspace::new(&scene);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.hdr"),
+        "--backend",
+        "cpu",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(
+        run.stderr.contains("warning:") && run.stderr.contains("clamped"),
+        "{}",
+        run.stderr
+    );
+    let image = image::open(ws.path("out.hdr"))
+        .expect("open hdr")
+        .to_rgb32f();
+    let centre = image.get_pixel(16, 12).0;
+    assert_eq!(centre[0], gpu_render::output::HDR_MAX, "{centre:?}");
+}
+
+#[test]
+fn albedo_textures_above_one_are_clamped_with_a_warning_unless_quiet() {
+    let ws = Workspace::new(&TINY_SCENE.replace("albedo = 0.7", "albedo_texture = \"hot.exr\""));
+    image::Rgba32FImage::from_pixel(2, 2, image::Rgba([4.0, 0.5, 0.5, 1.0]))
+        .save(ws.path("hot.exr"))
+        .expect("write the texture");
+    let args = [
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+    ];
+    let run = gpu_render(&args);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(
+        run.stderr.contains("warning: ") && run.stderr.contains("clamped to 1"),
+        "{}",
+        run.stderr
+    );
+    let quiet = gpu_render(&[args.as_slice(), &["-q"]].concat());
+    assert_eq!(quiet.status, Some(0));
+    assert!(quiet.stderr.is_empty(), "{}", quiet.stderr);
+}
+
+#[test]
+fn the_environment_map_is_never_the_output_nor_the_standard_error() {
+    let ws = Workspace::new(&format!("{TINY_SCENE}\n[environment]\nmap = \"sky.hdr\"\n"));
+    let sky = image::Rgb32FImage::from_pixel(4, 2, image::Rgb([0.5, 0.6, 0.7]));
+    image::DynamicImage::ImageRgb32F(sky)
+        .save(ws.path("sky.hdr"))
+        .expect("write the map");
+    let before = std::fs::read(ws.path("sky.hdr")).expect("read");
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("sky.hdr"),
+        "--backend",
+        "cpu",
+    ]);
+    assert_fails_with(&run, &["sky.hdr", "same file as the environment map"]);
+    std::fs::copy(ws.path("sky.hdr"), ws.path("sky.exr")).expect("copy");
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(ws.path("sky.hdr"), ws.path("link.exr")).expect("symlink");
+    #[cfg(not(unix))]
+    std::fs::copy(ws.path("sky.hdr"), ws.path("link.exr")).expect("copy");
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--standard-error",
+        &ws.arg("link.exr"),
+        "--backend",
+        "cpu",
+    ]);
+    if cfg!(unix) {
+        assert_fails_with(&run, &["link.exr", "same file as the environment map"]);
+    }
+    assert_eq!(std::fs::read(ws.path("sky.hdr")).expect("read"), before);
+    assert_eq!(std::fs::read(ws.path("out.png")).expect("read"), OLD_OUTPUT);
+}
+
+#[test]
+fn the_sandbox_refuses_textures_outside_the_scene_folder() {
+    let ws =
+        Workspace::new(&TINY_SCENE.replace("albedo = 0.7", "albedo_texture = \"../wood.png\""));
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+        "--sandbox",
+    ]);
+    assert_fails_with(&run, &["scene.toml:", "albedo_texture", "`..`"]);
+    ws.assert_old_output_kept();
+}
+
+/// Runs gpu-render with `args` (`{}` replaced by the workspace's folder) and expects
+/// it to fail within 30 s (a blocking open would hang it until killed) with exit 1 and
+/// every `needle` in stderr.
+#[cfg(unix)]
+fn assert_refused_at_once(ws: &Workspace, args: &[&str], needles: &[&str]) {
+    let dir = ws.dir.path().to_string_lossy().into_owned();
+    let args: Vec<String> = args.iter().map(|a| a.replace("{}", &dir)).collect();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gpu-render"))
+        .args(&args)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    let status = wait_at_most(&mut child, Duration::from_secs(30));
+    let mut stderr = String::new();
+    if let Some(mut pipe) = child.stderr.take() {
+        use std::io::Read;
+        pipe.read_to_string(&mut stderr).expect("read stderr");
+    }
+    assert_eq!(status.and_then(|s| s.code()), Some(1), "{args:?}: {stderr}");
+    for needle in needles {
+        assert!(stderr.contains(needle), "{args:?}: {stderr} lacks {needle}");
+    }
+}
+
+#[cfg(unix)]
+fn mkfifo(path: &Path) {
+    let made = Command::new("mkfifo").arg(path).status().expect("mkfifo");
+    assert!(made.success());
+}
+
+#[cfg(unix)]
+#[test]
+fn a_fifo_as_scene_is_refused_at_once() {
+    let ws = Workspace::new(TINY_SCENE);
+    mkfifo(&ws.path("pipe.toml"));
+    assert_refused_at_once(
+        &ws,
+        &["{}/pipe.toml", "-o", "{}/out.png", "--backend", "cpu"],
+        &["a FIFO, not a regular file"],
+    );
+}
+
+/// Every file the program opens is checked, not only the scene: a FIFO as a model
+/// file, a material library, a glTF buffer, a texture, an environment map or a tile
+/// to merge is refused at once, and so is a device behind a link with a model's name.
+#[cfg(unix)]
+#[test]
+fn fifos_and_devices_are_refused_at_every_open() {
+    let triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let ws = Workspace::new(TINY_SCENE);
+    let write = |name: &str, text: &str| std::fs::write(ws.path(name), text).expect("write");
+    for fifo in [
+        "pipe.obj", "pipe.mtl", "pipe.bin", "pipe.png", "pipe.hdr", "pipe.exr",
+    ] {
+        mkfifo(&ws.path(fifo));
+    }
+    write("lib.obj", &format!("mtllib pipe.mtl\n{triangle}"));
+    write(
+        "buffer.gltf",
+        r#"{"asset": {"version": "2.0"}, "buffers": [{"uri": "pipe.bin", "byteLength": 36}],
+            "bufferViews": [{"buffer": 0, "byteLength": 36}],
+            "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                           "min": [0, 0, 0], "max": [1, 1, 0]}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+            "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0}"#,
+    );
+    write(
+        "textured.toml",
+        &TINY_SCENE.replace("albedo = 0.7", "albedo_texture = \"pipe.png\""),
+    );
+    write(
+        "sky.toml",
+        &format!("{TINY_SCENE}\n[environment]\nmap = \"pipe.hdr\"\n"),
+    );
+    std::os::unix::fs::symlink("/dev/zero", ws.path("zero.obj")).expect("symlink");
+    write("zero-lib.obj", &format!("mtllib /dev/zero\n{triangle}"));
+    let render = |input: &str| {
+        vec![
+            input.to_owned(),
+            "-o".into(),
+            "{}/out.png".into(),
+            "--backend".into(),
+            "cpu".into(),
+        ]
+    };
+    for (input, needle) in [
+        ("{}/pipe.obj", "a FIFO"),
+        ("{}/lib.obj", "a FIFO"),
+        ("{}/buffer.gltf", "a FIFO"),
+        ("{}/textured.toml", "a FIFO"),
+        ("{}/sky.toml", "a FIFO"),
+        ("{}/zero.obj", "a device"),
+        ("{}/zero-lib.obj", "a device"),
+    ] {
+        let args = render(input);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        assert_refused_at_once(&ws, &args, &[needle]);
+    }
+    assert_refused_at_once(
+        &ws,
+        &["merge", "{}/pipe.exr", "-o", "{}/out.png"],
+        &["pipe.exr", "a FIFO"],
+    );
+    ws.assert_old_output_kept_beside(&[
+        "buffer.gltf",
+        "lib.obj",
+        "pipe.bin",
+        "pipe.exr",
+        "pipe.hdr",
+        "pipe.mtl",
+        "pipe.obj",
+        "pipe.png",
+        "sky.toml",
+        "textured.toml",
+        "zero-lib.obj",
+        "zero.obj",
+    ]);
+}
+
+// ------------------------------------------------------------- flag values
+
+#[test]
+fn a_negative_width_says_it_must_be_positive() {
+    let run = gpu_render(&["scene.toml", "-o", "x.png", "--width", "-1"]);
+    assert_eq!(run.status, Some(2), "stderr:\n{}", run.stderr);
+    assert!(
+        run.stderr.contains("--width") && run.stderr.contains("positive integer"),
+        "{}",
+        run.stderr
+    );
+    let run = gpu_render(&["scene.toml", "-o", "x.png", "--min-ray-weight", "-0.5"]);
+    assert!(
+        !run.stderr.contains("unexpected argument"),
+        "{}",
+        run.stderr
+    );
+}
+
+#[test]
+fn tradeoff_refuses_bad_counts_before_creating_its_folder() {
+    let ws = Workspace::new(TINY_SCENE);
+    let out_dir = ws.path("sweep");
+    for (flag, value) in [
+        ("--reference-spp", "0"),
+        ("--repeats", "0"),
+        ("--width", "-5"),
+    ] {
+        let run = gpu_render(&[
+            "tradeoff",
+            &ws.arg("scene.toml"),
+            "--out-dir",
+            &out_dir.to_string_lossy(),
+            "--backend",
+            "cpu",
+            flag,
+            value,
+        ]);
+        assert_eq!(run.status, Some(2), "{flag} {value}: {}", run.stderr);
+        assert!(run.stderr.contains(flag), "{flag}: {}", run.stderr);
+        assert!(
+            !out_dir.exists(),
+            "{flag} {value} created the output folder"
+        );
+    }
+    ws.assert_old_output_kept();
+}
+
+// ------------------------------------------------------------------ signals
+
+use std::time::{Duration, Instant};
+
+/// Waits for `child` for at most `limit`; kills it (a failure) if it is still running.
+fn wait_at_most(
+    child: &mut std::process::Child,
+    limit: Duration,
+) -> Option<std::process::ExitStatus> {
+    let started = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().expect("wait") {
+            return Some(status);
+        }
+        if started.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+#[cfg(unix)]
+fn send_signal(child: &std::process::Child, signal: &str) {
+    let sent = Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status()
+        .expect("run kill");
+    assert!(sent.success(), "kill {signal} failed");
+}
+
+/// Temporary files of gpu-render in `dir`, with their sizes.
+fn temporaries(dir: &Path) -> Vec<(String, u64)> {
+    std::fs::read_dir(dir)
+        .expect("list")
+        .filter_map(|e| {
+            let e = e.ok()?;
+            let name = e.file_name().to_string_lossy().into_owned();
+            let size = e.metadata().ok()?.len();
+            (name.starts_with(".gpu-render-") && name.ends_with(".tmp")).then_some((name, size))
+        })
+        .collect()
+}
+
+/// Whether `child` is writing an output in `dir`: a temporary file there has data, or
+/// (on Linux, where the temporary file has no name until it is complete) one of the
+/// child's open files is an unnamed file of `dir` with data.
+#[cfg(unix)]
+fn writing_in(child: &std::process::Child, dir: &Path) -> bool {
+    if temporaries(dir).iter().any(|&(_, size)| size > 0) {
+        return true;
+    }
+    let Ok(fds) = std::fs::read_dir(format!("/proc/{}/fd", child.id())) else {
+        return false;
+    };
+    let dir = dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf());
+    fds.flatten().any(|fd| {
+        let Ok(target) = std::fs::read_link(fd.path()) else {
+            return false;
+        };
+        let unnamed = target.to_string_lossy().ends_with("(deleted)");
+        unnamed
+            && target.parent() == Some(dir.as_path())
+            && std::fs::metadata(fd.path()).is_ok_and(|m| m.len() > 0)
+    })
+}
+
+/// Renders an empty 4096x4096 scene to `out.exr` (256 MiB) and sends `signal` once
+/// the temporary file has data in it: the write is in progress.
+#[cfg(unix)]
+fn interrupt_a_write(signal: &str) {
+    let ws = Workspace::new(
+        "[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\n[environment]\nbackground = 0.5\n",
+    );
+    std::fs::write(ws.path("out.exr"), OLD_OUTPUT).expect("old exr");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gpu-render"))
+        .args([
+            &ws.arg("scene.toml"),
+            "-o",
+            &ws.arg("out.exr"),
+            "--backend",
+            "cpu",
+            "--width",
+            "4096",
+            "--height",
+            "4096",
+            "-q",
+        ])
+        .spawn()
+        .expect("spawn");
+    let started = Instant::now();
+    let mut sent = false;
+    while started.elapsed() < Duration::from_secs(120) {
+        if child.try_wait().expect("wait").is_some() {
+            break;
+        }
+        if writing_in(&child, ws.dir.path()) {
+            send_signal(&child, signal);
+            sent = true;
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let status = wait_at_most(&mut child, Duration::from_secs(60));
+    assert!(sent, "the write finished before the signal could be sent");
+    if signal == "-KILL" {
+        use std::os::unix::process::ExitStatusExt;
+        assert_eq!(status.and_then(|s| s.signal()), Some(9), "{status:?}");
+    } else {
+        assert_eq!(
+            status.and_then(|s| s.code()),
+            Some(130),
+            "{signal}: {status:?}"
+        );
+    }
+    assert!(
+        temporaries(ws.dir.path()).is_empty(),
+        "{signal} left {:?}",
+        temporaries(ws.dir.path())
+    );
+    assert_eq!(std::fs::read(ws.path("out.exr")).expect("read"), OLD_OUTPUT);
+    // A later render into the same folder completes and leaves nothing either.
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("next.png"),
+        "--backend",
+        "cpu",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "-q",
+    ]);
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    assert!(
+        temporaries(ws.dir.path()).is_empty(),
+        "after the next render: {:?}",
+        temporaries(ws.dir.path())
+    );
+}
+
+#[cfg(unix)]
+#[test]
+fn sigint_during_a_write_leaves_no_temporary_file_and_exits_130() {
+    interrupt_a_write("-INT");
+}
+
+#[cfg(unix)]
+#[test]
+fn sigterm_during_a_write_leaves_no_temporary_file_and_exits_130() {
+    interrupt_a_write("-TERM");
+}
+
+/// SIGKILL, which no handler sees (what Slurm and Kubernetes send after their grace
+/// period), leaves no temporary file either, and a render after it leaves none.
+#[cfg(unix)]
+#[test]
+fn sigkill_during_a_write_leaves_no_temporary_file_before_or_after_the_next_render() {
+    interrupt_a_write("-KILL");
+}
+
+#[cfg(unix)]
+#[test]
+fn sigint_during_a_render_stops_it_and_keeps_the_old_output() {
+    let ws = Workspace::new(TINY_SCENE);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gpu-render"))
+        .args([
+            &ws.arg("scene.toml"),
+            "-o",
+            &ws.arg("out.png"),
+            "--backend",
+            "cpu",
+            "--width",
+            "2048",
+            "--height",
+            "2048",
+            "--spp",
+            "256",
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    // The render takes minutes; the handler is installed within milliseconds of the
+    // start, and by a second the render is well under way.
+    std::thread::sleep(Duration::from_secs(1));
+    let started = Instant::now();
+    send_signal(&child, "-INT");
+    let status = wait_at_most(&mut child, Duration::from_secs(30));
+    assert_eq!(status.and_then(|s| s.code()), Some(130), "{status:?}");
+    assert!(started.elapsed() < Duration::from_secs(30));
+    let mut rest = String::new();
+    use std::io::Read;
+    child
+        .stderr
+        .take()
+        .expect("stderr")
+        .read_to_string(&mut rest)
+        .expect("read");
+    assert!(rest.contains("interrupted"), "{rest}");
+    ws.assert_old_output_kept();
+}
+
+// ---------------------------------------------------------------- model files
+
+#[test]
+fn a_model_file_renders_directly_with_a_framing_camera_and_default_lights() {
+    let ws = Workspace::new(TINY_SCENE);
+    let vase = shipped_path("scenes/models/vase.gltf");
+    let run = gpu_render(&[
+        &vase,
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+        "--width",
+        "40",
+        "--height",
+        "30",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    for needle in ["has no camera", "has no lights", "40x30"] {
+        assert!(
+            run.stderr.contains(needle),
+            "stderr lacks {needle:?}:\n{}",
+            run.stderr
+        );
+    }
+    let image = image::open(ws.path("out.png")).expect("open").to_rgb8();
+    assert_eq!(image.dimensions(), (40, 30));
+    // The framed model fills the middle of the image and differs from the background.
+    let corner = *image.get_pixel(0, 0);
+    let centre = *image.get_pixel(20, 15);
+    assert_ne!(
+        corner, centre,
+        "the model is not in the middle of the frame"
+    );
+}
+
+#[test]
+fn a_broken_model_file_is_an_error_naming_it_and_keeps_the_old_output() {
+    let ws = Workspace::new(TINY_SCENE);
+    std::fs::write(ws.path("broken.glb"), b"glTF\x02\x00\x00\x00trunc").expect("write");
+    let run = gpu_render(&[&ws.arg("broken.glb"), "-o", &ws.arg("out.png"), "-q"]);
+    assert_fails_with(&run, &["broken.glb"]);
+    std::fs::remove_file(ws.path("broken.glb")).expect("remove");
+    ws.assert_old_output_kept();
+}
+
+#[test]
+fn the_sandbox_refuses_model_files() {
+    let ws = Workspace::new(TINY_SCENE);
+    let vase = shipped_path("scenes/models/vase.gltf");
+    let run = gpu_render(&[&vase, "-o", &ws.arg("out.png"), "--sandbox", "-q"]);
+    assert_fails_with(&run, &["vase.gltf", "--sandbox"]);
+    ws.assert_old_output_kept();
+}
+
+// ---------------------------------------------------------------- integrators
+
+#[test]
+fn the_path_integrator_renders_with_auto_which_says_why_when_it_chooses_the_cpu() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--integrator",
+        "path",
+        "--spp",
+        "2",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    // On a CPU device (lavapipe) auto renders path-traced scenes of more than a few
+    // primitives on the CPU reference and says so; this small one, unrolled, and every
+    // scene on a real GPU render on the GPU.
+    if run.stderr.contains("is a CPU device") {
+        assert!(
+            run.stderr.contains("CPU reference") && run.stderr.contains("path-traced"),
+            "stderr:\n{}",
+            run.stderr
+        );
+    }
+    assert_eq!(read_png_size(&ws.path("out.png")), (32, 24));
+}
+
+#[test]
+fn the_path_integrator_renders_on_the_gpu_when_asked() {
+    // Fails loudly in CI without an adapter, as every GPU test does.
+    if crate::support::gpu::headless_gpu().is_none() {
+        return;
+    }
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--integrator",
+        "path",
+        "--spp",
+        "2",
+        "--backend",
+        "gpu",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert_eq!(read_png_size(&ws.path("out.png")), (32, 24));
+}
+
+#[test]
+fn a_scene_may_choose_its_integrator_and_a_bad_one_is_named() {
+    let path_scene = TINY_SCENE.replace("[render]\n", "[render]\nintegrator = \"path\"\n");
+    let ws = Workspace::new(&path_scene);
+    let run = gpu_render(&[&ws.arg("scene.toml"), "-o", &ws.arg("out.png"), "-q"]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    let bad = TINY_SCENE.replace("[render]\n", "[render]\nintegrator = \"photon\"\n");
+    let ws = Workspace::new(&bad);
+    let run = gpu_render(&[&ws.arg("scene.toml"), "-o", &ws.arg("out.png"), "-q"]);
+    assert_fails_with(&run, &["scene.toml:3", "photon", "whitted", "path"]);
+    ws.assert_old_output_kept();
+}
+
+/// A sphere only the CPU reference's f64 can place (a unit sphere a million units out,
+/// seen from 5 units): the load warning names it and its precision on both backends,
+/// and `--backend auto` renders on the CPU and says why (or, with no GPU at all, says
+/// that). A ground sphere of radius 1000 loads without a warning.
+#[test]
+fn a_sphere_beyond_the_gpus_precision_is_warned_about_and_auto_renders_on_the_cpu() {
+    let far = TINY_SCENE
+        .replace("eye = [0.0, 0.0, 3.0]", "eye = [1000000.0, 0.0, 6.0]")
+        .replace(
+            "look_at = [0.0, 0.0, 0.0]",
+            "look_at = [1000000.0, 0.0, 0.0]",
+        )
+        .replace(
+            "position = [0.0, 2.0, 3.0]",
+            "position = [1000000.0, 2.0, 3.0]",
+        )
+        .replace("center = [0.0, 0.0, 0.0]", "center = [1000000.0, 0.0, 0.0]");
+    let ws = Workspace::new(&far);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "auto",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(
+        run.stderr.contains("warning: ")
+            && run.stderr.contains("objects[0] (sphere): radius 1e0")
+            && run.stderr.contains("on the CPU reference (f64")
+            && run.stderr.contains("the GPU cannot place it"),
+        "{}",
+        run.stderr
+    );
+    assert!(
+        run.stderr
+            .contains("CPU reference (auto: a sphere of radius 1e0")
+            || run.stderr.contains("CPU reference (auto: no GPU adapter"),
+        "{}",
+        run.stderr
+    );
+
+    let ground = TINY_SCENE
+        .replace("center = [0.0, 0.0, 0.0]", "center = [0.0, -1001.0, 0.0]")
+        .replace("radius = 1.0", "radius = 1000.0");
+    let ws = Workspace::new(&ground);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.png"),
+        "--backend",
+        "cpu",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(!run.stderr.contains("warning"), "{}", run.stderr);
+}
+
+#[test]
+fn standard_error_is_written_beside_the_image_and_summarised() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.exr"),
+        "--standard-error",
+        &ws.arg("se.exr"),
+        "--backend",
+        "cpu",
+        "--width",
+        "16",
+        "--height",
+        "8",
+        "--spp",
+        "4",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(
+        run.stderr.contains("estimated noise ") && run.stderr.contains("% (relative RMSE"),
+        "summary:\n{}",
+        run.stderr
+    );
+    let se = image::open(ws.path("se.exr"))
+        .expect("open se.exr")
+        .to_rgba32f();
+    assert_eq!(se.dimensions(), (16, 8));
+    assert!(
+        se.pixels()
+            .all(|p| p[0].is_finite() && p[0] >= 0.0 && p[0] == p[1])
+    );
+    // The black background's samples are all equal; the sphere's silhouette is not.
+    assert_eq!(se.get_pixel(0, 0)[0], 0.0);
+    assert!(se.pixels().any(|p| p[0] > 1e-3), "no pixel has noise");
+}
+
+#[test]
+fn standard_error_must_be_another_exr() {
+    let ws = Workspace::new(TINY_SCENE);
+    for (name, needle) in [("se.png", ".exr"), ("out.exr", "another file")] {
+        let run = gpu_render(&[
+            &ws.arg("scene.toml"),
+            "-o",
+            &ws.arg("out.exr"),
+            "--standard-error",
+            &ws.arg(name),
+            "--backend",
+            "cpu",
+        ]);
+        assert_fails_with(&run, &["--standard-error", needle]);
+        assert!(!ws.path("out.exr").exists(), "{name}: rendered anyway");
+    }
+}

@@ -1,0 +1,49 @@
+//! The integration tests, one binary (matklad, "Delete Cargo Integration Tests",
+//! 2021): each module is one area's tests, `support` the helpers they share. One
+//! binary compiles and links once, and dead helpers are found by the compiler.
+
+mod support;
+
+mod bvh_cpu;
+mod bvh_gpu;
+mod bxdf_gpu_twin;
+mod bxdf_plausibility;
+mod cli;
+mod display_pass;
+mod emissive_texture;
+mod environment;
+mod environment_gpu;
+mod environment_reference;
+mod extremes;
+mod frame_loop;
+mod fuzz_pipeline;
+mod fuzz_scenes;
+mod gpu_memory;
+mod gpu_smoke;
+mod gpu_vs_cpu;
+mod import_fuzz;
+mod import_gltf;
+mod import_obj;
+mod instancing;
+mod layout;
+mod load_time;
+mod material_errors;
+mod noise;
+mod path_gpu;
+mod path_reference;
+mod path_tracing;
+mod radiometry;
+mod recipes;
+mod sampler_chi2;
+mod sampling_bias;
+mod sampling_gpu_twin;
+mod scene_errors;
+mod scene_models;
+mod shading_normals;
+mod specialisation;
+mod stress_scenes;
+mod tiles;
+mod uniform_records;
+mod unrolled;
+mod uv_wrap_gpu;
+mod viewer;
