@@ -68,6 +68,38 @@ impl Doc {
         ))
     }
 
+    /// An accessor of integer components (`component_type` 5120 byte, 5121 unsigned
+    /// byte, 5122 short, 5123 unsigned short), each element padded to 4 bytes as glTF
+    /// 2.0 §3.6.2.4 requires of vertex attributes.
+    fn integers(
+        &mut self,
+        type_: &str,
+        component_type: u32,
+        normalized: bool,
+        elements: &[Vec<i32>],
+    ) -> usize {
+        let size = if component_type <= 5121 { 1 } else { 2 };
+        let components = elements.first().map_or(1, Vec::len);
+        let stride = (components * size).next_multiple_of(4);
+        let mut bytes = Vec::new();
+        for element in elements {
+            for &c in element {
+                if size == 1 {
+                    bytes.push(c as u8);
+                } else {
+                    bytes.extend_from_slice(&(c as u16).to_le_bytes());
+                }
+            }
+            bytes.resize(bytes.len().next_multiple_of(4), 0);
+        }
+        let view = self.view(&bytes);
+        self.views[view] = self.views[view].replace('}', &format!(r#","byteStride":{stride}}}"#));
+        self.accessor(format!(
+            r#"{{"bufferView":{view},"componentType":{component_type},"normalized":{normalized},"count":{},"type":"{type_}"}}"#,
+            elements.len()
+        ))
+    }
+
     fn indices(&mut self, data: &[u16]) -> usize {
         let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
         let view = self.view(&bytes);
@@ -263,6 +295,171 @@ fn strips_and_fans_become_triangles_and_indices_are_optional() {
         assert!((b - a).cross(c - a).z > 0.0, "{triangle:?}");
     }
     assert_eq!(model.meshes[0].name, "mesh 0, primitive 0");
+}
+
+/// The value of a normalized integer as glTF 2.0 §3.11 and `KHR_mesh_quantization`
+/// decode it.
+fn dequantize(component_type: u32, normalized: bool, c: i32) -> f64 {
+    let c = f64::from(c);
+    match (component_type, normalized) {
+        (_, false) => c,
+        (5120, true) => (c / 127.0).max(-1.0),
+        (5121, true) => c / 255.0,
+        (5122, true) => (c / 32767.0).max(-1.0),
+        (_, true) => c / 65535.0,
+    }
+}
+
+#[test]
+fn quantized_attributes_import_as_their_float_twins() {
+    // One triangle per POSITION component type (KHR_mesh_quantization's table), each
+    // with quantized normals and texture coordinates; the twin holds the same values as
+    // floats.
+    let mut quantized = Doc::default();
+    let mut float = Doc::default();
+    let mut primitives_q = Vec::new();
+    let mut primitives_f = Vec::new();
+    let kinds = [
+        (5120, false),
+        (5120, true),
+        (5121, false),
+        (5121, true),
+        (5122, false),
+        (5122, true),
+        (5123, false),
+        (5123, true),
+    ];
+    for (k, &(position_type, position_normalized)) in kinds.iter().enumerate() {
+        let signed = position_type == 5120 || position_type == 5122;
+        let big = if position_type <= 5121 { 100 } else { 30000 };
+        let low = if signed { -big } else { 0 };
+        let positions = vec![vec![low, low, 0], vec![big, low, 0], vec![low, big, 1]];
+        // Normals: normalized signed bytes or shorts only, -128 and -32768 included
+        // (they clamp to -1).
+        let (normal_type, unit, below) = if k % 2 == 0 {
+            (5120, 127, -128)
+        } else {
+            (5122, 32767, -32768)
+        };
+        let normals = vec![vec![0, 0, unit], vec![0, below, unit], vec![unit, 0, unit]];
+        // Texture coordinates: every type, normalized or not, in turn.
+        let (uv_type, uv_normalized) = kinds[(k + 3) % kinds.len()];
+        let uv_big = if uv_type <= 5121 { 127 } else { 32767 };
+        let uv_low = if uv_type == 5120 || uv_type == 5122 {
+            -uv_big
+        } else {
+            0
+        };
+        let uvs = vec![vec![uv_low, 0], vec![uv_big, 1], vec![0, uv_big]];
+        let p = quantized.integers("VEC3", position_type, position_normalized, &positions);
+        let n = quantized.integers("VEC3", normal_type, true, &normals);
+        let t = quantized.integers("VEC2", uv_type, uv_normalized, &uvs);
+        primitives_q.push(format!(
+            r#"{{"attributes":{{"POSITION":{p},"NORMAL":{n},"TEXCOORD_0":{t}}}}}"#
+        ));
+        let as_f32 = |elements: &[Vec<i32>], ty: u32, normalized: bool| -> Vec<Vec<f32>> {
+            elements
+                .iter()
+                .map(|e| {
+                    e.iter()
+                        .map(|&c| dequantize(ty, normalized, c) as f32)
+                        .collect()
+                })
+                .collect()
+        };
+        let vec3 =
+            |v: Vec<Vec<f32>>| -> Vec<[f32; 3]> { v.iter().map(|e| [e[0], e[1], e[2]]).collect() };
+        let p = float.vec3(&vec3(as_f32(
+            &positions,
+            position_type,
+            position_normalized,
+        )));
+        let n = float.vec3(&vec3(as_f32(&normals, normal_type, true)));
+        let t = float.vec2(
+            &as_f32(&uvs, uv_type, uv_normalized)
+                .iter()
+                .map(|e| [e[0], e[1]])
+                .collect::<Vec<_>>(),
+        );
+        primitives_f.push(format!(
+            r#"{{"attributes":{{"POSITION":{p},"NORMAL":{n},"TEXCOORD_0":{t}}}}}"#
+        ));
+    }
+    let body = |primitives: &[String]| {
+        format!(
+            r#""extensionsUsed":["KHR_mesh_quantization"],"extensionsRequired":["KHR_mesh_quantization"],
+               "scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0,"scale":[0.01,0.01,0.01]}}],
+               "meshes":[{{"primitives":[{}]}}]"#,
+            primitives.join(",")
+        )
+    };
+    let q = imported(
+        "quantized.gltf",
+        quantized.embedded(&body(&primitives_q)).as_bytes(),
+    );
+    let f = imported(
+        "float.gltf",
+        float.embedded(&body(&primitives_f)).as_bytes(),
+    );
+    assert!(q.warnings.is_empty(), "{:?}", q.warnings);
+    assert_eq!(q.meshes.len(), kinds.len());
+    assert_eq!(q.meshes.len(), f.meshes.len());
+    for (mq, mf) in q.meshes.iter().zip(&f.meshes) {
+        assert_eq!(mq.triangles, mf.triangles, "{}", mq.name);
+        assert_eq!(mq.instances, mf.instances, "{}", mq.name);
+        for (a, b) in mq.positions.iter().zip(&mf.positions) {
+            assert_close(*a, *b, 1e-7 * b.length().max(1.0));
+        }
+        let (nq, nf) = (
+            mq.normals.as_ref().expect("normals"),
+            mf.normals.as_ref().expect("normals"),
+        );
+        for (a, b) in nq.iter().zip(nf) {
+            assert_close(*a, *b, 1e-7);
+        }
+        let (uq, uf) = (mq.uvs.as_ref().expect("uvs"), mf.uvs.as_ref().expect("uvs"));
+        for (a, b) in uq.iter().zip(uf) {
+            assert!(
+                (*a - *b).length() <= 1e-7 * b.length().max(1.0),
+                "{a} vs {b}"
+            );
+        }
+    }
+    // Exactly the specification's formulas: 32767 short → 1, -32768 → -1 (clamped),
+    // 65535 unsigned short → 1, -128 byte → -1.
+    let short_normalized = &q.meshes[5];
+    assert_eq!(
+        short_normalized.positions[0],
+        DVec3::new(-30000.0 / 32767.0, -30000.0 / 32767.0, 0.0)
+    );
+    assert_eq!(short_normalized.positions[2].z, 1.0 / 32767.0);
+    let normals = q.meshes[1].normals.as_ref().expect("normals");
+    assert_eq!(normals[0], DVec3::Z);
+    assert_eq!(normals[1], DVec3::new(0.0, -1.0, 1.0).normalize());
+    let normals = q.meshes[0].normals.as_ref().expect("normals");
+    assert_eq!(normals[1], DVec3::new(0.0, -1.0, 1.0).normalize());
+    let uvs = q.meshes[2].uvs.as_ref().expect("uvs");
+    assert_eq!(uvs[1].x, 32767.0 / 32767.0, "normalized short");
+    let uvs = q.meshes[1].uvs.as_ref().expect("uvs");
+    assert_eq!(
+        (uvs[0].x, uvs[1].x),
+        (-32767.0, 32767.0),
+        "short, not normalized"
+    );
+
+    // Without the extension listed, the values are read with one warning.
+    let unlisted = body(&primitives_q).replace(
+        r#""extensionsUsed":["KHR_mesh_quantization"],"extensionsRequired":["KHR_mesh_quantization"],"#,
+        "",
+    );
+    let model = imported("unlisted.gltf", quantized.embedded(&unlisted).as_bytes());
+    assert_eq!(model.meshes, q.meshes);
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    assert!(
+        model.warnings[0].contains("unlisted.gltf: mesh 0, primitive 0: POSITION (accessor 0) holds I8 components, which only KHR_mesh_quantization allows"),
+        "{:?}",
+        model.warnings
+    );
 }
 
 #[test]

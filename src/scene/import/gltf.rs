@@ -15,7 +15,7 @@ use ::gltf::texture::WrappingMode;
 use base64::Engine;
 use glam::{DMat4, DQuat, DVec2, DVec3};
 
-use super::accessor::{Expect, read, view_bytes};
+use super::accessor::{Expect, Normalized, read, view_bytes};
 use super::mesh::{Budget, RawMesh, finish_mesh};
 use super::texture::{Encoding, Textures};
 use super::{
@@ -38,6 +38,32 @@ const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
     "KHR_materials_transmission",
+    "KHR_mesh_quantization",
+];
+/// `KHR_mesh_quantization`, which widens the component types of vertex attributes.
+const MESH_QUANTIZATION: &str = "KHR_mesh_quantization";
+/// Component types of `POSITION`: `FLOAT` (glTF 2.0 §3.7.2.1), and under
+/// `KHR_mesh_quantization` (its table "Extending Mesh Attributes") signed and unsigned
+/// bytes and shorts, normalized or not.
+const POSITION_TYPES: &[DataType] = &[
+    DataType::F32,
+    DataType::I8,
+    DataType::U8,
+    DataType::I16,
+    DataType::U16,
+];
+/// Component types of `NORMAL`: `FLOAT`, and under `KHR_mesh_quantization` normalized
+/// signed bytes and shorts.
+const NORMAL_TYPES: &[DataType] = &[DataType::F32, DataType::I8, DataType::I16];
+/// Component types of `TEXCOORD_n`: `FLOAT` and normalized unsigned bytes and shorts
+/// (glTF 2.0 §3.7.2.1), and under `KHR_mesh_quantization` also signed ones and both
+/// not normalized.
+const TEXCOORD_TYPES: &[DataType] = &[
+    DataType::F32,
+    DataType::I8,
+    DataType::U8,
+    DataType::I16,
+    DataType::U16,
 ];
 /// Index of refraction of `KHR_materials_ior`'s default (and of glass without it).
 const DEFAULT_IOR: f64 = 1.5;
@@ -173,8 +199,11 @@ fn validate(document: &Document, path: &Path) -> Result<(), SceneError> {
         let where_ = where_();
         // POSITION's min and max are required (§3.7.2.1) but only serve to bound the
         // mesh without reading it; some exporters leave them out or get them wrong, and
-        // the positions are read (and checked) anyway.
-        if !where_.as_str().contains(r#"["POSITION"].m"#) {
+        // the positions are read (and checked) anyway. Required extensions were judged
+        // against what this importer reads, not what the crate knows.
+        if !where_.as_str().contains(r#"["POSITION"].m"#)
+            && !where_.as_str().starts_with("extensionsRequired")
+        {
             problems.push(format!("{where_}: {what}"));
         }
     });
@@ -472,7 +501,7 @@ impl Importer<'_> {
         for primitive in mesh.primitives() {
             let name = format!("{mesh_name}, primitive {}", primitive.index());
             let raw = self
-                .primitive(&primitive)
+                .primitive(&primitive, &name)
                 .map_err(|e| self.fail(format!("{name}: {e}")))?;
             let material = self.material(primitive.material().index())?;
             self.budget
@@ -491,8 +520,13 @@ impl Importer<'_> {
         Ok(())
     }
 
-    /// Reads one primitive's positions, normals, `TEXCOORD_0` and triangles.
-    fn primitive(&mut self, primitive: &::gltf::Primitive<'_>) -> Result<RawMesh, String> {
+    /// Reads one primitive's positions, normals, `TEXCOORD_0` and triangles; `name`
+    /// (mesh and primitive) is for warnings, the caller prefixes it to errors.
+    fn primitive(
+        &mut self,
+        primitive: &::gltf::Primitive<'_>,
+        name: &str,
+    ) -> Result<RawMesh, String> {
         let mode = primitive.mode();
         if !matches!(
             mode,
@@ -533,11 +567,12 @@ impl Importer<'_> {
             &Expect {
                 name: "POSITION",
                 dimensions: Dimensions::Vec3,
-                types: &[DataType::F32],
-                normalized: false,
+                types: POSITION_TYPES,
+                normalized: Normalized::Either,
             },
             &self.buffers,
         )?);
+        self.check_quantization(&positions_accessor, name, "POSITION", false);
         let same_count = |accessor: &::gltf::Accessor<'_>, name: &str| {
             if accessor.count() == count {
                 Ok(())
@@ -551,16 +586,18 @@ impl Importer<'_> {
         let normals = match primitive.get(&::gltf::Semantic::Normals) {
             Some(accessor) => {
                 same_count(&accessor, "NORMAL")?;
-                Some(vec3(read(
+                let normals = vec3(read(
                     &accessor,
                     &Expect {
                         name: "NORMAL",
                         dimensions: Dimensions::Vec3,
-                        types: &[DataType::F32],
-                        normalized: false,
+                        types: NORMAL_TYPES,
+                        normalized: Normalized::Always,
                     },
                     &self.buffers,
-                )?))
+                )?);
+                self.check_quantization(&accessor, name, "NORMAL", false);
+                Some(normals)
             }
             None => None,
         };
@@ -572,11 +609,12 @@ impl Importer<'_> {
                     &Expect {
                         name: "TEXCOORD_0",
                         dimensions: Dimensions::Vec2,
-                        types: &[DataType::F32, DataType::U8, DataType::U16],
-                        normalized: true,
+                        types: TEXCOORD_TYPES,
+                        normalized: Normalized::Either,
                     },
                     &self.buffers,
                 )?;
+                self.check_quantization(&accessor, name, "TEXCOORD_0", true);
                 Some(
                     values
                         .chunks_exact(2)
@@ -593,7 +631,7 @@ impl Importer<'_> {
                     name: "indices",
                     dimensions: Dimensions::Scalar,
                     types: &[DataType::U8, DataType::U16, DataType::U32],
-                    normalized: false,
+                    normalized: Normalized::Never,
                 },
                 &self.buffers,
             )?
@@ -605,7 +643,7 @@ impl Importer<'_> {
         let triangles = triangles(mode, &indices);
         if mode == Mode::Triangles && !indices.len().is_multiple_of(3) {
             self.warn(format!(
-                "a triangle list of {} indices (not a multiple of 3): the last {} ignored",
+                "{name}: a triangle list of {} indices (not a multiple of 3): the last {} ignored",
                 indices.len(),
                 indices.len() % 3
             ));
@@ -616,6 +654,39 @@ impl Importer<'_> {
             uvs,
             triangles,
         })
+    }
+
+    /// Warns (once per file) when `accessor` holds one of the component types that only
+    /// `KHR_mesh_quantization` allows but the file does not list the extension in
+    /// `extensionsUsed` (glTF 2.0 §3.12: an extension a file uses must be listed). The
+    /// values are unambiguous either way, so they are read.
+    fn check_quantization(
+        &mut self,
+        accessor: &::gltf::Accessor<'_>,
+        primitive: &str,
+        attribute: &str,
+        texcoord: bool,
+    ) {
+        let data_type = accessor.data_type();
+        let core = data_type == DataType::F32
+            || (texcoord
+                && accessor.normalized()
+                && matches!(data_type, DataType::U8 | DataType::U16));
+        if !core
+            && !self
+                .document
+                .extensions_used()
+                .any(|e| e == MESH_QUANTIZATION)
+        {
+            self.warn_once(
+                "quantization",
+                format!(
+                    "{primitive}: {attribute} (accessor {}) holds {}{data_type:?} components, which only {MESH_QUANTIZATION} allows, but the file does not list that extension in extensionsUsed; read anyway",
+                    accessor.index(),
+                    if accessor.normalized() { "normalized " } else { "" }
+                ),
+            );
+        }
     }
 
     /// The model's index of glTF material `index` (`None`: the default material, glTF
