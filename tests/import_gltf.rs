@@ -872,13 +872,62 @@ fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
         (
             "glTF 1",
             ok.replace(r#""version":"2.0""#, r#""version":"1.0""#).into_bytes(),
-            "glTF version 1.0 is not supported",
+            r#"the file is glTF 1.0 (asset.version is "1.0"); only glTF 2.0 is read"#,
         ),
         (
-            "required extension",
-            ok.replacen('{', r#"{"extensionsRequired":["KHR_draco_mesh_compression"],"#, 1)
+            "glTF 1 structure",
+            br#"{"asset":{"version":"1.0"},"accessors":{"accessor_21":{"bufferView":"bufferView_29","componentType":5123,"count":36,"type":"SCALAR"}}}"#.to_vec(),
+            r#"the file is glTF 1.0 (asset.version is "1.0"); only glTF 2.0 is read: convert it first, e.g. with gltf-pipeline"#,
+        ),
+        (
+            "glTF 1 structure without a version",
+            br#"{"meshes":{"mesh_0":{"primitives":[]}},"scene":"defaultScene"}"#.to_vec(),
+            "the file is glTF 1.0 (its meshes are an object keyed by id, glTF 1.0's layout); only glTF 2.0 is read",
+        ),
+        (
+            "binary glTF 1",
+            [b"glTF".as_slice(), &1u32.to_le_bytes(), &40u32.to_le_bytes(), &[0; 28]].concat(),
+            "the file is glTF 1.0 (a GLB container of version 1, glTF 1.0's KHR_binary_glTF); only glTF 2.0 is read",
+        ),
+        (
+            "Draco required",
+            ok.replacen(
+                '{',
+                r#"{"extensionsUsed":["KHR_draco_mesh_compression","KHR_mesh_quantization"],"extensionsRequired":["KHR_mesh_quantization","KHR_draco_mesh_compression"],"#,
+                1,
+            )
+            .into_bytes(),
+            "the file requires the extension KHR_draco_mesh_compression, which is not supported (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_mesh_quantization). Its meshes are Draco-compressed (KHR_draco_mesh_compression), and Draco mesh compression is not supported: decompress the file first, e.g. with `gltf-transform cp IN OUT`",
+        ),
+        (
+            "meshopt required",
+            ok.replacen(
+                '{',
+                r#"{"extensionsUsed":["EXT_meshopt_compression"],"extensionsRequired":["EXT_meshopt_compression"],"#,
+                1,
+            )
+            .into_bytes(),
+            "requires the extension EXT_meshopt_compression, which is not supported (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_mesh_quantization). Its buffers are meshopt-compressed (EXT_meshopt_compression), and meshopt compression is not supported: decompress the file first, e.g. with `gltfpack -i IN -o OUT`",
+        ),
+        (
+            "several required extensions",
+            ok.replacen(
+                '{',
+                r#"{"extensionsRequired":["KHR_texture_transform","KHR_lights_punctual","KHR_materials_unlit","EXT_meshopt_compression"],"#,
+                1,
+            )
+            .into_bytes(),
+            "the file requires 3 extensions that are not supported: KHR_texture_transform, KHR_materials_unlit, EXT_meshopt_compression (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_mesh_quantization). Its buffers are meshopt-compressed (EXT_meshopt_compression)",
+        ),
+        (
+            // As gltf-transform's BoxDraco.gltf: Draco used, not required, and no
+            // uncompressed copy.
+            "Draco without a fallback",
+            ok.replacen('{', r#"{"extensionsUsed":["KHR_draco_mesh_compression"],"#, 1)
+                .replace(r#""bufferView":0,"#, "")
+                .replace(r#""bufferView":1,"#, "")
                 .into_bytes(),
-            "requires the extension KHR_draco_mesh_compression, which is not supported",
+            "the file's meshes are Draco-compressed (KHR_draco_mesh_compression) without uncompressed copies (accessors 0, 1 have no bufferView), and Draco mesh compression is not supported: decompress the file first",
         ),
         (
             "dangling reference",

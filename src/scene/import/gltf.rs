@@ -92,25 +92,33 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError
     if bytes.is_empty() {
         return Err(error(path, "not a valid glTF file: the file is empty"));
     }
-    let gltf =
-        ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| parse_error(path, e))?;
+    if let Some(why) = gltf1_binary(bytes) {
+        return Err(gltf1_error(path, why));
+    }
+    let gltf = ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| {
+        // A glTF 1.0 file fails to parse as 2.0 (its top-level arrays were objects);
+        // say what it is rather than where the 2.0 parser stopped.
+        match gltf1_json(bytes) {
+            Some(why) => gltf1_error(path, why),
+            None => parse_error(path, e),
+        }
+    })?;
     let version = &gltf.as_json().asset.version;
+    if version.starts_with("1.") {
+        return Err(gltf1_error(path, format!("asset.version is \"{version}\"")));
+    }
     if !version.starts_with("2.") {
         return Err(error(
             path,
             format!("glTF version {version} is not supported (only 2.x)"),
         ));
     }
-    for extension in gltf.extensions_required() {
-        if !SUPPORTED_EXTENSIONS.contains(&extension) {
-            return Err(error(
-                path,
-                format!(
-                    "the file requires the extension {extension}, which is not supported (supported: {})",
-                    SUPPORTED_EXTENSIONS.join(", ")
-                ),
-            ));
-        }
+    let unsupported: Vec<&str> = gltf
+        .extensions_required()
+        .filter(|e| !SUPPORTED_EXTENSIONS.contains(e))
+        .collect();
+    if !unsupported.is_empty() {
+        return Err(error(path, unsupported_extensions(&unsupported)));
     }
     validate(&gltf.document, path)?;
     let mut importer = Importer {
@@ -141,6 +149,79 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError
     let mut model = importer.model;
     model.images = importer.textures.images;
     Ok(model)
+}
+
+/// Draco mesh compression (`KHR_draco_mesh_compression`), which is not decoded here.
+const DRACO: &str = "KHR_draco_mesh_compression";
+/// meshoptimizer's buffer compression, as a vendor extension and as ratified by Khronos;
+/// not decoded here.
+const MESHOPT: &[&str] = &["EXT_meshopt_compression", "KHR_meshopt_compression"];
+
+/// The message for a file that requires the `unsupported` extensions (at least one):
+/// all of them at once, and for a compression what to do about it.
+fn unsupported_extensions(unsupported: &[&str]) -> String {
+    let list = unsupported.join(", ");
+    let supported = SUPPORTED_EXTENSIONS.join(", ");
+    let mut message = if let [_] = unsupported {
+        format!(
+            "the file requires the extension {list}, which is not supported (supported: {supported})"
+        )
+    } else {
+        format!(
+            "the file requires {} extensions that are not supported: {list} (supported: {supported})",
+            unsupported.len()
+        )
+    };
+    for &extension in unsupported {
+        if extension == DRACO {
+            message += &format!(
+                ". Its meshes are Draco-compressed ({extension}), and Draco mesh compression is not supported: decompress the file first, e.g. with `gltf-transform cp IN OUT` (glTF Transform decodes Draco on reading)"
+            );
+        } else if MESHOPT.contains(&extension) {
+            message += &format!(
+                ". Its buffers are meshopt-compressed ({extension}), and meshopt compression is not supported: decompress the file first, e.g. with `gltfpack -i IN -o OUT` (gltfpack compresses only when given -c)"
+            );
+        }
+    }
+    message
+}
+
+/// Why `bytes` is a binary glTF 1.0 file (a GLB container of version 1, the
+/// `KHR_binary_glTF` extension of glTF 1.0), if it is one.
+fn gltf1_binary(bytes: &[u8]) -> Option<String> {
+    let version = bytes.strip_prefix(b"glTF")?.get(..4)?;
+    (u32::from_le_bytes([version[0], version[1], version[2], version[3]]) == 1)
+        .then(|| "a GLB container of version 1, glTF 1.0's KHR_binary_glTF".to_string())
+}
+
+/// Why the JSON `bytes` are a glTF 1.0 document, if they are one: `asset.version` "1.x",
+/// or (1.0 files often leave `version` out) top-level properties that glTF 1.0 made
+/// objects keyed by id and glTF 2.0 made arrays.
+fn gltf1_json(bytes: &[u8]) -> Option<String> {
+    let value: ::gltf::json::Value = ::gltf::json::deserialize::from_slice(bytes).ok()?;
+    let root = value.as_object()?;
+    if let Some(version) = root
+        .get("asset")
+        .and_then(|a| a.get("version"))
+        .and_then(|v| v.as_str())
+        .filter(|v| v.starts_with("1."))
+    {
+        return Some(format!("asset.version is \"{version}\""));
+    }
+    ["accessors", "meshes", "nodes", "buffers", "bufferViews"]
+        .into_iter()
+        .find(|key| root.get(*key).is_some_and(|v| v.is_object()))
+        .map(|key| format!("its {key} are an object keyed by id, glTF 1.0's layout"))
+}
+
+/// The error for a glTF 1.0 file, `why` saying how it was recognised.
+fn gltf1_error(path: &Path, why: String) -> SceneError {
+    error(
+        path,
+        format!(
+            "the file is glTF 1.0 ({why}); only glTF 2.0 is read: convert it first, e.g. with gltf-pipeline (`gltf-pipeline -i IN -o OUT`), which updates glTF 1.0 to 2.0"
+        ),
+    )
 }
 
 /// The error for a file the `gltf` crate cannot parse, with the JSON line and column
@@ -194,6 +275,29 @@ fn validate(document: &Document, path: &Path) -> Result<(), SceneError> {
             }
         }
     }
+    // A file that uses Draco without requiring it must keep uncompressed copies of its
+    // meshes (KHR_draco_mesh_compression, "Conformance"); without them its accessors
+    // hold no data, and it is Draco that is missing, not just a bufferView.
+    if root.extensions_used.iter().any(|e| e == DRACO) {
+        let empty: Vec<String> = root
+            .accessors
+            .iter()
+            .enumerate()
+            .filter(|(_, a)| a.buffer_view.is_none() && a.sparse.is_none())
+            .map(|(i, _)| i.to_string())
+            .collect();
+        if !empty.is_empty() {
+            return Err(error(
+                path,
+                format!(
+                    "the file's meshes are Draco-compressed ({DRACO}) without uncompressed copies (accessor{} {} {} no bufferView), and Draco mesh compression is not supported: decompress the file first, e.g. with `gltf-transform cp IN OUT` (glTF Transform decodes Draco on reading)",
+                    if empty.len() == 1 { "" } else { "s" },
+                    quote_list(&empty),
+                    if empty.len() == 1 { "has" } else { "have" },
+                ),
+            ));
+        }
+    }
     let mut problems = Vec::new();
     root.validate(root, ::gltf::json::Path::new, &mut |where_, what| {
         let where_ = where_();
@@ -224,6 +328,16 @@ fn validate(document: &Document, path: &Path) -> Result<(), SceneError> {
             }
         ),
     ))
+}
+
+/// The first [`QUOTED_PROBLEMS`] of `items`, comma-separated, and how many more there are.
+fn quote_list(items: &[String]) -> String {
+    let shown = items.len().min(QUOTED_PROBLEMS);
+    let mut list = items[..shown].join(", ");
+    if items.len() > shown {
+        list += &format!(" and {} more", items.len() - shown);
+    }
+    list
 }
 
 /// A data URI's bytes (RFC 2397), base64 or percent-encoded.
