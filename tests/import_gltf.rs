@@ -463,6 +463,45 @@ fn quantized_attributes_import_as_their_float_twins() {
 }
 
 #[test]
+fn points_and_lines_are_skipped_with_one_warning() {
+    let mut doc = Doc::default();
+    let square = doc.vec3(&[
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+    ]);
+    let body = format!(
+        r#""scenes":[{{"nodes":[0,1]}}],"nodes":[{{"mesh":0}},{{"mesh":1}}],"meshes":[
+            {{"name":"guides","primitives":[
+              {{"attributes":{{"POSITION":{square}}},"mode":0}},
+              {{"attributes":{{"POSITION":{square}}},"mode":3}}]}},
+            {{"primitives":[
+              {{"attributes":{{"POSITION":{square}}},"mode":2}},
+              {{"attributes":{{"POSITION":{square}}},"mode":5}}]}}]"#
+    );
+    let model = imported("mixed.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(model.meshes.len(), 1);
+    assert_eq!(model.meshes[0].name, "mesh 1, primitive 1");
+    assert_eq!(model.meshes[0].triangles.len(), 2);
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    assert!(
+        model.warnings[0].ends_with(
+            "mixed.gltf: skipped 3 primitives of points or lines, which are not rendered: mesh 0 ('guides'), primitive 0: POINTS (0); mesh 0 ('guides'), primitive 1: LINE_STRIP (3); mesh 1, primitive 0: LINE_LOOP (2)"
+        ),
+        "{:?}",
+        model.warnings
+    );
+    // Without the strip, nothing is left to render.
+    let body = body.replace(r#""mode":5"#, r#""mode":1"#);
+    let message = failure("lines.gltf", doc.embedded(&body).as_bytes());
+    assert!(
+        message.contains("lines.gltf: no triangles: the primitives it places are points or lines, which are not rendered (mesh 0 ('guides'), primitive 0: POINTS (0); mesh 0 ('guides'), primitive 1: LINE_STRIP (3); mesh 1, primitive 0: LINE_LOOP (2); mesh 1, primitive 1: LINES (1))"),
+        "{message}"
+    );
+}
+
+#[test]
 fn embedded_external_and_glb_buffers_give_the_same_model() {
     let mut doc = Doc::default();
     let positions = doc.vec3(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
@@ -959,9 +998,9 @@ fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
             "node 0: its matrix has a component that is not finite",
         ),
         (
-            "lines",
+            "only lines",
             ok.replace(r#""indices":1}"#, r#""indices":1,"mode":1}"#).into_bytes(),
-            "mesh 0 ('tri'), primitive 0: its mode is Lines; only triangles, triangle strips and triangle fans are supported",
+            "bad.gltf: no triangles: the primitives it places are points or lines, which are not rendered (mesh 0 ('tri'), primitive 0: LINES (1))",
         ),
         (
             "remote buffer",

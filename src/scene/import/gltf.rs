@@ -131,6 +131,8 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError
         textures: Textures::default(),
         materials: HashMap::new(),
         warned: BTreeSet::new(),
+        not_triangles: Vec::new(),
+        triangle_primitives: 0,
     };
     for extension in gltf.extensions_used() {
         if !SUPPORTED_EXTENSIONS.contains(&extension) {
@@ -292,7 +294,7 @@ fn validate(document: &Document, path: &Path) -> Result<(), SceneError> {
                 format!(
                     "the file's meshes are Draco-compressed ({DRACO}) without uncompressed copies (accessor{} {} {} no bufferView), and Draco mesh compression is not supported: decompress the file first, e.g. with `gltf-transform cp IN OUT` (glTF Transform decodes Draco on reading)",
                     if empty.len() == 1 { "" } else { "s" },
-                    quote_list(&empty),
+                    quote_list(&empty, ", "),
                     if empty.len() == 1 { "has" } else { "have" },
                 ),
             ));
@@ -330,10 +332,11 @@ fn validate(document: &Document, path: &Path) -> Result<(), SceneError> {
     ))
 }
 
-/// The first [`QUOTED_PROBLEMS`] of `items`, comma-separated, and how many more there are.
-fn quote_list(items: &[String]) -> String {
+/// The first [`QUOTED_PROBLEMS`] of `items`, joined by `separator`, and how many more
+/// there are.
+fn quote_list(items: &[String], separator: &str) -> String {
     let shown = items.len().min(QUOTED_PROBLEMS);
-    let mut list = items[..shown].join(", ");
+    let mut list = items[..shown].join(separator);
     if items.len() > shown {
         list += &format!(" and {} more", items.len() - shown);
     }
@@ -450,6 +453,10 @@ struct Importer<'a> {
     materials: HashMap<Option<usize>, u32>,
     /// Warnings already given once per file.
     warned: BTreeSet<&'static str>,
+    /// The primitives skipped for being points or lines (`mesh N, primitive P: MODE`).
+    not_triangles: Vec<String>,
+    /// How many primitives of triangles were read.
+    triangle_primitives: usize,
 }
 
 /// `what N ('name')`, or `what N` for an unnamed element.
@@ -600,6 +607,25 @@ impl Importer<'_> {
                 self.mesh(&mesh, instances)?;
             }
         }
+        if self.not_triangles.is_empty() {
+            return Ok(());
+        }
+        let count = self.not_triangles.len();
+        let list = quote_list(&self.not_triangles, "; ");
+        if self.model.meshes.is_empty() {
+            return Err(self.fail(format!(
+                "no triangles: the primitives it places are points or lines, which are not rendered ({list}){}",
+                if self.triangle_primitives > 0 {
+                    ", and the triangles of the others are all degenerate"
+                } else {
+                    ""
+                }
+            )));
+        }
+        self.warn(format!(
+            "skipped {count} primitive{} of points or lines, which are not rendered: {list}",
+            if count == 1 { "" } else { "s" }
+        ));
         Ok(())
     }
 
@@ -614,6 +640,18 @@ impl Importer<'_> {
         }
         for primitive in mesh.primitives() {
             let name = format!("{mesh_name}, primitive {}", primitive.index());
+            let mode = primitive.mode();
+            if !matches!(
+                mode,
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            ) {
+                // Points and lines have no area for a ray to hit; a file may well mix
+                // them with surfaces (guides, wireframes), so only they are left out.
+                self.not_triangles
+                    .push(format!("{name}: {}", mode_name(mode)));
+                continue;
+            }
+            self.triangle_primitives += 1;
             let raw = self
                 .primitive(&primitive, &name)
                 .map_err(|e| self.fail(format!("{name}: {e}")))?;
@@ -634,7 +672,8 @@ impl Importer<'_> {
         Ok(())
     }
 
-    /// Reads one primitive's positions, normals, `TEXCOORD_0` and triangles; `name`
+    /// Reads one primitive's positions, normals, `TEXCOORD_0` and triangles (its mode is
+    /// one of the three of triangles); `name`
     /// (mesh and primitive) is for warnings, the caller prefixes it to errors.
     fn primitive(
         &mut self,
@@ -642,14 +681,6 @@ impl Importer<'_> {
         name: &str,
     ) -> Result<RawMesh, String> {
         let mode = primitive.mode();
-        if !matches!(
-            mode,
-            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
-        ) {
-            return Err(format!(
-                "its mode is {mode:?}; only triangles, triangle strips and triangle fans are supported"
-            ));
-        }
         let positions_accessor = primitive
             .get(&::gltf::Semantic::Positions)
             .ok_or("it has no POSITION attribute")?;
@@ -1121,6 +1152,19 @@ impl Importer<'_> {
         };
         self.model.lights.push(converted);
         Ok(())
+    }
+}
+
+/// A primitive mode by its name and number in glTF 2.0 §5.24 (`mesh.primitive.mode`).
+fn mode_name(mode: Mode) -> &'static str {
+    match mode {
+        Mode::Points => "POINTS (0)",
+        Mode::Lines => "LINES (1)",
+        Mode::LineLoop => "LINE_LOOP (2)",
+        Mode::LineStrip => "LINE_STRIP (3)",
+        Mode::Triangles => "TRIANGLES (4)",
+        Mode::TriangleStrip => "TRIANGLE_STRIP (5)",
+        Mode::TriangleFan => "TRIANGLE_FAN (6)",
     }
 }
 
