@@ -502,6 +502,34 @@ fn points_and_lines_are_skipped_with_one_warning() {
 }
 
 #[test]
+fn vertex_colours_are_named_in_one_warning() {
+    let (mut doc, _) = triangle_doc();
+    let rgb = doc.integers(
+        "VEC3",
+        5121,
+        true,
+        &[vec![255, 0, 0], vec![0, 255, 0], vec![0, 0, 255]],
+    );
+    let body = format!(
+        r#""scenes":[{{"nodes":[0,1]}}],"nodes":[{{"mesh":0}},{{"mesh":0,"translation":[2,0,0]}}],
+           "meshes":[{{"name":"painted","primitives":[
+              {{"attributes":{{"POSITION":0,"COLOR_0":{rgb}}},"indices":1}},
+              {{"attributes":{{"POSITION":0}},"indices":1}},
+              {{"attributes":{{"POSITION":0,"COLOR_0":{rgb},"COLOR_1":{rgb}}},"indices":1}}]}}]"#
+    );
+    let model = imported("colours.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(model.meshes.len(), 3);
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    assert!(
+        model.warnings[0].ends_with(
+            "colours.gltf: vertex colours are present but not yet shaded; they are ignored (mesh 0 ('painted'), primitive 0: COLOR_0; mesh 0 ('painted'), primitive 2: COLOR_0, COLOR_1)"
+        ),
+        "{:?}",
+        model.warnings
+    );
+}
+
+#[test]
 fn embedded_external_and_glb_buffers_give_the_same_model() {
     let mut doc = Doc::default();
     let positions = doc.vec3(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use ::gltf::Document;
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::camera::Projection;
+use ::gltf::json::validation::Checked;
 use ::gltf::khr_lights_punctual::Kind;
 use ::gltf::mesh::Mode;
 use ::gltf::texture::WrappingMode;
@@ -133,6 +134,7 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError
         warned: BTreeSet::new(),
         not_triangles: Vec::new(),
         triangle_primitives: 0,
+        vertex_colors: Vec::new(),
     };
     for extension in gltf.extensions_used() {
         if !SUPPORTED_EXTENSIONS.contains(&extension) {
@@ -254,7 +256,7 @@ fn parse_error(path: &Path, e: ::gltf::Error) -> SceneError {
 /// Runs the `gltf` crate's validation (references in range, required properties present,
 /// enumerations valid), which its accessors rely on.
 fn validate(document: &Document, path: &Path) -> Result<(), SceneError> {
-    use ::gltf::json::validation::{Checked, Validate};
+    use ::gltf::json::validation::Validate;
     let root = document.as_json();
     // gltf-json 1.4's validation indexes the accessors with POSITION's index unchecked
     // (`primitive_validate_hook`), so that index is checked here first.
@@ -457,6 +459,9 @@ struct Importer<'a> {
     not_triangles: Vec<String>,
     /// How many primitives of triangles were read.
     triangle_primitives: usize,
+    /// The primitives with vertex colours, which are not stored (`mesh N, primitive P:
+    /// COLOR_0`).
+    vertex_colors: Vec<String>,
 }
 
 /// `what N ('name')`, or `what N` for an unnamed element.
@@ -607,6 +612,14 @@ impl Importer<'_> {
                 self.mesh(&mesh, instances)?;
             }
         }
+        if !self.vertex_colors.is_empty() {
+            // Vertex colours multiply the base colour (glTF 2.0 §3.7.2.1); the renderers
+            // have no per-vertex colour yet, so the model shades without them.
+            self.warn(format!(
+                "vertex colours are present but not yet shaded; they are ignored ({})",
+                quote_list(&self.vertex_colors, "; ")
+            ));
+        }
         if self.not_triangles.is_empty() {
             return Ok(());
         }
@@ -652,6 +665,20 @@ impl Importer<'_> {
                 continue;
             }
             self.triangle_primitives += 1;
+            // The JSON's keys, not `Primitive::attributes`, which unwraps each key.
+            let json = &self.document.as_json().meshes[mesh.index()].primitives[primitive.index()];
+            let colors: Vec<String> = json
+                .attributes
+                .keys()
+                .filter_map(|semantic| match semantic {
+                    Checked::Valid(::gltf::Semantic::Colors(set)) => Some(format!("COLOR_{set}")),
+                    _ => None,
+                })
+                .collect();
+            if !colors.is_empty() {
+                self.vertex_colors
+                    .push(format!("{name}: {}", colors.join(", ")));
+            }
             let raw = self
                 .primitive(&primitive, &name)
                 .map_err(|e| self.fail(format!("{name}: {e}")))?;
