@@ -782,6 +782,86 @@ fn materials_map_with_their_textures_and_wrap_modes() {
     assert_eq!(scene.images.len(), 3, "each image once");
 }
 
+/// A triangle with two texture coordinate sets (`TEXCOORD_1` = `TEXCOORD_0` + 10) and
+/// a material whose base colour, metallic-roughness and emissive textures ask for the
+/// sets given (`None`: no such texture); the JSON body.
+fn two_uv_sets(doc: &mut Doc, base: Option<u32>, mr: Option<u32>, emissive: Option<u32>) -> String {
+    let uv0 = doc.vec2(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+    let uv1 = doc.vec2(&[[10.0, 10.0], [11.0, 10.0], [10.0, 11.0]]);
+    let texture = |slot: &str, set: Option<u32>| match set {
+        Some(set) => format!(r#""{slot}":{{"index":0,"texCoord":{set}}},"#),
+        None => String::new(),
+    };
+    let png = png(1, 1, &[[200, 100, 50, 255]]);
+    let uri = format!(
+        "data:image/png;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&png)
+    );
+    format!(
+        r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+           "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"TEXCOORD_0":{uv0},"TEXCOORD_1":{uv1}}},"indices":1,"material":0}}]}}],
+           "materials":[{{"name":"multi",{}"pbrMetallicRoughness":{{{}"metallicFactor":0}}}}],
+           "textures":[{{"source":0}}],"images":[{{"uri":"{uri}"}}]"#,
+        texture("emissiveTexture", emissive).replace(
+            r#""emissiveTexture""#,
+            r#""emissiveFactor":[1,1,1],"emissiveTexture""#
+        ),
+        texture("baseColorTexture", base) + &texture("metallicRoughnessTexture", mr),
+    )
+}
+
+#[test]
+fn textures_choose_the_texture_coordinate_set_they_use() {
+    let first_u = |model: &ImportedModel| model.meshes[0].uvs.as_ref().expect("uvs")[1].x;
+    // Every texture on TEXCOORD_1: it is the mesh's, without a warning.
+    let (mut doc, _) = triangle_doc();
+    let body = two_uv_sets(&mut doc, Some(1), Some(1), Some(1));
+    let model = imported("one.gltf", doc.embedded(&body).as_bytes());
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    assert_eq!(first_u(&model), 11.0);
+    assert!(model.materials[0].emissive_texture.is_some());
+
+    // MultiUVTest: base colour on TEXCOORD_0, emission on TEXCOORD_1. A tie: the base
+    // colour's set, with a warning.
+    let (mut doc, _) = triangle_doc();
+    let body = two_uv_sets(&mut doc, Some(0), None, Some(1));
+    let model = imported("multi.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(first_u(&model), 1.0);
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    assert!(
+        model.warnings[0].ends_with(
+            "multi.gltf: material 0 ('multi'): its textures use different texture coordinate sets (baseColorTexture: TEXCOORD_0, emissiveTexture: TEXCOORD_1), and a mesh is read with one: TEXCOORD_0, so emissiveTexture is mapped by the wrong coordinates"
+        ),
+        "{:?}",
+        model.warnings
+    );
+
+    // Two of three on TEXCOORD_1: the majority wins over the base colour.
+    let (mut doc, _) = triangle_doc();
+    let body = two_uv_sets(&mut doc, Some(0), Some(1), Some(1));
+    let model = imported("most.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(first_u(&model), 11.0);
+    assert!(
+        model.warnings[0]
+            .ends_with("TEXCOORD_1, so baseColorTexture is mapped by the wrong coordinates"),
+        "{:?}",
+        model.warnings
+    );
+
+    // Only emission, on TEXCOORD_1, but the primitive has no such set: TEXCOORD_0.
+    let (mut doc, _) = triangle_doc();
+    let body = two_uv_sets(&mut doc, None, None, Some(1)).replace(r#","TEXCOORD_1":3"#, "");
+    let model = imported("missing.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(first_u(&model), 1.0);
+    assert!(
+        model.warnings[0].ends_with(
+            "missing.gltf: mesh 0, primitive 0: its material's textures use TEXCOORD_1, which it does not have; TEXCOORD_0 is used"
+        ),
+        "{:?}",
+        model.warnings
+    );
+}
+
 #[test]
 fn jpeg_textures_load() {
     let (doc, _) = triangle_doc();

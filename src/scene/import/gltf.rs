@@ -451,8 +451,9 @@ struct Importer<'a> {
     model: ImportedModel,
     budget: Budget,
     textures: Textures,
-    /// glTF material index (`None`: the default material) → index in the model.
-    materials: HashMap<Option<usize>, u32>,
+    /// glTF material index (`None`: the default material) → index in the model and the
+    /// texture coordinate set its meshes are read with.
+    materials: HashMap<Option<usize>, (u32, u32)>,
     /// Warnings already given once per file.
     warned: BTreeSet<&'static str>,
     /// The primitives skipped for being points or lines (`mesh N, primitive P: MODE`).
@@ -665,6 +666,8 @@ impl Importer<'_> {
                 continue;
             }
             self.triangle_primitives += 1;
+            // The material first: it decides which texture coordinates to read.
+            let (material, uv_set) = self.material(primitive.material().index())?;
             // The JSON's keys, not `Primitive::attributes`, which unwraps each key.
             let json = &self.document.as_json().meshes[mesh.index()].primitives[primitive.index()];
             let colors: Vec<String> = json
@@ -680,9 +683,8 @@ impl Importer<'_> {
                     .push(format!("{name}: {}", colors.join(", ")));
             }
             let raw = self
-                .primitive(&primitive, &name)
+                .primitive(&primitive, &name, uv_set)
                 .map_err(|e| self.fail(format!("{name}: {e}")))?;
-            let material = self.material(primitive.material().index())?;
             self.budget
                 .charge_instances(instances.len())
                 .map_err(|e| self.fail(e))?;
@@ -699,13 +701,15 @@ impl Importer<'_> {
         Ok(())
     }
 
-    /// Reads one primitive's positions, normals, `TEXCOORD_0` and triangles (its mode is
-    /// one of the three of triangles); `name`
-    /// (mesh and primitive) is for warnings, the caller prefixes it to errors.
+    /// Reads one primitive's positions, normals, texture coordinates (set `uv_set`, the
+    /// one its material's textures use) and triangles (its mode is one of the three of
+    /// triangles); `name` (mesh and primitive) is for warnings, the caller prefixes it to
+    /// errors.
     fn primitive(
         &mut self,
         primitive: &::gltf::Primitive<'_>,
         name: &str,
+        uv_set: u32,
     ) -> Result<RawMesh, String> {
         let mode = primitive.mode();
         let positions_accessor = primitive
@@ -773,20 +777,36 @@ impl Importer<'_> {
             }
             None => None,
         };
-        let uvs = match primitive.get(&::gltf::Semantic::TexCoords(0)) {
+        let mut uv_accessor = primitive.get(&::gltf::Semantic::TexCoords(uv_set));
+        let mut uv_name = format!("TEXCOORD_{uv_set}");
+        if uv_accessor.is_none() && uv_set != 0 {
+            // A texture that names a set the primitive lacks is invalid (glTF 2.0
+            // §5.30, textureInfo.texCoord); the first set is the likeliest intent.
+            uv_accessor = primitive.get(&::gltf::Semantic::TexCoords(0));
+            self.warn(format!(
+                "{name}: its material's textures use {uv_name}, which it does not have; {}",
+                if uv_accessor.is_some() {
+                    "TEXCOORD_0 is used"
+                } else {
+                    "it has no texture coordinates"
+                }
+            ));
+            uv_name = "TEXCOORD_0".into();
+        }
+        let uvs = match uv_accessor {
             Some(accessor) => {
-                same_count(&accessor, "TEXCOORD_0")?;
+                same_count(&accessor, &uv_name)?;
                 let values = read(
                     &accessor,
                     &Expect {
-                        name: "TEXCOORD_0",
+                        name: &uv_name,
                         dimensions: Dimensions::Vec2,
                         types: TEXCOORD_TYPES,
                         normalized: Normalized::Either,
                     },
                     &self.buffers,
                 )?;
-                self.check_quantization(&accessor, name, "TEXCOORD_0", true);
+                self.check_quantization(&accessor, name, &uv_name, true);
                 Some(
                     values
                         .chunks_exact(2)
@@ -863,38 +883,42 @@ impl Importer<'_> {
 
     /// The model's index of glTF material `index` (`None`: the default material, glTF
     /// 2.0 §3.9.6), mapping it on first use.
-    fn material(&mut self, index: Option<usize>) -> Result<u32, SceneError> {
-        if let Some(&ours) = self.materials.get(&index) {
-            return Ok(ours);
+    fn material(&mut self, index: Option<usize>) -> Result<(u32, u32), SceneError> {
+        if let Some(&known) = self.materials.get(&index) {
+            return Ok(known);
         }
-        let imported = match index.and_then(|i| self.document.materials().nth(i)) {
+        let (imported, uv_set) = match index.and_then(|i| self.document.materials().nth(i)) {
             Some(material) => self.map_material(&material)?,
-            None => ImportedMaterial {
-                name: "default".into(),
-                // glTF's default material: white, fully metallic and rough... which is
-                // black under Whitted lighting; a white dielectric PBR is what viewers show.
-                material: Material {
-                    diffuse: DVec3::ONE,
-                    metallic: 0.0,
-                    roughness: 1.0,
-                    ..Material::blank(MaterialKind::Pbr)
+            None => (
+                ImportedMaterial {
+                    name: "default".into(),
+                    // glTF's default material: white, fully metallic and rough... which is
+                    // black under Whitted lighting; a white dielectric PBR is what viewers show.
+                    material: Material {
+                        diffuse: DVec3::ONE,
+                        metallic: 0.0,
+                        roughness: 1.0,
+                        ..Material::blank(MaterialKind::Pbr)
+                    },
+                    base_color_texture: None,
+                    metallic_roughness_texture: None,
+                    emissive_texture: None,
                 },
-                base_color_texture: None,
-                metallic_roughness_texture: None,
-                emissive_texture: None,
-            },
+                0,
+            ),
         };
         let ours = self.model.materials.len() as u32;
         self.model.materials.push(imported);
-        self.materials.insert(index, ours);
-        Ok(ours)
+        self.materials.insert(index, (ours, uv_set));
+        Ok((ours, uv_set))
     }
 
-    /// Maps a glTF metallic-roughness material onto ours (the table in `docs/models.md`).
+    /// Maps a glTF metallic-roughness material onto ours (the table in `docs/models.md`),
+    /// with the texture coordinate set its meshes are read with ([`Importer::uv_set`]).
     fn map_material(
         &mut self,
         material: &::gltf::Material<'_>,
-    ) -> Result<ImportedMaterial, SceneError> {
+    ) -> Result<(ImportedMaterial, u32), SceneError> {
         let name = describe("material", material.index().unwrap_or(0), material.name());
         let pbr = material.pbr_metallic_roughness();
         let [r, g, b, _alpha] = pbr.base_color_factor().map(f64::from);
@@ -996,13 +1020,72 @@ impl Importer<'_> {
             Some(info) => Some(self.texture(&info, Encoding::Color, &name, "emissiveTexture")?),
             None => None,
         };
-        Ok(ImportedMaterial {
+        let uv_set = self.uv_set(
+            &name,
+            &[
+                (
+                    "baseColorTexture",
+                    pbr.base_color_texture().map(|t| t.tex_coord()),
+                ),
+                (
+                    "metallicRoughnessTexture",
+                    pbr.metallic_roughness_texture().map(|t| t.tex_coord()),
+                ),
+                (
+                    "emissiveTexture",
+                    material.emissive_texture().map(|t| t.tex_coord()),
+                ),
+            ],
+        );
+        let imported = ImportedMaterial {
             name: material.name().map_or_else(|| name.clone(), str::to_string),
             material: ours,
             base_color_texture,
             metallic_roughness_texture,
             emissive_texture,
-        })
+        };
+        Ok((imported, uv_set))
+    }
+
+    /// The texture coordinate set (`TEXCOORD_n`) for the meshes of `material`, whose
+    /// textures the renderers use ask for the sets in `slots` (`None`: no such texture).
+    /// A mesh carries one set, so when they disagree the set most of them use is taken
+    /// (on a tie the base colour's, else the lowest), with a warning naming the textures
+    /// that are then mapped by the wrong set.
+    fn uv_set(&mut self, material: &str, slots: &[(&str, Option<u32>)]) -> u32 {
+        let used: Vec<(&str, u32)> = slots
+            .iter()
+            .filter_map(|&(slot, set)| set.map(|set| (slot, set)))
+            .collect();
+        let Some(&(_, first)) = used.first() else {
+            return 0;
+        };
+        if used.iter().all(|&(_, set)| set == first) {
+            return first;
+        }
+        let count = |set: u32| used.iter().filter(|&&(_, s)| s == set).count();
+        let base = used
+            .iter()
+            .find(|&&(slot, _)| slot == "baseColorTexture")
+            .map(|&(_, set)| set);
+        let chosen = used
+            .iter()
+            .map(|&(_, set)| set)
+            .max_by_key(|&set| (count(set), Some(set) == base, std::cmp::Reverse(set)))
+            .unwrap_or(0);
+        let describe = |&(slot, set): &(&str, u32)| format!("{slot}: TEXCOORD_{set}");
+        let wrong: Vec<&str> = used
+            .iter()
+            .filter(|&&(_, set)| set != chosen)
+            .map(|&(slot, _)| slot)
+            .collect();
+        self.warn(format!(
+            "{material}: its textures use different texture coordinate sets ({}), and a mesh is read with one: TEXCOORD_{chosen}, so {} {} mapped by the wrong coordinates",
+            used.iter().map(describe).collect::<Vec<_>>().join(", "),
+            wrong.join(" and "),
+            if wrong.len() == 1 { "is" } else { "are" }
+        ));
+        chosen
     }
 
     /// Loads the image of a material's texture and keeps its sampler's wrap modes.
@@ -1013,12 +1096,6 @@ impl Importer<'_> {
         material: &str,
         slot: &str,
     ) -> Result<TextureRef, SceneError> {
-        if info.tex_coord() != 0 {
-            self.warn(format!(
-                "{material}: {slot} uses TEXCOORD_{}, which is not imported; TEXCOORD_0 is used",
-                info.tex_coord()
-            ));
-        }
         let texture = info.texture();
         let image = texture.source();
         let image_name = describe("image", image.index(), image.name());
