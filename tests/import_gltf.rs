@@ -233,6 +233,30 @@ fn a_transformed_node_s_triangle_lands_where_the_matrices_say() {
 }
 
 #[test]
+fn a_matrix_beside_identity_trs_or_with_rounding_in_its_last_row_is_accepted() {
+    let (doc, meshes) = triangle_doc();
+    // Identity translation/rotation/scale beside a matrix change nothing, whichever a
+    // reader applies; a last row off by 1e-8 is rounding, and is made exact.
+    let body = format!(
+        r#""scenes":[{{"nodes":[0,1]}}],"nodes":[
+            {{"mesh":0,"matrix":[2,0,0,0, 0,2,0,0, 0,0,2,0, 1,2,3,1],"translation":[0,0,0],"rotation":[0,0,0,1],"scale":[1,1,1]}},
+            {{"mesh":0,"matrix":[1,0,0,1e-8, 0,1,0,0, 0,0,1,0, 0,0,0,1.00000001]}}],{meshes}"#
+    );
+    let model = imported("matrix.gltf", doc.embedded(&body).as_bytes());
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let instances = &model.meshes[0].instances;
+    assert_eq!(
+        instances[0],
+        DMat4::from_scale_rotation_translation(
+            DVec3::splat(2.0),
+            DQuat::IDENTITY,
+            DVec3::new(1.0, 2.0, 3.0)
+        )
+    );
+    assert_eq!(instances[1], DMat4::IDENTITY);
+}
+
+#[test]
 fn a_mesh_under_two_nodes_is_stored_once_with_two_instances() {
     let (doc, meshes) = triangle_doc();
     let body = format!(
@@ -1104,6 +1128,24 @@ fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
             )
             .into_bytes(),
             "node 0: its matrix has a component that is not finite",
+        ),
+        (
+            "matrix and translation",
+            ok.replace(
+                r#"{"mesh":0}"#,
+                r#"{"name":"both","mesh":0,"matrix":[1,0,0,0,0,1,0,0,0,0,1,0,5,0,0,1],"translation":[1,0,0],"scale":[1,1,1],"rotation":[0,0,1,0]}"#,
+            )
+            .into_bytes(),
+            "bad.gltf: node 0 ('both'): it has both a matrix and translation, rotation (glTF 2.0 §3.5.3: a node's transform is a matrix or translation/rotation/scale, not both); which applies is ambiguous",
+        ),
+        (
+            "projective matrix",
+            ok.replace(
+                r#"{"mesh":0}"#,
+                r#"{"name":"lens","mesh":0,"matrix":[1,0,0,0.5,0,1,0,0,0,0,1,0,0,0,0,1]}"#,
+            )
+            .into_bytes(),
+            "bad.gltf: node 0 ('lens'): its matrix's last row is [0.5, 0, 0, 1], not [0, 0, 0, 1]: a projective transform",
         ),
         (
             "only lines",

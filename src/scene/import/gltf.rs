@@ -473,41 +473,74 @@ fn describe(what: &str, index: usize, name: Option<&str>) -> String {
     }
 }
 
-/// A glTF matrix or translation/rotation/scale as a matrix, exactly from its `f32`s.
-fn local_transform(node: &::gltf::Node<'_>) -> Result<DMat4, String> {
-    match node.transform() {
-        ::gltf::scene::Transform::Matrix { matrix } => {
-            let matrix = DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from)));
-            if !matrix.is_finite() {
-                return Err("its matrix has a component that is not finite".into());
-            }
-            Ok(matrix)
+/// How far a node matrix's last row may stray from `0 0 0 1` and still count as affine:
+/// rounding in a writer's arithmetic, far below anything a renderer would show.
+const AFFINE_TOLERANCE: f64 = 1e-6;
+
+/// A node's `matrix` or translation/rotation/scale as a matrix, exactly from its `f32`s.
+///
+/// glTF 2.0 §3.5.3 gives a node's transform as either a matrix or TRS properties, and
+/// requires a matrix to decompose into TRS. So a matrix given together with TRS
+/// properties that are not the identity is an error (readers disagree on which
+/// applies), as is a projective matrix (last row not `0 0 0 1`, which an affine
+/// transform would silently drop). A sheared matrix is applied as it is.
+fn local_transform(node: &::gltf::json::Node) -> Result<DMat4, String> {
+    if let Some(matrix) = node.matrix {
+        let mut trs = Vec::new();
+        if node.translation.is_some_and(|t| t != [0.0; 3]) {
+            trs.push("translation");
         }
-        ::gltf::scene::Transform::Decomposed {
-            translation,
-            rotation,
-            scale,
-        } => {
-            let [x, y, z, w] = rotation.map(f64::from);
-            let rotation = DQuat::from_xyzw(x, y, z, w);
-            let length = rotation.length();
-            if !length.is_finite() || length == 0.0 {
-                return Err(format!(
-                    "its rotation quaternion {rotation} is not a rotation"
-                ));
-            }
-            let translation = DVec3::from_array(translation.map(f64::from));
-            let scale = DVec3::from_array(scale.map(f64::from));
-            if !translation.is_finite() || !scale.is_finite() {
-                return Err("its translation or scale has a component that is not finite".into());
-            }
-            Ok(DMat4::from_scale_rotation_translation(
-                scale,
-                rotation / length,
-                translation,
-            ))
+        if node.rotation.is_some_and(|r| r.0 != [0.0, 0.0, 0.0, 1.0]) {
+            trs.push("rotation");
         }
+        if node.scale.is_some_and(|s| s != [1.0; 3]) {
+            trs.push("scale");
+        }
+        if !trs.is_empty() {
+            return Err(format!(
+                "it has both a matrix and {} (glTF 2.0 §3.5.3: a node's transform is a matrix or translation/rotation/scale, not both); which applies is ambiguous",
+                trs.join(", ")
+            ));
+        }
+        let matrix = DMat4::from_cols_array(&matrix.map(f64::from));
+        if !matrix.is_finite() {
+            return Err("its matrix has a component that is not finite".into());
+        }
+        let last_row = matrix.row(3);
+        if (last_row - glam::DVec4::W).abs().max_element() > AFFINE_TOLERANCE {
+            return Err(format!(
+                "its matrix's last row is {last_row}, not [0, 0, 0, 1]: a projective transform, which glTF 2.0 §3.5.3 does not allow (a node's matrix must decompose into translation, rotation and scale)"
+            ));
+        }
+        // Within the tolerance, the last row is rounding: it is made exact.
+        return Ok(DMat4::from_cols(
+            matrix.x_axis.truncate().extend(0.0),
+            matrix.y_axis.truncate().extend(0.0),
+            matrix.z_axis.truncate().extend(0.0),
+            matrix.w_axis.truncate().extend(1.0),
+        ));
     }
+    let [x, y, z, w] = node
+        .rotation
+        .map_or([0.0, 0.0, 0.0, 1.0], |r| r.0)
+        .map(f64::from);
+    let rotation = DQuat::from_xyzw(x, y, z, w);
+    let length = rotation.length();
+    if !length.is_finite() || length == 0.0 {
+        return Err(format!(
+            "its rotation quaternion {rotation} is not a rotation"
+        ));
+    }
+    let translation = DVec3::from_array(node.translation.unwrap_or([0.0; 3]).map(f64::from));
+    let scale = DVec3::from_array(node.scale.unwrap_or([1.0; 3]).map(f64::from));
+    if !translation.is_finite() || !scale.is_finite() {
+        return Err("its translation or scale has a component that is not finite".into());
+    }
+    Ok(DMat4::from_scale_rotation_translation(
+        scale,
+        rotation / length,
+        translation,
+    ))
 }
 
 impl Importer<'_> {
@@ -574,7 +607,8 @@ impl Importer<'_> {
                     "{name} is reached twice: it has two parents or is its own ancestor (glTF nodes form trees, §3.5.2)"
                 )));
             }
-            let local = local_transform(&node).map_err(|e| self.fail(format!("{name}: {e}")))?;
+            let local = local_transform(&document.as_json().nodes[node.index()])
+                .map_err(|e| self.fail(format!("{name}: {e}")))?;
             let world = parent * local;
             if !world.is_finite() {
                 return Err(self.fail(format!(
