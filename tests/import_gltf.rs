@@ -887,6 +887,27 @@ fn textures_choose_the_texture_coordinate_set_they_use() {
 }
 
 #[test]
+fn occlusion_textures_are_left_to_the_path_tracer_and_normal_textures_warned_about() {
+    let (mut doc, _) = triangle_doc();
+    let body = two_uv_sets(&mut doc, None, None, None).replace(
+        r#""name":"multi","#,
+        r#""name":"baked","occlusionTexture":{"index":0},"#,
+    );
+    let model = imported("baked.gltf", doc.embedded(&body).as_bytes());
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let body = body.replace(r#""occlusionTexture""#, r#""normalTexture""#);
+    let model = imported("bumpy.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    assert!(
+        model.warnings[0].ends_with(
+            "bumpy.gltf: material 0 ('baked'): normalTexture is not supported yet; ignored (the surface shades with its mesh normals)"
+        ),
+        "{:?}",
+        model.warnings
+    );
+}
+
+#[test]
 fn jpeg_textures_load() {
     let (doc, _) = triangle_doc();
     let image = image::RgbImage::from_pixel(4, 2, image::Rgb([200, 100, 50]));

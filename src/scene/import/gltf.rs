@@ -981,11 +981,14 @@ impl Importer<'_> {
                 material.alpha_mode()
             ));
         }
-        if material.normal_texture().is_some() || material.occlusion_texture().is_some() {
+        if material.normal_texture().is_some() {
             self.warn(format!(
-                "{name}: normal and occlusion textures are not supported; ignored"
+                "{name}: normalTexture is not supported yet; ignored (the surface shades with its mesh normals)"
             ));
         }
+        // occlusionTexture is left out without a warning: baked ambient occlusion is a
+        // rasteriser's stand-in for the shadowing of indirect light (glTF 2.0 §3.9.3),
+        // which a path tracer computes; applying it too would darken creases twice.
         let emission = emissive * strength;
         let transmission = material
             .transmission()
