@@ -554,6 +554,18 @@ fn vertex_colours_are_named_in_one_warning() {
 }
 
 #[test]
+fn application_specific_attributes_are_not_read() {
+    // glTF 2.0 §3.7.2.1: attribute names that start with `_` are the application's own
+    // (Cesium's `_BATCHID`, `_FEATURE_ID_0`).
+    let (doc, meshes) = triangle_doc();
+    let body = format!(r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],{meshes}"#)
+        .replace(r#""POSITION":0"#, r#""POSITION":0,"_BATCHID":0"#);
+    let model = imported("batched.gltf", doc.embedded(&body).as_bytes());
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    assert_eq!(model.meshes[0].triangles.len(), 1);
+}
+
+#[test]
 fn embedded_external_and_glb_buffers_give_the_same_model() {
     let mut doc = Doc::default();
     let positions = doc.vec3(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
