@@ -76,10 +76,12 @@ const QUOTED_PROBLEMS: usize = 5;
 /// apart by content.
 ///
 /// Fails, naming the file and the element (buffer, accessor, mesh and primitive, node,
-/// material, texture, camera, light), on a missing, truncated or malformed file, an
-/// extension it requires that is not supported, a primitive that is not made of
-/// triangles, an index or range out of bounds, a non-finite position or transform, a
-/// texture that does not load, or a model beyond the size limits.
+/// material, texture, camera, light), on a missing, truncated or malformed file, a
+/// glTF 1.0 file, extensions it requires that are not supported (all named at once;
+/// Draco and meshopt compression with how to decompress), a file whose primitives are
+/// all points or lines, an index or range out of bounds, a non-finite position or
+/// transform, a node matrix that is projective or given beside translation, rotation or
+/// scale, a texture that does not load, or a model beyond the size limits.
 pub fn import_gltf(path: &Path) -> Result<ImportedModel, SceneError> {
     let bytes = read_file(path, path, "the model file")?;
     parse_gltf(&bytes, path)
