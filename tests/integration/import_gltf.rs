@@ -68,6 +68,38 @@ impl Doc {
         ))
     }
 
+    /// An accessor of integer components (`component_type` 5120 byte, 5121 unsigned
+    /// byte, 5122 short, 5123 unsigned short), each element padded to 4 bytes as glTF
+    /// 2.0 §3.6.2.4 requires of vertex attributes.
+    fn integers(
+        &mut self,
+        type_: &str,
+        component_type: u32,
+        normalized: bool,
+        elements: &[Vec<i32>],
+    ) -> usize {
+        let size = if component_type <= 5121 { 1 } else { 2 };
+        let components = elements.first().map_or(1, Vec::len);
+        let stride = (components * size).next_multiple_of(4);
+        let mut bytes = Vec::new();
+        for element in elements {
+            for &c in element {
+                if size == 1 {
+                    bytes.push(c as u8);
+                } else {
+                    bytes.extend_from_slice(&(c as u16).to_le_bytes());
+                }
+            }
+            bytes.resize(bytes.len().next_multiple_of(4), 0);
+        }
+        let view = self.view(&bytes);
+        self.views[view] = self.views[view].replace('}', &format!(r#","byteStride":{stride}}}"#));
+        self.accessor(format!(
+            r#"{{"bufferView":{view},"componentType":{component_type},"normalized":{normalized},"count":{},"type":"{type_}"}}"#,
+            elements.len()
+        ))
+    }
+
     fn indices(&mut self, data: &[u16]) -> usize {
         let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_le_bytes()).collect();
         let view = self.view(&bytes);
@@ -201,6 +233,30 @@ fn a_transformed_node_s_triangle_lands_where_the_matrices_say() {
 }
 
 #[test]
+fn a_matrix_beside_identity_trs_or_with_rounding_in_its_last_row_is_accepted() {
+    let (doc, meshes) = triangle_doc();
+    // Identity translation/rotation/scale beside a matrix change nothing, whichever a
+    // reader applies; a last row off by 1e-8 is rounding, and is made exact.
+    let body = format!(
+        r#""scenes":[{{"nodes":[0,1]}}],"nodes":[
+            {{"mesh":0,"matrix":[2,0,0,0, 0,2,0,0, 0,0,2,0, 1,2,3,1],"translation":[0,0,0],"rotation":[0,0,0,1],"scale":[1,1,1]}},
+            {{"mesh":0,"matrix":[1,0,0,1e-8, 0,1,0,0, 0,0,1,0, 0,0,0,1.00000001]}}],{meshes}"#
+    );
+    let model = imported("matrix.gltf", doc.embedded(&body).as_bytes());
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let instances = &model.meshes[0].instances;
+    assert_eq!(
+        instances[0],
+        DMat4::from_scale_rotation_translation(
+            DVec3::splat(2.0),
+            DQuat::IDENTITY,
+            DVec3::new(1.0, 2.0, 3.0)
+        )
+    );
+    assert_eq!(instances[1], DMat4::IDENTITY);
+}
+
+#[test]
 fn a_mesh_under_two_nodes_is_stored_once_with_two_instances() {
     let (doc, meshes) = triangle_doc();
     let body = format!(
@@ -263,6 +319,250 @@ fn strips_and_fans_become_triangles_and_indices_are_optional() {
         assert!((b - a).cross(c - a).z > 0.0, "{triangle:?}");
     }
     assert_eq!(model.meshes[0].name, "mesh 0, primitive 0");
+}
+
+/// The value of a normalized integer as glTF 2.0 §3.11 and `KHR_mesh_quantization`
+/// decode it.
+fn dequantize(component_type: u32, normalized: bool, c: i32) -> f64 {
+    let c = f64::from(c);
+    match (component_type, normalized) {
+        (_, false) => c,
+        (5120, true) => (c / 127.0).max(-1.0),
+        (5121, true) => c / 255.0,
+        (5122, true) => (c / 32767.0).max(-1.0),
+        (_, true) => c / 65535.0,
+    }
+}
+
+#[test]
+fn quantized_attributes_import_as_their_float_twins() {
+    // One triangle per POSITION component type (KHR_mesh_quantization's table), each
+    // with quantized normals and texture coordinates; the twin holds the same values as
+    // floats.
+    let mut quantized = Doc::default();
+    let mut float = Doc::default();
+    let mut primitives_q = Vec::new();
+    let mut primitives_f = Vec::new();
+    let kinds = [
+        (5120, false),
+        (5120, true),
+        (5121, false),
+        (5121, true),
+        (5122, false),
+        (5122, true),
+        (5123, false),
+        (5123, true),
+    ];
+    for (k, &(position_type, position_normalized)) in kinds.iter().enumerate() {
+        let signed = position_type == 5120 || position_type == 5122;
+        let big = if position_type <= 5121 { 100 } else { 30000 };
+        let low = if signed { -big } else { 0 };
+        let positions = vec![vec![low, low, 0], vec![big, low, 0], vec![low, big, 1]];
+        // Normals: normalized signed bytes or shorts only, -128 and -32768 included
+        // (they clamp to -1).
+        let (normal_type, unit, below) = if k % 2 == 0 {
+            (5120, 127, -128)
+        } else {
+            (5122, 32767, -32768)
+        };
+        let normals = vec![vec![0, 0, unit], vec![0, below, unit], vec![unit, 0, unit]];
+        // Texture coordinates: every type, normalized or not, in turn.
+        let (uv_type, uv_normalized) = kinds[(k + 3) % kinds.len()];
+        let uv_big = if uv_type <= 5121 { 127 } else { 32767 };
+        let uv_low = if uv_type == 5120 || uv_type == 5122 {
+            -uv_big
+        } else {
+            0
+        };
+        let uvs = vec![vec![uv_low, 0], vec![uv_big, 1], vec![0, uv_big]];
+        let p = quantized.integers("VEC3", position_type, position_normalized, &positions);
+        let n = quantized.integers("VEC3", normal_type, true, &normals);
+        let t = quantized.integers("VEC2", uv_type, uv_normalized, &uvs);
+        primitives_q.push(format!(
+            r#"{{"attributes":{{"POSITION":{p},"NORMAL":{n},"TEXCOORD_0":{t}}}}}"#
+        ));
+        let as_f32 = |elements: &[Vec<i32>], ty: u32, normalized: bool| -> Vec<Vec<f32>> {
+            elements
+                .iter()
+                .map(|e| {
+                    e.iter()
+                        .map(|&c| dequantize(ty, normalized, c) as f32)
+                        .collect()
+                })
+                .collect()
+        };
+        let vec3 =
+            |v: Vec<Vec<f32>>| -> Vec<[f32; 3]> { v.iter().map(|e| [e[0], e[1], e[2]]).collect() };
+        let p = float.vec3(&vec3(as_f32(
+            &positions,
+            position_type,
+            position_normalized,
+        )));
+        let n = float.vec3(&vec3(as_f32(&normals, normal_type, true)));
+        let t = float.vec2(
+            &as_f32(&uvs, uv_type, uv_normalized)
+                .iter()
+                .map(|e| [e[0], e[1]])
+                .collect::<Vec<_>>(),
+        );
+        primitives_f.push(format!(
+            r#"{{"attributes":{{"POSITION":{p},"NORMAL":{n},"TEXCOORD_0":{t}}}}}"#
+        ));
+    }
+    let body = |primitives: &[String]| {
+        format!(
+            r#""extensionsUsed":["KHR_mesh_quantization"],"extensionsRequired":["KHR_mesh_quantization"],
+               "scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0,"scale":[0.01,0.01,0.01]}}],
+               "meshes":[{{"primitives":[{}]}}]"#,
+            primitives.join(",")
+        )
+    };
+    let q = imported(
+        "quantized.gltf",
+        quantized.embedded(&body(&primitives_q)).as_bytes(),
+    );
+    let f = imported(
+        "float.gltf",
+        float.embedded(&body(&primitives_f)).as_bytes(),
+    );
+    assert!(q.warnings.is_empty(), "{:?}", q.warnings);
+    assert_eq!(q.meshes.len(), kinds.len());
+    assert_eq!(q.meshes.len(), f.meshes.len());
+    for (mq, mf) in q.meshes.iter().zip(&f.meshes) {
+        assert_eq!(mq.triangles, mf.triangles, "{}", mq.name);
+        assert_eq!(mq.instances, mf.instances, "{}", mq.name);
+        for (a, b) in mq.positions.iter().zip(&mf.positions) {
+            assert_close(*a, *b, 1e-7 * b.length().max(1.0));
+        }
+        let (nq, nf) = (
+            mq.normals.as_ref().expect("normals"),
+            mf.normals.as_ref().expect("normals"),
+        );
+        for (a, b) in nq.iter().zip(nf) {
+            assert_close(*a, *b, 1e-7);
+        }
+        let (uq, uf) = (mq.uvs.as_ref().expect("uvs"), mf.uvs.as_ref().expect("uvs"));
+        for (a, b) in uq.iter().zip(uf) {
+            assert!(
+                (*a - *b).length() <= 1e-7 * b.length().max(1.0),
+                "{a} vs {b}"
+            );
+        }
+    }
+    // Exactly the specification's formulas: 32767 short → 1, -32768 → -1 (clamped),
+    // 65535 unsigned short → 1, -128 byte → -1.
+    let short_normalized = &q.meshes[5];
+    assert_eq!(
+        short_normalized.positions[0],
+        DVec3::new(-30000.0 / 32767.0, -30000.0 / 32767.0, 0.0)
+    );
+    assert_eq!(short_normalized.positions[2].z, 1.0 / 32767.0);
+    let normals = q.meshes[1].normals.as_ref().expect("normals");
+    assert_eq!(normals[0], DVec3::Z);
+    assert_eq!(normals[1], DVec3::new(0.0, -1.0, 1.0).normalize());
+    let normals = q.meshes[0].normals.as_ref().expect("normals");
+    assert_eq!(normals[1], DVec3::new(0.0, -1.0, 1.0).normalize());
+    let uvs = q.meshes[2].uvs.as_ref().expect("uvs");
+    assert_eq!(uvs[1].x, 32767.0 / 32767.0, "normalized short");
+    let uvs = q.meshes[1].uvs.as_ref().expect("uvs");
+    assert_eq!(
+        (uvs[0].x, uvs[1].x),
+        (-32767.0, 32767.0),
+        "short, not normalized"
+    );
+
+    // Without the extension listed, the values are read with one warning.
+    let unlisted = body(&primitives_q).replace(
+        r#""extensionsUsed":["KHR_mesh_quantization"],"extensionsRequired":["KHR_mesh_quantization"],"#,
+        "",
+    );
+    let model = imported("unlisted.gltf", quantized.embedded(&unlisted).as_bytes());
+    assert_eq!(model.meshes, q.meshes);
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    assert!(
+        model.warnings[0].contains("unlisted.gltf: mesh 0, primitive 0: POSITION (accessor 0) holds I8 components, which only KHR_mesh_quantization allows"),
+        "{:?}",
+        model.warnings
+    );
+}
+
+#[test]
+fn points_and_lines_are_skipped_with_one_warning() {
+    let mut doc = Doc::default();
+    let square = doc.vec3(&[
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+    ]);
+    let body = format!(
+        r#""scenes":[{{"nodes":[0,1]}}],"nodes":[{{"mesh":0}},{{"mesh":1}}],"meshes":[
+            {{"name":"guides","primitives":[
+              {{"attributes":{{"POSITION":{square}}},"mode":0}},
+              {{"attributes":{{"POSITION":{square}}},"mode":3}}]}},
+            {{"primitives":[
+              {{"attributes":{{"POSITION":{square}}},"mode":2}},
+              {{"attributes":{{"POSITION":{square}}},"mode":5}}]}}]"#
+    );
+    let model = imported("mixed.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(model.meshes.len(), 1);
+    assert_eq!(model.meshes[0].name, "mesh 1, primitive 1");
+    assert_eq!(model.meshes[0].triangles.len(), 2);
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    assert!(
+        model.warnings[0].ends_with(
+            "mixed.gltf: skipped 3 primitives of points or lines, which are not rendered: mesh 0 ('guides'), primitive 0: POINTS (0); mesh 0 ('guides'), primitive 1: LINE_STRIP (3); mesh 1, primitive 0: LINE_LOOP (2)"
+        ),
+        "{:?}",
+        model.warnings
+    );
+    // Without the strip, nothing is left to render.
+    let body = body.replace(r#""mode":5"#, r#""mode":1"#);
+    let message = failure("lines.gltf", doc.embedded(&body).as_bytes());
+    assert!(
+        message.contains("lines.gltf: no triangles: the primitives it places are points or lines, which are not rendered (mesh 0 ('guides'), primitive 0: POINTS (0); mesh 0 ('guides'), primitive 1: LINE_STRIP (3); mesh 1, primitive 0: LINE_LOOP (2); mesh 1, primitive 1: LINES (1))"),
+        "{message}"
+    );
+}
+
+#[test]
+fn vertex_colours_are_named_in_one_warning() {
+    let (mut doc, _) = triangle_doc();
+    let rgb = doc.integers(
+        "VEC3",
+        5121,
+        true,
+        &[vec![255, 0, 0], vec![0, 255, 0], vec![0, 0, 255]],
+    );
+    let body = format!(
+        r#""scenes":[{{"nodes":[0,1]}}],"nodes":[{{"mesh":0}},{{"mesh":0,"translation":[2,0,0]}}],
+           "meshes":[{{"name":"painted","primitives":[
+              {{"attributes":{{"POSITION":0,"COLOR_0":{rgb}}},"indices":1}},
+              {{"attributes":{{"POSITION":0}},"indices":1}},
+              {{"attributes":{{"POSITION":0,"COLOR_0":{rgb},"COLOR_1":{rgb}}},"indices":1}}]}}]"#
+    );
+    let model = imported("colours.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(model.meshes.len(), 3);
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    assert!(
+        model.warnings[0].ends_with(
+            "colours.gltf: vertex colours are present but not yet shaded; they are ignored (mesh 0 ('painted'), primitive 0: COLOR_0; mesh 0 ('painted'), primitive 2: COLOR_0, COLOR_1)"
+        ),
+        "{:?}",
+        model.warnings
+    );
+}
+
+#[test]
+fn application_specific_attributes_are_not_read() {
+    // glTF 2.0 §3.7.2.1: attribute names that start with `_` are the application's own
+    // (Cesium's `_BATCHID`, `_FEATURE_ID_0`).
+    let (doc, meshes) = triangle_doc();
+    let body = format!(r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],{meshes}"#)
+        .replace(r#""POSITION":0"#, r#""POSITION":0,"_BATCHID":0"#);
+    let model = imported("batched.gltf", doc.embedded(&body).as_bytes());
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    assert_eq!(model.meshes[0].triangles.len(), 1);
 }
 
 #[test]
@@ -518,6 +818,107 @@ fn materials_map_with_their_textures_and_wrap_modes() {
     assert_eq!(scene.images.len(), 3, "each image once");
 }
 
+/// A triangle with two texture coordinate sets (`TEXCOORD_1` = `TEXCOORD_0` + 10) and
+/// a material whose base colour, metallic-roughness and emissive textures ask for the
+/// sets given (`None`: no such texture); the JSON body.
+fn two_uv_sets(doc: &mut Doc, base: Option<u32>, mr: Option<u32>, emissive: Option<u32>) -> String {
+    let uv0 = doc.vec2(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+    let uv1 = doc.vec2(&[[10.0, 10.0], [11.0, 10.0], [10.0, 11.0]]);
+    let texture = |slot: &str, set: Option<u32>| match set {
+        Some(set) => format!(r#""{slot}":{{"index":0,"texCoord":{set}}},"#),
+        None => String::new(),
+    };
+    let png = png(1, 1, &[[200, 100, 50, 255]]);
+    let uri = format!(
+        "data:image/png;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&png)
+    );
+    format!(
+        r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+           "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"TEXCOORD_0":{uv0},"TEXCOORD_1":{uv1}}},"indices":1,"material":0}}]}}],
+           "materials":[{{"name":"multi",{}"pbrMetallicRoughness":{{{}"metallicFactor":0}}}}],
+           "textures":[{{"source":0}}],"images":[{{"uri":"{uri}"}}]"#,
+        texture("emissiveTexture", emissive).replace(
+            r#""emissiveTexture""#,
+            r#""emissiveFactor":[1,1,1],"emissiveTexture""#
+        ),
+        texture("baseColorTexture", base) + &texture("metallicRoughnessTexture", mr),
+    )
+}
+
+#[test]
+fn textures_choose_the_texture_coordinate_set_they_use() {
+    let first_u = |model: &ImportedModel| model.meshes[0].uvs.as_ref().expect("uvs")[1].x;
+    // Every texture on TEXCOORD_1: it is the mesh's, without a warning.
+    let (mut doc, _) = triangle_doc();
+    let body = two_uv_sets(&mut doc, Some(1), Some(1), Some(1));
+    let model = imported("one.gltf", doc.embedded(&body).as_bytes());
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    assert_eq!(first_u(&model), 11.0);
+    assert!(model.materials[0].emissive_texture.is_some());
+
+    // MultiUVTest: base colour on TEXCOORD_0, emission on TEXCOORD_1. A tie: the base
+    // colour's set, with a warning.
+    let (mut doc, _) = triangle_doc();
+    let body = two_uv_sets(&mut doc, Some(0), None, Some(1));
+    let model = imported("multi.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(first_u(&model), 1.0);
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    assert!(
+        model.warnings[0].ends_with(
+            "multi.gltf: material 0 ('multi'): its textures use different texture coordinate sets (baseColorTexture: TEXCOORD_0, emissiveTexture: TEXCOORD_1), and a mesh is read with one: TEXCOORD_0, so emissiveTexture is mapped by the wrong coordinates"
+        ),
+        "{:?}",
+        model.warnings
+    );
+
+    // Two of three on TEXCOORD_1: the majority wins over the base colour.
+    let (mut doc, _) = triangle_doc();
+    let body = two_uv_sets(&mut doc, Some(0), Some(1), Some(1));
+    let model = imported("most.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(first_u(&model), 11.0);
+    assert!(
+        model.warnings[0]
+            .ends_with("TEXCOORD_1, so baseColorTexture is mapped by the wrong coordinates"),
+        "{:?}",
+        model.warnings
+    );
+
+    // Only emission, on TEXCOORD_1, but the primitive has no such set: TEXCOORD_0.
+    let (mut doc, _) = triangle_doc();
+    let body = two_uv_sets(&mut doc, None, None, Some(1)).replace(r#","TEXCOORD_1":3"#, "");
+    let model = imported("missing.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(first_u(&model), 1.0);
+    assert!(
+        model.warnings[0].ends_with(
+            "missing.gltf: mesh 0, primitive 0: its material's textures use TEXCOORD_1, which it does not have; TEXCOORD_0 is used"
+        ),
+        "{:?}",
+        model.warnings
+    );
+}
+
+#[test]
+fn occlusion_textures_are_left_to_the_path_tracer_and_normal_textures_warned_about() {
+    let (mut doc, _) = triangle_doc();
+    let body = two_uv_sets(&mut doc, None, None, None).replace(
+        r#""name":"multi","#,
+        r#""name":"baked","occlusionTexture":{"index":0},"#,
+    );
+    let model = imported("baked.gltf", doc.embedded(&body).as_bytes());
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let body = body.replace(r#""occlusionTexture""#, r#""normalTexture""#);
+    let model = imported("bumpy.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    assert!(
+        model.warnings[0].ends_with(
+            "bumpy.gltf: material 0 ('baked'): normalTexture is not supported yet; ignored (the surface shades with its mesh normals)"
+        ),
+        "{:?}",
+        model.warnings
+    );
+}
+
 #[test]
 fn jpeg_textures_load() {
     let (doc, _) = triangle_doc();
@@ -675,13 +1076,62 @@ fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
         (
             "glTF 1",
             ok.replace(r#""version":"2.0""#, r#""version":"1.0""#).into_bytes(),
-            "glTF version 1.0 is not supported",
+            r#"the file is glTF 1.0 (asset.version is "1.0"); only glTF 2.0 is read"#,
         ),
         (
-            "required extension",
-            ok.replacen('{', r#"{"extensionsRequired":["KHR_draco_mesh_compression"],"#, 1)
+            "glTF 1 structure",
+            br#"{"asset":{"version":"1.0"},"accessors":{"accessor_21":{"bufferView":"bufferView_29","componentType":5123,"count":36,"type":"SCALAR"}}}"#.to_vec(),
+            r#"the file is glTF 1.0 (asset.version is "1.0"); only glTF 2.0 is read: convert it first, e.g. with gltf-pipeline"#,
+        ),
+        (
+            "glTF 1 structure without a version",
+            br#"{"meshes":{"mesh_0":{"primitives":[]}},"scene":"defaultScene"}"#.to_vec(),
+            "the file is glTF 1.0 (its meshes are an object keyed by id, glTF 1.0's layout); only glTF 2.0 is read",
+        ),
+        (
+            "binary glTF 1",
+            [b"glTF".as_slice(), &1u32.to_le_bytes(), &40u32.to_le_bytes(), &[0; 28]].concat(),
+            "the file is glTF 1.0 (a GLB container of version 1, glTF 1.0's KHR_binary_glTF); only glTF 2.0 is read",
+        ),
+        (
+            "Draco required",
+            ok.replacen(
+                '{',
+                r#"{"extensionsUsed":["KHR_draco_mesh_compression","KHR_mesh_quantization"],"extensionsRequired":["KHR_mesh_quantization","KHR_draco_mesh_compression"],"#,
+                1,
+            )
+            .into_bytes(),
+            "the file requires the extension KHR_draco_mesh_compression, which is not supported (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_mesh_quantization). Its meshes are Draco-compressed (KHR_draco_mesh_compression), and Draco mesh compression is not supported: decompress the file first, e.g. with `gltf-transform cp IN OUT`",
+        ),
+        (
+            "meshopt required",
+            ok.replacen(
+                '{',
+                r#"{"extensionsUsed":["EXT_meshopt_compression"],"extensionsRequired":["EXT_meshopt_compression"],"#,
+                1,
+            )
+            .into_bytes(),
+            "requires the extension EXT_meshopt_compression, which is not supported (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_mesh_quantization). Its buffers are meshopt-compressed (EXT_meshopt_compression), and meshopt compression is not supported: decompress the file first, e.g. with `gltfpack -i IN -o OUT`",
+        ),
+        (
+            "several required extensions",
+            ok.replacen(
+                '{',
+                r#"{"extensionsRequired":["KHR_texture_transform","KHR_lights_punctual","KHR_materials_unlit","EXT_meshopt_compression"],"#,
+                1,
+            )
+            .into_bytes(),
+            "the file requires 3 extensions that are not supported: KHR_texture_transform, KHR_materials_unlit, EXT_meshopt_compression (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_mesh_quantization). Its buffers are meshopt-compressed (EXT_meshopt_compression)",
+        ),
+        (
+            // As gltf-transform's BoxDraco.gltf: Draco used, not required, and no
+            // uncompressed copy.
+            "Draco without a fallback",
+            ok.replacen('{', r#"{"extensionsUsed":["KHR_draco_mesh_compression"],"#, 1)
+                .replace(r#""bufferView":0,"#, "")
+                .replace(r#""bufferView":1,"#, "")
                 .into_bytes(),
-            "requires the extension KHR_draco_mesh_compression, which is not supported",
+            "the file's meshes are Draco-compressed (KHR_draco_mesh_compression) without uncompressed copies (accessors 0, 1 have no bufferView), and Draco mesh compression is not supported: decompress the file first",
         ),
         (
             "dangling reference",
@@ -713,9 +1163,27 @@ fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
             "node 0: its matrix has a component that is not finite",
         ),
         (
-            "lines",
+            "matrix and translation",
+            ok.replace(
+                r#"{"mesh":0}"#,
+                r#"{"name":"both","mesh":0,"matrix":[1,0,0,0,0,1,0,0,0,0,1,0,5,0,0,1],"translation":[1,0,0],"scale":[1,1,1],"rotation":[0,0,1,0]}"#,
+            )
+            .into_bytes(),
+            "bad.gltf: node 0 ('both'): it has both a matrix and translation, rotation (glTF 2.0 §3.5.3: a node's transform is a matrix or translation/rotation/scale, not both); which applies is ambiguous",
+        ),
+        (
+            "projective matrix",
+            ok.replace(
+                r#"{"mesh":0}"#,
+                r#"{"name":"lens","mesh":0,"matrix":[1,0,0,0.5,0,1,0,0,0,0,1,0,0,0,0,1]}"#,
+            )
+            .into_bytes(),
+            "bad.gltf: node 0 ('lens'): its matrix's last row is [0.5, 0, 0, 1], not [0, 0, 0, 1]: a projective transform",
+        ),
+        (
+            "only lines",
             ok.replace(r#""indices":1}"#, r#""indices":1,"mode":1}"#).into_bytes(),
-            "mesh 0 ('tri'), primitive 0: its mode is Lines; only triangles, triangle strips and triangle fans are supported",
+            "bad.gltf: no triangles: the primitives it places are points or lines, which are not rendered (mesh 0 ('tri'), primitive 0: LINES (1))",
         ),
         (
             "remote buffer",

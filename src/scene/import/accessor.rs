@@ -29,17 +29,30 @@ pub(super) fn view_bytes<'b>(view: &View<'_>, buffers: &'b [Vec<u8>]) -> Result<
         })
 }
 
+/// Whether an attribute's integer components may be normalized integers (glTF 2.0
+/// §3.6.2.1, accessor `normalized`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Normalized {
+    /// Integers taken as they are (indices).
+    Never,
+    /// Integers that stand for [0, 1] or [-1, 1] (`NORMAL` under `KHR_mesh_quantization`).
+    Always,
+    /// Either, as the accessor's `normalized` says (`POSITION` and `TEXCOORD_n` under
+    /// `KHR_mesh_quantization`).
+    Either,
+}
+
 /// What an attribute may hold.
-pub(super) struct Expect {
+pub(super) struct Expect<'a> {
     /// The attribute, for messages (`POSITION`, `TEXCOORD_0`, `indices`).
-    pub name: &'static str,
+    pub name: &'a str,
     /// Its element type.
     pub dimensions: Dimensions,
-    /// The component types allowed (glTF 2.0 §3.7.2.1, table "Meshes").
+    /// The component types allowed (glTF 2.0 §3.7.2.1, table "Meshes", widened by
+    /// `KHR_mesh_quantization` where the caller allows it).
     pub types: &'static [DataType],
-    /// Whether integer components are normalized to [0, 1] (texture coordinates) or
-    /// taken as they are (indices).
-    pub normalized: bool,
+    /// Whether its integer components may be normalized.
+    pub normalized: Normalized,
 }
 
 /// Reads `accessor` as `f64` components, `count × components` of them, after checking
@@ -68,10 +81,18 @@ pub(super) fn read(
             expect.types
         )));
     }
-    if data_type != DataType::F32 && accessor.normalized() != expect.normalized {
+    // `normalized` only means something for integers (glTF 2.0 §5.1, accessor.normalized:
+    // it must not be true for FLOAT); a float accessor that sets it is read as floats.
+    let normalized = data_type != DataType::F32 && accessor.normalized();
+    let allowed = match expect.normalized {
+        Normalized::Never => !normalized,
+        Normalized::Always => normalized || data_type == DataType::F32,
+        Normalized::Either => true,
+    };
+    if !allowed {
         return Err(fail(format!(
-            "its integer components are {}normalized, which this attribute does not allow",
-            if accessor.normalized() { "" } else { "not " }
+            "its {data_type:?} components are {}normalized, which this attribute does not allow",
+            if normalized { "" } else { "not " }
         )));
     }
     let components = expect.dimensions.multiplicity();
@@ -97,7 +118,7 @@ pub(super) fn read(
                 count,
                 components,
                 data_type,
-                expect.normalized,
+                normalized,
             )
             .ok_or_else(|| {
                 fail(format!(
@@ -144,7 +165,7 @@ pub(super) fn read(
             sparse_count,
             components,
             data_type,
-            expect.normalized,
+            normalized,
         )
         .ok_or_else(|| {
             fail(format!(
@@ -168,6 +189,9 @@ pub(super) fn read(
 
 /// Decodes `count` elements of `components` little-endian components each, the first at
 /// `offset` and one every `stride` bytes; `None` when they do not fit in `bytes`.
+/// Normalized integers become reals as glTF 2.0 §3.11 ("Animations", the table every
+/// normalized accessor follows, `KHR_mesh_quantization` included) says: `c / 255`,
+/// `c / 65535` unsigned, `max(c / 127, -1)`, `max(c / 32767, -1)` signed.
 fn decode(
     bytes: &[u8],
     offset: usize,

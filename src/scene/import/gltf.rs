@@ -9,13 +9,14 @@ use std::path::{Path, PathBuf};
 use ::gltf::Document;
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::camera::Projection;
+use ::gltf::json::validation::Checked;
 use ::gltf::khr_lights_punctual::Kind;
 use ::gltf::mesh::Mode;
 use ::gltf::texture::WrappingMode;
 use base64::Engine;
 use glam::{DMat4, DQuat, DVec2, DVec3};
 
-use super::accessor::{Expect, read, view_bytes};
+use super::accessor::{Expect, Normalized, read, view_bytes};
 use super::mesh::{Budget, RawMesh, finish_mesh};
 use super::texture::{Encoding, Textures};
 use super::{
@@ -38,6 +39,32 @@ const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
     "KHR_materials_transmission",
+    "KHR_mesh_quantization",
+];
+/// `KHR_mesh_quantization`, which widens the component types of vertex attributes.
+const MESH_QUANTIZATION: &str = "KHR_mesh_quantization";
+/// Component types of `POSITION`: `FLOAT` (glTF 2.0 §3.7.2.1), and under
+/// `KHR_mesh_quantization` (its table "Extending Mesh Attributes") signed and unsigned
+/// bytes and shorts, normalized or not.
+const POSITION_TYPES: &[DataType] = &[
+    DataType::F32,
+    DataType::I8,
+    DataType::U8,
+    DataType::I16,
+    DataType::U16,
+];
+/// Component types of `NORMAL`: `FLOAT`, and under `KHR_mesh_quantization` normalized
+/// signed bytes and shorts.
+const NORMAL_TYPES: &[DataType] = &[DataType::F32, DataType::I8, DataType::I16];
+/// Component types of `TEXCOORD_n`: `FLOAT` and normalized unsigned bytes and shorts
+/// (glTF 2.0 §3.7.2.1), and under `KHR_mesh_quantization` also signed ones and both
+/// not normalized.
+const TEXCOORD_TYPES: &[DataType] = &[
+    DataType::F32,
+    DataType::I8,
+    DataType::U8,
+    DataType::I16,
+    DataType::U16,
 ];
 /// Index of refraction of `KHR_materials_ior`'s default (and of glass without it).
 const DEFAULT_IOR: f64 = 1.5;
@@ -49,10 +76,12 @@ const QUOTED_PROBLEMS: usize = 5;
 /// apart by content.
 ///
 /// Fails, naming the file and the element (buffer, accessor, mesh and primitive, node,
-/// material, texture, camera, light), on a missing, truncated or malformed file, an
-/// extension it requires that is not supported, a primitive that is not made of
-/// triangles, an index or range out of bounds, a non-finite position or transform, a
-/// texture that does not load, or a model beyond the size limits.
+/// material, texture, camera, light), on a missing, truncated or malformed file, a
+/// glTF 1.0 file, extensions it requires that are not supported (all named at once;
+/// Draco and meshopt compression with how to decompress), a file whose primitives are
+/// all points or lines, an index or range out of bounds, a non-finite position or
+/// transform, a node matrix that is projective or given beside translation, rotation or
+/// scale, a texture that does not load, or a model beyond the size limits.
 pub fn import_gltf(path: &Path) -> Result<ImportedModel, SceneError> {
     let bytes = read_file(path, path, "the model file")?;
     parse_gltf(&bytes, path)
@@ -66,25 +95,33 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError
     if bytes.is_empty() {
         return Err(error(path, "not a valid glTF file: the file is empty"));
     }
-    let gltf =
-        ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| parse_error(path, e))?;
+    if let Some(why) = gltf1_binary(bytes) {
+        return Err(gltf1_error(path, why));
+    }
+    let gltf = ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| {
+        // A glTF 1.0 file fails to parse as 2.0 (its top-level arrays were objects);
+        // say what it is rather than where the 2.0 parser stopped.
+        match gltf1_json(bytes) {
+            Some(why) => gltf1_error(path, why),
+            None => parse_error(path, e),
+        }
+    })?;
     let version = &gltf.as_json().asset.version;
+    if version.starts_with("1.") {
+        return Err(gltf1_error(path, format!("asset.version is \"{version}\"")));
+    }
     if !version.starts_with("2.") {
         return Err(error(
             path,
             format!("glTF version {version} is not supported (only 2.x)"),
         ));
     }
-    for extension in gltf.extensions_required() {
-        if !SUPPORTED_EXTENSIONS.contains(&extension) {
-            return Err(error(
-                path,
-                format!(
-                    "the file requires the extension {extension}, which is not supported (supported: {})",
-                    SUPPORTED_EXTENSIONS.join(", ")
-                ),
-            ));
-        }
+    let unsupported: Vec<&str> = gltf
+        .extensions_required()
+        .filter(|e| !SUPPORTED_EXTENSIONS.contains(e))
+        .collect();
+    if !unsupported.is_empty() {
+        return Err(error(path, unsupported_extensions(&unsupported)));
     }
     validate(&gltf.document, path)?;
     let mut importer = Importer {
@@ -97,6 +134,9 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError
         textures: Textures::default(),
         materials: HashMap::new(),
         warned: BTreeSet::new(),
+        not_triangles: Vec::new(),
+        triangle_primitives: 0,
+        vertex_colors: Vec::new(),
     };
     for extension in gltf.extensions_used() {
         if !SUPPORTED_EXTENSIONS.contains(&extension) {
@@ -115,6 +155,79 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError
     let mut model = importer.model;
     model.images = importer.textures.images;
     Ok(model)
+}
+
+/// Draco mesh compression (`KHR_draco_mesh_compression`), which is not decoded here.
+const DRACO: &str = "KHR_draco_mesh_compression";
+/// meshoptimizer's buffer compression, as a vendor extension and as ratified by Khronos;
+/// not decoded here.
+const MESHOPT: &[&str] = &["EXT_meshopt_compression", "KHR_meshopt_compression"];
+
+/// The message for a file that requires the `unsupported` extensions (at least one):
+/// all of them at once, and for a compression what to do about it.
+fn unsupported_extensions(unsupported: &[&str]) -> String {
+    let list = unsupported.join(", ");
+    let supported = SUPPORTED_EXTENSIONS.join(", ");
+    let mut message = if let [_] = unsupported {
+        format!(
+            "the file requires the extension {list}, which is not supported (supported: {supported})"
+        )
+    } else {
+        format!(
+            "the file requires {} extensions that are not supported: {list} (supported: {supported})",
+            unsupported.len()
+        )
+    };
+    for &extension in unsupported {
+        if extension == DRACO {
+            message += &format!(
+                ". Its meshes are Draco-compressed ({extension}), and Draco mesh compression is not supported: decompress the file first, e.g. with `gltf-transform cp IN OUT` (glTF Transform decodes Draco on reading)"
+            );
+        } else if MESHOPT.contains(&extension) {
+            message += &format!(
+                ". Its buffers are meshopt-compressed ({extension}), and meshopt compression is not supported: decompress the file first, e.g. with `gltfpack -i IN -o OUT` (gltfpack compresses only when given -c)"
+            );
+        }
+    }
+    message
+}
+
+/// Why `bytes` is a binary glTF 1.0 file (a GLB container of version 1, the
+/// `KHR_binary_glTF` extension of glTF 1.0), if it is one.
+fn gltf1_binary(bytes: &[u8]) -> Option<String> {
+    let version = bytes.strip_prefix(b"glTF")?.get(..4)?;
+    (u32::from_le_bytes([version[0], version[1], version[2], version[3]]) == 1)
+        .then(|| "a GLB container of version 1, glTF 1.0's KHR_binary_glTF".to_string())
+}
+
+/// Why the JSON `bytes` are a glTF 1.0 document, if they are one: `asset.version` "1.x",
+/// or (1.0 files often leave `version` out) top-level properties that glTF 1.0 made
+/// objects keyed by id and glTF 2.0 made arrays.
+fn gltf1_json(bytes: &[u8]) -> Option<String> {
+    let value: ::gltf::json::Value = ::gltf::json::deserialize::from_slice(bytes).ok()?;
+    let root = value.as_object()?;
+    if let Some(version) = root
+        .get("asset")
+        .and_then(|a| a.get("version"))
+        .and_then(|v| v.as_str())
+        .filter(|v| v.starts_with("1."))
+    {
+        return Some(format!("asset.version is \"{version}\""));
+    }
+    ["accessors", "meshes", "nodes", "buffers", "bufferViews"]
+        .into_iter()
+        .find(|key| root.get(*key).is_some_and(|v| v.is_object()))
+        .map(|key| format!("its {key} are an object keyed by id, glTF 1.0's layout"))
+}
+
+/// The error for a glTF 1.0 file, `why` saying how it was recognised.
+fn gltf1_error(path: &Path, why: String) -> SceneError {
+    error(
+        path,
+        format!(
+            "the file is glTF 1.0 ({why}); only glTF 2.0 is read: convert it first, e.g. with gltf-pipeline (`gltf-pipeline -i IN -o OUT`), which updates glTF 1.0 to 2.0"
+        ),
+    )
 }
 
 /// The error for a file the `gltf` crate cannot parse, with the JSON line and column
@@ -145,7 +258,7 @@ fn parse_error(path: &Path, e: ::gltf::Error) -> SceneError {
 /// Runs the `gltf` crate's validation (references in range, required properties present,
 /// enumerations valid), which its accessors rely on.
 fn validate(document: &Document, path: &Path) -> Result<(), SceneError> {
-    use ::gltf::json::validation::{Checked, Validate};
+    use ::gltf::json::validation::Validate;
     let root = document.as_json();
     // gltf-json 1.4's validation indexes the accessors with POSITION's index unchecked
     // (`primitive_validate_hook`), so that index is checked here first.
@@ -168,13 +281,46 @@ fn validate(document: &Document, path: &Path) -> Result<(), SceneError> {
             }
         }
     }
+    // A file that uses Draco without requiring it must keep uncompressed copies of its
+    // meshes (KHR_draco_mesh_compression, "Conformance"); without them its accessors
+    // hold no data, and it is Draco that is missing, not just a bufferView.
+    if root.extensions_used.iter().any(|e| e == DRACO) {
+        let empty: Vec<String> = root
+            .accessors
+            .iter()
+            .enumerate()
+            .filter(|(_, a)| a.buffer_view.is_none() && a.sparse.is_none())
+            .map(|(i, _)| i.to_string())
+            .collect();
+        if !empty.is_empty() {
+            return Err(error(
+                path,
+                format!(
+                    "the file's meshes are Draco-compressed ({DRACO}) without uncompressed copies (accessor{} {} {} no bufferView), and Draco mesh compression is not supported: decompress the file first, e.g. with `gltf-transform cp IN OUT` (glTF Transform decodes Draco on reading)",
+                    if empty.len() == 1 { "" } else { "s" },
+                    quote_list(&empty, ", "),
+                    if empty.len() == 1 { "has" } else { "have" },
+                ),
+            ));
+        }
+    }
     let mut problems = Vec::new();
     root.validate(root, ::gltf::json::Path::new, &mut |where_, what| {
         let where_ = where_();
         // POSITION's min and max are required (§3.7.2.1) but only serve to bound the
         // mesh without reading it; some exporters leave them out or get them wrong, and
-        // the positions are read (and checked) anyway.
-        if !where_.as_str().contains(r#"["POSITION"].m"#) {
+        // the positions are read (and checked) anyway. Required extensions were judged
+        // against what this importer reads, not what the crate knows.
+        //
+        // Attributes whose names start with `_` are the application's own (§3.7.2.1),
+        // which gltf-json without its `extras` feature calls invalid (and names
+        // "<invalid semantic name>", like any name it does not know); they are not read.
+        if !where_.as_str().contains(r#"["POSITION"].m"#)
+            && !where_.as_str().starts_with("extensionsRequired")
+            && !where_
+                .as_str()
+                .contains(r#".attributes["<invalid semantic name>"]"#)
+        {
             problems.push(format!("{where_}: {what}"));
         }
     });
@@ -195,6 +341,17 @@ fn validate(document: &Document, path: &Path) -> Result<(), SceneError> {
             }
         ),
     ))
+}
+
+/// The first [`QUOTED_PROBLEMS`] of `items`, joined by `separator`, and how many more
+/// there are.
+fn quote_list(items: &[String], separator: &str) -> String {
+    let shown = items.len().min(QUOTED_PROBLEMS);
+    let mut list = items[..shown].join(separator);
+    if items.len() > shown {
+        list += &format!(" and {} more", items.len() - shown);
+    }
+    list
 }
 
 /// A data URI's bytes (RFC 2397), base64 or percent-encoded.
@@ -303,10 +460,18 @@ struct Importer<'a> {
     model: ImportedModel,
     budget: Budget,
     textures: Textures,
-    /// glTF material index (`None`: the default material) → index in the model.
-    materials: HashMap<Option<usize>, u32>,
+    /// glTF material index (`None`: the default material) → index in the model and the
+    /// texture coordinate set its meshes are read with.
+    materials: HashMap<Option<usize>, (u32, u32)>,
     /// Warnings already given once per file.
     warned: BTreeSet<&'static str>,
+    /// The primitives skipped for being points or lines (`mesh N, primitive P: MODE`).
+    not_triangles: Vec<String>,
+    /// How many primitives of triangles were read.
+    triangle_primitives: usize,
+    /// The primitives with vertex colours, which are not stored (`mesh N, primitive P:
+    /// COLOR_0`).
+    vertex_colors: Vec<String>,
 }
 
 /// `what N ('name')`, or `what N` for an unnamed element.
@@ -317,41 +482,74 @@ fn describe(what: &str, index: usize, name: Option<&str>) -> String {
     }
 }
 
-/// A glTF matrix or translation/rotation/scale as a matrix, exactly from its `f32`s.
-fn local_transform(node: &::gltf::Node<'_>) -> Result<DMat4, String> {
-    match node.transform() {
-        ::gltf::scene::Transform::Matrix { matrix } => {
-            let matrix = DMat4::from_cols_array_2d(&matrix.map(|c| c.map(f64::from)));
-            if !matrix.is_finite() {
-                return Err("its matrix has a component that is not finite".into());
-            }
-            Ok(matrix)
+/// How far a node matrix's last row may stray from `0 0 0 1` and still count as affine:
+/// rounding in a writer's arithmetic, far below anything a renderer would show.
+const AFFINE_TOLERANCE: f64 = 1e-6;
+
+/// A node's `matrix` or translation/rotation/scale as a matrix, exactly from its `f32`s.
+///
+/// glTF 2.0 §3.5.3 gives a node's transform as either a matrix or TRS properties, and
+/// requires a matrix to decompose into TRS. So a matrix given together with TRS
+/// properties that are not the identity is an error (readers disagree on which
+/// applies), as is a projective matrix (last row not `0 0 0 1`, which an affine
+/// transform would silently drop). A sheared matrix is applied as it is.
+fn local_transform(node: &::gltf::json::Node) -> Result<DMat4, String> {
+    if let Some(matrix) = node.matrix {
+        let mut trs = Vec::new();
+        if node.translation.is_some_and(|t| t != [0.0; 3]) {
+            trs.push("translation");
         }
-        ::gltf::scene::Transform::Decomposed {
-            translation,
-            rotation,
-            scale,
-        } => {
-            let [x, y, z, w] = rotation.map(f64::from);
-            let rotation = DQuat::from_xyzw(x, y, z, w);
-            let length = rotation.length();
-            if !length.is_finite() || length == 0.0 {
-                return Err(format!(
-                    "its rotation quaternion {rotation} is not a rotation"
-                ));
-            }
-            let translation = DVec3::from_array(translation.map(f64::from));
-            let scale = DVec3::from_array(scale.map(f64::from));
-            if !translation.is_finite() || !scale.is_finite() {
-                return Err("its translation or scale has a component that is not finite".into());
-            }
-            Ok(DMat4::from_scale_rotation_translation(
-                scale,
-                rotation / length,
-                translation,
-            ))
+        if node.rotation.is_some_and(|r| r.0 != [0.0, 0.0, 0.0, 1.0]) {
+            trs.push("rotation");
         }
+        if node.scale.is_some_and(|s| s != [1.0; 3]) {
+            trs.push("scale");
+        }
+        if !trs.is_empty() {
+            return Err(format!(
+                "it has both a matrix and {} (glTF 2.0 §3.5.3: a node's transform is a matrix or translation/rotation/scale, not both); which applies is ambiguous",
+                trs.join(", ")
+            ));
+        }
+        let matrix = DMat4::from_cols_array(&matrix.map(f64::from));
+        if !matrix.is_finite() {
+            return Err("its matrix has a component that is not finite".into());
+        }
+        let last_row = matrix.row(3);
+        if (last_row - glam::DVec4::W).abs().max_element() > AFFINE_TOLERANCE {
+            return Err(format!(
+                "its matrix's last row is {last_row}, not [0, 0, 0, 1]: a projective transform, which glTF 2.0 §3.5.3 does not allow (a node's matrix must decompose into translation, rotation and scale)"
+            ));
+        }
+        // Within the tolerance, the last row is rounding: it is made exact.
+        return Ok(DMat4::from_cols(
+            matrix.x_axis.truncate().extend(0.0),
+            matrix.y_axis.truncate().extend(0.0),
+            matrix.z_axis.truncate().extend(0.0),
+            matrix.w_axis.truncate().extend(1.0),
+        ));
     }
+    let [x, y, z, w] = node
+        .rotation
+        .map_or([0.0, 0.0, 0.0, 1.0], |r| r.0)
+        .map(f64::from);
+    let rotation = DQuat::from_xyzw(x, y, z, w);
+    let length = rotation.length();
+    if !length.is_finite() || length == 0.0 {
+        return Err(format!(
+            "its rotation quaternion {rotation} is not a rotation"
+        ));
+    }
+    let translation = DVec3::from_array(node.translation.unwrap_or([0.0; 3]).map(f64::from));
+    let scale = DVec3::from_array(node.scale.unwrap_or([1.0; 3]).map(f64::from));
+    if !translation.is_finite() || !scale.is_finite() {
+        return Err("its translation or scale has a component that is not finite".into());
+    }
+    Ok(DMat4::from_scale_rotation_translation(
+        scale,
+        rotation / length,
+        translation,
+    ))
 }
 
 impl Importer<'_> {
@@ -418,7 +616,8 @@ impl Importer<'_> {
                     "{name} is reached twice: it has two parents or is its own ancestor (glTF nodes form trees, §3.5.2)"
                 )));
             }
-            let local = local_transform(&node).map_err(|e| self.fail(format!("{name}: {e}")))?;
+            let local = local_transform(&document.as_json().nodes[node.index()])
+                .map_err(|e| self.fail(format!("{name}: {e}")))?;
             let world = parent * local;
             if !world.is_finite() {
                 return Err(self.fail(format!(
@@ -457,6 +656,33 @@ impl Importer<'_> {
                 self.mesh(&mesh, instances)?;
             }
         }
+        if !self.vertex_colors.is_empty() {
+            // Vertex colours multiply the base colour (glTF 2.0 §3.7.2.1); the renderers
+            // have no per-vertex colour yet, so the model shades without them.
+            self.warn(format!(
+                "vertex colours are present but not yet shaded; they are ignored ({})",
+                quote_list(&self.vertex_colors, "; ")
+            ));
+        }
+        if self.not_triangles.is_empty() {
+            return Ok(());
+        }
+        let count = self.not_triangles.len();
+        let list = quote_list(&self.not_triangles, "; ");
+        if self.model.meshes.is_empty() {
+            return Err(self.fail(format!(
+                "no triangles: the primitives it places are points or lines, which are not rendered ({list}){}",
+                if self.triangle_primitives > 0 {
+                    ", and the triangles of the others are all degenerate"
+                } else {
+                    ""
+                }
+            )));
+        }
+        self.warn(format!(
+            "skipped {count} primitive{} of points or lines, which are not rendered: {list}",
+            if count == 1 { "" } else { "s" }
+        ));
         Ok(())
     }
 
@@ -471,10 +697,37 @@ impl Importer<'_> {
         }
         for primitive in mesh.primitives() {
             let name = format!("{mesh_name}, primitive {}", primitive.index());
+            let mode = primitive.mode();
+            if !matches!(
+                mode,
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            ) {
+                // Points and lines have no area for a ray to hit; a file may well mix
+                // them with surfaces (guides, wireframes), so only they are left out.
+                self.not_triangles
+                    .push(format!("{name}: {}", mode_name(mode)));
+                continue;
+            }
+            self.triangle_primitives += 1;
+            // The material first: it decides which texture coordinates to read.
+            let (material, uv_set) = self.material(primitive.material().index())?;
+            // The JSON's keys, not `Primitive::attributes`, which unwraps each key.
+            let json = &self.document.as_json().meshes[mesh.index()].primitives[primitive.index()];
+            let colors: Vec<String> = json
+                .attributes
+                .keys()
+                .filter_map(|semantic| match semantic {
+                    Checked::Valid(::gltf::Semantic::Colors(set)) => Some(format!("COLOR_{set}")),
+                    _ => None,
+                })
+                .collect();
+            if !colors.is_empty() {
+                self.vertex_colors
+                    .push(format!("{name}: {}", colors.join(", ")));
+            }
             let raw = self
-                .primitive(&primitive)
+                .primitive(&primitive, &name, uv_set)
                 .map_err(|e| self.fail(format!("{name}: {e}")))?;
-            let material = self.material(primitive.material().index())?;
             self.budget
                 .charge_instances(instances.len())
                 .map_err(|e| self.fail(e))?;
@@ -491,17 +744,17 @@ impl Importer<'_> {
         Ok(())
     }
 
-    /// Reads one primitive's positions, normals, `TEXCOORD_0` and triangles.
-    fn primitive(&mut self, primitive: &::gltf::Primitive<'_>) -> Result<RawMesh, String> {
+    /// Reads one primitive's positions, normals, texture coordinates (set `uv_set`, the
+    /// one its material's textures use) and triangles (its mode is one of the three of
+    /// triangles); `name` (mesh and primitive) is for warnings, the caller prefixes it to
+    /// errors.
+    fn primitive(
+        &mut self,
+        primitive: &::gltf::Primitive<'_>,
+        name: &str,
+        uv_set: u32,
+    ) -> Result<RawMesh, String> {
         let mode = primitive.mode();
-        if !matches!(
-            mode,
-            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
-        ) {
-            return Err(format!(
-                "its mode is {mode:?}; only triangles, triangle strips and triangle fans are supported"
-            ));
-        }
         let positions_accessor = primitive
             .get(&::gltf::Semantic::Positions)
             .ok_or("it has no POSITION attribute")?;
@@ -533,11 +786,12 @@ impl Importer<'_> {
             &Expect {
                 name: "POSITION",
                 dimensions: Dimensions::Vec3,
-                types: &[DataType::F32],
-                normalized: false,
+                types: POSITION_TYPES,
+                normalized: Normalized::Either,
             },
             &self.buffers,
         )?);
+        self.check_quantization(&positions_accessor, name, "POSITION", false);
         let same_count = |accessor: &::gltf::Accessor<'_>, name: &str| {
             if accessor.count() == count {
                 Ok(())
@@ -551,32 +805,51 @@ impl Importer<'_> {
         let normals = match primitive.get(&::gltf::Semantic::Normals) {
             Some(accessor) => {
                 same_count(&accessor, "NORMAL")?;
-                Some(vec3(read(
+                let normals = vec3(read(
                     &accessor,
                     &Expect {
                         name: "NORMAL",
                         dimensions: Dimensions::Vec3,
-                        types: &[DataType::F32],
-                        normalized: false,
+                        types: NORMAL_TYPES,
+                        normalized: Normalized::Always,
                     },
                     &self.buffers,
-                )?))
+                )?);
+                self.check_quantization(&accessor, name, "NORMAL", false);
+                Some(normals)
             }
             None => None,
         };
-        let uvs = match primitive.get(&::gltf::Semantic::TexCoords(0)) {
+        let mut uv_accessor = primitive.get(&::gltf::Semantic::TexCoords(uv_set));
+        let mut uv_name = format!("TEXCOORD_{uv_set}");
+        if uv_accessor.is_none() && uv_set != 0 {
+            // A texture that names a set the primitive lacks is invalid (glTF 2.0
+            // §5.30, textureInfo.texCoord); the first set is the likeliest intent.
+            uv_accessor = primitive.get(&::gltf::Semantic::TexCoords(0));
+            self.warn(format!(
+                "{name}: its material's textures use {uv_name}, which it does not have; {}",
+                if uv_accessor.is_some() {
+                    "TEXCOORD_0 is used"
+                } else {
+                    "it has no texture coordinates"
+                }
+            ));
+            uv_name = "TEXCOORD_0".into();
+        }
+        let uvs = match uv_accessor {
             Some(accessor) => {
-                same_count(&accessor, "TEXCOORD_0")?;
+                same_count(&accessor, &uv_name)?;
                 let values = read(
                     &accessor,
                     &Expect {
-                        name: "TEXCOORD_0",
+                        name: &uv_name,
                         dimensions: Dimensions::Vec2,
-                        types: &[DataType::F32, DataType::U8, DataType::U16],
-                        normalized: true,
+                        types: TEXCOORD_TYPES,
+                        normalized: Normalized::Either,
                     },
                     &self.buffers,
                 )?;
+                self.check_quantization(&accessor, name, &uv_name, true);
                 Some(
                     values
                         .chunks_exact(2)
@@ -593,7 +866,7 @@ impl Importer<'_> {
                     name: "indices",
                     dimensions: Dimensions::Scalar,
                     types: &[DataType::U8, DataType::U16, DataType::U32],
-                    normalized: false,
+                    normalized: Normalized::Never,
                 },
                 &self.buffers,
             )?
@@ -605,7 +878,7 @@ impl Importer<'_> {
         let triangles = triangles(mode, &indices);
         if mode == Mode::Triangles && !indices.len().is_multiple_of(3) {
             self.warn(format!(
-                "a triangle list of {} indices (not a multiple of 3): the last {} ignored",
+                "{name}: a triangle list of {} indices (not a multiple of 3): the last {} ignored",
                 indices.len(),
                 indices.len() % 3
             ));
@@ -618,40 +891,77 @@ impl Importer<'_> {
         })
     }
 
+    /// Warns (once per file) when `accessor` holds one of the component types that only
+    /// `KHR_mesh_quantization` allows but the file does not list the extension in
+    /// `extensionsUsed` (glTF 2.0 §3.12: an extension a file uses must be listed). The
+    /// values are unambiguous either way, so they are read.
+    fn check_quantization(
+        &mut self,
+        accessor: &::gltf::Accessor<'_>,
+        primitive: &str,
+        attribute: &str,
+        texcoord: bool,
+    ) {
+        let data_type = accessor.data_type();
+        let core = data_type == DataType::F32
+            || (texcoord
+                && accessor.normalized()
+                && matches!(data_type, DataType::U8 | DataType::U16));
+        if !core
+            && !self
+                .document
+                .extensions_used()
+                .any(|e| e == MESH_QUANTIZATION)
+        {
+            self.warn_once(
+                "quantization",
+                format!(
+                    "{primitive}: {attribute} (accessor {}) holds {}{data_type:?} components, which only {MESH_QUANTIZATION} allows, but the file does not list that extension in extensionsUsed; read anyway",
+                    accessor.index(),
+                    if accessor.normalized() { "normalized " } else { "" }
+                ),
+            );
+        }
+    }
+
     /// The model's index of glTF material `index` (`None`: the default material, glTF
     /// 2.0 §3.9.6), mapping it on first use.
-    fn material(&mut self, index: Option<usize>) -> Result<u32, SceneError> {
-        if let Some(&ours) = self.materials.get(&index) {
-            return Ok(ours);
+    fn material(&mut self, index: Option<usize>) -> Result<(u32, u32), SceneError> {
+        if let Some(&known) = self.materials.get(&index) {
+            return Ok(known);
         }
-        let imported = match index.and_then(|i| self.document.materials().nth(i)) {
+        let (imported, uv_set) = match index.and_then(|i| self.document.materials().nth(i)) {
             Some(material) => self.map_material(&material)?,
-            None => ImportedMaterial {
-                name: "default".into(),
-                // glTF's default material: white, fully metallic and rough... which is
-                // black under Whitted lighting; a white dielectric PBR is what viewers show.
-                material: Material {
-                    diffuse: DVec3::ONE,
-                    metallic: 0.0,
-                    roughness: 1.0,
-                    ..Material::blank(MaterialKind::Pbr)
+            None => (
+                ImportedMaterial {
+                    name: "default".into(),
+                    // glTF's default material: white, fully metallic and rough... which is
+                    // black under Whitted lighting; a white dielectric PBR is what viewers show.
+                    material: Material {
+                        diffuse: DVec3::ONE,
+                        metallic: 0.0,
+                        roughness: 1.0,
+                        ..Material::blank(MaterialKind::Pbr)
+                    },
+                    base_color_texture: None,
+                    metallic_roughness_texture: None,
+                    emissive_texture: None,
                 },
-                base_color_texture: None,
-                metallic_roughness_texture: None,
-                emissive_texture: None,
-            },
+                0,
+            ),
         };
         let ours = self.model.materials.len() as u32;
         self.model.materials.push(imported);
-        self.materials.insert(index, ours);
-        Ok(ours)
+        self.materials.insert(index, (ours, uv_set));
+        Ok((ours, uv_set))
     }
 
-    /// Maps a glTF metallic-roughness material onto ours (the table in `docs/models.md`).
+    /// Maps a glTF metallic-roughness material onto ours (the table in `docs/models.md`),
+    /// with the texture coordinate set its meshes are read with ([`Importer::uv_set`]).
     fn map_material(
         &mut self,
         material: &::gltf::Material<'_>,
-    ) -> Result<ImportedMaterial, SceneError> {
+    ) -> Result<(ImportedMaterial, u32), SceneError> {
         let name = describe("material", material.index().unwrap_or(0), material.name());
         let pbr = material.pbr_metallic_roughness();
         let [r, g, b, _alpha] = pbr.base_color_factor().map(f64::from);
@@ -680,11 +990,14 @@ impl Importer<'_> {
                 material.alpha_mode()
             ));
         }
-        if material.normal_texture().is_some() || material.occlusion_texture().is_some() {
+        if material.normal_texture().is_some() {
             self.warn(format!(
-                "{name}: normal and occlusion textures are not supported; ignored"
+                "{name}: normalTexture is not supported yet; ignored (the surface shades with its mesh normals)"
             ));
         }
+        // occlusionTexture is left out without a warning: baked ambient occlusion is a
+        // rasteriser's stand-in for the shadowing of indirect light (glTF 2.0 §3.9.3),
+        // which a path tracer computes; applying it too would darken creases twice.
         let emission = emissive * strength;
         let transmission = material
             .transmission()
@@ -753,13 +1066,72 @@ impl Importer<'_> {
             Some(info) => Some(self.texture(&info, Encoding::Color, &name, "emissiveTexture")?),
             None => None,
         };
-        Ok(ImportedMaterial {
+        let uv_set = self.uv_set(
+            &name,
+            &[
+                (
+                    "baseColorTexture",
+                    pbr.base_color_texture().map(|t| t.tex_coord()),
+                ),
+                (
+                    "metallicRoughnessTexture",
+                    pbr.metallic_roughness_texture().map(|t| t.tex_coord()),
+                ),
+                (
+                    "emissiveTexture",
+                    material.emissive_texture().map(|t| t.tex_coord()),
+                ),
+            ],
+        );
+        let imported = ImportedMaterial {
             name: material.name().map_or_else(|| name.clone(), str::to_string),
             material: ours,
             base_color_texture,
             metallic_roughness_texture,
             emissive_texture,
-        })
+        };
+        Ok((imported, uv_set))
+    }
+
+    /// The texture coordinate set (`TEXCOORD_n`) for the meshes of `material`, whose
+    /// textures the renderers use ask for the sets in `slots` (`None`: no such texture).
+    /// A mesh carries one set, so when they disagree the set most of them use is taken
+    /// (on a tie the base colour's, else the lowest), with a warning naming the textures
+    /// that are then mapped by the wrong set.
+    fn uv_set(&mut self, material: &str, slots: &[(&str, Option<u32>)]) -> u32 {
+        let used: Vec<(&str, u32)> = slots
+            .iter()
+            .filter_map(|&(slot, set)| set.map(|set| (slot, set)))
+            .collect();
+        let Some(&(_, first)) = used.first() else {
+            return 0;
+        };
+        if used.iter().all(|&(_, set)| set == first) {
+            return first;
+        }
+        let count = |set: u32| used.iter().filter(|&&(_, s)| s == set).count();
+        let base = used
+            .iter()
+            .find(|&&(slot, _)| slot == "baseColorTexture")
+            .map(|&(_, set)| set);
+        let chosen = used
+            .iter()
+            .map(|&(_, set)| set)
+            .max_by_key(|&set| (count(set), Some(set) == base, std::cmp::Reverse(set)))
+            .unwrap_or(0);
+        let describe = |&(slot, set): &(&str, u32)| format!("{slot}: TEXCOORD_{set}");
+        let wrong: Vec<&str> = used
+            .iter()
+            .filter(|&&(_, set)| set != chosen)
+            .map(|&(slot, _)| slot)
+            .collect();
+        self.warn(format!(
+            "{material}: its textures use different texture coordinate sets ({}), and a mesh is read with one: TEXCOORD_{chosen}, so {} {} mapped by the wrong coordinates",
+            used.iter().map(describe).collect::<Vec<_>>().join(", "),
+            wrong.join(" and "),
+            if wrong.len() == 1 { "is" } else { "are" }
+        ));
+        chosen
     }
 
     /// Loads the image of a material's texture and keeps its sampler's wrap modes.
@@ -770,12 +1142,6 @@ impl Importer<'_> {
         material: &str,
         slot: &str,
     ) -> Result<TextureRef, SceneError> {
-        if info.tex_coord() != 0 {
-            self.warn(format!(
-                "{material}: {slot} uses TEXCOORD_{}, which is not imported; TEXCOORD_0 is used",
-                info.tex_coord()
-            ));
-        }
         let texture = info.texture();
         let image = texture.source();
         let image_name = describe("image", image.index(), image.name());
@@ -936,6 +1302,19 @@ impl Importer<'_> {
         };
         self.model.lights.push(converted);
         Ok(())
+    }
+}
+
+/// A primitive mode by its name and number in glTF 2.0 §5.24 (`mesh.primitive.mode`).
+fn mode_name(mode: Mode) -> &'static str {
+    match mode {
+        Mode::Points => "POINTS (0)",
+        Mode::Lines => "LINES (1)",
+        Mode::LineLoop => "LINE_LOOP (2)",
+        Mode::LineStrip => "LINE_STRIP (3)",
+        Mode::Triangles => "TRIANGLES (4)",
+        Mode::TriangleStrip => "TRIANGLE_STRIP (5)",
+        Mode::TriangleFan => "TRIANGLE_FAN (6)",
     }
 }
 
