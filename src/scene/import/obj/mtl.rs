@@ -2,16 +2,17 @@
 //! each line checked here (errors name the library, line and column), then parsed by
 //! `tobj`, and each material mapped onto ours (the table in `docs/models.md`).
 
-use std::collections::HashMap;
-use std::io::Cursor;
+use std::collections::{HashMap, HashSet};
+use std::io::{Cursor, ErrorKind};
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 
-use super::{DEFAULT_OBJ_ALBEDO, ObjScan, at, finite, words};
+use super::{DEFAULT_OBJ_ALBEDO, Notes, at, decode_text, finite, strip_comment, words};
+use crate::input::{InputError, read_input};
 use crate::scene::import::mesh::Budget;
 use crate::scene::import::texture::{Encoding, Textures};
-use crate::scene::import::{ImportedMaterial, TextureRef, WrapMode, error, read_file};
+use crate::scene::import::{ImportedMaterial, MAX_MODEL_FILE_BYTES, TextureRef, WrapMode, error};
 use crate::scene::{Material, MaterialKind, SceneError};
 
 /// Index of refraction assumed for glass (`illum` 4, 6, 7, 9) and coats (`illum` 3, 5, 8)
@@ -29,76 +30,100 @@ pub(super) struct SourceMaterial {
     library: PathBuf,
     /// The line of its `newmtl`.
     line: usize,
+    /// The line of the OBJ file's `mtllib` that named the library.
+    pub(super) mtllib_line: usize,
     /// `map_Kd` line and column, when it has one.
     map_kd_at: Option<(usize, usize)>,
     /// `map_Ke` line and column, when it has one.
     map_ke_at: Option<(usize, usize)>,
 }
 
-/// The material libraries loaded while `tobj` reads the OBJ file.
+/// The material libraries an OBJ file names.
 #[derive(Default)]
 pub(super) struct Libraries {
-    /// Every material, in library order (the index `tobj` gives meshes).
+    /// Every material, libraries in `mtllib` order, materials in file order.
     pub(super) materials: Vec<SourceMaterial>,
-    /// Material name → index, as `tobj` resolves `usemtl`.
+    /// Material name → index; of two materials of one name the later one wins.
     pub(super) index: HashMap<String, usize>,
-    /// The first error, reported once `tobj` returns.
-    pub(super) failure: Option<SceneError>,
+    /// Whether a library could not be read (a warning said so).
+    pub(super) any_missing: bool,
 }
 
 impl Libraries {
-    /// Loads the library `name` (as written after `mtllib`) for `tobj`; on failure keeps
-    /// the error to report and gives `tobj` an empty library.
+    /// Reads the libraries of the OBJ file `obj` named by its `mtllib` statements (the
+    /// text after the keyword, and the line), relative to `directory`, each file once.
+    /// A library that does not exist is a warning, one per statement, its materials
+    /// replaced by the default one (as tinyobjloader and assimp do); one that exists but
+    /// cannot be read (a FIFO, a device, too large), or has a malformed line, is an
+    /// error naming the library, line and column.
     pub(super) fn load(
-        &mut self,
+        statements: &[(String, usize)],
         directory: &Path,
-        name: &Path,
         obj: &Path,
-        scan: &ObjScan,
-    ) -> tobj::MTLLoadResult {
-        if self.failure.is_some() {
-            return Err(tobj::LoadError::GenericFailure);
-        }
-        let line = scan
-            .libraries
-            .get(name.to_string_lossy().as_ref())
-            .copied()
-            .unwrap_or(1);
-        let library = directory.join(name);
-        let result = read_file(
-            &library,
-            obj,
-            &format!("the material library {}", library.display()),
-        )
-        .map_err(|e| {
-            at(
-                obj,
-                line,
-                1,
-                format!("mtllib {}: {}", name.display(), e.message),
-            )
-        })
-        .and_then(|bytes| self.parse(&library, &bytes));
-        match result {
-            Ok(loaded) => Ok(loaded),
-            Err(e) => {
-                self.failure = Some(e);
-                Err(tobj::LoadError::GenericFailure)
+        warnings: &mut Vec<String>,
+    ) -> Result<Self, SceneError> {
+        let mut libraries = Self::default();
+        let mut read = HashSet::new();
+        for (text, line) in statements {
+            let mut unread: Vec<(String, String)> = Vec::new();
+            for name in library_names(text, directory) {
+                let mut file = directory.join(&name);
+                if !file.exists() && name.contains('\\') {
+                    file = directory.join(name.replace('\\', "/"));
+                }
+                if !read.insert(file.clone()) {
+                    continue;
+                }
+                let message = |e: InputError| {
+                    format!("cannot read the material library {}: {e}", file.display())
+                };
+                match read_input(&file, MAX_MODEL_FILE_BYTES) {
+                    Ok(bytes) => libraries.parse(&file, &bytes, *line, warnings)?,
+                    Err(InputError::Io(e)) if e.kind() == ErrorKind::NotFound => {
+                        unread.push((name, message(InputError::Io(e))));
+                    }
+                    // A FIFO, a device or a huge file is not a library that went missing
+                    // but one that must not be read (src/input.rs).
+                    Err(e) => {
+                        return Err(at(obj, *line, 1, format!("mtllib {name}: {}", message(e))));
+                    }
+                }
+            }
+            if let Some((name, message)) = unread.first() {
+                libraries.any_missing = true;
+                let others = match unread.len() - 1 {
+                    0 => String::new(),
+                    _ => format!(
+                        " (nor can {}, named on the same line)",
+                        unread[1..]
+                            .iter()
+                            .map(|(name, _)| name.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                };
+                warnings.push(format!(
+                    "{}:{line}: mtllib {name}: {message}{others}; the materials it would define are replaced by the default material",
+                    obj.display()
+                ));
             }
         }
+        Ok(libraries)
     }
 
-    /// Checks and parses one library's text. Its materials are kept here too, with the
-    /// indices `tobj` gives them (libraries in `mtllib` order, materials in file order).
+    /// Checks and parses one library's text, named on line `mtllib_line` of the OBJ file.
     fn parse(
         &mut self,
         library: &Path,
         bytes: &[u8],
-    ) -> Result<(Vec<tobj::Material>, HashMap<String, usize>), SceneError> {
-        let text = String::from_utf8_lossy(bytes);
-        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
-        let (clean, lines) = scan_mtl(text, library)?;
-        let (materials, names) =
+        mtllib_line: usize,
+        warnings: &mut Vec<String>,
+    ) -> Result<(), SceneError> {
+        let text = decode_text(bytes, library, warnings);
+        let mut notes = Notes::default();
+        let (clean, lines) = scan_mtl(&text, library, &mut notes)?;
+        notes.report(library, warnings);
+        let (materials, _) =
             tobj::load_mtl_buf(&mut Cursor::new(clean.as_bytes())).map_err(|e| {
                 error(
                     library,
@@ -112,7 +137,7 @@ impl Libraries {
                 map_kd_at,
                 map_ke_at,
             },
-        ) in materials.iter().cloned().zip(lines)
+        ) in materials.into_iter().zip(lines)
         {
             self.index
                 .insert(material.name.clone(), self.materials.len());
@@ -120,12 +145,41 @@ impl Libraries {
                 material,
                 library: library.to_path_buf(),
                 line,
+                mtllib_line,
                 map_kd_at,
                 map_ke_at,
             });
         }
-        Ok((materials, names))
+        Ok(())
     }
+}
+
+/// The file names a `mtllib` statement gives: the whole text when a file has that name
+/// (names with spaces are common; tobj reads them so), otherwise its words, `\ ` within
+/// a word standing for a space (several libraries on one line, as the specification
+/// and tinyobjloader read it).
+fn library_names(text: &str, directory: &Path) -> Vec<String> {
+    if !text.contains(char::is_whitespace) || directory.join(text).is_file() {
+        return vec![text.to_string()];
+    }
+    let mut names = Vec::new();
+    let mut name = String::new();
+    let mut characters = text.chars().peekable();
+    while let Some(c) = characters.next() {
+        if c == '\\' && characters.peek().is_some_and(|next| next.is_whitespace()) {
+            name.extend(characters.next());
+        } else if c.is_whitespace() {
+            if !name.is_empty() {
+                names.push(std::mem::take(&mut name));
+            }
+        } else {
+            name.push(c);
+        }
+    }
+    if !name.is_empty() {
+        names.push(name);
+    }
+    names
 }
 
 /// Colour keywords of MTL (1 or 3 numbers).
@@ -157,11 +211,17 @@ struct MtlLines {
 /// Checks every line of an MTL library and returns the text for `tobj` (colours with one
 /// number spelled out as three, unsupported forms blanked) and, per material in order,
 /// where it is defined.
-fn scan_mtl(text: &str, path: &Path) -> Result<(String, Vec<MtlLines>), SceneError> {
+fn scan_mtl(
+    text: &str,
+    path: &Path,
+    notes: &mut Notes,
+) -> Result<(String, Vec<MtlLines>), SceneError> {
     let mut clean = String::with_capacity(text.len());
     let mut lines = Vec::new();
+    let mut nameless = false;
     for (index, line) in text.lines().enumerate() {
         let n = index + 1;
+        let line = strip_comment(line);
         let words = words(line);
         let Some(&(column, keyword)) = words.first() else {
             clean.push('\n');
@@ -169,12 +229,18 @@ fn scan_mtl(text: &str, path: &Path) -> Result<(String, Vec<MtlLines>), SceneErr
         };
         let values = &words[1..];
         let mut kept = line.trim().to_string();
-        if keyword.starts_with('#') {
-            kept.clear();
-        } else if keyword == "newmtl" {
-            if values.is_empty() {
-                return Err(at(path, n, column, "`newmtl` needs a material name"));
+        if keyword == "newmtl" {
+            // A material no `usemtl` can name (tobj refuses it): skipped to the next.
+            nameless = values.is_empty();
+            if nameless {
+                notes.nameless_materials.note(|| n);
             }
+        }
+        if nameless {
+            clean.push('\n');
+            continue;
+        }
+        if keyword == "newmtl" {
             lines.push(MtlLines {
                 line: n,
                 map_kd_at: None,
@@ -201,7 +267,7 @@ fn scan_mtl(text: &str, path: &Path) -> Result<(String, Vec<MtlLines>), SceneErr
                 }
                 let mut rgb = [0.0; 3];
                 for (c, word) in values.iter().enumerate() {
-                    rgb[c] = finite(path, n, *word, keyword)?;
+                    rgb[c] = finite(path, n, *word, keyword, notes)?;
                 }
                 if values.len() == 1 {
                     rgb = [rgb[0]; 3];
@@ -219,7 +285,7 @@ fn scan_mtl(text: &str, path: &Path) -> Result<(String, Vec<MtlLines>), SceneErr
                     format!("`{keyword}` takes one number, got {}", values.len()),
                 ));
             }
-            let value = finite(path, n, *values[0], keyword)?;
+            let value = finite(path, n, *values[0], keyword, notes)?;
             kept = format!("{keyword} {value:?}");
         } else if keyword == "illum" {
             let [word] = values else {
@@ -326,6 +392,15 @@ pub(super) fn map_material(
         let mut file_path = directory.join(&file);
         if !file_path.exists() && file.contains('\\') {
             file_path = directory.join(file.replace('\\', "/"));
+        }
+        if !file_path.exists() {
+            // Exporters write absolute paths of the author's machine, and models are
+            // shared without their textures: the geometry is still worth seeing.
+            warn(format!(
+                "{key}: the texture {} does not exist; the material is used without it",
+                file_path.display()
+            ));
+            return Ok(None);
         }
         let image = textures
             .file(&file_path, Encoding::Color, budget)
@@ -512,6 +587,7 @@ pub(super) fn texture_options(spec: &str) -> (String, WrapMode, Vec<String>) {
         ("-boost", 1),
         ("-cc", 1),
         ("-clamp", 1),
+        ("-colorspace", 1),
         ("-imfchan", 1),
         ("-mm", 2),
         ("-o", 3),
