@@ -1028,3 +1028,43 @@ fn a_200k_group_obj_loads_in_linear_time() {
         "loading {large} groups took {ratio:.1}x as long as {small} ({large_time:?} against {small_time:?}); expected about 4x"
     );
 }
+
+/// The fastest of `runs` placements of `model` once per material override, `count`
+/// overrides.
+fn fastest_placements(model: &ImportedModel, count: u32, runs: usize) -> std::time::Duration {
+    use gpu_render::scene::import::ModelPlacement;
+    let placements: Vec<ModelPlacement> = (0..count)
+        .map(|material| ModelPlacement {
+            material: Some(material),
+            ..ModelPlacement::IDENTITY
+        })
+        .collect();
+    (0..runs)
+        .map(|_| {
+            let mut scene = model.into_scene(Default::default());
+            let started = std::time::Instant::now();
+            model.add_placements_to_scene(&mut scene, &placements);
+            let elapsed = started.elapsed();
+            assert_eq!(scene.meshes.len(), 1 + count as usize);
+            elapsed
+        })
+        .min()
+        .unwrap_or(std::time::Duration::MAX)
+}
+
+/// Placements are grouped by their material override: 4x the placements, each with
+/// its own override, take about 4x the time (a ratio, as above).
+#[test]
+fn placements_with_many_material_overrides_are_added_in_linear_time() {
+    let model = imported(&[("triangle.obj", &format!("{TRIANGLE}f 1 2 3\n"))]);
+    let (small, large) = (20_000, 80_000);
+    fastest_placements(&model, small, 1);
+    let small_time = fastest_placements(&model, small, 5);
+    let large_time = fastest_placements(&model, large, 5);
+    let ratio = large_time.as_secs_f64() / small_time.as_secs_f64().max(1e-9);
+    eprintln!("{small} placements: {small_time:?}, {large}: {large_time:?}, ratio {ratio:.2}");
+    assert!(
+        ratio < 8.0,
+        "adding {large} placements took {ratio:.1}x as long as {small} ({large_time:?} against {small_time:?}); expected about 4x"
+    );
+}
