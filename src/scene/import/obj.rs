@@ -237,7 +237,7 @@ struct ObjFile {
     /// Statements of any known kind.
     statements: usize,
     /// Lines with anything but a comment.
-    words: usize,
+    nonblank_lines: usize,
 }
 
 impl ObjFile {
@@ -256,7 +256,7 @@ impl ObjFile {
                 self.lines_and_points,
                 plural(self.lines_and_points)
             )
-        } else if self.words == 0 {
+        } else if self.nonblank_lines == 0 {
             "the file is empty (or holds only comments)".to_string()
         } else if self.statements == 0 {
             "no OBJ statement was recognised in it: is it a text file in UTF-8 (or UTF-16 with a byte-order mark)?".to_string()
@@ -494,7 +494,7 @@ impl<'p> ObjReader<'p> {
                 faces: 0,
                 lines_and_points: 0,
                 statements: 0,
-                words: 0,
+                nonblank_lines: 0,
             },
             object: UNNAMED.to_string(),
             material: None,
@@ -527,7 +527,7 @@ impl<'p> ObjReader<'p> {
         let values = &words[1..];
         // The rest of the line, for names that may hold spaces.
         let rest = || line.trim_start()[keyword.len()..].trim();
-        self.file.words += 1;
+        self.file.nonblank_lines += 1;
         self.file.statements += 1;
         match keyword {
             "v" => {
