@@ -141,14 +141,19 @@ fn is_convex(points: &[[f64; 2]]) -> bool {
         return false;
     }
     let sign_changes = |component: fn(DVec2) -> f64| {
-        let signs: Vec<f64> = (0..n)
+        let mut signs = (0..n)
             .map(|i| component(edge(i)))
             .filter(|c| *c != 0.0)
-            .map(f64::signum)
-            .collect();
-        (0..signs.len())
-            .filter(|&i| signs[i] != signs[(i + 1) % signs.len()])
-            .count()
+            .map(f64::signum);
+        let Some(first) = signs.next() else {
+            return 0;
+        };
+        let (mut changes, mut previous) = (0, first);
+        for sign in signs.chain([first]) {
+            changes += usize::from(sign != previous);
+            previous = sign;
+        }
+        changes
     };
     sign_changes(|e| e.x) <= 2 && sign_changes(|e| e.y) <= 2
 }
