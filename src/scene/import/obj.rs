@@ -1,89 +1,80 @@
-//! Wavefront OBJ and MTL (Wavefront's "Object Files" and "Material Library Files"
-//! specifications, Alias|Wavefront Advanced Visualizer manual, appendices B1 and B2),
-//! read through the `tobj` crate.
+//! Wavefront OBJ (Wavefront's "Object Files" specification, Alias|Wavefront Advanced
+//! Visualizer manual, appendix B1) with its MTL material libraries ([`mtl`]), read as
+//! tinyobjloader and assimp read them.
 //!
-//! Every line is first checked here, so that each error names its file, line and column
-//! and so that `tobj` only ever sees well-formed lines (it has no line numbers of its own
-//! and panics on some malformed ones). `tobj` then groups the faces into objects, fans
-//! them into triangles and unifies the position/texture/normal indices.
+//! Every line is read here, so that each error names its file, line and column: vertex
+//! data, faces (cut into triangles by [`face`]: fans for convex faces, ear clipping
+//! for the others), objects, groups and material changes. The faces are collected into
+//! one mesh per object (or group) name and material, each with its own vertices: one
+//! per distinct position/texture/normal index triple it uses. Everything is a single
+//! pass over the lines with hash lookups, so the time is linear in the file however
+//! many groups, objects or material changes it has. The libraries are read once the
+//! whole file is, so that a material is found by its name wherever its `mtllib` stands.
+//!
+//! The readers other programs use decide what is lenient: an inline `#` comment, a
+//! missing library or texture, an empty `usemtl`, normal indices in a file without
+//! `vn`, and a number followed by junk (`3.1+e2`) are warnings, never errors.
 
-use std::cell::RefCell;
-use std::collections::{BTreeSet, HashMap};
-use std::io::Cursor;
-use std::path::{Path, PathBuf};
+mod face;
+mod mtl;
+
+use std::borrow::Cow;
+use std::collections::{HashMap, HashSet};
+use std::path::Path;
 
 use glam::{DVec2, DVec3};
 
+use self::face::{Cut, FaceCutter};
+use self::mtl::{Libraries, map_material};
 use super::mesh::{Budget, RawMesh, finish_mesh};
-use super::texture::{Encoding, Textures};
+use super::texture::Textures;
 use super::{
-    ImportedMaterial, ImportedModel, MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES, TextureRef, WrapMode,
-    error, read_file,
+    ImportedMaterial, ImportedModel, MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES, error, read_file,
 };
-use crate::scene::{Material, MaterialKind, SceneError};
+use crate::scene::{Material, SceneError};
 
 /// Diffuse albedo of a material whose MTL gives no `Kd` (and of geometry with no
 /// material at all); 1 when a `map_Kd` texture supplies the colour.
 pub const DEFAULT_OBJ_ALBEDO: f64 = 0.8;
-/// Index of refraction assumed for glass (`illum` 4, 6, 7, 9) and coats (`illum` 3, 5, 8)
-/// whose material gives no usable `Ni`.
-const DEFAULT_IOR: f64 = 1.5;
-/// Blinn-Phong exponent assumed when `Ns` is absent (as tinyobjloader does).
-const DEFAULT_NS: f64 = 1.0;
-/// Largest accepted Blinn-Phong exponent (the scene format's limit).
-const MAX_SHININESS: f64 = 1e6;
+
+/// A corner's missing texture coordinate or normal index.
+const NONE: u32 = u32::MAX;
+
+/// The name of faces before any `o` or `g` (and of an `o` or `g` without a name), as
+/// tobj names them.
+const UNNAMED: &str = "unnamed_object";
+
+/// How many kinds of unsupported statement are named one by one in the warnings; the
+/// rest are counted together.
+const MAX_NAMED_STATEMENTS: usize = 16;
 
 /// Reads the OBJ file at `path` with the MTL libraries it names (relative to its
-/// directory) and their `map_Kd` textures (relative to each library's directory).
+/// directory) and their `map_Kd` and `map_Ke` textures (relative to each library's
+/// directory).
 ///
-/// Fails, naming the file, line and column, on a missing or unreadable file, a
-/// malformed line, a non-finite position, a face index out of range, a missing material
-/// library or a texture that does not load. Degenerate triangles are skipped and counted
-/// in a warning.
+/// Fails, naming the file, line and column, on a missing or unreadable OBJ file, a
+/// malformed line, a non-finite position, a face index out of range, a malformed MTL
+/// line or a texture file that exists but does not decode, and, naming the file, on a
+/// file that has no triangles to render. A material library or texture that is missing
+/// is a warning (the default material, or the material without the texture, is used);
+/// degenerate triangles are skipped and counted in a warning.
 pub fn import_obj(path: &Path) -> Result<ImportedModel, SceneError> {
     let bytes = read_file(path, path, "the model file")?;
     parse_obj(&bytes, path)
 }
 
-/// Reads OBJ text from `bytes`; `path` names the file in messages and its directory is
-/// where the material libraries are looked up.
+/// Reads OBJ text from `bytes` (UTF-8, or UTF-16 with a byte-order mark); `path` names
+/// the file in messages and its directory is where the material libraries are looked
+/// up.
 pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError> {
     let mut model = ImportedModel::empty(path);
-    let text = String::from_utf8_lossy(bytes);
-    if std::str::from_utf8(bytes).is_err() {
-        model.warnings.push(format!(
-            "{}: not valid UTF-8; the invalid bytes were replaced",
-            path.display()
-        ));
-    }
-    // A byte-order mark would hide the first line's keyword.
-    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
-    let scan = scan_obj(text, path, &mut model.warnings)?;
-    let directory = path.parent().unwrap_or(Path::new("")).to_path_buf();
-    let libraries = RefCell::new(Libraries::default());
-    let options = tobj::LoadOptions {
-        single_index: true,
-        triangulate: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let (models, _) =
-        tobj::load_obj_buf(&mut Cursor::new(scan.text.as_bytes()), &options, |name| {
-            libraries.borrow_mut().load(&directory, name, path, &scan)
-        })
-        .map_err(|e| error(path, format!("the OBJ file could not be read: {e}")))?;
-    let libraries = libraries.into_inner();
-    if let Some(failure) = libraries.failure {
-        return Err(failure);
-    }
-    for (name, line) in &scan.used_materials {
-        if !libraries.index.contains_key(name) {
-            model.warnings.push(format!(
-                "{}:{line}: usemtl {name}: no material library defines it; the default material is used",
-                path.display()
-            ));
-        }
-    }
+    let text = decode_text(bytes, path, &mut model.warnings);
+    let mut notes = Notes::default();
+    let mut file = ObjReader::new(path).read(&text, &mut notes)?;
+    notes.report(path, &mut model.warnings);
+    let directory = path.parent().unwrap_or(Path::new(""));
+    let libraries = Libraries::load(&file.libraries, directory, path, &mut model.warnings)?;
+    check_material_uses(&file.used_materials, &libraries, path, &mut model.warnings);
 
     let mut budget = Budget::default();
     let mut textures = Textures::default();
@@ -92,14 +83,14 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError>
         model.materials.push(imported);
     }
     let mut default_material = None;
-    for obj in models {
-        let mesh = obj.mesh;
-        if mesh.indices.is_empty() {
-            continue;
-        }
-        let material = match mesh.material_id {
-            Some(id) if id < model.materials.len() => id as u32,
-            _ => *default_material.get_or_insert_with(|| {
+    for group in std::mem::take(&mut file.groups) {
+        let found = group
+            .material
+            .as_ref()
+            .and_then(|name| libraries.index.get(name));
+        let material = match found {
+            Some(&index) => index as u32,
+            None => *default_material.get_or_insert_with(|| {
                 model.materials.push(ImportedMaterial {
                     name: "default".into(),
                     material: Material::lambert(DVec3::splat(DEFAULT_OBJ_ALBEDO)),
@@ -112,55 +103,706 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError>
         };
         let name = format!(
             "object '{}' (material '{}')",
-            obj.name, model.materials[material as usize].name
+            group.object, model.materials[material as usize].name
         );
-        let vertices = mesh.positions.len() / 3;
         budget
-            .charge_mesh(vertices, mesh.indices.len() / 3)
+            .charge_mesh(group.vertices.len(), group.triangles.len())
             .map_err(|e| error(path, e))?;
-        let raw = RawMesh {
-            positions: mesh
-                .positions
-                .chunks_exact(3)
-                .map(|p| DVec3::new(p[0], p[1], p[2]))
-                .collect(),
-            normals: (!mesh.normals.is_empty()).then(|| {
-                mesh.normals
-                    .chunks_exact(3)
-                    .map(|n| DVec3::new(n[0], n[1], n[2]))
-                    .collect()
-            }),
-            // OBJ's v grows upwards (row 0 of the image at v = 1); ours downwards.
-            uvs: (!mesh.texcoords.is_empty()).then(|| {
-                mesh.texcoords
-                    .chunks_exact(2)
-                    .map(|t| DVec2::new(t[0], 1.0 - t[1]))
-                    .collect()
-            }),
-            triangles: mesh
-                .indices
-                .chunks_exact(3)
-                .map(|t| [t[0], t[1], t[2]])
-                .collect(),
-        };
+        let raw = group.into_raw_mesh(&file.positions, &file.texcoords, &file.normals);
         if let Some(mesh) = finish_mesh(name, path, raw, material, &mut model.warnings)
             .map_err(|e| error(path, e))?
         {
             model.meshes.push(mesh);
         }
     }
+    if model.meshes.is_empty() {
+        return Err(error(path, file.why_no_triangles()));
+    }
     model.images = textures.images;
     Ok(model)
 }
 
-/// What the line check found: the text handed to `tobj` (every line kept or blanked, so
-/// the numbering stays), and where the material libraries and materials are named.
-struct ObjScan {
-    text: String,
-    /// `mtllib` argument → line naming it.
-    libraries: HashMap<String, usize>,
-    /// `usemtl` name → first line using it.
+/// The text of an OBJ or MTL file: UTF-16 when it starts with a UTF-16 byte-order
+/// mark (as assimp reads it), otherwise UTF-8 without its byte-order mark (which would
+/// hide the first line's keyword), invalid bytes replaced with a warning.
+fn decode_text<'a>(bytes: &'a [u8], path: &Path, warnings: &mut Vec<String>) -> Cow<'a, str> {
+    let utf16 = |rest: &[u8], unit: fn([u8; 2]) -> u16| {
+        let units = rest.chunks_exact(2).map(|pair| unit([pair[0], pair[1]]));
+        let text: String = char::decode_utf16(units)
+            .map(|c| c.unwrap_or(char::REPLACEMENT_CHARACTER))
+            .collect();
+        Cow::Owned(text)
+    };
+    match bytes {
+        [0xFE, 0xFF, rest @ ..] => return utf16(rest, u16::from_be_bytes),
+        [0xFF, 0xFE, rest @ ..] => return utf16(rest, u16::from_le_bytes),
+        _ => {}
+    }
+    let text = String::from_utf8_lossy(bytes);
+    if matches!(text, Cow::Owned(_)) {
+        warnings.push(format!(
+            "{}: not valid UTF-8; the invalid bytes were replaced",
+            path.display()
+        ));
+    }
+    match text {
+        Cow::Borrowed(text) => Cow::Borrowed(text.strip_prefix('\u{feff}').unwrap_or(text)),
+        Cow::Owned(text) => match text.strip_prefix('\u{feff}') {
+            Some(rest) => Cow::Owned(rest.to_string()),
+            None => Cow::Owned(text),
+        },
+    }
+}
+
+/// Warns about `usemtl` names that no library defines (unless a library could not be
+/// read: its materials are the likely ones, and its warning says so) and about a
+/// `usemtl` before the `mtllib` that defines its material (found anyway, by name, as
+/// assimp finds it; tinyobjloader and tobj would use their default material).
+fn check_material_uses(
+    used: &[(String, usize)],
+    libraries: &Libraries,
+    path: &Path,
+    warnings: &mut Vec<String>,
+) {
+    let undefined: Vec<&(String, usize)> = used
+        .iter()
+        .filter(|(name, _)| !libraries.index.contains_key(name))
+        .collect();
+    if let Some((name, line)) = undefined.first().filter(|_| !libraries.any_missing) {
+        let others = match undefined.len() - 1 {
+            0 => String::new(),
+            more => format!(
+                " (nor {more} other name{} used later: {})",
+                plural(more),
+                list(undefined[1..].iter().map(|(name, _)| name.as_str()))
+            ),
+        };
+        warnings.push(format!(
+            "{}:{line}: usemtl {name}: no material library defines it{others}; the default material is used",
+            path.display()
+        ));
+    }
+    let early: Vec<(&str, usize, usize)> = used
+        .iter()
+        .filter_map(|(name, line)| {
+            let material = &libraries.materials[*libraries.index.get(name)?];
+            (material.mtllib_line > *line).then_some((name.as_str(), *line, material.mtllib_line))
+        })
+        .collect();
+    if let Some(&(name, line, mtllib_line)) = early.first() {
+        let others = match early.len() - 1 {
+            0 => String::new(),
+            more => format!(" (and {more} more material{})", plural(more)),
+        };
+        warnings.push(format!(
+            "{}:{line}: usemtl {name} comes before the mtllib on line {mtllib_line} that defines it{others}; it is used, but other readers may show their default material",
+            path.display()
+        ));
+    }
+}
+
+/// `""` for one, `"s"` for any other count.
+fn plural(count: usize) -> &'static str {
+    if count == 1 { "" } else { "s" }
+}
+
+/// The first few of `names`, comma-separated, with `…` when there are more.
+fn list<'a>(names: impl Iterator<Item = &'a str>) -> String {
+    const SHOWN: usize = 5;
+    let names: Vec<&str> = names.collect();
+    let mut text = names[..names.len().min(SHOWN)].join(", ");
+    if names.len() > SHOWN {
+        text.push_str(", …");
+    }
+    text
+}
+
+/// What an OBJ file holds, read but not yet made into meshes.
+struct ObjFile {
+    positions: Vec<DVec3>,
+    /// Texture coordinates, `v` already flipped to grow downwards (ours and glTF's
+    /// convention: OBJ's row 0 of the image is at `v` = 1).
+    texcoords: Vec<DVec2>,
+    normals: Vec<DVec3>,
+    /// The faces by object (or group) name and material, in order of first use.
+    groups: Vec<FaceGroup>,
+    /// Each `mtllib` statement: the text after the keyword and its line.
+    libraries: Vec<(String, usize)>,
+    /// Each material name `usemtl` gives, with the first line giving it, in that order.
     used_materials: Vec<(String, usize)>,
+    /// `f` statements read (with fewer than three corners too).
+    faces: usize,
+    /// `l` and `p` statements.
+    lines_and_points: usize,
+    /// Statements of any known kind.
+    statements: usize,
+    /// Lines with anything but a comment.
+    nonblank_lines: usize,
+}
+
+impl ObjFile {
+    /// Why a file gave no mesh: the message of its error.
+    fn why_no_triangles(&self) -> String {
+        let why = if self.faces == 1 {
+            "its only face is degenerate (no area) or has fewer than 3 corners".to_string()
+        } else if self.faces > 1 {
+            format!(
+                "all {} faces are degenerate (no area) or have fewer than 3 corners",
+                self.faces
+            )
+        } else if self.lines_and_points > 0 {
+            format!(
+                "it has no faces, only lines and points ({} `l` and `p` statement{}), which are not rendered",
+                self.lines_and_points,
+                plural(self.lines_and_points)
+            )
+        } else if self.nonblank_lines == 0 {
+            "the file is empty (or holds only comments)".to_string()
+        } else if self.statements == 0 {
+            "no OBJ statement was recognised in it: is it a text file in UTF-8 (or UTF-16 with a byte-order mark)?".to_string()
+        } else {
+            "it has no faces (`f`)".to_string()
+        };
+        format!("no triangles to render: {why}")
+    }
+}
+
+/// The faces of one object (or group) name and material.
+struct FaceGroup {
+    object: String,
+    /// The `usemtl` name (`None` before any `usemtl`, or after an empty one).
+    material: Option<String>,
+    /// The mesh's vertices: each distinct (position, texture coordinate, normal) index
+    /// triple its faces use, 0-based, [`NONE`] for an absent index.
+    vertices: Vec<[u32; 3]>,
+    /// Index triple → its vertex.
+    lookup: HashMap<[u32; 3], u32>,
+    /// Triangles as indices into `vertices`.
+    triangles: Vec<[u32; 3]>,
+}
+
+impl FaceGroup {
+    /// The vertex of `corner`, added on first use.
+    fn vertex(&mut self, corner: [u32; 3]) -> u32 {
+        let vertices = &mut self.vertices;
+        *self.lookup.entry(corner).or_insert_with(|| {
+            vertices.push(corner);
+            (vertices.len() - 1) as u32
+        })
+    }
+
+    /// The group's geometry for the checks of [`finish_mesh`]: an attribute that only
+    /// some vertices have is passed short, which drops it with a warning.
+    fn into_raw_mesh(self, positions: &[DVec3], texcoords: &[DVec2], normals: &[DVec3]) -> RawMesh {
+        fn attribute<T: Copy>(vertices: &[[u32; 3]], slot: usize, values: &[T]) -> Option<Vec<T>> {
+            let present: Vec<T> = vertices
+                .iter()
+                .filter(|corner| corner[slot] != NONE)
+                .map(|corner| values[corner[slot] as usize])
+                .collect();
+            (!present.is_empty()).then_some(present)
+        }
+        RawMesh {
+            positions: self
+                .vertices
+                .iter()
+                .map(|corner| positions[corner[0] as usize])
+                .collect(),
+            normals: attribute(&self.vertices, 2, normals),
+            uvs: attribute(&self.vertices, 1, texcoords),
+            triangles: self.triangles,
+        }
+    }
+}
+
+/// Problems that do not stop the import, each kind reported once per file, at its
+/// first place and with how often it occurs, however many lines have it.
+#[derive(Default)]
+struct Notes {
+    /// Words read by their leading number: line, column, the word, the number.
+    partial_numbers: Counted<(usize, usize, String, f64)>,
+    short_faces: Counted<usize>,
+    fanned_faces: Counted<usize>,
+    normals_without_vn: Counted<usize>,
+    empty_usemtl: Counted<usize>,
+    empty_mtllib: Counted<usize>,
+    vertex_colours: Counted<usize>,
+    /// MTL `newmtl` statements without a name.
+    nameless_materials: Counted<usize>,
+    /// Statements that are not read, by keyword: the first line, in order of first use
+    /// (at most [`MAX_NAMED_STATEMENTS`]).
+    ignored: Vec<(String, usize)>,
+    ignored_kinds: HashSet<String>,
+    /// Lines with further kinds of unsupported statement, and the first of them.
+    ignored_others: Counted<usize>,
+}
+
+/// The first occurrence of something and how many there are.
+struct Counted<T> {
+    first: Option<T>,
+    count: usize,
+}
+
+impl<T> Default for Counted<T> {
+    fn default() -> Self {
+        Self {
+            first: None,
+            count: 0,
+        }
+    }
+}
+
+impl<T> Counted<T> {
+    fn note(&mut self, first: impl FnOnce() -> T) {
+        if self.first.is_none() {
+            self.first = Some(first());
+        }
+        self.count += 1;
+    }
+}
+
+impl Notes {
+    fn ignore(&mut self, keyword: &str, line: usize) {
+        if self.ignored_kinds.contains(keyword) {
+            return;
+        }
+        if self.ignored_kinds.len() < MAX_NAMED_STATEMENTS {
+            self.ignored_kinds.insert(keyword.to_string());
+            self.ignored.push((keyword.to_string(), line));
+        } else {
+            self.ignored_others.note(|| line);
+        }
+    }
+
+    /// Adds one warning per kind of problem noted to `warnings`.
+    fn report(self, path: &Path, warnings: &mut Vec<String>) {
+        let file = path.display();
+        let times = |count: usize| match count {
+            1 => String::new(),
+            _ => format!(" ({count} times)"),
+        };
+        if let Some((line, column, word, value)) = self.partial_numbers.first {
+            let more = match self.partial_numbers.count - 1 {
+                0 => String::new(),
+                more => format!(" ({more} more such number{})", plural(more)),
+            };
+            warnings.push(format!(
+                "{file}:{line}:{column}: `{word}` is read as {value}, the number it starts with, as tinyobjloader and assimp read it{more}"
+            ));
+        }
+        if let Some(line) = self.short_faces.first {
+            let count = self.short_faces.count;
+            warnings.push(format!(
+                "{file}:{line}: {count} face{} of fewer than 3 vertices skipped",
+                plural(count)
+            ));
+        }
+        if let Some(line) = self.fanned_faces.first {
+            let count = self.fanned_faces.count;
+            warnings.push(format!(
+                "{file}:{line}: {count} face{} could not be ear-clipped (the outline crosses itself in the face's plane); fanned from the first corner, so triangles may overlap",
+                plural(count)
+            ));
+        }
+        if let Some(line) = self.normals_without_vn.first {
+            let count = self.normals_without_vn.count;
+            warnings.push(format!(
+                "{file}:{line}: {count} face{} give normal indices, but no `vn` is defined before them; the indices are ignored (flat shading)",
+                plural(count)
+            ));
+        }
+        if let Some(line) = self.empty_usemtl.first {
+            warnings.push(format!(
+                "{file}:{line}: `usemtl` without a material name{}; the default material is used",
+                times(self.empty_usemtl.count)
+            ));
+        }
+        if let Some(line) = self.empty_mtllib.first {
+            warnings.push(format!(
+                "{file}:{line}: `mtllib` without a file name{}; ignored",
+                times(self.empty_mtllib.count)
+            ));
+        }
+        if let Some(line) = self.vertex_colours.first {
+            warnings.push(format!(
+                "{file}:{line}: vertex colours (`v x y z r g b`) are read but not yet shaded; the model shows its materials' colours"
+            ));
+        }
+        if let Some(line) = self.nameless_materials.first {
+            warnings.push(format!(
+                "{file}:{line}: `newmtl` without a material name{}; the material is skipped",
+                times(self.nameless_materials.count)
+            ));
+        }
+        for (keyword, line) in &self.ignored {
+            let what = match keyword.as_str() {
+                "l" => "lines are not rendered",
+                "p" => "points are not rendered",
+                "cstype" | "curv" | "curv2" | "surf" | "deg" | "bmat" | "step" | "parm"
+                | "trim" | "hole" | "scrv" | "sp" | "end" => {
+                    "free-form curves and surfaces are not supported"
+                }
+                _ => "not supported",
+            };
+            warnings.push(format!(
+                "{file}:{line}: `{keyword}`: {what}; ignored (here and on any later line)"
+            ));
+        }
+        if let Some(line) = self.ignored_others.first {
+            let count = self.ignored_others.count;
+            warnings.push(format!(
+                "{file}:{line}: {count} more line{} of other unknown statements ignored",
+                plural(count)
+            ));
+        }
+    }
+}
+
+/// The state of reading an OBJ file line by line.
+struct ObjReader<'p> {
+    path: &'p Path,
+    file: ObjFile,
+    /// The current `o`/`g` name and `usemtl` material.
+    object: String,
+    material: Option<String>,
+    /// The group of the current name and material, once a face has asked for it.
+    current: Option<usize>,
+    /// (name, material) → its group in `file.groups`.
+    group_of: HashMap<(String, Option<String>), usize>,
+    /// Material names already in `file.used_materials`.
+    used: HashSet<String>,
+    /// Triangles so far, against [`MAX_MODEL_TRIANGLES`].
+    triangles: usize,
+    cutter: FaceCutter,
+    /// Buffers reused from face to face.
+    corners: Vec<[u32; 3]>,
+    points: Vec<DVec3>,
+    cut: Vec<[u32; 3]>,
+}
+
+impl<'p> ObjReader<'p> {
+    fn new(path: &'p Path) -> Self {
+        Self {
+            path,
+            file: ObjFile {
+                positions: Vec::new(),
+                texcoords: Vec::new(),
+                normals: Vec::new(),
+                groups: Vec::new(),
+                libraries: Vec::new(),
+                used_materials: Vec::new(),
+                faces: 0,
+                lines_and_points: 0,
+                statements: 0,
+                nonblank_lines: 0,
+            },
+            object: UNNAMED.to_string(),
+            material: None,
+            current: None,
+            group_of: HashMap::new(),
+            used: HashSet::new(),
+            triangles: 0,
+            cutter: FaceCutter::default(),
+            corners: Vec::new(),
+            points: Vec::new(),
+            cut: Vec::new(),
+        }
+    }
+
+    /// Reads every line of `text`.
+    fn read(mut self, text: &str, notes: &mut Notes) -> Result<ObjFile, SceneError> {
+        for (index, line) in text.lines().enumerate() {
+            self.statement(index + 1, strip_comment(line), notes)?;
+        }
+        Ok(self.file)
+    }
+
+    /// Reads the statement on line `n` (its comment already cut off).
+    fn statement(&mut self, n: usize, line: &str, notes: &mut Notes) -> Result<(), SceneError> {
+        let path = self.path;
+        let words = words(line);
+        let Some(&(column, keyword)) = words.first() else {
+            return Ok(());
+        };
+        let values = &words[1..];
+        // The rest of the line, for names that may hold spaces.
+        let rest = || line.trim_start()[keyword.len()..].trim();
+        self.file.nonblank_lines += 1;
+        self.file.statements += 1;
+        match keyword {
+            "v" => {
+                if !matches!(values.len(), 3 | 4 | 6) {
+                    return Err(at(
+                        path,
+                        n,
+                        column,
+                        format!(
+                            "`v` takes x y z (and optionally w, or r g b), got {} numbers",
+                            values.len()
+                        ),
+                    ));
+                }
+                let mut position = [0.0; 3];
+                for (what, (value, word)) in ["position x", "position y", "position z"]
+                    .iter()
+                    .zip(position.iter_mut().zip(values))
+                {
+                    *value = finite(path, n, *word, what, notes)?;
+                }
+                // `w` weighs rational curves' control points; a polygon's vertex is
+                // where x y z say (tinyobjloader and assimp ignore it too).
+                for word in &values[3..] {
+                    let what = if values.len() == 4 {
+                        "position w"
+                    } else {
+                        "vertex colour"
+                    };
+                    number(path, n, *word, what, notes)?;
+                }
+                if values.len() == 6 {
+                    notes.vertex_colours.note(|| n);
+                }
+                if self.file.positions.len() == MAX_MODEL_VERTICES {
+                    return Err(at(
+                        path,
+                        n,
+                        column,
+                        format!(
+                            "more than {MAX_MODEL_VERTICES} vertex positions, more than accepted"
+                        ),
+                    ));
+                }
+                self.file.positions.push(DVec3::from(position));
+            }
+            "vt" => {
+                if !(1..=3).contains(&values.len()) {
+                    return Err(at(
+                        path,
+                        n,
+                        column,
+                        format!("`vt` takes u (v (w)), got {} numbers", values.len()),
+                    ));
+                }
+                let u = number(path, n, values[0], "texture coordinate u", notes)?;
+                // A missing v is 0 (the specification's default); w is for 3D textures.
+                let v = match values.get(1) {
+                    Some(word) => number(path, n, *word, "texture coordinate v", notes)?,
+                    None => 0.0,
+                };
+                if let Some(word) = values.get(2) {
+                    number(path, n, *word, "texture coordinate w", notes)?;
+                }
+                self.file.texcoords.push(DVec2::new(u, 1.0 - v));
+            }
+            "vn" => {
+                if values.len() != 3 {
+                    return Err(at(
+                        path,
+                        n,
+                        column,
+                        format!("`vn` takes i j k, got {} numbers", values.len()),
+                    ));
+                }
+                let mut normal = [0.0; 3];
+                for (value, word) in normal.iter_mut().zip(values) {
+                    *value = number(path, n, *word, "normal", notes)?;
+                }
+                self.file.normals.push(DVec3::from(normal));
+            }
+            "f" => self.face(n, column, values, notes)?,
+            "o" | "g" => {
+                let name = rest();
+                self.object = if name.is_empty() { UNNAMED } else { name }.to_string();
+                self.current = None;
+            }
+            "usemtl" => {
+                let name = rest();
+                if name.is_empty() {
+                    notes.empty_usemtl.note(|| n);
+                    self.material = None;
+                } else {
+                    if self.used.insert(name.to_string()) {
+                        self.file.used_materials.push((name.to_string(), n));
+                    }
+                    self.material = Some(name.to_string());
+                }
+                self.current = None;
+            }
+            "mtllib" => {
+                let names = rest();
+                if names.is_empty() {
+                    notes.empty_mtllib.note(|| n);
+                } else {
+                    self.file.libraries.push((names.to_string(), n));
+                }
+            }
+            // Smoothing groups: the normals come from `vn`.
+            "s" => {}
+            "l" | "p" => {
+                self.file.lines_and_points += 1;
+                notes.ignore(keyword, n);
+            }
+            _ => {
+                self.file.statements -= 1;
+                notes.ignore(keyword, n);
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads the face on line `n` (`values` are its corners) into the current group.
+    fn face(
+        &mut self,
+        n: usize,
+        column: usize,
+        values: &[(usize, &str)],
+        notes: &mut Notes,
+    ) -> Result<(), SceneError> {
+        self.file.faces += 1;
+        let defined = [
+            self.file.positions.len(),
+            self.file.texcoords.len(),
+            self.file.normals.len(),
+        ];
+        let mut dropped_normals = false;
+        self.corners.clear();
+        for (k, word) in values.iter().enumerate() {
+            let corner = corner(self.path, n, k + 1, *word, defined, &mut dropped_normals)?;
+            self.corners.push(corner);
+        }
+        if dropped_normals {
+            notes.normals_without_vn.note(|| n);
+        }
+        if values.len() < 3 {
+            notes.short_faces.note(|| n);
+            return Ok(());
+        }
+        self.triangles += values.len() - 2;
+        if self.triangles > MAX_MODEL_TRIANGLES {
+            return Err(at(
+                self.path,
+                n,
+                column,
+                format!("more than {MAX_MODEL_TRIANGLES} triangles, more than accepted"),
+            ));
+        }
+        self.points.clear();
+        let positions = &self.file.positions;
+        self.points
+            .extend(self.corners.iter().map(|c| positions[c[0] as usize]));
+        self.cut.clear();
+        if self.cutter.cut(&self.points, &mut self.cut) == Cut::FanAfterEarsFailed {
+            notes.fanned_faces.note(|| n);
+        }
+        let group = self.group();
+        let group = &mut self.file.groups[group];
+        for triangle in &self.cut {
+            let vertices = triangle.map(|k| group.vertex(self.corners[k as usize]));
+            group.triangles.push(vertices);
+        }
+        Ok(())
+    }
+
+    /// The group of the current name and material, made on first use.
+    fn group(&mut self) -> usize {
+        if let Some(group) = self.current {
+            return group;
+        }
+        let key = (self.object.clone(), self.material.clone());
+        let groups = &mut self.file.groups;
+        let group = *self.group_of.entry(key).or_insert_with(|| {
+            groups.push(FaceGroup {
+                object: self.object.clone(),
+                material: self.material.clone(),
+                vertices: Vec::new(),
+                lookup: HashMap::new(),
+                triangles: Vec::new(),
+            });
+            groups.len() - 1
+        });
+        self.current = Some(group);
+        group
+    }
+}
+
+/// `line` without its comment: a `#` that starts a word starts a comment running to the
+/// end of the line (inline comments are common, though the specification only has
+/// whole-line ones); a `#` inside a word (`mat#1`) is part of it.
+fn strip_comment(line: &str) -> &str {
+    let mut after_space = true;
+    for (offset, c) in line.char_indices() {
+        if c == '#' && after_space {
+            return &line[..offset];
+        }
+        after_space = c.is_whitespace();
+    }
+    line
+}
+
+/// Reads face corner number `k` (`v`, `v/vt`, `v//vn` or `v/vt/vn`, each index from 1,
+/// or negative counting back from the last defined) as 0-based indices, against the
+/// counts of positions, texture coordinates and normals defined before the line.
+/// Normal indices in a file with no `vn` before the face are dropped (as tinyobjloader
+/// does), setting `dropped_normals`.
+fn corner(
+    path: &Path,
+    line: usize,
+    k: usize,
+    (column, word): (usize, &str),
+    defined: [usize; 3],
+    dropped_normals: &mut bool,
+) -> Result<[u32; 3], SceneError> {
+    if word.split('/').count() > 3 {
+        return Err(at(
+            path,
+            line,
+            column,
+            format!("face corner {k} `{word}` has more than three indices (v/vt/vn)"),
+        ));
+    }
+    let kinds = ["position", "texture coordinate", "normal"];
+    let mut corner = [NONE; 3];
+    for (slot, part) in word.split('/').enumerate() {
+        if part.is_empty() {
+            if slot == 0 {
+                return Err(at(
+                    path,
+                    line,
+                    column,
+                    format!("face corner {k} `{word}` has no position index"),
+                ));
+            }
+            continue;
+        }
+        let kind = kinds[slot];
+        let fail = |message: String| at(path, line, column, format!("face corner {k}: {message}"));
+        let index: i64 = part
+            .parse()
+            .map_err(|_| fail(format!("the {kind} index `{part}` is not an integer")))?;
+        if index == 0 {
+            return Err(fail(format!("the {kind} index is 0 (OBJ counts from 1)")));
+        }
+        let count = defined[slot];
+        if slot == 2 && count == 0 {
+            *dropped_normals = true;
+            continue;
+        }
+        let resolved = if index > 0 {
+            index.unsigned_abs().checked_sub(1)
+        } else {
+            (count as u64).checked_sub(index.unsigned_abs())
+        };
+        match resolved {
+            Some(resolved) if resolved < count as u64 => corner[slot] = resolved as u32,
+            _ => {
+                return Err(fail(format!(
+                    "the {kind} index {index} is out of range: {count} {kind}{} defined before this line",
+                    if count == 1 { " is" } else { "s are" }
+                )));
+            }
+        }
+    }
+    Ok(corner)
 }
 
 /// The words of a line with their 1-based columns (in characters).
@@ -198,26 +840,76 @@ fn at(path: &Path, line: usize, column: usize, message: impl Into<String>) -> Sc
     }
 }
 
-/// Parses `word` as a number, failing with a message that names `what`.
+/// Parses `word` as a number, failing with a message that names `what`. A word that
+/// starts with a number and goes on with something else (`3.1+e2`) is read as that
+/// number, as C's `strtod` (and so tinyobjloader and assimp) read it, with a note.
 fn number(
     path: &Path,
     line: usize,
     (column, word): (usize, &str),
     what: &str,
+    notes: &mut Notes,
 ) -> Result<f64, SceneError> {
-    word.parse::<f64>().map_err(|_| {
-        at(
+    if let Ok(value) = word.parse::<f64>() {
+        return Ok(value);
+    }
+    match word[..number_prefix(word)].parse::<f64>() {
+        Ok(value) => {
+            notes
+                .partial_numbers
+                .note(|| (line, column, word.to_string(), value));
+            Ok(value)
+        }
+        Err(_) => Err(at(
             path,
             line,
             column,
             format!("{what}: `{word}` is not a number"),
-        )
-    })
+        )),
+    }
+}
+
+/// The length of the longest start of `word` that is a decimal number: an optional
+/// sign, digits with at most one point (at least one digit), and an exponent when it
+/// has digits.
+fn number_prefix(word: &str) -> usize {
+    let bytes = word.as_bytes();
+    let digits_from = |mut i: usize| {
+        while bytes.get(i).is_some_and(u8::is_ascii_digit) {
+            i += 1;
+        }
+        i
+    };
+    let start = usize::from(matches!(bytes.first(), Some(b'+' | b'-')));
+    let mut end = digits_from(start);
+    let mut digits = end - start;
+    if bytes.get(end) == Some(&b'.') {
+        let fraction = digits_from(end + 1);
+        digits += fraction - end - 1;
+        end = fraction;
+    }
+    if digits == 0 {
+        return 0;
+    }
+    if matches!(bytes.get(end), Some(b'e' | b'E')) {
+        let sign = end + 1 + usize::from(matches!(bytes.get(end + 1), Some(b'+' | b'-')));
+        let exponent = digits_from(sign);
+        if exponent > sign {
+            end = exponent;
+        }
+    }
+    end
 }
 
 /// Parses `word` as a finite number.
-fn finite(path: &Path, line: usize, word: (usize, &str), what: &str) -> Result<f64, SceneError> {
-    let value = number(path, line, word, what)?;
+fn finite(
+    path: &Path,
+    line: usize,
+    word: (usize, &str),
+    what: &str,
+    notes: &mut Notes,
+) -> Result<f64, SceneError> {
+    let value = number(path, line, word, what, notes)?;
     if !value.is_finite() {
         return Err(at(
             path,
@@ -229,801 +921,37 @@ fn finite(path: &Path, line: usize, word: (usize, &str), what: &str) -> Result<f
     Ok(value)
 }
 
-/// Checks every line of an OBJ file; see [`ObjScan`].
-fn scan_obj(text: &str, path: &Path, warnings: &mut Vec<String>) -> Result<ObjScan, SceneError> {
-    let mut scan = ObjScan {
-        text: String::with_capacity(text.len()),
-        libraries: HashMap::new(),
-        used_materials: Vec::new(),
-    };
-    let mut seen_materials = BTreeSet::new();
-    let (mut positions, mut texcoords, mut normals) = (0usize, 0usize, 0usize);
-    let mut triangles = 0usize;
-    let mut ignored: Vec<(&str, usize)> = Vec::new();
-    let mut short_faces = Vec::new();
-    for (index, line) in text.lines().enumerate() {
-        let number_of_line = index + 1;
-        let n = number_of_line;
-        let words = words(line);
-        let keep = match words.first().map(|w| w.1) {
-            None => false,
-            Some(keyword) if keyword.starts_with('#') => false,
-            Some("v") => {
-                let values = &words[1..];
-                if !matches!(values.len(), 3 | 4 | 6) {
-                    return Err(at(
-                        path,
-                        n,
-                        words[0].0,
-                        format!(
-                            "`v` takes x y z (and optionally w, or r g b), got {} numbers",
-                            values.len()
-                        ),
-                    ));
-                }
-                for (axis, word) in ["x", "y", "z"].iter().zip(values) {
-                    finite(path, n, *word, &format!("position {axis}"))?;
-                }
-                if values.len() == 4 {
-                    let w = finite(path, n, values[3], "position w")?;
-                    if w == 0.0 {
-                        return Err(at(path, n, values[3].0, "position w is 0"));
-                    }
-                }
-                for word in values.iter().skip(3) {
-                    number(path, n, *word, "vertex colour")?;
-                }
-                positions += 1;
-                true
-            }
-            Some("vt") => {
-                let values = &words[1..];
-                if !(1..=3).contains(&values.len()) {
-                    return Err(at(
-                        path,
-                        n,
-                        words[0].0,
-                        format!("`vt` takes u (v (w)), got {} numbers", values.len()),
-                    ));
-                }
-                let u = number(path, n, values[0], "texture coordinate u")?;
-                let v = match values.get(1) {
-                    Some(word) => number(path, n, *word, "texture coordinate v")?,
-                    None => 0.0,
-                };
-                if let Some(word) = values.get(2) {
-                    number(path, n, *word, "texture coordinate w")?;
-                }
-                texcoords += 1;
-                // tobj needs both u and v; a missing v is 0 (the specification's default).
-                scan.text.push_str(&format!("vt {u:?} {v:?}\n"));
-                continue;
-            }
-            Some("vn") => {
-                let values = &words[1..];
-                if values.len() != 3 {
-                    return Err(at(
-                        path,
-                        n,
-                        words[0].0,
-                        format!("`vn` takes i j k, got {} numbers", values.len()),
-                    ));
-                }
-                for word in values {
-                    number(path, n, *word, "normal")?;
-                }
-                normals += 1;
-                true
-            }
-            Some("f") => {
-                let corners = &words[1..];
-                for (k, corner) in corners.iter().enumerate() {
-                    check_corner(path, n, k + 1, *corner, [positions, texcoords, normals])?;
-                }
-                if corners.len() < 3 {
-                    short_faces.push(n);
-                    false
-                } else {
-                    triangles = triangles.saturating_add(corners.len() - 2);
-                    true
-                }
-            }
-            Some("o" | "g") => true,
-            Some("usemtl") => {
-                let name = line.trim_start()[6..].trim();
-                if name.is_empty() {
-                    return Err(at(path, n, words[0].0, "`usemtl` needs a material name"));
-                }
-                if seen_materials.insert(name.to_string()) {
-                    scan.used_materials.push((name.to_string(), n));
-                }
-                // tobj takes the name after the first space.
-                scan.text.push_str(&format!("usemtl {name}\n"));
-                continue;
-            }
-            Some("mtllib") => {
-                // As tobj reads it: the rest of the line is one file name (names with
-                // spaces are common, several names on one line are not).
-                let rest = line.trim_start()[6..].trim();
-                if rest.is_empty() {
-                    return Err(at(path, n, words[0].0, "`mtllib` needs a file name"));
-                }
-                scan.libraries.entry(rest.to_string()).or_insert(n);
-                scan.text.push_str(&format!("mtllib {rest}\n"));
-                continue;
-            }
-            Some("s" | "l" | "p") => {
-                if words[0].1 != "s" {
-                    ignored.push((words[0].1, n));
-                }
-                false
-            }
-            Some(keyword) => {
-                ignored.push((keyword, n));
-                false
-            }
-        };
-        if keep {
-            scan.text.push_str(line.trim());
-        }
-        scan.text.push('\n');
-    }
-    if positions > MAX_MODEL_VERTICES {
-        return Err(error(
-            path,
-            format!("{positions} vertex positions, more than the {MAX_MODEL_VERTICES} accepted"),
-        ));
-    }
-    if triangles > MAX_MODEL_TRIANGLES {
-        return Err(error(
-            path,
-            format!("{triangles} triangles, more than the {MAX_MODEL_TRIANGLES} accepted"),
-        ));
-    }
-    if let Some(first) = short_faces.first() {
-        warnings.push(format!(
-            "{}:{first}: {} face{} of fewer than 3 vertices skipped",
-            path.display(),
-            short_faces.len(),
-            if short_faces.len() == 1 { "" } else { "s" }
-        ));
-    }
-    let mut reported = BTreeSet::new();
-    for (keyword, line) in ignored {
-        if reported.insert(keyword) {
-            let what = match keyword {
-                "l" => "lines are not rendered",
-                "p" => "points are not rendered",
-                "cstype" | "curv" | "curv2" | "surf" | "deg" | "bmat" | "step" | "parm"
-                | "trim" | "hole" | "scrv" | "sp" | "end" => {
-                    "free-form curves and surfaces are not supported"
-                }
-                _ => "not supported",
-            };
-            warnings.push(format!(
-                "{}:{line}: `{keyword}`: {what}; ignored (here and on any later line)",
-                path.display()
-            ));
-        }
-    }
-    Ok(scan)
-}
-
-/// Checks face corner number `k` (`v`, `v/vt`, `v//vn` or `v/vt/vn`) against the
-/// counts of positions, texture coordinates and normals defined so far.
-fn check_corner(
-    path: &Path,
-    line: usize,
-    k: usize,
-    (column, word): (usize, &str),
-    defined: [usize; 3],
-) -> Result<(), SceneError> {
-    let parts: Vec<&str> = word.split('/').collect();
-    if parts.len() > 3 {
-        return Err(at(
-            path,
-            line,
-            column,
-            format!("face corner {k} `{word}` has more than three indices (v/vt/vn)"),
-        ));
-    }
-    let kinds = ["position", "texture coordinate", "normal"];
-    for (slot, part) in parts.iter().enumerate() {
-        if part.is_empty() {
-            if slot == 0 {
-                return Err(at(
-                    path,
-                    line,
-                    column,
-                    format!("face corner {k} `{word}` has no position index"),
-                ));
-            }
-            continue;
-        }
-        let kind = kinds[slot];
-        let fail = |message: String| at(path, line, column, format!("face corner {k}: {message}"));
-        let index: i64 = part
-            .parse()
-            .map_err(|_| fail(format!("the {kind} index `{part}` is not an integer")))?;
-        let count = defined[slot];
-        let in_range = match index {
-            0 => return Err(fail(format!("the {kind} index is 0 (OBJ counts from 1)"))),
-            i if i > 0 => (i as u64) <= count as u64,
-            i => i.unsigned_abs() <= count as u64,
-        };
-        if !in_range {
-            return Err(fail(format!(
-                "the {kind} index {index} is out of range: {count} {kind}{} defined before this line",
-                if count == 1 { " is" } else { "s are" }
-            )));
-        }
-    }
-    Ok(())
-}
-
-/// A material of an MTL library with what `tobj` does not keep: where it was defined.
-struct SourceMaterial {
-    material: tobj::Material,
-    /// The library file.
-    library: PathBuf,
-    /// The line of its `newmtl`.
-    line: usize,
-    /// `map_Kd` line and column, when it has one.
-    map_kd_at: Option<(usize, usize)>,
-    /// `map_Ke` line and column, when it has one.
-    map_ke_at: Option<(usize, usize)>,
-}
-
-/// The material libraries loaded while `tobj` reads the OBJ file.
-#[derive(Default)]
-struct Libraries {
-    /// Every material, in library order (the index `tobj` gives meshes).
-    materials: Vec<SourceMaterial>,
-    /// Material name → index, as `tobj` resolves `usemtl`.
-    index: HashMap<String, usize>,
-    /// The first error, reported once `tobj` returns.
-    failure: Option<SceneError>,
-}
-
-impl Libraries {
-    /// Loads the library `name` (as written after `mtllib`) for `tobj`; on failure keeps
-    /// the error to report and gives `tobj` an empty library.
-    fn load(
-        &mut self,
-        directory: &Path,
-        name: &Path,
-        obj: &Path,
-        scan: &ObjScan,
-    ) -> tobj::MTLLoadResult {
-        if self.failure.is_some() {
-            return Err(tobj::LoadError::GenericFailure);
-        }
-        let line = scan
-            .libraries
-            .get(name.to_string_lossy().as_ref())
-            .copied()
-            .unwrap_or(1);
-        let library = directory.join(name);
-        let result = read_file(
-            &library,
-            obj,
-            &format!("the material library {}", library.display()),
-        )
-        .map_err(|e| {
-            at(
-                obj,
-                line,
-                1,
-                format!("mtllib {}: {}", name.display(), e.message),
-            )
-        })
-        .and_then(|bytes| self.parse(&library, &bytes));
-        match result {
-            Ok(loaded) => Ok(loaded),
-            Err(e) => {
-                self.failure = Some(e);
-                Err(tobj::LoadError::GenericFailure)
-            }
-        }
-    }
-
-    /// Checks and parses one library's text. Its materials are kept here too, with the
-    /// indices `tobj` gives them (libraries in `mtllib` order, materials in file order).
-    fn parse(
-        &mut self,
-        library: &Path,
-        bytes: &[u8],
-    ) -> Result<(Vec<tobj::Material>, HashMap<String, usize>), SceneError> {
-        let text = String::from_utf8_lossy(bytes);
-        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
-        let (clean, lines) = scan_mtl(text, library)?;
-        let (materials, names) =
-            tobj::load_mtl_buf(&mut Cursor::new(clean.as_bytes())).map_err(|e| {
-                error(
-                    library,
-                    format!("the material library could not be read: {e}"),
-                )
-            })?;
-        for (
-            material,
-            MtlLines {
-                line,
-                map_kd_at,
-                map_ke_at,
-            },
-        ) in materials.iter().cloned().zip(lines)
-        {
-            self.index
-                .insert(material.name.clone(), self.materials.len());
-            self.materials.push(SourceMaterial {
-                material,
-                library: library.to_path_buf(),
-                line,
-                map_kd_at,
-                map_ke_at,
-            });
-        }
-        Ok((materials, names))
-    }
-}
-
-/// Colour keywords of MTL (1 or 3 numbers).
-const MTL_COLOURS: &[&str] = &["Ka", "Kd", "Ks", "Ke", "Tf"];
-/// Scalar keywords of MTL and of its PBR extension.
-const MTL_SCALARS: &[&str] = &[
-    "Ns",
-    "Ni",
-    "d",
-    "Tr",
-    "Pr",
-    "Pm",
-    "Ps",
-    "Pc",
-    "Pcr",
-    "aniso",
-    "anisor",
-    "sharpness",
-];
-
-/// Where a material of an MTL library is defined: the line of its `newmtl`, and the line
-/// and column of its `map_Kd` and `map_Ke`, when it has them.
-struct MtlLines {
-    line: usize,
-    map_kd_at: Option<(usize, usize)>,
-    map_ke_at: Option<(usize, usize)>,
-}
-
-/// Checks every line of an MTL library and returns the text for `tobj` (colours with one
-/// number spelled out as three, unsupported forms blanked) and, per material in order,
-/// where it is defined.
-fn scan_mtl(text: &str, path: &Path) -> Result<(String, Vec<MtlLines>), SceneError> {
-    let mut clean = String::with_capacity(text.len());
-    let mut lines = Vec::new();
-    for (index, line) in text.lines().enumerate() {
-        let n = index + 1;
-        let words = words(line);
-        let Some(&(column, keyword)) = words.first() else {
-            clean.push('\n');
-            continue;
-        };
-        let values = &words[1..];
-        let mut kept = line.trim().to_string();
-        if keyword.starts_with('#') {
-            kept.clear();
-        } else if keyword == "newmtl" {
-            if values.is_empty() {
-                return Err(at(path, n, column, "`newmtl` needs a material name"));
-            }
-            lines.push(MtlLines {
-                line: n,
-                map_kd_at: None,
-                map_ke_at: None,
-            });
-        } else if MTL_COLOURS.contains(&keyword) {
-            if values
-                .first()
-                .is_some_and(|w| w.1 == "spectral" || w.1 == "xyz")
-            {
-                // Spectral and CIE XYZ colours are not supported: dropped.
-                kept.clear();
-            } else {
-                if values.len() != 1 && values.len() != 3 {
-                    return Err(at(
-                        path,
-                        n,
-                        column,
-                        format!(
-                            "`{keyword}` takes r g b (or one grey value), got {} numbers",
-                            values.len()
-                        ),
-                    ));
-                }
-                let mut rgb = [0.0; 3];
-                for (c, word) in values.iter().enumerate() {
-                    rgb[c] = finite(path, n, *word, keyword)?;
-                }
-                if values.len() == 1 {
-                    rgb = [rgb[0]; 3];
-                }
-                kept = format!("{keyword} {:?} {:?} {:?}", rgb[0], rgb[1], rgb[2]);
-            }
-        } else if MTL_SCALARS.contains(&keyword) {
-            // `d -halo 0.5`: the halo form is read as a plain dissolve.
-            let values: Vec<_> = values.iter().filter(|w| w.1 != "-halo").collect();
-            if values.len() != 1 {
-                return Err(at(
-                    path,
-                    n,
-                    column,
-                    format!("`{keyword}` takes one number, got {}", values.len()),
-                ));
-            }
-            let value = finite(path, n, *values[0], keyword)?;
-            kept = format!("{keyword} {value:?}");
-        } else if keyword == "illum" {
-            let [word] = values else {
-                return Err(at(path, n, column, "`illum` takes one number (0 to 10)"));
-            };
-            let illum: i64 = word.1.parse().map_err(|_| {
-                at(
-                    path,
-                    n,
-                    word.0,
-                    format!("illum: `{}` is not an integer", word.1),
-                )
-            })?;
-            if !(0..=10).contains(&illum) {
-                return Err(at(
-                    path,
-                    n,
-                    word.0,
-                    format!("illum {illum} is not an illumination model (0 to 10)"),
-                ));
-            }
-        } else if keyword.starts_with("map_")
-            || matches!(keyword, "bump" | "disp" | "decal" | "refl" | "norm")
-        {
-            if values.is_empty() {
-                return Err(at(
-                    path,
-                    n,
-                    column,
-                    format!("`{keyword}` needs a file name"),
-                ));
-            }
-            if keyword == "map_Kd" || keyword == "map_Ke" {
-                match lines.last_mut() {
-                    Some(last) if keyword == "map_Kd" => last.map_kd_at = Some((n, column)),
-                    Some(last) => last.map_ke_at = Some((n, column)),
-                    None => kept.clear(),
-                }
-            }
-        }
-        if lines.is_empty() {
-            // Before the first `newmtl`: belongs to no material.
-            kept.clear();
-        }
-        clean.push_str(&kept);
-        clean.push('\n');
-    }
-    Ok((clean, lines))
-}
-
-/// A number from a material's keys that `tobj` keeps as text (checked by [`scan_mtl`]).
-fn extra(material: &tobj::Material, key: &str) -> Option<f64> {
-    material.unknown_param.get(key)?.parse().ok()
-}
-
-/// A colour from a material's keys that `tobj` keeps as text.
-fn extra_colour(material: &tobj::Material, key: &str) -> Option<DVec3> {
-    let values: Vec<f64> = material
-        .unknown_param
-        .get(key)?
-        .split_whitespace()
-        .filter_map(|w| w.parse().ok())
-        .collect();
-    match values.as_slice() {
-        [r, g, b] => Some(DVec3::new(*r, *g, *b)),
-        _ => None,
-    }
-}
-
-/// Maps one MTL material onto ours (the table in `docs/models.md`).
-fn map_material(
-    source: &SourceMaterial,
-    textures: &mut Textures,
-    budget: &mut Budget,
-    warnings: &mut Vec<String>,
-) -> Result<ImportedMaterial, SceneError> {
-    let m = &source.material;
-    let place = format!(
-        "{}:{}: material '{}'",
-        source.library.display(),
-        source.line,
-        m.name
-    );
-    let mut warn = |message: String| warnings.push(format!("{place}: {message}"));
-    let colour = |c: Option<[f64; 3]>| c.map(|[r, g, b]| DVec3::new(r, g, b));
-
-    // A colour texture statement (`map_Kd`, `map_Ke`) at `at`, loaded relative to the
-    // library's directory.
-    let mut colour_texture = |key: &str,
-                              spec: Option<&String>,
-                              at_line: Option<(usize, usize)>|
-     -> Result<Option<TextureRef>, SceneError> {
-        let (Some(spec), Some((line, column))) = (spec, at_line) else {
-            return Ok(None);
-        };
-        let (file, wrap, ignored) = texture_options(spec);
-        if !ignored.is_empty() {
-            warn(format!(
-                "{key} options {} are not supported; ignored",
-                ignored.join(" ")
-            ));
-        }
-        let directory = source.library.parent().unwrap_or(Path::new(""));
-        let mut file_path = directory.join(&file);
-        if !file_path.exists() && file.contains('\\') {
-            file_path = directory.join(file.replace('\\', "/"));
-        }
-        let image = textures
-            .file(&file_path, Encoding::Color, budget)
-            .map_err(|e| {
-                at(
-                    &source.library,
-                    line,
-                    column,
-                    format!("material '{}': {key}: {e}", m.name),
-                )
-            })?;
-        Ok(Some(TextureRef {
-            image,
-            wrap_u: wrap,
-            wrap_v: wrap,
-        }))
-    };
-    let base_color_texture =
-        colour_texture("map_Kd", m.diffuse_texture.as_ref(), source.map_kd_at)?;
-    let emissive_texture =
-        colour_texture("map_Ke", m.unknown_param.get("map_Ke"), source.map_ke_at)?;
-    for (key, present) in [
-        ("map_Ks", m.specular_texture.is_some()),
-        ("map_Ka", m.ambient_texture.is_some()),
-        ("map_Ns", m.shininess_texture.is_some()),
-        ("map_d", m.dissolve_texture.is_some()),
-        ("bump", m.normal_texture.is_some()),
-    ] {
-        if present {
-            warn(format!("{key} is not supported; ignored"));
-        }
-    }
-    let mut others: Vec<&String> = m
-        .unknown_param
-        .keys()
-        .filter(|k| {
-            (k.starts_with("map_") && k.as_str() != "map_Ke")
-                || matches!(k.as_str(), "disp" | "decal" | "refl" | "norm")
-        })
-        .collect();
-    others.sort();
-    for key in others {
-        warn(format!("{key} is not supported; ignored"));
-    }
-
-    let default_albedo = if base_color_texture.is_some() {
-        1.0
-    } else {
-        DEFAULT_OBJ_ALBEDO
-    };
-    let mut kd = colour(m.diffuse).unwrap_or(DVec3::splat(default_albedo));
-    let mut ks = colour(m.specular).unwrap_or(DVec3::ZERO);
-    let ke = colour(m.emissive).unwrap_or(DVec3::ZERO);
-    let ns = m.shininess.unwrap_or(DEFAULT_NS);
-    let ni = m.optical_density;
-    let dissolve = m
-        .dissolve
-        .or_else(|| extra(m, "Tr").map(|tr| 1.0 - tr))
-        .unwrap_or(1.0);
-    let tf = extra_colour(m, "Tf");
-    let (pr, pm) = (extra(m, "Pr"), extra(m, "Pm"));
-    let illum = m.illumination_model.unwrap_or(2);
-
-    let unit = |name: &str, c: DVec3, warn: &mut dyn FnMut(String)| {
-        let clamped = c.clamp(DVec3::ZERO, DVec3::ONE);
-        if clamped != c {
-            warn(format!("{name} {c} is outside [0, 1]; clamped"));
-        }
-        clamped
-    };
-    let emission = ke.max(DVec3::ZERO);
-    if emission != ke {
-        warn(format!("Ke {ke} is negative; clamped to 0"));
-    }
-    let ior_or_default = |warn: &mut dyn FnMut(String), what: &str| match ni {
-        Some(ni) if ni > 0.0 => ni,
-        Some(ni) => {
-            warn(format!(
-                "Ni {ni} is not positive; {what} uses {DEFAULT_IOR}"
-            ));
-            DEFAULT_IOR
-        }
-        None => DEFAULT_IOR,
-    };
-
-    let material = if matches!(illum, 4 | 6 | 7 | 9) {
-        let ior = ior_or_default(&mut warn, "the glass");
-        let transmittance = unit("Tf", tf.unwrap_or(DVec3::ONE), &mut warn);
-        Material {
-            ior,
-            transmittance,
-            emission,
-            ..Material::blank(MaterialKind::Dielectric)
-        }
-    } else if pr.is_some() || pm.is_some() {
-        if matches!(illum, 3 | 5 | 8) {
-            warn(format!(
-                "illum {illum} (coat) is ignored: Pr/Pm make it a metal/roughness material"
-            ));
-        }
-        let clamp01 = |name: &str, v: f64, warn: &mut dyn FnMut(String)| {
-            if !(0.0..=1.0).contains(&v) {
-                warn(format!("{name} {v} is outside [0, 1]; clamped"));
-            }
-            v.clamp(0.0, 1.0)
-        };
-        Material {
-            diffuse: unit("Kd", kd, &mut warn),
-            metallic: clamp01("Pm", pm.unwrap_or(0.0), &mut warn),
-            roughness: clamp01("Pr", pr.unwrap_or(1.0), &mut warn),
-            emission,
-            ..Material::blank(MaterialKind::Pbr)
-        }
-    } else {
-        kd = unit("Kd", kd, &mut warn);
-        ks = unit("Ks", ks, &mut warn);
-        if matches!(illum, 0 | 1) {
-            ks = DVec3::ZERO;
-        }
-        let sum = (kd + ks).max_element();
-        if sum > 1.0 {
-            warn(format!(
-                "Kd + Ks reaches {sum} in a channel; both are scaled by 1/{sum} so that the surface does not reflect more light than it receives"
-            ));
-            kd /= sum;
-            ks /= sum;
-        }
-        let coat_ior = if matches!(illum, 3 | 5 | 8) {
-            let ior = ior_or_default(&mut warn, "the coat");
-            if ior < 1.0 {
-                warn(format!("Ni {ior} is below 1; the coat uses {DEFAULT_IOR}"));
-                DEFAULT_IOR
-            } else {
-                ior
-            }
-        } else {
-            0.0
-        };
-        if ks == DVec3::ZERO {
-            Material {
-                coat_ior,
-                emission,
-                ..Material::lambert(kd)
-            }
-        } else {
-            let shininess = if (0.0..=MAX_SHININESS).contains(&ns) {
-                ns
-            } else {
-                warn(format!("Ns {ns} is outside [0, {MAX_SHININESS}]; clamped"));
-                ns.clamp(0.0, MAX_SHININESS)
-            };
-            Material {
-                diffuse: kd,
-                specular: ks,
-                shininess,
-                coat_ior,
-                emission,
-                ..Material::blank(MaterialKind::BlinnPhong)
-            }
-        }
-    };
-    if dissolve < 1.0 && material.kind != MaterialKind::Dielectric {
-        warn(format!(
-            "d {dissolve} (partial transparency) is not supported; the material is opaque"
-        ));
-    }
-    Ok(ImportedMaterial {
-        name: m.name.clone(),
-        material,
-        base_color_texture,
-        metallic_roughness_texture: None,
-        emissive_texture,
-    })
-}
-
-/// Splits a texture statement (`-clamp on -s 2 2 file name.png`) into the file name, the
-/// wrap mode (`-clamp on` clamps) and the options that are not supported.
-fn texture_options(spec: &str) -> (String, WrapMode, Vec<String>) {
-    /// Options and how many arguments each takes at most (all but the last are numbers).
-    const OPTIONS: &[(&str, usize)] = &[
-        ("-blendu", 1),
-        ("-blendv", 1),
-        ("-bm", 1),
-        ("-boost", 1),
-        ("-cc", 1),
-        ("-clamp", 1),
-        ("-imfchan", 1),
-        ("-mm", 2),
-        ("-o", 3),
-        ("-s", 3),
-        ("-t", 3),
-        ("-texres", 1),
-        ("-type", 1),
-    ];
-    let words: Vec<&str> = spec.split_whitespace().collect();
-    let mut wrap = WrapMode::Repeat;
-    if words.is_empty() {
-        return (String::new(), wrap, Vec::new());
-    }
-    let mut ignored = Vec::new();
-    let mut i = 0;
-    while i < words.len() {
-        let Some(&(option, most)) = OPTIONS.iter().find(|(o, _)| *o == words[i]) else {
-            break;
-        };
-        let mut taken = 0;
-        while taken < most
-            && i + 1 + taken < words.len() - 1
-            && (taken == 0 || words[i + 1 + taken].parse::<f64>().is_ok())
-        {
-            taken += 1;
-        }
-        let arguments = &words[i + 1..i + 1 + taken];
-        if option == "-clamp" {
-            if arguments.first() == Some(&"on") {
-                wrap = WrapMode::ClampToEdge;
-            }
-        } else {
-            ignored.push(
-                format!("{option} {}", arguments.join(" "))
-                    .trim()
-                    .to_string(),
-            );
-        }
-        i += 1 + taken;
-    }
-    (words[i.min(words.len())..].join(" "), wrap, ignored)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn texture_options_are_split_from_the_file_name() {
-        assert_eq!(
-            texture_options("wood grain.png"),
-            ("wood grain.png".into(), WrapMode::Repeat, vec![])
-        );
-        assert_eq!(
-            texture_options("-clamp on -s 2 2 1 a.png"),
-            (
-                "a.png".into(),
-                WrapMode::ClampToEdge,
-                vec!["-s 2 2 1".to_string()]
-            )
-        );
-        assert_eq!(
-            texture_options("-bm 0.5 b.png"),
-            (
-                "b.png".into(),
-                WrapMode::Repeat,
-                vec!["-bm 0.5".to_string()]
-            )
-        );
+    fn words_know_their_columns() {
+        assert_eq!(words("  v 1\t2"), vec![(3, "v"), (5, "1"), (7, "2")]);
     }
 
     #[test]
-    fn words_know_their_columns() {
-        assert_eq!(words("  v 1\t2"), vec![(3, "v"), (5, "1"), (7, "2")]);
+    fn comments_start_at_a_hash_that_starts_a_word() {
+        assert_eq!(strip_comment("v 1 2 3 # corner"), "v 1 2 3 ");
+        assert_eq!(strip_comment("# whole line"), "");
+        assert_eq!(strip_comment("usemtl mat#1"), "usemtl mat#1");
+        assert_eq!(strip_comment("v 1 2 3\t#tab"), "v 1 2 3\t");
+    }
+
+    #[test]
+    fn numbers_followed_by_junk_are_read_by_their_start() {
+        for (word, length) in [
+            ("3.1+e2", 3),
+            ("3.1-e2", 3),
+            ("1e+2", 4),
+            ("2.e", 2),
+            ("-.5x", 3),
+            ("+", 0),
+            (".", 0),
+            ("e5", 0),
+            ("12abc", 2),
+        ] {
+            assert_eq!(number_prefix(word), length, "{word}");
+        }
     }
 }

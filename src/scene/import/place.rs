@@ -2,6 +2,7 @@
 //! and texture coordinates), its materials and the textures they use, under a
 //! placement transform; or a whole scene around a model file rendered on its own.
 
+use std::collections::HashMap;
 use std::path::Path;
 
 use glam::{DMat4, DQuat, DVec3, EulerRot};
@@ -80,19 +81,20 @@ impl ImportedModel {
         if placements.iter().any(|p| p.material.is_none()) {
             self.add_materials(scene, &stem);
         }
-        // The distinct (material override, smooth) pairs, in order of first use.
-        let mut kinds: Vec<(Option<u32>, bool)> = Vec::new();
+        // The distinct (material override, smooth) pairs, in order of first use, each
+        // with its placements' transforms; by hash, so that many placements with many
+        // overrides are grouped in linear time.
+        type Kind = (Option<u32>, bool);
+        let mut kinds: Vec<(Kind, Vec<DMat4>)> = Vec::new();
+        let mut kind_of: HashMap<Kind, usize> = HashMap::new();
         for p in placements {
-            if !kinds.contains(&(p.material, p.smooth)) {
-                kinds.push((p.material, p.smooth));
-            }
+            let kind = *kind_of.entry((p.material, p.smooth)).or_insert_with(|| {
+                kinds.push(((p.material, p.smooth), Vec::new()));
+                kinds.len() - 1
+            });
+            kinds[kind].1.push(p.transform);
         }
-        for (material, smooth) in kinds {
-            let transforms: Vec<DMat4> = placements
-                .iter()
-                .filter(|p| (p.material, p.smooth) == (material, smooth))
-                .map(|p| p.transform)
-                .collect();
+        for ((material, smooth), transforms) in kinds {
             for mesh in &self.meshes {
                 scene.meshes.push(Mesh {
                     name: format!("{stem}/{}", mesh.name),

@@ -1,0 +1,661 @@
+//! MTL material libraries (Alias|Wavefront Advanced Visualizer manual, appendix B2):
+//! each line checked here (errors name the library, line and column), then parsed by
+//! `tobj`, and each material mapped onto ours (the table in `docs/models.md`).
+
+use std::collections::{HashMap, HashSet};
+use std::io::{Cursor, ErrorKind};
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+
+use super::{DEFAULT_OBJ_ALBEDO, Notes, at, decode_text, finite, strip_comment, words};
+use crate::input::{InputError, read_input};
+use crate::scene::import::mesh::Budget;
+use crate::scene::import::texture::{Encoding, Textures};
+use crate::scene::import::{ImportedMaterial, MAX_MODEL_FILE_BYTES, TextureRef, WrapMode, error};
+use crate::scene::{Material, MaterialKind, SceneError};
+
+/// Index of refraction assumed for glass (`illum` 4, 6, 7, 9) and coats (`illum` 3, 5, 8)
+/// whose material gives no usable `Ni`.
+const DEFAULT_IOR: f64 = 1.5;
+/// Blinn-Phong exponent assumed when `Ns` is absent (as tinyobjloader does).
+const DEFAULT_NS: f64 = 1.0;
+/// Largest accepted Blinn-Phong exponent (the scene format's limit).
+const MAX_SHININESS: f64 = 1e6;
+
+/// A material of an MTL library with what `tobj` does not keep: where it was defined.
+pub(super) struct SourceMaterial {
+    material: tobj::Material,
+    /// The library file.
+    library: PathBuf,
+    /// The line of its `newmtl`.
+    line: usize,
+    /// The line of the OBJ file's `mtllib` that named the library.
+    pub(super) mtllib_line: usize,
+    /// `map_Kd` line and column, when it has one.
+    map_kd_at: Option<(usize, usize)>,
+    /// `map_Ke` line and column, when it has one.
+    map_ke_at: Option<(usize, usize)>,
+}
+
+/// The material libraries an OBJ file names.
+#[derive(Default)]
+pub(super) struct Libraries {
+    /// Every material, libraries in `mtllib` order, materials in file order.
+    pub(super) materials: Vec<SourceMaterial>,
+    /// Material name → index; of two materials of one name the later one wins.
+    pub(super) index: HashMap<String, usize>,
+    /// Whether a library could not be read (a warning said so).
+    pub(super) any_missing: bool,
+}
+
+impl Libraries {
+    /// Reads the libraries of the OBJ file `obj` named by its `mtllib` statements (the
+    /// text after the keyword, and the line), relative to `directory`, each file once.
+    /// A library that does not exist is a warning, one per statement, its materials
+    /// replaced by the default one (as tinyobjloader and assimp do); one that exists but
+    /// cannot be read (a FIFO, a device, too large), or has a malformed line, is an
+    /// error naming the library, line and column.
+    pub(super) fn load(
+        statements: &[(String, usize)],
+        directory: &Path,
+        obj: &Path,
+        warnings: &mut Vec<String>,
+    ) -> Result<Self, SceneError> {
+        let mut libraries = Self::default();
+        let mut read = HashSet::new();
+        for (text, line) in statements {
+            let mut unread: Vec<(String, String)> = Vec::new();
+            for name in library_names(text, directory) {
+                let mut file = directory.join(&name);
+                if !file.exists() && name.contains('\\') {
+                    file = directory.join(name.replace('\\', "/"));
+                }
+                if !read.insert(file.clone()) {
+                    continue;
+                }
+                let message = |e: InputError| {
+                    format!("cannot read the material library {}: {e}", file.display())
+                };
+                match read_input(&file, MAX_MODEL_FILE_BYTES) {
+                    Ok(bytes) => libraries.parse(&file, &bytes, *line, warnings)?,
+                    Err(InputError::Io(e)) if e.kind() == ErrorKind::NotFound => {
+                        unread.push((name, message(InputError::Io(e))));
+                    }
+                    // A FIFO, a device or a huge file is not a library that went missing
+                    // but one that must not be read (src/input.rs).
+                    Err(e) => {
+                        return Err(at(obj, *line, 1, format!("mtllib {name}: {}", message(e))));
+                    }
+                }
+            }
+            if let Some((name, message)) = unread.first() {
+                libraries.any_missing = true;
+                let others = match unread.len() - 1 {
+                    0 => String::new(),
+                    _ => format!(
+                        " (nor can {}, named on the same line)",
+                        unread[1..]
+                            .iter()
+                            .map(|(name, _)| name.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                };
+                warnings.push(format!(
+                    "{}:{line}: mtllib {name}: {message}{others}; the materials it would define are replaced by the default material",
+                    obj.display()
+                ));
+            }
+        }
+        Ok(libraries)
+    }
+
+    /// Checks and parses one library's text, named on line `mtllib_line` of the OBJ file.
+    fn parse(
+        &mut self,
+        library: &Path,
+        bytes: &[u8],
+        mtllib_line: usize,
+        warnings: &mut Vec<String>,
+    ) -> Result<(), SceneError> {
+        let text = decode_text(bytes, library, warnings);
+        let mut notes = Notes::default();
+        let (clean, lines) = scan_mtl(&text, library, &mut notes)?;
+        notes.report(library, warnings);
+        let (materials, _) =
+            tobj::load_mtl_buf(&mut Cursor::new(clean.as_bytes())).map_err(|e| {
+                error(
+                    library,
+                    format!("the material library could not be read: {e}"),
+                )
+            })?;
+        for (
+            material,
+            MtlLines {
+                line,
+                map_kd_at,
+                map_ke_at,
+            },
+        ) in materials.into_iter().zip(lines)
+        {
+            self.index
+                .insert(material.name.clone(), self.materials.len());
+            self.materials.push(SourceMaterial {
+                material,
+                library: library.to_path_buf(),
+                line,
+                mtllib_line,
+                map_kd_at,
+                map_ke_at,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The file names a `mtllib` statement gives: the whole text when a file has that name
+/// (names with spaces are common; tobj reads them so), otherwise its words, `\ ` within
+/// a word standing for a space (several libraries on one line, as the specification
+/// and tinyobjloader read it).
+fn library_names(text: &str, directory: &Path) -> Vec<String> {
+    if !text.contains(char::is_whitespace) || directory.join(text).is_file() {
+        return vec![text.to_string()];
+    }
+    let mut names = Vec::new();
+    let mut name = String::new();
+    let mut characters = text.chars().peekable();
+    while let Some(c) = characters.next() {
+        if c == '\\' && characters.peek().is_some_and(|next| next.is_whitespace()) {
+            name.extend(characters.next());
+        } else if c.is_whitespace() {
+            if !name.is_empty() {
+                names.push(std::mem::take(&mut name));
+            }
+        } else {
+            name.push(c);
+        }
+    }
+    if !name.is_empty() {
+        names.push(name);
+    }
+    names
+}
+
+/// Colour keywords of MTL (1 or 3 numbers).
+const MTL_COLOURS: &[&str] = &["Ka", "Kd", "Ks", "Ke", "Tf"];
+/// Scalar keywords of MTL and of its PBR extension.
+const MTL_SCALARS: &[&str] = &[
+    "Ns",
+    "Ni",
+    "d",
+    "Tr",
+    "Pr",
+    "Pm",
+    "Ps",
+    "Pc",
+    "Pcr",
+    "aniso",
+    "anisor",
+    "sharpness",
+];
+
+/// Where a material of an MTL library is defined: the line of its `newmtl`, and the line
+/// and column of its `map_Kd` and `map_Ke`, when it has them.
+struct MtlLines {
+    line: usize,
+    map_kd_at: Option<(usize, usize)>,
+    map_ke_at: Option<(usize, usize)>,
+}
+
+/// Checks every line of an MTL library and returns the text for `tobj` (colours with one
+/// number spelled out as three, unsupported forms blanked) and, per material in order,
+/// where it is defined.
+fn scan_mtl(
+    text: &str,
+    path: &Path,
+    notes: &mut Notes,
+) -> Result<(String, Vec<MtlLines>), SceneError> {
+    let mut clean = String::with_capacity(text.len());
+    let mut lines = Vec::new();
+    let mut nameless = false;
+    for (index, line) in text.lines().enumerate() {
+        let n = index + 1;
+        let line = strip_comment(line);
+        let words = words(line);
+        let Some(&(column, keyword)) = words.first() else {
+            clean.push('\n');
+            continue;
+        };
+        let values = &words[1..];
+        let mut kept = line.trim().to_string();
+        if keyword == "newmtl" {
+            // A material no `usemtl` can name (tobj refuses it): skipped to the next.
+            nameless = values.is_empty();
+            if nameless {
+                notes.nameless_materials.note(|| n);
+            }
+        }
+        if nameless {
+            clean.push('\n');
+            continue;
+        }
+        if keyword == "newmtl" {
+            lines.push(MtlLines {
+                line: n,
+                map_kd_at: None,
+                map_ke_at: None,
+            });
+        } else if MTL_COLOURS.contains(&keyword) {
+            if values
+                .first()
+                .is_some_and(|w| w.1 == "spectral" || w.1 == "xyz")
+            {
+                // Spectral and CIE XYZ colours are not supported: dropped.
+                kept.clear();
+            } else {
+                if values.len() != 1 && values.len() != 3 {
+                    return Err(at(
+                        path,
+                        n,
+                        column,
+                        format!(
+                            "`{keyword}` takes r g b (or one grey value), got {} numbers",
+                            values.len()
+                        ),
+                    ));
+                }
+                let mut rgb = [0.0; 3];
+                for (c, word) in values.iter().enumerate() {
+                    rgb[c] = finite(path, n, *word, keyword, notes)?;
+                }
+                if values.len() == 1 {
+                    rgb = [rgb[0]; 3];
+                }
+                kept = format!("{keyword} {:?} {:?} {:?}", rgb[0], rgb[1], rgb[2]);
+            }
+        } else if MTL_SCALARS.contains(&keyword) {
+            // `d -halo 0.5`: the halo form is read as a plain dissolve.
+            let values: Vec<_> = values.iter().filter(|w| w.1 != "-halo").collect();
+            if values.len() != 1 {
+                return Err(at(
+                    path,
+                    n,
+                    column,
+                    format!("`{keyword}` takes one number, got {}", values.len()),
+                ));
+            }
+            let value = finite(path, n, *values[0], keyword, notes)?;
+            kept = format!("{keyword} {value:?}");
+        } else if keyword == "illum" {
+            let [word] = values else {
+                return Err(at(path, n, column, "`illum` takes one number (0 to 10)"));
+            };
+            let illum: i64 = word.1.parse().map_err(|_| {
+                at(
+                    path,
+                    n,
+                    word.0,
+                    format!("illum: `{}` is not an integer", word.1),
+                )
+            })?;
+            if !(0..=10).contains(&illum) {
+                return Err(at(
+                    path,
+                    n,
+                    word.0,
+                    format!("illum {illum} is not an illumination model (0 to 10)"),
+                ));
+            }
+        } else if keyword.starts_with("map_")
+            || matches!(keyword, "bump" | "disp" | "decal" | "refl" | "norm")
+        {
+            if values.is_empty() {
+                return Err(at(
+                    path,
+                    n,
+                    column,
+                    format!("`{keyword}` needs a file name"),
+                ));
+            }
+            if keyword == "map_Kd" || keyword == "map_Ke" {
+                match lines.last_mut() {
+                    Some(last) if keyword == "map_Kd" => last.map_kd_at = Some((n, column)),
+                    Some(last) => last.map_ke_at = Some((n, column)),
+                    None => kept.clear(),
+                }
+            }
+        }
+        if lines.is_empty() {
+            // Before the first `newmtl`: belongs to no material.
+            kept.clear();
+        }
+        clean.push_str(&kept);
+        clean.push('\n');
+    }
+    Ok((clean, lines))
+}
+
+/// A number from a material's keys that `tobj` keeps as text (checked by [`scan_mtl`]).
+fn extra(material: &tobj::Material, key: &str) -> Option<f64> {
+    material.unknown_param.get(key)?.parse().ok()
+}
+
+/// A colour from a material's keys that `tobj` keeps as text.
+fn extra_colour(material: &tobj::Material, key: &str) -> Option<DVec3> {
+    let values: Vec<f64> = material
+        .unknown_param
+        .get(key)?
+        .split_whitespace()
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    match values.as_slice() {
+        [r, g, b] => Some(DVec3::new(*r, *g, *b)),
+        _ => None,
+    }
+}
+
+/// Maps one MTL material onto ours (the table in `docs/models.md`).
+pub(super) fn map_material(
+    source: &SourceMaterial,
+    textures: &mut Textures,
+    budget: &mut Budget,
+    warnings: &mut Vec<String>,
+) -> Result<ImportedMaterial, SceneError> {
+    let m = &source.material;
+    let place = format!(
+        "{}:{}: material '{}'",
+        source.library.display(),
+        source.line,
+        m.name
+    );
+    let mut warn = |message: String| warnings.push(format!("{place}: {message}"));
+    let colour = |c: Option<[f64; 3]>| c.map(|[r, g, b]| DVec3::new(r, g, b));
+
+    // A colour texture statement (`map_Kd`, `map_Ke`) at `at`, loaded relative to the
+    // library's directory.
+    let mut colour_texture = |key: &str,
+                              spec: Option<&String>,
+                              at_line: Option<(usize, usize)>|
+     -> Result<Option<TextureRef>, SceneError> {
+        let (Some(spec), Some((line, column))) = (spec, at_line) else {
+            return Ok(None);
+        };
+        let (file, wrap, ignored) = texture_options(spec);
+        if !ignored.is_empty() {
+            warn(format!(
+                "{key} options {} are not supported; ignored",
+                ignored.join(" ")
+            ));
+        }
+        let directory = source.library.parent().unwrap_or(Path::new(""));
+        let mut file_path = directory.join(&file);
+        if !file_path.exists() && file.contains('\\') {
+            file_path = directory.join(file.replace('\\', "/"));
+        }
+        if !file_path.exists() {
+            // Exporters write absolute paths of the author's machine, and models are
+            // shared without their textures: the geometry is still worth seeing.
+            warn(format!(
+                "{key}: the texture {} does not exist; the material is used without it",
+                file_path.display()
+            ));
+            return Ok(None);
+        }
+        let image = textures
+            .file(&file_path, Encoding::Color, budget)
+            .map_err(|e| {
+                at(
+                    &source.library,
+                    line,
+                    column,
+                    format!("material '{}': {key}: {e}", m.name),
+                )
+            })?;
+        Ok(Some(TextureRef {
+            image,
+            wrap_u: wrap,
+            wrap_v: wrap,
+        }))
+    };
+    let base_color_texture =
+        colour_texture("map_Kd", m.diffuse_texture.as_ref(), source.map_kd_at)?;
+    let emissive_texture =
+        colour_texture("map_Ke", m.unknown_param.get("map_Ke"), source.map_ke_at)?;
+    for (key, present) in [
+        ("map_Ks", m.specular_texture.is_some()),
+        ("map_Ka", m.ambient_texture.is_some()),
+        ("map_Ns", m.shininess_texture.is_some()),
+        ("map_d", m.dissolve_texture.is_some()),
+        ("bump", m.normal_texture.is_some()),
+    ] {
+        if present {
+            warn(format!("{key} is not supported; ignored"));
+        }
+    }
+    let mut others: Vec<&String> = m
+        .unknown_param
+        .keys()
+        .filter(|k| {
+            (k.starts_with("map_") && k.as_str() != "map_Ke")
+                || matches!(k.as_str(), "disp" | "decal" | "refl" | "norm")
+        })
+        .collect();
+    others.sort();
+    for key in others {
+        warn(format!("{key} is not supported; ignored"));
+    }
+
+    let default_albedo = if base_color_texture.is_some() {
+        1.0
+    } else {
+        DEFAULT_OBJ_ALBEDO
+    };
+    let mut kd = colour(m.diffuse).unwrap_or(DVec3::splat(default_albedo));
+    let mut ks = colour(m.specular).unwrap_or(DVec3::ZERO);
+    let ke = colour(m.emissive).unwrap_or(DVec3::ZERO);
+    let ns = m.shininess.unwrap_or(DEFAULT_NS);
+    let ni = m.optical_density;
+    let dissolve = m
+        .dissolve
+        .or_else(|| extra(m, "Tr").map(|tr| 1.0 - tr))
+        .unwrap_or(1.0);
+    let tf = extra_colour(m, "Tf");
+    let (pr, pm) = (extra(m, "Pr"), extra(m, "Pm"));
+    let illum = m.illumination_model.unwrap_or(2);
+
+    let unit = |name: &str, c: DVec3, warn: &mut dyn FnMut(String)| {
+        let clamped = c.clamp(DVec3::ZERO, DVec3::ONE);
+        if clamped != c {
+            warn(format!("{name} {c} is outside [0, 1]; clamped"));
+        }
+        clamped
+    };
+    let emission = ke.max(DVec3::ZERO);
+    if emission != ke {
+        warn(format!("Ke {ke} is negative; clamped to 0"));
+    }
+    let ior_or_default = |warn: &mut dyn FnMut(String), what: &str| match ni {
+        Some(ni) if ni > 0.0 => ni,
+        Some(ni) => {
+            warn(format!(
+                "Ni {ni} is not positive; {what} uses {DEFAULT_IOR}"
+            ));
+            DEFAULT_IOR
+        }
+        None => DEFAULT_IOR,
+    };
+
+    let material = if matches!(illum, 4 | 6 | 7 | 9) {
+        let ior = ior_or_default(&mut warn, "the glass");
+        let transmittance = unit("Tf", tf.unwrap_or(DVec3::ONE), &mut warn);
+        Material {
+            ior,
+            transmittance,
+            emission,
+            ..Material::blank(MaterialKind::Dielectric)
+        }
+    } else if pr.is_some() || pm.is_some() {
+        if matches!(illum, 3 | 5 | 8) {
+            warn(format!(
+                "illum {illum} (coat) is ignored: Pr/Pm make it a metal/roughness material"
+            ));
+        }
+        let clamp01 = |name: &str, v: f64, warn: &mut dyn FnMut(String)| {
+            if !(0.0..=1.0).contains(&v) {
+                warn(format!("{name} {v} is outside [0, 1]; clamped"));
+            }
+            v.clamp(0.0, 1.0)
+        };
+        Material {
+            diffuse: unit("Kd", kd, &mut warn),
+            metallic: clamp01("Pm", pm.unwrap_or(0.0), &mut warn),
+            roughness: clamp01("Pr", pr.unwrap_or(1.0), &mut warn),
+            emission,
+            ..Material::blank(MaterialKind::Pbr)
+        }
+    } else {
+        kd = unit("Kd", kd, &mut warn);
+        ks = unit("Ks", ks, &mut warn);
+        if matches!(illum, 0 | 1) {
+            ks = DVec3::ZERO;
+        }
+        let sum = (kd + ks).max_element();
+        if sum > 1.0 {
+            warn(format!(
+                "Kd + Ks reaches {sum} in a channel; both are scaled by 1/{sum} so that the surface does not reflect more light than it receives"
+            ));
+            kd /= sum;
+            ks /= sum;
+        }
+        let coat_ior = if matches!(illum, 3 | 5 | 8) {
+            let ior = ior_or_default(&mut warn, "the coat");
+            if ior < 1.0 {
+                warn(format!("Ni {ior} is below 1; the coat uses {DEFAULT_IOR}"));
+                DEFAULT_IOR
+            } else {
+                ior
+            }
+        } else {
+            0.0
+        };
+        if ks == DVec3::ZERO {
+            Material {
+                coat_ior,
+                emission,
+                ..Material::lambert(kd)
+            }
+        } else {
+            let shininess = if (0.0..=MAX_SHININESS).contains(&ns) {
+                ns
+            } else {
+                warn(format!("Ns {ns} is outside [0, {MAX_SHININESS}]; clamped"));
+                ns.clamp(0.0, MAX_SHININESS)
+            };
+            Material {
+                diffuse: kd,
+                specular: ks,
+                shininess,
+                coat_ior,
+                emission,
+                ..Material::blank(MaterialKind::BlinnPhong)
+            }
+        }
+    };
+    if dissolve < 1.0 && material.kind != MaterialKind::Dielectric {
+        warn(format!(
+            "d {dissolve} (partial transparency) is not supported; the material is opaque"
+        ));
+    }
+    Ok(ImportedMaterial {
+        name: m.name.clone(),
+        material,
+        base_color_texture,
+        metallic_roughness_texture: None,
+        emissive_texture,
+    })
+}
+
+/// Splits a texture statement (`-clamp on -s 2 2 file name.png`) into the file name, the
+/// wrap mode (`-clamp on` clamps) and the options that are not supported.
+pub(super) fn texture_options(spec: &str) -> (String, WrapMode, Vec<String>) {
+    /// Options and how many arguments each takes at most (all but the last are numbers).
+    const OPTIONS: &[(&str, usize)] = &[
+        ("-blendu", 1),
+        ("-blendv", 1),
+        ("-bm", 1),
+        ("-boost", 1),
+        ("-cc", 1),
+        ("-clamp", 1),
+        ("-colorspace", 1),
+        ("-imfchan", 1),
+        ("-mm", 2),
+        ("-o", 3),
+        ("-s", 3),
+        ("-t", 3),
+        ("-texres", 1),
+        ("-type", 1),
+    ];
+    let words: Vec<&str> = spec.split_whitespace().collect();
+    let mut wrap = WrapMode::Repeat;
+    if words.is_empty() {
+        return (String::new(), wrap, Vec::new());
+    }
+    let mut ignored = Vec::new();
+    let mut i = 0;
+    while i < words.len() {
+        let Some(&(option, most)) = OPTIONS.iter().find(|(o, _)| *o == words[i]) else {
+            break;
+        };
+        let mut taken = 0;
+        while taken < most
+            && i + 1 + taken < words.len() - 1
+            && (taken == 0 || words[i + 1 + taken].parse::<f64>().is_ok())
+        {
+            taken += 1;
+        }
+        let arguments = &words[i + 1..i + 1 + taken];
+        if option == "-clamp" {
+            if arguments.first() == Some(&"on") {
+                wrap = WrapMode::ClampToEdge;
+            }
+        } else {
+            ignored.push(
+                format!("{option} {}", arguments.join(" "))
+                    .trim()
+                    .to_string(),
+            );
+        }
+        i += 1 + taken;
+    }
+    (words[i.min(words.len())..].join(" "), wrap, ignored)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn texture_options_are_split_from_the_file_name() {
+        assert_eq!(
+            texture_options("wood grain.png"),
+            ("wood grain.png".into(), WrapMode::Repeat, vec![])
+        );
+        assert_eq!(
+            texture_options("-clamp on -s 2 2 1 a.png"),
+            (
+                "a.png".into(),
+                WrapMode::ClampToEdge,
+                vec!["-s 2 2 1".to_string()]
+            )
+        );
+        assert_eq!(
+            texture_options("-bm 0.5 b.png"),
+            (
+                "b.png".into(),
+                WrapMode::Repeat,
+                vec!["-bm 0.5".to_string()]
+            )
+        );
+    }
+}
