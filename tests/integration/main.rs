@@ -9,6 +9,7 @@ mod bvh_gpu;
 mod bxdf_gpu_twin;
 mod bxdf_plausibility;
 mod cli;
+mod corpus;
 mod display_pass;
 mod emissive_texture;
 mod environment;

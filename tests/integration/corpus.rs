@@ -15,7 +15,7 @@
 //! and commit it with the change:
 //!
 //! ```text
-//! GPU_RENDER_BLESS=1 cargo test --test corpus
+//! GPU_RENDER_BLESS=1 cargo test --test integration corpus::
 //! ```
 //!
 //! `GPU_RENDER_CORPUS=DIR` reads the corpus from `DIR` instead. Where the corpus is
@@ -193,9 +193,9 @@ fn every_corpus_file_imports_or_is_refused_as_the_table_says() {
     let expected_path = Path::new(env!("CARGO_MANIFEST_DIR")).join(EXPECTED);
     if flag("GPU_RENDER_BLESS") {
         let mut text = String::from(
-            "# Outcome of every model file of the corpus (tests/corpus.rs): \
+            "# Outcome of every model file of the corpus (tests/integration/corpus.rs): \
              file, then `renders`, triangles, warnings or `refused`, reason.\n\
-             # Rewritten by GPU_RENDER_BLESS=1 cargo test --test corpus\n",
+             # Rewritten by GPU_RENDER_BLESS=1 cargo test --test integration corpus::\n",
         );
         for (file, row) in &actual {
             text.push_str(&format!("{file}\t{row}\n"));
@@ -231,7 +231,7 @@ fn every_corpus_file_imports_or_is_refused_as_the_table_says() {
     assert!(
         changes.is_empty(),
         "{} of {} corpus files differ from {EXPECTED}:\n{}\n\
-         If the change is intended, run GPU_RENDER_BLESS=1 cargo test --test corpus and commit the table.",
+         If the change is intended, run GPU_RENDER_BLESS=1 cargo test --test integration corpus:: and commit the table.",
         changes.len(),
         actual.len(),
         changes.join("\n")
