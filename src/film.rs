@@ -63,7 +63,7 @@ pub struct RenderStats {
     /// submitted chunk, from the start of its first trace pass to the end of its last,
     /// summed over the chunks. `None` where the device lacks
     /// [`wgpu::Features::TIMESTAMP_QUERY`], for the CPU reference, and where the
-    /// timestamps could not be trusted (see [`crate::gpu::GpuRenderer::render`]).
+    /// timestamps could not be trusted (see [`crate::gpu::Renderer::render`]).
     pub gpu_time: Option<Duration>,
 }
 

@@ -2,7 +2,7 @@
 
 use std::sync::{Arc, Mutex, PoisonError};
 
-use super::GpuError;
+use super::RenderError;
 
 /// Which adapter [`HeadlessGpu::new`] should open.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
@@ -79,11 +79,11 @@ pub fn adapter_listing(adapters: &[wgpu::Adapter]) -> String {
 /// contains the text (case-insensitive); [`AdapterChoice::Default`] takes the first.
 /// A window's program passes the adapters that can present to its surface.
 ///
-/// Errors: [`GpuError::NoAdapter`] naming the choice and listing `adapters`.
+/// Errors: [`RenderError::NoAdapter`] naming the choice and listing `adapters`.
 pub fn select_adapter(
     adapters: &[wgpu::Adapter],
     choice: &AdapterChoice,
-) -> Result<wgpu::Adapter, GpuError> {
+) -> Result<wgpu::Adapter, RenderError> {
     let found = match choice {
         AdapterChoice::Default => adapters.first(),
         AdapterChoice::Index(i) => adapters.get(*i),
@@ -100,7 +100,10 @@ pub fn select_adapter(
             AdapterChoice::Index(i) => format!("no adapter with index {i}"),
             AdapterChoice::NameContains(text) => format!("no adapter name contains {text:?}"),
         };
-        GpuError::NoAdapter(format!("{asked}; {}", adapter_listing(adapters)))
+        RenderError::NoAdapter {
+            requested: asked,
+            available: adapter_listing(adapters),
+        }
     })
 }
 
@@ -115,7 +118,7 @@ pub struct HeadlessGpu {
     pub instance: wgpu::Instance,
     /// The chosen adapter.
     pub adapter: wgpu::Adapter,
-    /// The device; pass it to [`super::GpuRenderer::new`] and its methods.
+    /// The device; pass it to [`super::Renderer::new`] and its methods.
     pub device: wgpu::Device,
     /// The device's queue.
     pub queue: wgpu::Queue,
@@ -134,16 +137,16 @@ impl std::fmt::Debug for HeadlessGpu {
 impl HeadlessGpu {
     /// Opens the adapter `choice` names and creates a device with its full limits.
     ///
-    /// Errors: [`GpuError::NoAdapter`] when nothing matches (the message lists what
-    /// exists), [`GpuError::RequestDevice`] when the adapter refuses the device.
+    /// Errors: [`RenderError::NoAdapter`] when nothing matches (the message lists what
+    /// exists), [`RenderError::RequestDevice`] when the adapter refuses the device.
     ///
     /// ```no_run
     /// use gpu_render::gpu::{AdapterChoice, HeadlessGpu};
     /// let gpu = HeadlessGpu::new(&AdapterChoice::NameContains("llvmpipe".into()))?;
     /// println!("rendering on {}", gpu.adapter_info().name);
-    /// # Ok::<(), gpu_render::gpu::GpuError>(())
+    /// # Ok::<(), gpu_render::gpu::RenderError>(())
     /// ```
-    pub fn new(choice: &AdapterChoice) -> Result<Self, GpuError> {
+    pub fn new(choice: &AdapterChoice) -> Result<Self, RenderError> {
         let (instance, adapters) = instance_with_adapters();
         let adapter = match choice {
             AdapterChoice::Default => {
@@ -155,9 +158,13 @@ impl HeadlessGpu {
                     Ok(adapter) => adapter,
                     // request_adapter may decline where enumeration found something
                     // (for example only a CPU adapter): take the first one then.
-                    Err(e) => adapters.first().cloned().ok_or_else(|| {
-                        GpuError::NoAdapter(format!("{e}; {}", adapter_listing(&adapters)))
-                    })?,
+                    Err(e) => adapters
+                        .first()
+                        .cloned()
+                        .ok_or_else(|| RenderError::NoAdapter {
+                            requested: e.to_string(),
+                            available: adapter_listing(&adapters),
+                        })?,
                 }
             }
             _ => select_adapter(&adapters, choice)?,
@@ -173,7 +180,7 @@ impl HeadlessGpu {
             trace: wgpu::Trace::Off,
         };
         let (device, queue) = pollster::block_on(adapter.request_device(&desc))
-            .map_err(|e| GpuError::RequestDevice(e.to_string()))?;
+            .map_err(RenderError::RequestDevice)?;
         // Record the reason if the device is lost, so callers can tell a reset from
         // other failures (see `lost_reason`).
         let lost = Arc::new(Mutex::new(None));

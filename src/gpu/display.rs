@@ -3,40 +3,57 @@
 
 use wgpu::util::DeviceExt;
 
-use super::GpuError;
+use super::RenderError;
 use super::layout::DisplayUniforms;
 use super::pipelines::{DISPLAY_FORMAT, LINEAR_FORMAT, Pipelines};
 use super::readback::{Caught, capture};
 use super::shaders::WORKGROUP_SIZE;
 
-/// Checks that `view`'s texture has `format`, `usage` and at least `width × height`.
+/// How a texture's size must relate to the image it is used with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum TextureSize {
+    /// The image's size exactly (a film's display target).
+    Exact,
+    /// At least the image's size (a trace target may hold more).
+    AtLeast,
+}
+
+/// Checks that `view`'s texture (the operation's `role` texture) has `format`,
+/// `usage` and the size `image` asks, as `size` says.
 pub(crate) fn check_texture(
     view: &wgpu::TextureView,
-    role: &str,
+    role: &'static str,
     format: wgpu::TextureFormat,
     usage: wgpu::TextureUsages,
-    width: u32,
-    height: u32,
-) -> Result<(), GpuError> {
+    image: (u32, u32),
+    size: TextureSize,
+) -> Result<(), RenderError> {
     let texture = view.texture();
     if texture.format() != format {
-        return Err(GpuError::Validation(format!(
-            "{role} texture must be {format:?}, got {:?}",
-            texture.format()
-        )));
+        return Err(RenderError::TargetFormat {
+            role,
+            expected: format,
+            found: texture.format(),
+        });
     }
     if !texture.usage().contains(usage) {
-        return Err(GpuError::Validation(format!(
-            "{role} texture needs usage {usage:?}, has {:?}",
-            texture.usage()
-        )));
+        return Err(RenderError::TargetUsage {
+            role,
+            needed: usage,
+            found: texture.usage(),
+        });
     }
-    if texture.width() < width || texture.height() < height {
-        return Err(GpuError::Validation(format!(
-            "{role} texture is {}x{}, the image is {width}x{height}",
-            texture.width(),
-            texture.height()
-        )));
+    let target = (texture.width(), texture.height());
+    let fits = match size {
+        TextureSize::Exact => target == image,
+        TextureSize::AtLeast => target.0 >= image.0 && target.1 >= image.1,
+    };
+    if !fits {
+        return Err(RenderError::TargetSize {
+            role,
+            film: image,
+            target,
+        });
     }
     Ok(())
 }
@@ -52,23 +69,23 @@ pub(crate) fn encode_display(
     linear: &wgpu::TextureView,
     display: &wgpu::TextureView,
     encode_srgb: bool,
-) -> Result<(), GpuError> {
+) -> Result<(), RenderError> {
     let (width, height) = (linear.texture().width(), linear.texture().height());
     check_texture(
         linear,
         "display input",
         LINEAR_FORMAT,
         wgpu::TextureUsages::TEXTURE_BINDING,
-        width,
-        height,
+        (width, height),
+        TextureSize::Exact,
     )?;
     check_texture(
         display,
         "display output",
         DISPLAY_FORMAT,
         wgpu::TextureUsages::STORAGE_BINDING,
-        width,
-        height,
+        (width, height),
+        TextureSize::Exact,
     )?;
     let uniforms = DisplayUniforms {
         encode_srgb: u32::from(encode_srgb),

@@ -2,7 +2,7 @@
 //! fullscreen-triangle render pipeline for the colour format given in
 //! [`super::RendererOptions::surface_format`], one per sRGB rule.
 
-use super::GpuError;
+use super::RenderError;
 use super::readback::{Caught, capture};
 use super::shaders::draw_shader_source;
 
@@ -43,7 +43,7 @@ pub(crate) struct DrawPipelines {
 
 impl DrawPipelines {
     /// Builds both pipelines for `format` inside error scopes.
-    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Result<Self, GpuError> {
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Result<Self, RenderError> {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gpu-render draw bindings"),
             entries: &[wgpu::BindGroupLayoutEntry {

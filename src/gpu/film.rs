@@ -20,8 +20,7 @@ use super::gpu_scene::GpuScene;
 use super::layout::GpuCounters;
 use super::limits::{check_binding_bytes, check_film_size};
 use super::pipelines::LINEAR_FORMAT;
-use super::readback::{Caught, capture};
-use super::renderer::create_texture;
+use super::readback::{Caught, capture, create_texture};
 use super::wavefront::{SlotBuffers, check_errors};
 use super::{RenderError, Renderer};
 
@@ -275,7 +274,7 @@ impl Film {
             }
             if let Err(e) = check_errors(report.counters.errors) {
                 self.reset();
-                return Err(RenderError::TraceIncomplete(e));
+                return Err(e);
             }
             if u64::from(report.counters.pixels_done) >= pixels {
                 let samples = f64::from(pass.end - pass.first);

@@ -1,14 +1,17 @@
-//! [`GpuScene`]: a scene uploaded for the frame loop, with its trace pipelines built,
-//! and its camera kept on the host so that a camera move uploads nothing but the
-//! next trace pass's constants.
+//! [`GpuScene`]: a scene uploaded to one device, with its trace pipelines built, and
+//! its camera kept on the host so that a camera move uploads nothing but the next
+//! trace pass's constants.
 
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Duration;
 
 use wgpu::util::DeviceExt;
 
+use super::ShaderFeatures;
 use super::layout::{DisplayUniforms, FrameUniforms};
 use super::pipelines::TracePipelines;
-use super::scene_buffers::PreparedScene;
+use super::scene_buffers::DeviceScene;
+use crate::accel::BvhStats;
 use crate::camera::CameraFrame;
 use crate::scene::{Camera, DielectricSphere, MediumStack, media_around};
 
@@ -26,7 +29,7 @@ static NEXT_SCENE_ID: AtomicU64 = AtomicU64::new(1);
 #[derive(Debug)]
 pub struct GpuScene {
     pub(crate) id: u64,
-    pub(crate) prepared: PreparedScene,
+    pub(crate) prepared: DeviceScene,
     pub(crate) pipelines: TracePipelines,
     /// The display pass's constants (the scene's sRGB rule), bound by
     /// [`super::Renderer::encode_display`].
@@ -35,13 +38,15 @@ pub struct GpuScene {
     /// Increased by every camera change: films accumulating an older camera restart.
     pub(crate) camera_version: u64,
     dielectric_spheres: Vec<DielectricSphere>,
+    compile_time: Duration,
 }
 
 impl GpuScene {
     pub(crate) fn new(
         device: &wgpu::Device,
-        prepared: PreparedScene,
+        prepared: DeviceScene,
         pipelines: TracePipelines,
+        compile_time: Duration,
         camera: Camera,
         dielectric_spheres: Vec<DielectricSphere>,
     ) -> Self {
@@ -62,6 +67,7 @@ impl GpuScene {
             camera,
             camera_version: 0,
             dielectric_spheres,
+            compile_time,
         }
     }
 
@@ -103,9 +109,40 @@ impl GpuScene {
         self.prepared.scene_bytes()
     }
 
-    /// The uploaded scene of the blocking layer (its buffers and constants).
-    pub fn prepared(&self) -> &PreparedScene {
-        &self.prepared
+    /// Bytes of the scene's image array on the device (albedo textures and BRDF
+    /// maps, `Rgba32Float`, at least one 1×1 layer).
+    pub fn image_bytes(&self) -> u64 {
+        self.prepared.image_bytes()
+    }
+
+    /// Capacity of each path's bounce stack (a film made for this scene holds it).
+    pub fn stack_size(&self) -> u32 {
+        self.prepared.stack_size()
+    }
+
+    /// The shader features of the scene's trace pipelines (what its module contains).
+    pub fn features(&self) -> ShaderFeatures {
+        self.prepared.features()
+    }
+
+    /// How the scene's BVH was built.
+    pub fn bvh_stats(&self) -> &BvhStats {
+        self.prepared.bvh_stats()
+    }
+
+    /// How long [`super::Renderer::upload`] spent building the scene's trace
+    /// pipelines and running each once over no work (drivers compile at pipeline
+    /// creation or, as lavapipe does, at the first dispatch): the kernel compile.
+    /// Zero when the renderer had them cached from an earlier scene with the same
+    /// features.
+    pub fn compile_time(&self) -> Duration {
+        self.compile_time
+    }
+
+    /// The trace constants of the whole image at upload, before any camera move (the
+    /// scheduler sets region, samples, slots and budget per trace).
+    pub fn frame_uniforms(&self) -> &FrameUniforms {
+        self.prepared.frame_uniforms()
     }
 
     /// The trace constants of one pass over a `width × height` film: the scene's

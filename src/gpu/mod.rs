@@ -1,28 +1,28 @@
 //! The wgpu backend: tracing in WGSL compute shaders, driven from the host here.
 //!
-//! - The frame loop, for applications that own their device and frame
-//!   (`docs/embedding.md`): [`Renderer`] (`frame_loop`), [`GpuScene`] (`gpu_scene`),
-//!   [`Film`] (`film`), the draw pipeline (`draw`), the device [`limits`] it checks,
-//!   and its error type [`RenderError`] (`render_error`).
-//! - [`context`]: a headless instance/adapter/device/queue ([`HeadlessGpu`]) for apps
+//! - [`Renderer`] (`renderer`): the one renderer, built from the caller's `Device`
+//!   with [`RendererOptions`]; [`Renderer::upload`] makes a [`GpuScene`]; the frame
+//!   loop records samples into a [`Film`] and shows it (`docs/embedding.md`); whole
+//!   images and tiles are [`Renderer::render`], [`Renderer::render_region`] and
+//!   [`Renderer::trace_into`]. Its one error type is [`RenderError`].
+//! - [`HeadlessGpu`] (`context`): an instance, adapter, device and queue for programs
 //!   and tests that do not bring their own device.
-//! - [`renderer`]: [`GpuRenderer`], built from the caller's `Device`; a high-level
-//!   [`GpuRenderer::render`] and `prepare`/`trace_into`/`encode_display` for apps that
-//!   own their textures and frame.
-//! - `scene_buffers`: a scene uploaded to the device ([`PreparedScene`]).
-//! - `wavefront`: the path slots and the schedule of the two trace kernels.
-//! - `pipelines`, `display`: the pipelines and the display pass.
-//! - [`upload`]: pure conversion of a [`crate::scene::Scene`] into the GPU records.
+//! - The stages: `scene_buffers` (a scene uploaded to the device), `wavefront` (the
+//!   path slots and the schedule of the trace kernels), `pipelines`, `display`,
+//!   `draw`, and [`limits`] (what the renderer needs of a device).
 //! - [`shaders`]: composition of the WGSL sources, specialised by [`features`];
-//!   `uniform_records`: the scene records CPU devices read from uniform buffers;
-//!   [`unrolled`]: small scenes' closest-hit test without the tree.
-//! - [`layout`]: the `#[repr(C)]` records shared with `shaders/types.wgsl`.
+//!   [`upload`]: pure conversion of a [`crate::scene::Scene`] into the GPU records,
+//!   [`layout`] their `#[repr(C)]` twins of `shaders/types.wgsl`.
+//! - For CPU devices (lavapipe), strategies that only pay there: `uniform_records`
+//!   (the scene records in uniform buffers), [`unrolled`] (small scenes' closest-hit
+//!   test without the tree), and lanes that give way to finished ones
+//!   ([`ShaderFeatures::refill_lanes`]).
 //!
 //! ```no_run
-//! use gpu_render::gpu::{AdapterChoice, GpuRenderer, HeadlessGpu};
-//! # fn demo(scene: &gpu_render::scene::Scene) -> Result<(), gpu_render::gpu::GpuError> {
+//! use gpu_render::gpu::{AdapterChoice, HeadlessGpu, Renderer, RendererOptions};
+//! # fn demo(scene: &gpu_render::scene::Scene) -> Result<(), gpu_render::gpu::RenderError> {
 //! let gpu = HeadlessGpu::new(&AdapterChoice::Default)?;
-//! let renderer = GpuRenderer::new(&gpu.device)?;
+//! let renderer = Renderer::new(&gpu.device, RendererOptions::default())?;
 //! let rendered = renderer.render(&gpu.device, &gpu.queue, scene, None)?;
 //! println!("{} rays", rendered.stats.rays_traced);
 //! # Ok(())
@@ -37,13 +37,11 @@ pub mod environment;
 mod error;
 pub mod features;
 mod film;
-mod frame_loop;
 mod gpu_scene;
 pub mod layout;
 pub mod limits;
 mod pipelines;
 mod readback;
-mod render_error;
 pub mod renderer;
 mod scene_buffers;
 pub mod shaders;
@@ -53,16 +51,15 @@ pub mod upload;
 mod wavefront;
 
 pub use context::{AdapterChoice, HeadlessGpu, adapter_listing, list_adapters, select_adapter};
-pub use error::GpuError;
+pub use error::{RenderError, TraceFailure};
 pub use features::ShaderFeatures;
 pub use film::Film;
-pub use frame_loop::{BufferWrites, FilmImage, Renderer, RendererOptions};
 pub use gpu_scene::GpuScene;
 pub use pipelines::{DISPLAY_FORMAT, LINEAR_FORMAT, TRACE_STORAGE_BUFFERS, TracePipelines};
 pub use readback::read_texture;
-pub use render_error::RenderError;
-pub use renderer::{GpuRendered, GpuRenderer, TraceRegion, image_tiles};
-pub use scene_buffers::PreparedScene;
+pub use renderer::{
+    BufferWrites, FilmImage, RenderedImage, Renderer, RendererOptions, TraceRegion, image_tiles,
+};
 pub use wavefront::{
     LLVMPIPE_LOOP_LIMIT, Schedule, TARGET_SUBMISSION, default_schedule, default_slot_count,
     driver_loop_limit, iteration_budget_for,

@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 use std::sync::{Mutex, PoisonError};
 
-use super::GpuError;
+use super::RenderError;
 use super::features::ShaderFeatures;
 use super::readback::{Caught, capture};
 use super::shaders::{
@@ -72,7 +72,7 @@ struct TraceLayout {
 }
 
 impl TraceLayout {
-    fn new(device: &wgpu::Device, uniform_records: bool) -> Result<Self, GpuError> {
+    fn new(device: &wgpu::Device, uniform_records: bool) -> Result<Self, RenderError> {
         use binding::*;
         // The records every traversal step reads: storage or uniform arrays.
         let record = |binding: u32| {
@@ -202,7 +202,7 @@ fn float_texture_entry(
 
 impl Pipelines {
     /// Builds the layouts and the display pipeline (trace pipelines come on demand).
-    pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
+    pub fn new(device: &wgpu::Device) -> Result<Self, RenderError> {
         let storage_layout = TraceLayout::new(device, false)?;
         let uniform_layout = if device_allows(&device.limits()) {
             Some(TraceLayout::new(device, true)?)
@@ -246,16 +246,21 @@ impl Pipelines {
         &self,
         device: &wgpu::Device,
         features: &ShaderFeatures,
-    ) -> Result<TracePipelines, GpuError> {
+    ) -> Result<TracePipelines, RenderError> {
         let mut cache = self.trace.lock().unwrap_or_else(PoisonError::into_inner);
         if let Some(pipelines) = cache.get(features) {
             return Ok(pipelines.clone());
         }
         let layout = self.trace_layout(device, features)?;
-        let source = trace_shader_source(features).map_err(GpuError::Shader)?;
+        let label = format!("trace ({})", features.label());
+        let source =
+            trace_shader_source(features).map_err(|message| RenderError::ShaderSource {
+                module: label.clone(),
+                message,
+            })?;
         let mut built = build_pipelines(
             device,
-            &format!("trace ({})", features.label()),
+            &label,
             source,
             &layout.pipeline,
             &[SHADE_ENTRY_POINT, TRACE_ENTRY_POINT, FUSED_ENTRY_POINT],
@@ -269,25 +274,33 @@ impl Pipelines {
         Ok(pipelines)
     }
 
+    /// Whether the trace pipelines for `features` are built and cached already.
+    pub(crate) fn has_trace(&self, features: &ShaderFeatures) -> bool {
+        self.trace
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .contains_key(features)
+    }
+
     /// The layouts of the trace modules for `features` (their record bindings are
     /// storage or uniform buffers).
     ///
-    /// Errors: [`GpuError::DeviceLimit`] for uniform records on a device that binds too
+    /// Errors: [`RenderError::Limit`] for uniform records on a device that binds too
     /// few uniform buffers (an upload never chooses them there).
     fn trace_layout(
         &self,
         device: &wgpu::Device,
         features: &ShaderFeatures,
-    ) -> Result<&TraceLayout, GpuError> {
+    ) -> Result<&TraceLayout, RenderError> {
         if !features.uniform_records {
             return Ok(&self.storage_layout);
         }
         self.uniform_layout
             .as_ref()
-            .ok_or_else(|| GpuError::DeviceLimit {
-                what: "uniform buffers per shader stage (for uniform records)".into(),
-                value: u64::from(UNIFORM_BUFFERS),
-                limit: u64::from(device.limits().max_uniform_buffers_per_shader_stage),
+            .ok_or_else(|| RenderError::Limit {
+                limit: "max_uniform_buffers_per_shader_stage",
+                needed: u64::from(UNIFORM_BUFFERS),
+                available: u64::from(device.limits().max_uniform_buffers_per_shader_stage),
             })
     }
 
@@ -310,7 +323,7 @@ impl Pipelines {
 }
 
 /// Creates one shader module and a compute pipeline per entry point inside error
-/// scopes, so that WGSL or pipeline errors come back as [`GpuError::Shader`] instead of
+/// scopes, so that WGSL or pipeline errors come back as [`RenderError::Shader`] instead of
 /// panicking.
 fn build_pipelines(
     device: &wgpu::Device,
@@ -318,7 +331,7 @@ fn build_pipelines(
     source: String,
     layout: &wgpu::PipelineLayout,
     entry_points: &[&str],
-) -> Result<Vec<wgpu::ComputePipeline>, GpuError> {
+) -> Result<Vec<wgpu::ComputePipeline>, RenderError> {
     capture(device, &format!("{name} shader"), Caught::Shader, || {
         let desc = wgpu::ShaderModuleDescriptor {
             label: Some(name),

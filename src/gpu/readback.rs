@@ -1,18 +1,18 @@
 //! Error scopes, bounded waits and readback: the host-side plumbing that turns wgpu's
-//! panics and callbacks into [`GpuError`] values.
+//! panics and callbacks into [`RenderError`] values.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::mpsc;
 use std::time::Duration;
 
-use super::GpuError;
+use super::RenderError;
 
 /// How validation and internal errors caught by [`capture`] are reported.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Caught {
-    /// Shader module or pipeline creation: [`GpuError::Shader`].
+    /// Shader module or pipeline creation: [`RenderError::Shader`].
     Shader,
-    /// Anything else: [`GpuError::Validation`].
+    /// Anything else: [`RenderError::Wgpu`].
     Resource,
 }
 
@@ -27,7 +27,7 @@ pub(crate) fn capture<T>(
     what: &str,
     kind: Caught,
     f: impl FnOnce() -> T,
-) -> Result<T, GpuError> {
+) -> Result<T, RenderError> {
     let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
     let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let internal = device.push_error_scope(wgpu::ErrorFilter::Internal);
@@ -35,14 +35,17 @@ pub(crate) fn capture<T>(
     let internal = pollster::block_on(internal.pop());
     let validation = pollster::block_on(validation.pop());
     let oom = pollster::block_on(oom.pop());
-    if let Some(e) = oom {
-        return Err(GpuError::OutOfMemory(format!("{what}: {e}")));
+    if let Some(source) = oom {
+        return Err(RenderError::OutOfMemory {
+            what: what.to_owned(),
+            source,
+        });
     }
-    if let Some(e) = validation.or(internal) {
-        let message = format!("{what}: {e}");
+    if let Some(source) = validation.or(internal) {
+        let what = what.to_owned();
         return Err(match kind {
-            Caught::Shader => GpuError::Shader(message),
-            Caught::Resource => GpuError::Validation(message),
+            Caught::Shader => RenderError::Shader { what, source },
+            Caught::Resource => RenderError::Wgpu { what, source },
         });
     }
     Ok(value)
@@ -51,7 +54,7 @@ pub(crate) fn capture<T>(
 /// Blocks until `submission` has finished, for at most `timeout` (`None`: as long as
 /// it takes).
 ///
-/// A timeout is reported as [`GpuError::DeviceLost`]: a dispatch that runs that long
+/// A timeout is reported as [`RenderError::Timeout`]: a dispatch that runs that long
 /// has hung or been killed by a watchdog, and waiting forever is worse. wgpu panics
 /// (rather than returning an error) when the device fails during the wait; that panic
 /// is caught here and reported as a lost device too, so a driver reset cannot take the
@@ -60,7 +63,7 @@ pub(crate) fn wait(
     device: &wgpu::Device,
     submission: wgpu::SubmissionIndex,
     timeout: Option<Duration>,
-) -> Result<(), GpuError> {
+) -> Result<(), RenderError> {
     let poll = catch_unwind(AssertUnwindSafe(|| {
         device.poll(wgpu::PollType::Wait {
             submission_index: Some(submission),
@@ -69,18 +72,15 @@ pub(crate) fn wait(
     }));
     match poll {
         Ok(Ok(_)) => Ok(()),
-        Ok(Err(wgpu::PollError::Timeout)) => Err(GpuError::DeviceLost(format!(
-            "the GPU did not finish within {:?} (the renderer's poll timeout)",
-            timeout.unwrap_or_default()
-        ))),
-        Ok(Err(e)) => Err(GpuError::DeviceLost(e.to_string())),
+        Ok(Err(wgpu::PollError::Timeout)) => Err(RenderError::Timeout(timeout.unwrap_or_default())),
+        Ok(Err(e)) => Err(RenderError::DeviceLost(e.to_string())),
         Err(panic) => {
             let message = panic
                 .downcast_ref::<String>()
                 .cloned()
                 .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
                 .unwrap_or_else(|| "device poll failed".to_string());
-            Err(GpuError::DeviceLost(message))
+            Err(RenderError::DeviceLost(message))
         }
     }
 }
@@ -92,7 +92,7 @@ pub(crate) fn submit_and_wait(
     encoder: wgpu::CommandEncoder,
     what: &str,
     timeout: Option<Duration>,
-) -> Result<(), GpuError> {
+) -> Result<(), RenderError> {
     let submission = capture(device, what, Caught::Resource, || {
         queue.submit([encoder.finish()])
     })?;
@@ -105,7 +105,7 @@ pub(crate) fn map_read(
     buffer: &wgpu::Buffer,
     size: u64,
     timeout: Option<Duration>,
-) -> Result<Vec<u8>, GpuError> {
+) -> Result<Vec<u8>, RenderError> {
     let (sender, receiver) = mpsc::channel();
     buffer.map_async(wgpu::MapMode::Read, 0..size, move |result| {
         // The receiver outlives the wait below; if it is gone nobody needs the result.
@@ -120,17 +120,37 @@ pub(crate) fn map_read(
     }));
     match poll {
         Ok(Ok(_)) => {}
-        Ok(Err(e)) => return Err(GpuError::Readback(format!("waiting for the map: {e}"))),
-        Err(_) => return Err(GpuError::DeviceLost("device failed while mapping".into())),
+        Ok(Err(wgpu::PollError::Timeout)) => {
+            return Err(RenderError::Timeout(timeout.unwrap_or_default()));
+        }
+        Ok(Err(e)) => return Err(RenderError::DeviceLost(format!("waiting for a map: {e}"))),
+        Err(_) => {
+            return Err(RenderError::DeviceLost(
+                "device failed while mapping".into(),
+            ));
+        }
     }
     match receiver.try_recv() {
         Ok(Ok(())) => {}
-        Ok(Err(e)) => return Err(GpuError::Readback(format!("map failed: {e}"))),
-        Err(_) => return Err(GpuError::Readback("the map did not complete".into())),
+        Ok(Err(e)) => {
+            return Err(RenderError::Readback {
+                what: format!("map failed: {e}"),
+                source: Some(e),
+            });
+        }
+        Err(_) => {
+            return Err(RenderError::Readback {
+                what: "the map did not complete".into(),
+                source: None,
+            });
+        }
     }
     let bytes = buffer
         .get_mapped_range(0..size)
-        .map_err(|e| GpuError::Readback(format!("mapped range: {e}")))?
+        .map_err(|e| RenderError::Readback {
+            what: format!("mapped range: {e}"),
+            source: None,
+        })?
         .to_vec();
     buffer.unmap();
     Ok(bytes)
@@ -152,11 +172,11 @@ const READBACK_BAND_BYTES: u64 = 64 << 20;
 /// 256-byte alignment and the padding is stripped; large textures are read in bands of
 /// rows through one staging buffer of at most 64 MiB. Each wait is bounded by `timeout`.
 ///
-/// Errors: [`GpuError::Readback`], [`GpuError::DeviceLost`], [`GpuError::OutOfMemory`].
+/// Errors: [`RenderError::Readback`], [`RenderError::DeviceLost`], [`RenderError::OutOfMemory`].
 ///
 /// ```no_run
 /// # fn demo(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture)
-/// # -> Result<(), gpu_render::gpu::GpuError> {
+/// # -> Result<(), gpu_render::gpu::RenderError> {
 /// let rgba8 = gpu_render::gpu::read_texture(
 ///     device, queue, texture, 4, Some(std::time::Duration::from_secs(10)))?;
 /// assert_eq!(rgba8.len(), (texture.width() * texture.height() * 4) as usize);
@@ -169,12 +189,13 @@ pub fn read_texture(
     texture: &wgpu::Texture,
     bytes_per_texel: u32,
     timeout: Option<Duration>,
-) -> Result<Vec<u8>, GpuError> {
+) -> Result<Vec<u8>, RenderError> {
     let (width, height) = (texture.width(), texture.height());
     let row_bytes = u64::from(width) * u64::from(bytes_per_texel);
     let padded_row = align_up(row_bytes, u64::from(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT));
-    let padded_row_u32 = u32::try_from(padded_row).map_err(|_| {
-        GpuError::Readback(format!("a row of {padded_row} bytes is too wide to copy"))
+    let padded_row_u32 = u32::try_from(padded_row).map_err(|_| RenderError::Readback {
+        what: format!("a row of {padded_row} bytes is too wide to copy"),
+        source: None,
     })?;
     let band_rows = (READBACK_BAND_BYTES / padded_row).clamp(1, u64::from(height.max(1)));
     let staging_size = padded_row * band_rows;
@@ -229,14 +250,14 @@ pub fn read_texture(
 /// 4) through a staging buffer of at most 64 MiB, in bands. Each wait is bounded by
 /// `timeout`.
 ///
-/// Errors: [`GpuError::Readback`], [`GpuError::DeviceLost`], [`GpuError::OutOfMemory`].
+/// Errors: [`RenderError::Readback`], [`RenderError::DeviceLost`], [`RenderError::OutOfMemory`].
 pub(crate) fn read_buffer(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     buffer: &wgpu::Buffer,
     size: u64,
     timeout: Option<Duration>,
-) -> Result<Vec<u8>, GpuError> {
+) -> Result<Vec<u8>, RenderError> {
     let band = READBACK_BAND_BYTES.min(size).max(4);
     let staging = capture(device, "readback buffer", Caught::Resource, || {
         device.create_buffer(&wgpu::BufferDescriptor {
@@ -259,6 +280,34 @@ pub(crate) fn read_buffer(
         offset += bytes;
     }
     Ok(out)
+}
+
+/// Creates a 2D texture inside error scopes (allocation failure becomes
+/// [`RenderError::OutOfMemory`]).
+pub(crate) fn create_texture(
+    device: &wgpu::Device,
+    label: &str,
+    width: u32,
+    height: u32,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> Result<wgpu::Texture, RenderError> {
+    capture(device, label, Caught::Resource, || {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        })
+    })
 }
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 //! records every traversal step reads in uniform buffers where `super::uniform_records`
 //! says), its image array and its trace constants.
 
-use super::GpuError;
+use super::RenderError;
 use super::area_lights::{EMITTER_NONE, FLAG_PATH, GpuEmitter, emitter_records};
 use super::environment::environment_buffer;
 use super::features::ShaderFeatures;
@@ -34,10 +34,10 @@ pub(crate) struct SceneBuffers {
     pub environment: wgpu::Buffer,
 }
 
-/// A scene uploaded to one device, ready to trace with
-/// [`super::GpuRenderer::render_prepared`].
+/// A scene's buffers and constants on one device (what [`super::GpuScene`] holds
+/// besides its pipelines and camera).
 #[derive(Debug)]
-pub struct PreparedScene {
+pub(crate) struct DeviceScene {
     pub(crate) frame: FrameUniforms,
     pub(crate) stack_size: u32,
     pub(crate) features: ShaderFeatures,
@@ -50,7 +50,7 @@ pub struct PreparedScene {
     image_bytes: u64,
 }
 
-impl PreparedScene {
+impl DeviceScene {
     /// Image width in pixels.
     pub fn width(&self) -> u32 {
         self.frame.width
@@ -134,16 +134,16 @@ pub(crate) fn upload_scene(
     scene: &Scene,
     geometry: &SceneGeometry,
     options: UploadOptions,
-) -> Result<PreparedScene, GpuError> {
+) -> Result<DeviceScene, RenderError> {
     let UploadOptions {
         specialise,
         allow_uniform_records,
         allow_refill_lanes,
         allow_unrolled,
     } = options;
-    scene.render.check().map_err(GpuError::Validation)?;
+    scene.render.check().map_err(RenderError::InvalidSettings)?;
     if geometry.planes.len() > MAX_PLANES {
-        return Err(GpuError::DeviceLimit {
+        return Err(RenderError::SceneTooLarge {
             what: "infinite planes (every ray tests every plane; use polygons)".into(),
             value: geometry.planes.len() as u64,
             limit: MAX_PLANES as u64,
@@ -182,38 +182,39 @@ pub(crate) fn upload_scene(
         && uniform_records::preferred(&device.adapter_info())
         && uniform_records::fits(&padded, &limits);
     let mut scene_bytes = 0;
-    let mut upload = |what: &str, binding: u32, bytes: &[u8]| -> Result<wgpu::Buffer, GpuError> {
-        // A uniform record array is bound whole: its buffer has the array's length.
-        let uniform_bytes = uniform_records
-            .then(|| uniform_records::padded_bytes(binding))
-            .flatten();
-        let size = uniform_bytes.unwrap_or(bytes.len() as u64);
-        // A uniform record array fits its binding (`uniform_records::fits`).
-        if uniform_bytes.is_none() && size > max_binding {
-            return Err(GpuError::DeviceLimit {
-                what: format!("{what} buffer bytes"),
-                value: size,
-                limit: max_binding,
-            });
-        }
-        scene_bytes += size;
-        let buffer = capture(device, what, Caught::Resource, || {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(what),
-                size,
-                usage: if uniform_bytes.is_some() {
-                    wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST
-                } else {
-                    wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST
-                },
-                mapped_at_creation: false,
-            })
-        })?;
-        // write_buffer stages through the queue: no mapped_at_creation, whose mapping
-        // would panic if the allocation had failed.
-        queue.write_buffer(&buffer, 0, bytes);
-        Ok(buffer)
-    };
+    let mut upload =
+        |what: &str, binding: u32, bytes: &[u8]| -> Result<wgpu::Buffer, RenderError> {
+            // A uniform record array is bound whole: its buffer has the array's length.
+            let uniform_bytes = uniform_records
+                .then(|| uniform_records::padded_bytes(binding))
+                .flatten();
+            let size = uniform_bytes.unwrap_or(bytes.len() as u64);
+            // A uniform record array fits its binding (`uniform_records::fits`).
+            if uniform_bytes.is_none() && size > max_binding {
+                return Err(RenderError::SceneTooLarge {
+                    what: format!("{what} buffer bytes"),
+                    value: size,
+                    limit: max_binding,
+                });
+            }
+            scene_bytes += size;
+            let buffer = capture(device, what, Caught::Resource, || {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(what),
+                    size,
+                    usage: if uniform_bytes.is_some() {
+                        wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST
+                    } else {
+                        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST
+                    },
+                    mapped_at_creation: false,
+                })
+            })?;
+            // write_buffer stages through the queue: no mapped_at_creation, whose mapping
+            // would panic if the allocation had failed.
+            queue.write_buffer(&buffer, 0, bytes);
+            Ok(buffer)
+        };
     let buffers = SceneBuffers {
         spheres: upload(
             "sphere",
@@ -282,7 +283,7 @@ pub(crate) fn upload_scene(
         None
     };
     let (images, image_bytes) = upload_images(device, queue, &shaded, &limits)?;
-    Ok(PreparedScene {
+    Ok(DeviceScene {
         frame,
         // A path keeps its one continuation on the bounce stack.
         stack_size: if path {
@@ -317,11 +318,11 @@ fn upload_images(
     queue: &wgpu::Queue,
     scene: &Scene,
     limits: &wgpu::Limits,
-) -> Result<(wgpu::TextureView, u64), GpuError> {
+) -> Result<(wgpu::TextureView, u64), RenderError> {
     let cdfs = BrdfMapCdfs::new(&scene.images, &scene.materials);
     let (width, height, layers, texels) = image_layers(&scene.images, &cdfs);
     if layers > limits.max_texture_array_layers {
-        return Err(GpuError::DeviceLimit {
+        return Err(RenderError::SceneTooLarge {
             what: "images (texture array layers)".to_string(),
             value: u64::from(layers),
             limit: u64::from(limits.max_texture_array_layers),

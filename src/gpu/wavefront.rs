@@ -11,14 +11,16 @@
 
 use std::time::{Duration, Instant};
 
-use super::GpuError;
+use super::RenderError;
+use super::error::TraceFailure;
 use super::layout::{
     ERROR_LOOP_CUT, ERROR_TRAVERSAL_STACK, FrameUniforms, GpuCounters, GpuPathState, GpuStackEntry,
     GpuTraceRay, static_pixels_for,
 };
+use super::pipelines::LINEAR_FORMAT;
 use super::pipelines::{TracePipelines, binding};
-use super::readback::{Caught, capture, map_read, read_buffer, submit_and_wait};
-use super::scene_buffers::PreparedScene;
+use super::readback::{Caught, capture, create_texture, map_read, read_buffer, submit_and_wait};
+use super::scene_buffers::DeviceScene;
 use super::shaders::SLOT_WORKGROUP_SIZE;
 use crate::accel::MAX_BVH_DEPTH;
 use crate::noise::NoiseEstimate;
@@ -172,7 +174,7 @@ impl SlotBuffers {
         slot_count: u32,
         stack_size: u32,
         accumulation_pixels: u64,
-    ) -> Result<Self, GpuError> {
+    ) -> Result<Self, RenderError> {
         let storage = |label: &str, bytes: u64, extra: wgpu::BufferUsages| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -255,7 +257,7 @@ impl SlotBuffers {
         (width, height): (u32, u32),
         samples: u32,
         timeout: Option<Duration>,
-    ) -> Result<NoiseEstimate, GpuError> {
+    ) -> Result<NoiseEstimate, RenderError> {
         let pixels = u64::from(width) * u64::from(height);
         let bytes = read_buffer(device, queue, &self.accumulation, pixels * 16, timeout)?;
         let float = |b: &[u8]| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
@@ -278,9 +280,9 @@ impl SlotBuffers {
         &self,
         device: &wgpu::Device,
         layout: &wgpu::BindGroupLayout,
-        scene: &PreparedScene,
+        scene: &DeviceScene,
         target: &wgpu::TextureView,
-    ) -> Result<wgpu::BindGroup, GpuError> {
+    ) -> Result<wgpu::BindGroup, RenderError> {
         capture(device, "trace bind group", Caught::Resource, || {
             self.bind_group_unchecked(device, layout, scene, target)
         })
@@ -293,7 +295,7 @@ impl SlotBuffers {
         &self,
         device: &wgpu::Device,
         layout: &wgpu::BindGroupLayout,
-        scene: &PreparedScene,
+        scene: &DeviceScene,
         target: &wgpu::TextureView,
     ) -> wgpu::BindGroup {
         fn buffer(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
@@ -368,7 +370,7 @@ pub(crate) fn trace_region(
     frame: &FrameUniforms,
     timeout: Option<Duration>,
     report: &dyn Fn(u64),
-) -> Result<TraceOutcome, GpuError> {
+) -> Result<TraceOutcome, RenderError> {
     let pixels = u64::from(frame.region_width) * u64::from(frame.region_height);
     let mut outcome = TraceOutcome::default();
     if pixels == 0 {
@@ -481,24 +483,62 @@ pub(crate) fn encode_rounds(
     }
 }
 
+/// Runs each trace kernel of `pipelines` once over no slots (`slot_count` 0: every
+/// invocation returns at once), so that a driver that compiles a pipeline at its first
+/// dispatch rather than at its creation (lavapipe: LLVM, seconds for a trace module)
+/// compiles it now, at upload, and neither the first trace's time nor the first frame
+/// of a frame loop pays for it.
+pub(crate) fn warm_up(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    pipelines: &TracePipelines,
+    layout: &wgpu::BindGroupLayout,
+    scene: &DeviceScene,
+    timeout: Option<Duration>,
+) -> Result<(), RenderError> {
+    let slots = SlotBuffers::new(device, 1, scene.stack_size, 0)?;
+    let target = create_texture(
+        device,
+        "gpu-render warm-up target",
+        1,
+        1,
+        LINEAR_FORMAT,
+        wgpu::TextureUsages::STORAGE_BINDING,
+    )?;
+    let view = target.create_view(&wgpu::TextureViewDescriptor::default());
+    let bind_group = slots.bind_group(device, layout, scene, &view)?;
+    let frame = FrameUniforms {
+        slot_count: 0,
+        ..scene.frame
+    };
+    queue.write_buffer(&slots.uniforms, 0, bytemuck::bytes_of(&frame));
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+        label: Some("gpu-render warm-up"),
+    });
+    {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("gpu-render warm-up"),
+            timestamp_writes: None,
+        });
+        pass.set_bind_group(0, &bind_group, &[]);
+        for pipeline in [&pipelines.shade, &pipelines.trace, &pipelines.fused] {
+            pass.set_pipeline(pipeline);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+    }
+    submit_and_wait(device, queue, encoder, "warm-up dispatch", timeout)
+}
+
 /// Turns the kernels' error bits into an error: an image with a cut loop or an
 /// overflowing traversal stack would be silently wrong, so none is returned.
-pub(crate) fn check_errors(errors: u32) -> Result<(), GpuError> {
+pub(crate) fn check_errors(errors: u32) -> Result<(), RenderError> {
     if errors & ERROR_LOOP_CUT != 0 {
-        return Err(GpuError::TraceIncomplete(
-            "a shader loop was cut short by the driver before it finished (llvmpipe ends \
-             every loop of an invocation after 65,535 iterations); the image would miss \
-             rays, so none is returned. Lower the iteration budget \
-             (GpuRenderer::with_iteration_budget, or the CLI's --iteration-budget) or \
-             render with the CPU backend"
-                .into(),
-        ));
+        return Err(RenderError::TraceIncomplete(TraceFailure::LoopCut));
     }
     if errors & ERROR_TRAVERSAL_STACK != 0 {
-        return Err(GpuError::TraceIncomplete(format!(
-            "a BVH traversal needed more than {MAX_BVH_DEPTH} stack entries; the image would \
-             miss hits, so none is returned (a bug: the builders bound the depth)"
-        )));
+        return Err(RenderError::TraceIncomplete(TraceFailure::TraversalStack {
+            max_depth: MAX_BVH_DEPTH,
+        }));
     }
     Ok(())
 }

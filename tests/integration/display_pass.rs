@@ -109,7 +109,7 @@ fn run_display_pass(encode_srgb: bool) -> Option<(LinearImage, Vec<u8>)> {
     );
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
     renderer
-        .encode_display(
+        .encode_display_texture(
             device,
             &mut encoder,
             &linear.create_view(&Default::default()),

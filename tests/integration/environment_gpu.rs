@@ -19,7 +19,7 @@ use std::sync::Arc;
 
 use crate::support::compare::Tolerance;
 use glam::DVec3;
-use gpu_render::gpu::{GpuRenderer, HeadlessGpu};
+use gpu_render::gpu::{HeadlessGpu, Renderer};
 use gpu_render::scene::{Integrator, Material, MaterialKind, RenderOverrides, Scene, Shape};
 
 const TOLERANCE: Tolerance = crate::support::twins::TWIN_TOLERANCE;
@@ -39,7 +39,7 @@ fn env_materials(integrator: Integrator, width: u32, samples: u32) -> Scene {
     )
 }
 
-fn compare(gpu: &HeadlessGpu, renderer: &GpuRenderer, label: &str, scene: &Scene) {
+fn compare(gpu: &HeadlessGpu, renderer: &Renderer, label: &str, scene: &Scene) {
     crate::support::twins::assert_backends_agree(gpu, renderer, label, scene, TOLERANCE);
 }
 

@@ -17,7 +17,8 @@ use std::sync::Mutex;
 use crate::support::compare::{Comparison, Tolerance, assert_images_match, measure};
 use glam::DVec3;
 use gpu_render::film::LinearImage;
-use gpu_render::gpu::{GpuError, GpuRenderer, HeadlessGpu};
+use gpu_render::gpu::RendererOptions;
+use gpu_render::gpu::{HeadlessGpu, RenderError, Renderer};
 use gpu_render::scene::{
     Camera, Environment, Light, LightingSpace, Material, MaterialKind, RenderSettings, Scene, Shape,
 };
@@ -54,7 +55,7 @@ fn gpu_render_image(label: &str, gpu: &Gpu, scene: &Scene) -> LinearImage {
 
 struct Gpu {
     gpu: HeadlessGpu,
-    renderer: GpuRenderer,
+    renderer: Renderer,
 }
 
 fn gpu() -> Option<Gpu> {
@@ -901,7 +902,7 @@ fn images_beyond_the_texture_limit_render_in_tiles() {
         max_compute_workgroups_per_dimension: 3,
         ..l
     });
-    let renderer = GpuRenderer::new(&device).expect("renderer");
+    let renderer = Renderer::new(&device, RendererOptions::default()).expect("renderer");
     let mut scene = scaled_scene(1.0);
     scene.render = settings(70, 50, 6);
     let rows = Mutex::new(Vec::new());
@@ -947,7 +948,7 @@ fn images_beyond_the_texture_limit_render_in_tiles() {
     });
     let view = texture.create_view(&Default::default());
     match renderer.render_to_texture(&device, &queue, &scene, &view, None) {
-        Err(GpuError::DeviceLimit { what, value, limit }) => {
+        Err(RenderError::SceneTooLarge { what, value, limit }) => {
             assert!(what.contains("image width"), "{what}");
             assert_eq!((value, limit), (70, 32));
         }
@@ -966,9 +967,14 @@ fn oversized_scene_buffers_give_a_clear_error() {
         max_storage_buffer_binding_size: 1024,
         ..l
     });
-    let renderer = GpuRenderer::new(&device)
-        .expect("renderer")
-        .with_uniform_records(false);
+    let renderer = Renderer::new(
+        &device,
+        RendererOptions {
+            uniform_records: false,
+            ..RendererOptions::default()
+        },
+    )
+    .expect("renderer");
     let scene = mesh_scene(&icosphere_mesh(), DVec3::ZERO, DVec3::Y, 90.0);
     let error = renderer
         .render(&device, &queue, &scene, None)
@@ -1050,9 +1056,9 @@ fn a_device_with_few_uniform_buffers_keeps_storage_records() {
         max_uniform_buffers_per_shader_stage: 4,
         ..l
     });
-    let renderer = GpuRenderer::new(&device).expect("renderer");
+    let renderer = Renderer::new(&device, RendererOptions::default()).expect("renderer");
     let scene = mesh_scene(&icosphere_mesh(), DVec3::ZERO, DVec3::Y, 90.0);
-    let prepared = renderer.prepare(&device, &queue, &scene).expect("prepare");
+    let prepared = renderer.upload(&device, &queue, &scene).expect("prepare");
     assert!(!prepared.features().uniform_records);
     let rendered = renderer
         .render(&device, &queue, &scene, None)

@@ -650,7 +650,8 @@ fn unsuitable_targets_and_films_get_typed_errors() {
         display(&target(F::Rgba16Float, U::STORAGE_BINDING, 16)),
         Err(RenderError::TargetFormat {
             expected: F::Rgba8Unorm,
-            found: F::Rgba16Float
+            found: F::Rgba16Float,
+            ..
         })
     ));
     assert!(matches!(
@@ -661,7 +662,8 @@ fn unsuitable_targets_and_films_get_typed_errors() {
         display(&target(F::Rgba8Unorm, U::STORAGE_BINDING, 20)),
         Err(RenderError::TargetSize {
             film: (16, 12),
-            target: (20, 12)
+            target: (20, 12),
+            ..
         })
     ));
     assert!(display(&target(F::Rgba8Unorm, U::STORAGE_BINDING, 16)).is_ok());

@@ -6,6 +6,7 @@
 use std::sync::Mutex;
 
 use glam::DVec3;
+use gpu_render::gpu::RendererOptions;
 use gpu_render::scene::{
     Camera, Environment, Light, LightingSpace, Material, RenderSettings, Scene, Shape,
 };
@@ -57,9 +58,14 @@ fn scene(samples_per_pixel: u32) -> Scene {
 /// With `noise`, the render also keeps and reads back each pixel's noise estimate.
 fn peak_allocated(gpu: &gpu_render::gpu::HeadlessGpu, samples: u32, noise: bool) -> Option<u64> {
     // A small budget, so that even the short render takes several submissions.
-    let renderer = crate::support::gpu::renderer(gpu)
-        .with_iteration_budget(256)
-        .with_noise_estimate(noise);
+    let renderer = crate::support::gpu::renderer_with(
+        gpu,
+        RendererOptions {
+            iteration_budget: Some(256),
+            noise_estimate: noise,
+            ..RendererOptions::default()
+        },
+    );
     let peak = Mutex::new(None);
     let progress = |_: u32, _: u32| {
         if let Some(report) = gpu.device.generate_allocator_report() {

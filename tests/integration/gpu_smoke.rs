@@ -7,7 +7,8 @@ use std::sync::Mutex;
 use std::time::Duration;
 
 use glam::DVec3;
-use gpu_render::gpu::{GpuError, Schedule, TraceRegion, read_texture};
+use gpu_render::gpu::RendererOptions;
+use gpu_render::gpu::{RenderError, Schedule, TraceRegion, read_texture};
 use gpu_render::scene::{
     Camera, Environment, Light, LightingSpace, Material, RenderOverrides, RenderSettings, Scene,
     Shape,
@@ -71,7 +72,13 @@ fn render_reads_back_counts_rays_and_reports_progress() {
         return;
     };
     // A small budget, so that the render takes several submissions.
-    let renderer = crate::support::gpu::renderer(&gpu).with_iteration_budget(64);
+    let renderer = crate::support::gpu::renderer_with(
+        &gpu,
+        RendererOptions {
+            iteration_budget: Some(64),
+            ..RendererOptions::default()
+        },
+    );
     let scene = scene(SPP);
 
     let reported = Mutex::new(Vec::new());
@@ -181,7 +188,7 @@ fn regions_slots_and_budgets_do_not_change_the_image() {
         read_texture(device, queue, &reference, 16, timeout).expect("reference reads back");
 
     // Three uneven bands of rows, each traced into its place in one target.
-    let prepared = renderer.prepare(device, queue, &scene).expect("prepare");
+    let prepared = renderer.upload(device, queue, &scene).expect("prepare");
     // The reference gives way to finished lanes wherever the device can (lavapipe can).
     let subgroups = device.features().contains(wgpu::Features::SUBGROUP);
     assert_eq!(prepared.features().refill_lanes, subgroups);
@@ -210,45 +217,89 @@ fn regions_slots_and_budgets_do_not_change_the_image() {
     for (label, variant) in [
         (
             "one slot",
-            crate::support::gpu::renderer(&gpu).with_slot_count(1),
+            crate::support::gpu::renderer_with(
+                &gpu,
+                RendererOptions {
+                    slot_count: Some(1),
+                    ..RendererOptions::default()
+                },
+            ),
         ),
         (
             "budget 3",
-            crate::support::gpu::renderer(&gpu).with_iteration_budget(3),
+            crate::support::gpu::renderer_with(
+                &gpu,
+                RendererOptions {
+                    iteration_budget: Some(3),
+                    ..RendererOptions::default()
+                },
+            ),
         ),
         (
             "no lane refill",
-            crate::support::gpu::renderer(&gpu).with_refill_lanes(false),
+            crate::support::gpu::renderer_with(
+                &gpu,
+                RendererOptions {
+                    refill_lanes: false,
+                    ..RendererOptions::default()
+                },
+            ),
         ),
         (
             "wavefront schedule",
-            crate::support::gpu::renderer(&gpu).with_schedule(Schedule::Wavefront),
+            crate::support::gpu::renderer_with(
+                &gpu,
+                RendererOptions {
+                    schedule: Some(Schedule::Wavefront),
+                    ..RendererOptions::default()
+                },
+            ),
         ),
         (
             "fused schedule, budget 3",
-            crate::support::gpu::renderer(&gpu)
-                .with_schedule(Schedule::Fused)
-                .with_iteration_budget(3),
+            crate::support::gpu::renderer_with(
+                &gpu,
+                RendererOptions {
+                    schedule: Some(Schedule::Fused),
+                    iteration_budget: Some(3),
+                    ..RendererOptions::default()
+                },
+            ),
         ),
         // The smallest budgets: a budget of 1 once made no progress at all in the
         // fused kernel (its shading step spent the one iteration on nothing).
         (
             "fused schedule, budget 1",
-            crate::support::gpu::renderer(&gpu)
-                .with_schedule(Schedule::Fused)
-                .with_iteration_budget(1),
+            crate::support::gpu::renderer_with(
+                &gpu,
+                RendererOptions {
+                    schedule: Some(Schedule::Fused),
+                    iteration_budget: Some(1),
+                    ..RendererOptions::default()
+                },
+            ),
         ),
         (
             "fused schedule, budget 2",
-            crate::support::gpu::renderer(&gpu)
-                .with_schedule(Schedule::Fused)
-                .with_iteration_budget(2),
+            crate::support::gpu::renderer_with(
+                &gpu,
+                RendererOptions {
+                    schedule: Some(Schedule::Fused),
+                    iteration_budget: Some(2),
+                    ..RendererOptions::default()
+                },
+            ),
         ),
         (
             "wavefront schedule, budget 1",
-            crate::support::gpu::renderer(&gpu)
-                .with_schedule(Schedule::Wavefront)
-                .with_iteration_budget(1),
+            crate::support::gpu::renderer_with(
+                &gpu,
+                RendererOptions {
+                    schedule: Some(Schedule::Wavefront),
+                    iteration_budget: Some(1),
+                    ..RendererOptions::default()
+                },
+            ),
         ),
     ] {
         let target = linear_target(device);
@@ -270,10 +321,21 @@ fn giving_way_to_finished_lanes_does_not_change_the_image() {
     let Some(gpu) = crate::support::gpu::headless_gpu() else {
         return;
     };
-    let refill = crate::support::gpu::renderer(&gpu).with_schedule(Schedule::Fused);
-    let plain = crate::support::gpu::renderer(&gpu)
-        .with_schedule(Schedule::Fused)
-        .with_refill_lanes(false);
+    let refill = crate::support::gpu::renderer_with(
+        &gpu,
+        RendererOptions {
+            schedule: Some(Schedule::Fused),
+            ..RendererOptions::default()
+        },
+    );
+    let plain = crate::support::gpu::renderer_with(
+        &gpu,
+        RendererOptions {
+            schedule: Some(Schedule::Fused),
+            refill_lanes: false,
+            ..RendererOptions::default()
+        },
+    );
     for path in ["showcase.toml", "glass.toml", "models.toml"] {
         let scene = crate::support::scenes::reduced(
             crate::support::scenes::shipped(path),
@@ -299,8 +361,8 @@ fn bad_input_is_an_error_not_a_panic() {
     let mut bad = scene(1);
     bad.render.stack_size = 0;
     assert!(matches!(
-        renderer.prepare(device, queue, &bad),
-        Err(GpuError::Validation(_))
+        renderer.upload(device, queue, &bad),
+        Err(RenderError::InvalidSettings(_))
     ));
 
     // An image wider than one texture can be: `render` tiles it (tests/integration/extremes.rs),
@@ -312,14 +374,14 @@ fn bad_input_is_an_error_not_a_panic() {
         let target = linear_target(device);
         let view = target.create_view(&Default::default());
         match renderer.render_to_texture(device, queue, &wide, &view, None) {
-            Err(GpuError::DeviceLimit { value, limit, .. }) => {
+            Err(RenderError::SceneTooLarge { value, limit, .. }) => {
                 assert_eq!((value, limit), (u64::from(width), u64::from(width - 1)));
             }
             other => panic!("expected DeviceLimit, got {other:?}"),
         }
     }
 
-    let prepared = renderer.prepare(device, queue, &scene(1)).expect("prepare");
+    let prepared = renderer.upload(device, queue, &scene(1)).expect("prepare");
     let target = linear_target(device);
     let view = target.create_view(&Default::default());
     let outside = TraceRegion {
@@ -329,7 +391,7 @@ fn bad_input_is_an_error_not_a_panic() {
     };
     assert!(matches!(
         renderer.trace_into(device, queue, &prepared, &view, &outside, None),
-        Err(GpuError::Validation(_))
+        Err(RenderError::InvalidRegion { .. })
     ));
     let wrong_format = image_texture(
         device,
@@ -345,7 +407,16 @@ fn bad_input_is_an_error_not_a_panic() {
         &TraceRegion::whole(WIDTH, HEIGHT),
         None,
     );
-    assert!(matches!(result, Err(GpuError::Validation(_))), "{result:?}");
+    assert!(
+        matches!(
+            result,
+            Err(RenderError::TargetFormat {
+                role: "trace target",
+                ..
+            })
+        ),
+        "{result:?}"
+    );
 }
 
 #[test]
@@ -412,13 +483,20 @@ fn a_stalled_device_is_an_error_not_a_hang() {
     let Some(gpu) = crate::support::gpu::headless_gpu() else {
         return;
     };
-    let renderer = crate::support::gpu::renderer(&gpu).with_poll_timeout(Duration::from_nanos(1));
+    let renderer = crate::support::gpu::renderer_with(
+        &gpu,
+        RendererOptions {
+            poll_timeout: Some(Duration::from_nanos(1)),
+            ..RendererOptions::default()
+        },
+    );
     let started = std::time::Instant::now();
     match renderer.render(&gpu.device, &gpu.queue, &scene(256), None) {
-        Err(GpuError::DeviceLost(message)) => {
-            assert!(message.contains("did not finish"), "{message}");
+        Err(error @ RenderError::Timeout(limit)) => {
+            assert_eq!(limit, Duration::from_nanos(1));
+            assert!(error.to_string().contains("did not finish"), "{error}");
         }
-        Err(other) => panic!("expected a lost-device error, got {other}"),
+        Err(other) => panic!("expected a timeout, got {other}"),
         Ok(_) => panic!("a 1 ns limit cannot be met by a 256-sample render"),
     }
     assert!(

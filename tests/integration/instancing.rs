@@ -493,7 +493,7 @@ fn a_hundred_copies_cost_one_copy_and_a_hundred_instance_records() {
     let renderer = crate::support::gpu::renderer(&gpu);
     let uploaded = |copies: usize| {
         renderer
-            .prepare(&gpu.device, &gpu.queue, &scene(copies))
+            .upload(&gpu.device, &gpu.queue, &scene(copies))
             .unwrap_or_else(|e| panic!("upload failed: {e}"))
             .scene_bytes() as usize
     };

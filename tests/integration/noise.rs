@@ -108,7 +108,13 @@ fn gpu_estimates_equal_the_cpu_reference_per_pixel() {
     let Some(gpu) = crate::support::gpu::headless_gpu() else {
         return;
     };
-    let renderer = crate::support::gpu::renderer(&gpu).with_noise_estimate(true);
+    let renderer = crate::support::gpu::renderer_with(
+        &gpu,
+        RendererOptions {
+            noise_estimate: true,
+            ..RendererOptions::default()
+        },
+    );
     for (label, scene) in [
         ("path-traced Cornell box", cornell(48, 8, Integrator::Path)),
         ("Whitted Cornell box", cornell(48, 8, Integrator::Whitted)),

@@ -17,7 +17,7 @@
 
 use crate::support::compare::Tolerance;
 use glam::DVec3;
-use gpu_render::gpu::{GpuError, GpuRenderer, Renderer, RendererOptions, Schedule};
+use gpu_render::gpu::{RenderError, Renderer, RendererOptions, Schedule, TraceFailure};
 use gpu_render::scene::{
     Camera, Environment, Integrator, Material, MaterialKind, RenderOverrides, RenderSettings,
     Scene, Shape,
@@ -36,7 +36,7 @@ fn shipped(name: &str, width: u32, samples: u32) -> Scene {
 }
 
 /// Renders `scene` on both backends and compares them.
-fn compare(gpu: &gpu_render::gpu::HeadlessGpu, renderer: &GpuRenderer, label: &str, scene: &Scene) {
+fn compare(gpu: &gpu_render::gpu::HeadlessGpu, renderer: &Renderer, label: &str, scene: &Scene) {
     crate::support::twins::assert_backends_agree(gpu, renderer, label, scene, TOLERANCE);
 }
 
@@ -223,11 +223,16 @@ fn the_budget_bounds_path_tracing_and_a_cut_loop_is_an_error() {
     for schedule in [Schedule::Fused, Schedule::Wavefront] {
         // 1 is the smallest budget the CLI accepts; it once never finished (fused).
         for budget in [1, 3] {
-            let tiny = crate::support::gpu::renderer(&gpu)
-                .with_schedule(schedule)
-                .with_iteration_budget(budget)
-                .render(&gpu.device, &gpu.queue, &scene, None)
-                .expect("GPU render with a tiny budget");
+            let tiny = crate::support::gpu::renderer_with(
+                &gpu,
+                RendererOptions {
+                    schedule: Some(schedule),
+                    iteration_budget: Some(budget),
+                    ..RendererOptions::default()
+                },
+            )
+            .render(&gpu.device, &gpu.queue, &scene, None)
+            .expect("GPU render with a tiny budget");
             assert_eq!(
                 tiny.image.pixels, reference.image.pixels,
                 "{schedule:?}, budget {budget}: the image must not change"
@@ -237,14 +242,23 @@ fn the_budget_bounds_path_tracing_and_a_cut_loop_is_an_error() {
                 "{schedule:?}, budget {budget}: same rays"
             );
         }
-        let cut = GpuRenderer::new(&gpu.device)
-            .expect("renderer")
-            .with_schedule(schedule)
-            .with_simulated_loop_cut(true)
-            .render(&gpu.device, &gpu.queue, &scene, None);
+        let cut = Renderer::new(
+            &gpu.device,
+            RendererOptions {
+                schedule: Some(schedule),
+                simulate_loop_cut: true,
+                ..RendererOptions::default()
+            },
+        )
+        .expect("renderer")
+        .render(&gpu.device, &gpu.queue, &scene, None);
         match cut {
-            Err(GpuError::TraceIncomplete(message)) => {
-                assert!(message.contains("cut short"), "{schedule:?}: {message}")
+            Err(RenderError::TraceIncomplete(failure)) => {
+                assert_eq!(failure, TraceFailure::LoopCut, "{schedule:?}");
+                assert!(
+                    failure.to_string().contains("cut short"),
+                    "{schedule:?}: {failure}"
+                );
             }
             other => panic!("{schedule:?}: expected TraceIncomplete, got {other:?}"),
         }

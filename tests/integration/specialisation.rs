@@ -3,8 +3,9 @@
 
 use std::collections::BTreeSet;
 
+use gpu_render::gpu::RendererOptions;
 use gpu_render::gpu::shaders::trace_shader_source;
-use gpu_render::gpu::{GpuRenderer, ShaderFeatures};
+use gpu_render::gpu::{Renderer, ShaderFeatures};
 use gpu_render::scene::{RenderOverrides, Scene, load_scene};
 
 use crate::support::scenes::shipped as scene;
@@ -226,9 +227,14 @@ fn specialised_and_general_modules_render_the_same_pixels() {
         return;
     };
     let specialised = crate::support::gpu::renderer(&gpu);
-    let general = GpuRenderer::new(&gpu.device)
-        .expect("renderer")
-        .with_specialisation(false);
+    let general = Renderer::new(
+        &gpu.device,
+        RendererOptions {
+            specialise: false,
+            ..RendererOptions::default()
+        },
+    )
+    .expect("renderer");
     for path in crate::support::scenes::shipped_scenes() {
         let scene = reduced(load_scene(&path).unwrap_or_else(|e| panic!("{e}")));
         let a = specialised

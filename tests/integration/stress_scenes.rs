@@ -9,7 +9,8 @@
 use crate::support::compare::{Tolerance, assert_images_match};
 use crate::support::geometry::{SplitMix, uv_sphere};
 use glam::DVec3;
-use gpu_render::gpu::{GpuError, GpuRenderer, Schedule};
+use gpu_render::gpu::{RenderError, Renderer, Schedule};
+use gpu_render::gpu::{RendererOptions, TraceFailure};
 use gpu_render::scene::{
     Camera, Environment, Light, LightingSpace, Material, MaterialKind, RenderOverrides,
     RenderSettings, Scene, Shape,
@@ -336,31 +337,45 @@ fn a_loop_the_driver_cuts_is_an_error_not_a_short_image() {
             },
         ],
     );
-    let expect_cut = |renderer: GpuRenderer, what: &str| match renderer.render(
+    let expect_cut = |renderer: Renderer, what: &str| match renderer.render(
         &gpu.device,
         &gpu.queue,
         &scene,
         None,
     ) {
-        Err(GpuError::TraceIncomplete(message)) => {
-            assert!(message.contains("cut short"), "{what}: {message}")
+        Err(RenderError::TraceIncomplete(failure)) => {
+            assert_eq!(failure, TraceFailure::LoopCut, "{what}");
+            assert!(
+                failure.to_string().contains("cut short"),
+                "{what}: {failure}"
+            );
         }
         other => panic!("{what}: expected TraceIncomplete, got {other:?}"),
     };
     for schedule in [Schedule::Fused, Schedule::Wavefront] {
-        let simulated = GpuRenderer::new(&gpu.device)
-            .expect("renderer")
-            .with_schedule(schedule)
-            .with_simulated_loop_cut(true);
+        let simulated = Renderer::new(
+            &gpu.device,
+            RendererOptions {
+                schedule: Some(schedule),
+                simulate_loop_cut: true,
+                ..RendererOptions::default()
+            },
+        )
+        .expect("renderer");
         expect_cut(simulated, &format!("simulated cut, {schedule:?}"));
     }
     let info = gpu.adapter_info();
     if let Some(limit) = gpu_render::gpu::driver_loop_limit(&info) {
         // One slot tracing the whole image in one dispatch runs far past the limit.
-        let unbounded = GpuRenderer::new(&gpu.device)
-            .expect("renderer")
-            .with_slot_count(1)
-            .with_iteration_budget(u32::MAX);
+        let unbounded = Renderer::new(
+            &gpu.device,
+            RendererOptions {
+                slot_count: Some(1),
+                iteration_budget: Some(u32::MAX),
+                ..RendererOptions::default()
+            },
+        )
+        .expect("renderer");
         expect_cut(unbounded, &format!("{} (limit {limit})", info.name));
     }
 }

@@ -4,7 +4,8 @@
 //! buffers, and scenes too large for them keep storage buffers.
 
 use glam::DVec3;
-use gpu_render::gpu::GpuRenderer;
+use gpu_render::gpu::Renderer;
+use gpu_render::gpu::RendererOptions;
 use gpu_render::scene::{Light, RenderOverrides, Scene};
 
 /// Whether the test device is a CPU (lavapipe), where uniform records are preferred.
@@ -18,9 +19,14 @@ fn shipped_scenes_render_the_same_with_uniform_and_storage_records() {
         return;
     };
     let uniform = crate::support::gpu::renderer(&gpu);
-    let storage = GpuRenderer::new(&gpu.device)
-        .expect("renderer")
-        .with_uniform_records(false);
+    let storage = Renderer::new(
+        &gpu.device,
+        RendererOptions {
+            uniform_records: false,
+            ..RendererOptions::default()
+        },
+    )
+    .expect("renderer");
     let mut uniform_scenes = 0;
     // Whitted with polygons, triangles and glass; the path integrator; meshes and
     // textures; tabulated BRDFs; an environment map.
@@ -38,11 +44,11 @@ fn shipped_scenes_render_the_same_with_uniform_and_storage_records() {
             RenderOverrides::default(),
         );
         let prepared = uniform
-            .prepare(&gpu.device, &gpu.queue, &scene)
+            .upload(&gpu.device, &gpu.queue, &scene)
             .expect("prepare");
         assert!(
             !storage
-                .prepare(&gpu.device, &gpu.queue, &scene)
+                .upload(&gpu.device, &gpu.queue, &scene)
                 .expect("prepare")
                 .features()
                 .uniform_records
@@ -90,11 +96,11 @@ fn records_beyond_one_uniform_binding_stay_in_storage_buffers() {
     // 64 KiB of 32-byte light records hold 2,048 lights.
     let capacity = 65536 / std::mem::size_of::<gpu_render::gpu::layout::GpuLight>();
     let fits = renderer
-        .prepare(&gpu.device, &gpu.queue, &with_point_lights(capacity - base))
+        .upload(&gpu.device, &gpu.queue, &with_point_lights(capacity - base))
         .expect("prepare");
     assert_eq!(fits.features().uniform_records, cpu_device(&gpu));
     let beyond = renderer
-        .prepare(
+        .upload(
             &gpu.device,
             &gpu.queue,
             &with_point_lights(capacity - base + 1),

@@ -6,7 +6,8 @@
 
 use std::path::Path;
 
-use gpu_render::gpu::GpuRenderer;
+use gpu_render::gpu::Renderer;
+use gpu_render::gpu::RendererOptions;
 use gpu_render::gpu::unrolled::MAX_UNROLLED_PRIMITIVES;
 use gpu_render::scene::{RenderOverrides, Scene, parse_scene};
 
@@ -103,9 +104,14 @@ fn small_scenes_render_the_same_unrolled_and_through_the_tree() {
         return;
     };
     let unrolled = crate::support::gpu::renderer(&gpu);
-    let tree = GpuRenderer::new(&gpu.device)
-        .expect("renderer")
-        .with_unrolled_primitives(false);
+    let tree = Renderer::new(
+        &gpu.device,
+        RendererOptions {
+            unrolled: false,
+            ..RendererOptions::default()
+        },
+    )
+    .expect("renderer");
     let mut scenes = vec![("every kind of primitive".to_string(), every_kind())];
     for name in ["glass.toml", "direct-light.toml", "caustic-whitted.toml"] {
         let scene = crate::support::scenes::reduced(
@@ -128,10 +134,10 @@ fn small_scenes_render_the_same_unrolled_and_through_the_tree() {
     scenes.push(("glass.toml at depth 64".to_string(), deep));
     for (what, scene) in &scenes {
         let prepared = unrolled
-            .prepare(&gpu.device, &gpu.queue, scene)
+            .upload(&gpu.device, &gpu.queue, scene)
             .expect("prepare");
         assert!(
-            tree.prepare(&gpu.device, &gpu.queue, scene)
+            tree.upload(&gpu.device, &gpu.queue, scene)
                 .expect("prepare")
                 .features()
                 .unrolled
@@ -174,7 +180,7 @@ fn scenes_past_the_limit_walk_the_tree() {
         scene.shapes.push(sphere.clone());
     }
     let prepared = renderer
-        .prepare(&gpu.device, &gpu.queue, &scene)
+        .upload(&gpu.device, &gpu.queue, &scene)
         .expect("prepare");
     assert!(prepared.features().unrolled.is_none());
 }

@@ -6,7 +6,7 @@ use anyhow::{Context, Result, bail};
 use gpu_render::cpu;
 use gpu_render::film::{LinearImage, ProgressFn, RenderStats, Rendered};
 use gpu_render::gpu::unrolled::MAX_UNROLLED_PRIMITIVES;
-use gpu_render::gpu::{self, AdapterChoice, GpuRenderer, HeadlessGpu, TraceRegion};
+use gpu_render::gpu::{self, AdapterChoice, HeadlessGpu, Renderer, RendererOptions, TraceRegion};
 use gpu_render::noise::NoiseEstimate;
 use gpu_render::scene::{Integrator, Scene};
 use gpu_render::tiles::PixelWindow;
@@ -24,6 +24,9 @@ pub struct Frame {
     /// Each pixel's noise estimate, where the backend was opened with
     /// [`GpuOptions::noise`].
     pub noise: Option<NoiseEstimate>,
+    /// How long the GPU spent compiling the scene's kernels (zero when they were
+    /// cached); `None` on the CPU reference.
+    pub compile: Option<std::time::Duration>,
 }
 
 impl Frame {
@@ -37,6 +40,7 @@ impl Frame {
             display_rgba8,
             stats: rendered.stats,
             noise: rendered.noise,
+            compile: None,
         }
     }
 }
@@ -58,8 +62,8 @@ pub enum Backend {
     Gpu {
         /// Instance, adapter, device and queue.
         gpu: Box<HeadlessGpu>,
-        /// The compiled pipelines.
-        renderer: GpuRenderer,
+        /// The renderer built for the device.
+        renderer: Renderer,
         /// The adapter's name, for the summary.
         adapter_name: String,
     },
@@ -132,15 +136,14 @@ impl Backend {
 
     fn with_device(gpu: HeadlessGpu, options: &GpuOptions) -> Result<Self> {
         let adapter_name = gpu.adapter_info().name;
-        let mut renderer = GpuRenderer::new(&gpu.device)
+        let options = RendererOptions {
+            iteration_budget: options.iteration_budget,
+            poll_timeout: options.timeout,
+            noise_estimate: options.noise,
+            ..RendererOptions::default()
+        };
+        let renderer = Renderer::new(&gpu.device, options)
             .with_context(|| format!("cannot set up the GPU tracer on {adapter_name}"))?;
-        if let Some(budget) = options.iteration_budget {
-            renderer = renderer.with_iteration_budget(budget);
-        }
-        if let Some(timeout) = options.timeout {
-            renderer = renderer.with_poll_timeout(timeout);
-        }
-        renderer = renderer.with_noise_estimate(options.noise);
         Ok(Backend::Gpu {
             gpu: Box::new(gpu),
             renderer,
@@ -187,8 +190,8 @@ impl Backend {
     ) -> Result<Frame> {
         match self {
             Backend::Gpu { gpu, renderer, .. } => {
-                let prepared = renderer
-                    .prepare(&gpu.device, &gpu.queue, scene)
+                let uploaded = renderer
+                    .upload(&gpu.device, &gpu.queue, scene)
                     .context("cannot upload the scene to the GPU")?;
                 let region = TraceRegion {
                     columns: window.columns.clone(),
@@ -196,13 +199,14 @@ impl Backend {
                     target_origin: (window.columns.start, window.rows.start),
                 };
                 let rendered = renderer
-                    .render_region(&gpu.device, &gpu.queue, &prepared, &region, Some(progress))
+                    .render_region(&gpu.device, &gpu.queue, &uploaded, &region, Some(progress))
                     .context("GPU render failed")?;
                 Ok(Frame {
                     image: rendered.image,
                     display_rgba8: rendered.display_rgba8,
                     stats: rendered.stats,
                     noise: rendered.noise,
+                    compile: Some(uploaded.compile_time()),
                 })
             }
             Backend::Cpu { noise, .. } => {
@@ -226,14 +230,19 @@ impl Backend {
     pub fn render(&self, scene: &Scene, progress: ProgressFn<'_>) -> Result<Frame> {
         match self {
             Backend::Gpu { gpu, renderer, .. } => {
+                let uploaded = renderer
+                    .upload(&gpu.device, &gpu.queue, scene)
+                    .context("cannot upload the scene to the GPU")?;
+                let whole = TraceRegion::whole(uploaded.width(), uploaded.height());
                 let rendered = renderer
-                    .render(&gpu.device, &gpu.queue, scene, Some(progress))
+                    .render_region(&gpu.device, &gpu.queue, &uploaded, &whole, Some(progress))
                     .context("GPU render failed")?;
                 Ok(Frame {
                     image: rendered.image,
                     display_rgba8: rendered.display_rgba8,
                     stats: rendered.stats,
                     noise: rendered.noise,
+                    compile: Some(uploaded.compile_time()),
                 })
             }
             Backend::Cpu { noise, .. } => {

@@ -37,6 +37,7 @@ pub fn side_by_side(left: &Frame, right: &Frame) -> Result<Frame> {
         stats: crate::summary::add_stats(left.stats, right.stats),
         // --compare-gamma and --standard-error exclude each other.
         noise: None,
+        compile: left.compile.zip(right.compile).map(|(a, b)| a + b),
     })
 }
 
@@ -55,6 +56,7 @@ mod tests {
             display_rgba8: vec![byte; 16],
             stats: RenderStats::default(),
             noise: None,
+            compile: None,
         }
     }
 

@@ -299,6 +299,7 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
             frame: frame.map(|(k, _)| k),
             backend: &backend.describe(),
             wall,
+            compile: rendered.compile,
             stats: rendered.stats,
             output: &output_path,
             noise: rendered.noise.as_ref(),

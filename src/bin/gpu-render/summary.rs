@@ -22,6 +22,9 @@ pub struct Summary<'a> {
     pub backend: &'a str,
     /// Wall time of the render call(s), without loading or writing.
     pub wall: Duration,
+    /// Of the wall time, how long the GPU's kernels took to compile (`None` on the
+    /// CPU reference).
+    pub compile: Option<Duration>,
     /// Statistics summed over the passes.
     pub stats: RenderStats,
     /// The file written.
@@ -56,9 +59,12 @@ impl std::fmt::Display for Summary<'_> {
             ),
             Some(None) => ", estimated noise unknown (needs 2 spp and light)".to_owned(),
         };
+        let compile = self.compile.map_or(String::new(), |compile| {
+            format!(" (kernel compile {:.2} s)", compile.as_secs_f64())
+        });
         write!(
             f,
-            "rendered {passes}{piece}{}x{}{frame}, {} spp, max depth {} on {} in {:.2} s: {} rays, trace {:.2} s ({source}), {:.1} Mrays/s{noise} -> {}",
+            "rendered {passes}{piece}{}x{}{frame}, {} spp, max depth {} on {} in {:.2} s{compile}: {} rays, trace {:.2} s ({source}), {:.1} Mrays/s{noise} -> {}",
             s.width,
             s.height,
             s.samples_per_pixel,
@@ -123,6 +129,7 @@ mod tests {
             frame: None,
             backend: "GPU (Test)",
             wall: Duration::from_millis(1500),
+            compile: Some(Duration::from_millis(250)),
             stats: RenderStats {
                 rays_traced: 3_000_000,
                 elapsed: Duration::from_secs(1),
@@ -133,7 +140,7 @@ mod tests {
         };
         assert_eq!(
             summary.to_string(),
-            "rendered 32x24, 4 spp, max depth 5 on GPU (Test) in 1.50 s: 3.00 M rays, trace 1.00 s (wall clock), 3.0 Mrays/s -> out.png"
+            "rendered 32x24, 4 spp, max depth 5 on GPU (Test) in 1.50 s (kernel compile 0.25 s): 3.00 M rays, trace 1.00 s (wall clock), 3.0 Mrays/s -> out.png"
         );
         let timed = Summary {
             stats: RenderStats {
@@ -144,7 +151,17 @@ mod tests {
         };
         assert_eq!(
             timed.to_string(),
-            "rendered 32x24, 4 spp, max depth 5 on GPU (Test) in 1.50 s: 3.00 M rays, trace 0.75 s (GPU timestamps), 4.0 Mrays/s -> out.png"
+            "rendered 32x24, 4 spp, max depth 5 on GPU (Test) in 1.50 s (kernel compile 0.25 s): 3.00 M rays, trace 0.75 s (GPU timestamps), 4.0 Mrays/s -> out.png"
+        );
+        let cpu = Summary {
+            backend: "CPU reference",
+            compile: None,
+            ..timed
+        };
+        assert!(
+            cpu.to_string()
+                .contains("on CPU reference in 1.50 s: 3.00 M rays"),
+            "{cpu}"
         );
         let tile = Summary {
             piece: Some("tile 1/4 (x 0..32, y 6..12 (32x6))"),

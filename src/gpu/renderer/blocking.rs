@@ -1,26 +1,71 @@
-//! The blocking conveniences built on the stages of [`GpuRenderer`]: whole renders
-//! and regions traced in tiles of at most the device's texture size, with the display
-//! pass and readback ([`GpuRenderer::render`], [`GpuRenderer::render_region`]), and a
-//! trace into one caller texture ([`GpuRenderer::render_to_texture`]). The CLI and
-//! the tests use these; an application's frame loop uses [`super::super::Renderer`].
+//! Whole images and tiles, blocking: every sample of a region traced into a caller's
+//! texture ([`Renderer::trace_into`]), whole renders and regions traced in tiles of at
+//! most the device's texture size with the display pass and readback
+//! ([`Renderer::render`], [`Renderer::render_region`]), and a trace into one caller
+//! texture ([`Renderer::render_to_texture`]). The CLI, the tests and programs that
+//! want an image rather than a frame loop use these.
 
+use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
 
-use super::{GpuRenderer, TraceRegion, create_texture};
+use super::Renderer;
 use crate::film::{LinearImage, ProgressFn, RenderStats};
-use crate::gpu::GpuError;
+use crate::gpu::RenderError;
+use crate::gpu::display::{TextureSize, check_texture, encode_display};
+use crate::gpu::gpu_scene::GpuScene;
 use crate::gpu::pipelines::{DISPLAY_FORMAT, LINEAR_FORMAT};
-use crate::gpu::readback::{read_texture, submit_and_wait};
-use crate::gpu::scene_buffers::PreparedScene;
+use crate::gpu::readback::{create_texture, read_texture, submit_and_wait};
 use crate::gpu::shaders::WORKGROUP_SIZE;
+use crate::gpu::wavefront::{SlotBuffers, trace_region};
 use crate::noise::NoiseEstimate;
 use crate::scene::Scene;
 
-/// The result of [`GpuRenderer::render`], and of [`GpuRenderer::render_region`] (whose
+/// A rectangle of image pixels traced into one target texture, and where it lands
+/// there.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TraceRegion {
+    /// Image columns traced.
+    pub columns: Range<u32>,
+    /// Image rows traced.
+    pub rows: Range<u32>,
+    /// The image pixel stored at texel (0, 0) of the target.
+    pub target_origin: (u32, u32),
+}
+
+impl TraceRegion {
+    /// The whole image of `width × height`, stored at the target's origin.
+    pub fn whole(width: u32, height: u32) -> Self {
+        Self {
+            columns: 0..width,
+            rows: 0..height,
+            target_origin: (0, 0),
+        }
+    }
+
+    fn size(&self) -> (u32, u32) {
+        (
+            self.columns.end.saturating_sub(self.columns.start),
+            self.rows.end.saturating_sub(self.rows.start),
+        )
+    }
+
+    /// [`RenderError::InvalidRegion`] for this region of a `width × height` image.
+    fn invalid(&self, width: u32, height: u32) -> RenderError {
+        RenderError::InvalidRegion {
+            columns: self.columns.clone(),
+            rows: self.rows.clone(),
+            origin: self.target_origin,
+            width,
+            height,
+        }
+    }
+}
+
+/// The result of [`Renderer::render`], and of [`Renderer::render_region`] (whose
 /// images are the region's).
 #[derive(Debug, Clone, PartialEq)]
-pub struct GpuRendered {
+pub struct RenderedImage {
     /// The linear radiance image, as traced.
     pub image: LinearImage,
     /// The display pass's output: `width × height` RGBA8 pixels, row-major, top row
@@ -29,11 +74,11 @@ pub struct GpuRendered {
     /// Rays traced, the wall time of tracing and, where the device has timestamp
     /// queries, its GPU time.
     pub stats: RenderStats,
-    /// Each pixel's noise estimate, with [`GpuRenderer::with_noise_estimate`].
+    /// Each pixel's noise estimate, with [`super::RendererOptions::noise_estimate`].
     pub noise: Option<NoiseEstimate>,
 }
 
-/// The tiles [`GpuRenderer::render`] traces an image of `width × height` in: one tile
+/// The tiles [`Renderer::render`] traces an image of `width × height` in: one tile
 /// when the image fits `max_dimension` (the device's `max_texture_dimension_2d`), else a
 /// grid of tiles of at most `max_dimension` on a side, in row-major order, covering
 /// every pixel once. Each tile's `target_origin` is its own top-left pixel: it is traced
@@ -59,90 +104,71 @@ pub fn image_tiles(width: u32, height: u32, max_dimension: u32) -> Vec<TraceRegi
     tiles
 }
 
-impl GpuRenderer {
-    /// Renders `scene` completely: uploads it, traces it (in tiles of at most the
-    /// device's `max_texture_dimension_2d` on a side, each into a texture of its own),
-    /// runs the display pass and reads back both images; `progress(rows_done, height)`
-    /// follows the finished pixels (in rows' worth). `stats.elapsed` covers the trace
-    /// submissions only.
+impl Renderer {
+    /// Renders `scene` completely: uploads it ([`Renderer::upload`]), traces it (in
+    /// tiles of at most the device's `max_texture_dimension_2d` on a side, each into a
+    /// texture of its own), runs the display pass and reads back both images;
+    /// `progress(rows_done, height)` follows the finished pixels (in rows' worth).
+    /// `stats.elapsed` covers the trace submissions only.
     ///
-    /// Errors: see [`GpuRenderer::prepare`] and [`GpuRenderer::trace_into`];
-    /// [`GpuError::Readback`].
+    /// Errors: see [`Renderer::upload`] and [`Renderer::trace_into`];
+    /// [`RenderError::Readback`].
     pub fn render(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         scene: &Scene,
         progress: Option<ProgressFn<'_>>,
-    ) -> Result<GpuRendered, GpuError> {
-        let prepared = self.prepare(device, queue, scene)?;
-        self.render_prepared(device, queue, &prepared, progress)
-    }
-
-    /// [`GpuRenderer::render`] for a scene already uploaded: the region of the whole
-    /// image ([`GpuRenderer::render_region`]).
-    pub fn render_prepared(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        prepared: &PreparedScene,
-        progress: Option<ProgressFn<'_>>,
-    ) -> Result<GpuRendered, GpuError> {
-        let whole = TraceRegion::whole(prepared.width(), prepared.height());
-        self.render_region(device, queue, prepared, &whole, progress)
+    ) -> Result<RenderedImage, RenderError> {
+        let uploaded = self.upload(device, queue, scene)?;
+        let whole = TraceRegion::whole(uploaded.width(), uploaded.height());
+        self.render_region(device, queue, &uploaded, &whole, progress)
     }
 
     /// Renders only the pixels of `region` of a scene already uploaded: traces them in
     /// tiles of at most the device's limits (each into textures of its own), runs the
-    /// display pass and reads both images back. The result is the
-    /// region's: `image` is `columns × rows` pixels whose (0, 0) is the region's first
-    /// pixel, and `region.target_origin` is not used. Each pixel is bit-identical to
-    /// the same pixel of a whole render (`docs/model.md`, "Bounded work"), so regions
-    /// rendered apart, even in other processes, assemble into the whole image.
+    /// display pass and reads both images back. The result is the region's: `image`
+    /// is `columns × rows` pixels whose (0, 0) is the region's first pixel, and
+    /// `region.target_origin` is not used. Each pixel is bit-identical to the same
+    /// pixel of a whole render (`docs/model.md`, "Bounded work"), so regions rendered
+    /// apart, even in other processes, assemble into the whole image.
     /// `progress(rows_done, region_rows)` follows the finished pixels in rows' worth.
     ///
     /// ```no_run
-    /// use gpu_render::gpu::{AdapterChoice, GpuRenderer, HeadlessGpu, TraceRegion};
-    /// # fn demo(scene: &gpu_render::scene::Scene) -> Result<(), gpu_render::gpu::GpuError> {
+    /// use gpu_render::gpu::{AdapterChoice, HeadlessGpu, Renderer, RendererOptions, TraceRegion};
+    /// # fn demo(scene: &gpu_render::scene::Scene) -> Result<(), gpu_render::gpu::RenderError> {
     /// let gpu = HeadlessGpu::new(&AdapterChoice::Default)?;
-    /// let renderer = GpuRenderer::new(&gpu.device)?;
-    /// let prepared = renderer.prepare(&gpu.device, &gpu.queue, scene)?;
+    /// let renderer = Renderer::new(&gpu.device, RendererOptions::default())?;
+    /// let uploaded = renderer.upload(&gpu.device, &gpu.queue, scene)?;
     /// // The bottom half of the image.
     /// let region = TraceRegion {
-    ///     columns: 0..prepared.width(),
-    ///     rows: prepared.height() / 2..prepared.height(),
+    ///     columns: 0..uploaded.width(),
+    ///     rows: uploaded.height() / 2..uploaded.height(),
     ///     target_origin: (0, 0),
     /// };
-    /// let half = renderer.render_region(&gpu.device, &gpu.queue, &prepared, &region, None)?;
-    /// assert_eq!(half.image.height, prepared.height() - prepared.height() / 2);
+    /// let half = renderer.render_region(&gpu.device, &gpu.queue, &uploaded, &region, None)?;
+    /// assert_eq!(half.image.height, uploaded.height() - uploaded.height() / 2);
     /// # Ok(())
     /// # }
     /// ```
     ///
-    /// Errors: [`GpuError::Validation`] for a region that is empty or lies outside
-    /// the image; see [`GpuRenderer::prepare`] and [`GpuRenderer::trace_into`];
-    /// [`GpuError::Readback`].
+    /// Errors: [`RenderError::InvalidRegion`] for a region that is empty or lies
+    /// outside the image; see [`Renderer::trace_into`]; [`RenderError::Readback`].
     pub fn render_region(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        prepared: &PreparedScene,
+        scene: &GpuScene,
         region: &TraceRegion,
         progress: Option<ProgressFn<'_>>,
-    ) -> Result<GpuRendered, GpuError> {
+    ) -> Result<RenderedImage, RenderError> {
         let (width, height) = region.size();
         if width == 0
             || height == 0
-            || region.columns.end > prepared.width()
-            || region.rows.end > prepared.height()
+            || region.columns.end > scene.width()
+            || region.rows.end > scene.height()
         {
-            return Err(GpuError::Validation(format!(
-                "region columns {:?}, rows {:?} is empty or lies outside the {}x{} image",
-                region.columns,
-                region.rows,
-                prepared.width(),
-                prepared.height()
-            )));
+            return Err(region.invalid(scene.width(), scene.height()));
         }
         let limits = device.limits();
         // A tile must fit one texture and one display dispatch's workgroup count.
@@ -151,7 +177,8 @@ impl GpuRenderer {
                 .max_compute_workgroups_per_dimension
                 .saturating_mul(WORKGROUP_SIZE),
         );
-        if self.noise_estimate {
+        let noise_estimate = self.options().noise_estimate;
+        if noise_estimate {
             // And the noise estimate's sums, 16 bytes per pixel, one storage binding.
             let binding = limits
                 .max_storage_buffer_binding_size
@@ -178,15 +205,15 @@ impl GpuRenderer {
         };
         let mut stats = RenderStats::default();
         let mut gpu_time = Some(Duration::ZERO);
-        let mut noise = self.noise_estimate.then(|| NoiseEstimate {
+        let mut noise = noise_estimate.then(|| NoiseEstimate {
             width,
             height,
-            samples: prepared.samples_per_pixel(),
+            samples: scene.samples_per_pixel(),
             mean_luminance: vec![0.0; width as usize * height as usize],
             standard_error: vec![0.0; width as usize * height as usize],
         });
         for tile in tiles {
-            let traced = self.render_tile(device, queue, prepared, &tile, &report)?;
+            let traced = self.render_tile(device, queue, scene, &tile, &report)?;
             stats.rays_traced += traced.stats.rays_traced;
             stats.elapsed += traced.stats.elapsed;
             gpu_time = gpu_time.zip(traced.stats.gpu_time).map(|(a, b)| a + b);
@@ -211,7 +238,7 @@ impl GpuRenderer {
             }
         }
         stats.gpu_time = gpu_time;
-        Ok(GpuRendered {
+        Ok(RenderedImage {
             image: LinearImage {
                 width,
                 height,
@@ -230,10 +257,10 @@ impl GpuRenderer {
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        prepared: &PreparedScene,
+        scene: &GpuScene,
         tile: &TraceRegion,
         report: &dyn Fn(u64),
-    ) -> Result<GpuRendered, GpuError> {
+    ) -> Result<RenderedImage, RenderError> {
         let (tile_width, tile_height) = tile.size();
         let linear = create_texture(
             device,
@@ -263,26 +290,27 @@ impl GpuRenderer {
         let (stats, noise) = self.trace_region_into(
             device,
             queue,
-            prepared,
+            scene,
             &linear_view,
             tile,
             Some(&tile_progress),
-            self.noise_estimate,
+            self.options().noise_estimate,
         )?;
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("gpu-render display pass"),
         });
-        self.encode_display(
+        self.encode_display_texture(
             device,
             &mut encoder,
             &linear_view,
             &display_view,
-            prepared.display_encodes_srgb(),
+            scene.display_encodes_srgb(),
         )?;
-        submit_and_wait(device, queue, encoder, "display pass", self.poll_timeout)?;
-        let linear_bytes = read_texture(device, queue, &linear, 16, self.poll_timeout)?;
-        let display_rgba8 = read_texture(device, queue, &display, 4, self.poll_timeout)?;
-        Ok(GpuRendered {
+        let timeout = self.options().poll_timeout;
+        submit_and_wait(device, queue, encoder, "display pass", timeout)?;
+        let linear_bytes = read_texture(device, queue, &linear, 16, timeout)?;
+        let display_rgba8 = read_texture(device, queue, &display, 4, timeout)?;
+        Ok(RenderedImage {
             image: LinearImage {
                 width: tile_width,
                 height: tile_height,
@@ -296,13 +324,13 @@ impl GpuRenderer {
         })
     }
 
-    /// Traces `scene` into the caller's `target` (an `Rgba32Float` texture with
-    /// `STORAGE_BINDING`, at least image-sized), without the display pass or image
-    /// readback; returns the ray count and trace time.
+    /// Uploads `scene` and traces it into the caller's `target` (an `Rgba32Float`
+    /// texture with `STORAGE_BINDING`, at least image-sized), without the display pass
+    /// or image readback; returns the ray count and trace time.
     ///
-    /// Errors: as [`GpuRenderer::render`], and [`GpuError::DeviceLimit`] for an image
+    /// Errors: as [`Renderer::render`], and [`RenderError::SceneTooLarge`] for an image
     /// larger than `max_texture_dimension_2d`, which no single target can hold (use
-    /// [`GpuRenderer::render`], which tiles, or [`GpuRenderer::trace_into`]).
+    /// [`Renderer::render`], which tiles, or [`Renderer::trace_into`]).
     pub fn render_to_texture(
         &self,
         device: &wgpu::Device,
@@ -310,22 +338,22 @@ impl GpuRenderer {
         scene: &Scene,
         target: &wgpu::TextureView,
         progress: Option<ProgressFn<'_>>,
-    ) -> Result<RenderStats, GpuError> {
-        let prepared = self.prepare(device, queue, scene)?;
+    ) -> Result<RenderStats, RenderError> {
+        let uploaded = self.upload(device, queue, scene)?;
         let max_dimension = device.limits().max_texture_dimension_2d;
         for (what, value) in [
-            ("image width (one target texture)", prepared.width()),
-            ("image height (one target texture)", prepared.height()),
+            ("image width (one target texture)", uploaded.width()),
+            ("image height (one target texture)", uploaded.height()),
         ] {
             if value > max_dimension {
-                return Err(GpuError::DeviceLimit {
+                return Err(RenderError::SceneTooLarge {
                     what: what.to_string(),
                     value: u64::from(value),
                     limit: u64::from(max_dimension),
                 });
             }
         }
-        let (width, height) = (prepared.width(), prepared.height());
+        let (width, height) = (uploaded.width(), uploaded.height());
         let rows = |done: u64, _: u64| {
             if let Some(progress) = progress {
                 progress((done / u64::from(width)) as u32, height);
@@ -334,10 +362,179 @@ impl GpuRenderer {
         self.trace_into(
             device,
             queue,
-            &prepared,
+            &uploaded,
             target,
             &TraceRegion::whole(width, height),
             Some(&rows),
+        )
+    }
+
+    /// Traces the pixels of `region` of `scene` into `target` (an `Rgba32Float`
+    /// texture with `STORAGE_BINDING`, holding at least the region from
+    /// `region.target_origin` on), every sample of every pixel, blocking until done.
+    /// `progress(pixels_done, region_pixels)` is called after each submission.
+    ///
+    /// Errors: [`RenderError::InvalidRegion`] for a region outside the image;
+    /// [`RenderError::TargetFormat`], [`RenderError::TargetUsage`] or
+    /// [`RenderError::TargetSize`] for an unsuitable target;
+    /// [`RenderError::TraceIncomplete`] if the kernels report a loop the driver cut
+    /// short (the image is then not returned); [`RenderError::Timeout`] past the
+    /// renderer's poll timeout; [`RenderError::DeviceLost`].
+    pub fn trace_into(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &GpuScene,
+        target: &wgpu::TextureView,
+        region: &TraceRegion,
+        progress: Option<&dyn Fn(u64, u64)>,
+    ) -> Result<RenderStats, RenderError> {
+        self.trace_region_into(device, queue, scene, target, region, progress, false)
+            .map(|(stats, _)| stats)
+    }
+
+    /// [`Renderer::trace_into`], and with `noise` the region's noise estimate.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn trace_region_into(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &GpuScene,
+        target: &wgpu::TextureView,
+        region: &TraceRegion,
+        progress: Option<&dyn Fn(u64, u64)>,
+        noise: bool,
+    ) -> Result<(RenderStats, Option<NoiseEstimate>), RenderError> {
+        let (width, height) = region.size();
+        let (origin_x, origin_y) = region.target_origin;
+        if region.columns.end > scene.width()
+            || region.rows.end > scene.height()
+            || origin_x > region.columns.start
+            || origin_y > region.rows.start
+        {
+            return Err(region.invalid(scene.width(), scene.height()));
+        }
+        let pixels = u64::from(width) * u64::from(height);
+        if pixels == 0 {
+            return Ok((RenderStats::default(), None));
+        }
+        check_texture(
+            target,
+            "trace target",
+            LINEAR_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING,
+            (region.columns.end - origin_x, region.rows.end - origin_y),
+            TextureSize::AtLeast,
+        )?;
+        let prepared = &scene.prepared;
+        let slot_count = SlotBuffers::slot_count(
+            device,
+            self.options().slot_count,
+            pixels,
+            prepared.stack_size,
+        );
+        // The sums are kept only for the noise estimate (16 bytes per region pixel).
+        let sums = if noise { pixels } else { 0 };
+        let slots = SlotBuffers::new(device, slot_count, prepared.stack_size, sums)?;
+        let bind_group = slots.bind_group(
+            device,
+            self.pipelines.trace_bind_group_layout(&prepared.features),
+            prepared,
+            target,
+        )?;
+        // The camera of the upload, or where `set_camera` moved it since.
+        let base = if scene.camera_version == 0 {
+            prepared.frame
+        } else {
+            scene.frame_for(scene.width(), scene.height())
+        };
+        let frame = crate::gpu::layout::FrameUniforms {
+            region_x: region.columns.start,
+            region_y: region.rows.start,
+            region_width: width,
+            region_height: height,
+            target_x: origin_x,
+            target_y: origin_y,
+            first_sample: 0,
+            end_sample: prepared.samples_per_pixel(),
+            slot_count,
+            iteration_budget: self.iteration_budget(),
+            // The scene's own flags (its integrator) and the test switch.
+            flags: prepared.frame.flags
+                | if self.options().simulate_loop_cut {
+                    crate::gpu::layout::FLAG_SIMULATE_LOOP_CUT
+                } else {
+                    0
+                }
+                | if noise {
+                    crate::gpu::layout::FLAG_STORE_SUM
+                } else {
+                    0
+                },
+            ..base
+        };
+        let done = AtomicU64::new(0);
+        let report = |new: u64| {
+            let total = done.fetch_add(new, Ordering::Relaxed) + new;
+            if let Some(progress) = progress {
+                progress(total, pixels);
+            }
+        };
+        let timeout = self.options().poll_timeout;
+        let outcome = trace_region(
+            device,
+            queue,
+            &scene.pipelines,
+            self.schedule(),
+            &slots,
+            &bind_group,
+            &frame,
+            timeout,
+            &report,
+        )?;
+        let stats = RenderStats {
+            rays_traced: outcome.rays,
+            elapsed: outcome.elapsed,
+            gpu_time: outcome.gpu_time,
+        };
+        let estimate = if noise {
+            Some(slots.read_noise(
+                device,
+                queue,
+                (width, height),
+                prepared.samples_per_pixel(),
+                timeout,
+            )?)
+        } else {
+            None
+        };
+        Ok((stats, estimate))
+    }
+
+    /// Records the display pass over any pair of textures into `encoder`: reads
+    /// `linear` (an `Rgba32Float` texture with `TEXTURE_BINDING`), applies the exact
+    /// sRGB curve if `encode_srgb` (else clamps only; take it from
+    /// [`GpuScene::display_encodes_srgb`]), quantises to 8 bits and writes `display`
+    /// (an `Rgba8Unorm` texture with `STORAGE_BINDING` of the same size). A film's
+    /// display is [`Renderer::encode_display`].
+    ///
+    /// Errors: [`RenderError::TargetFormat`], [`RenderError::TargetUsage`] or
+    /// [`RenderError::TargetSize`] for unsuitable textures.
+    pub fn encode_display_texture(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        linear: &wgpu::TextureView,
+        display: &wgpu::TextureView,
+        encode_srgb: bool,
+    ) -> Result<(), RenderError> {
+        encode_display(
+            &self.pipelines,
+            device,
+            encoder,
+            linear,
+            display,
+            encode_srgb,
         )
     }
 }

@@ -1,7 +1,7 @@
 //! GPU test helpers: a headless device that is optional on developer machines and
 //! mandatory in CI.
 
-use gpu_render::gpu::{AdapterChoice, GpuRenderer, HeadlessGpu};
+use gpu_render::gpu::{AdapterChoice, HeadlessGpu, Renderer, RendererOptions};
 
 /// A headless GPU, or `None` (with a note on stderr) when this machine has no adapter.
 ///
@@ -24,13 +24,22 @@ pub fn headless_gpu() -> Option<HeadlessGpu> {
     }
 }
 
-/// A renderer for `gpu`'s device.
+/// A renderer for `gpu`'s device with the default options.
 ///
 /// # Panics
 ///
 /// If the renderer cannot be built (its shaders fail to compile): a test failure.
-pub fn renderer(gpu: &HeadlessGpu) -> GpuRenderer {
-    GpuRenderer::new(&gpu.device).unwrap_or_else(|e| panic!("GpuRenderer::new failed: {e}"))
+pub fn renderer(gpu: &HeadlessGpu) -> Renderer {
+    renderer_with(gpu, RendererOptions::default())
+}
+
+/// A renderer for `gpu`'s device with `options`.
+///
+/// # Panics
+///
+/// If the renderer cannot be built: a test failure.
+pub fn renderer_with(gpu: &HeadlessGpu, options: RendererOptions) -> Renderer {
+    Renderer::new(&gpu.device, options).unwrap_or_else(|e| panic!("Renderer::new failed: {e}"))
 }
 
 /// Renders `scene` with `a` and with `b` on `gpu` and asserts the same pixels bit for
@@ -38,8 +47,8 @@ pub fn renderer(gpu: &HeadlessGpu) -> GpuRenderer {
 /// its result. `what` names the scene and the pair in a failure.
 pub fn assert_renders_identical(
     gpu: &HeadlessGpu,
-    a: &GpuRenderer,
-    b: &GpuRenderer,
+    a: &Renderer,
+    b: &Renderer,
     scene: &gpu_render::scene::Scene,
     what: &str,
 ) {

@@ -23,7 +23,7 @@ use std::fmt::Write as _;
 use std::panic::AssertUnwindSafe;
 
 use gpu_render::film::LinearImage;
-use gpu_render::gpu::{GpuRenderer, HeadlessGpu};
+use gpu_render::gpu::{HeadlessGpu, Renderer, RendererOptions};
 use proptest::prelude::*;
 
 use crate::support::compare::{Comparison, Tolerance, measure};
@@ -648,7 +648,7 @@ fn object() -> impl Strategy<Value = ObjectSpec> {
 /// shader so that no case waits for a pipeline of its own.
 pub struct PipelineChecker {
     gpu: HeadlessGpu,
-    renderer: GpuRenderer,
+    renderer: Renderer,
 }
 
 /// What a passing case measured.
@@ -673,10 +673,13 @@ impl PipelineChecker {
     /// A checker on `gpu`: every case with the general trace module walking the BVH,
     /// one module for all cases (compiled once).
     pub fn new(gpu: HeadlessGpu) -> Self {
-        let renderer = GpuRenderer::new(&gpu.device)
-            .unwrap_or_else(|e| panic!("GpuRenderer::new failed: {e}"))
-            .with_specialisation(false)
-            .with_unrolled_primitives(false);
+        let options = RendererOptions {
+            specialise: false,
+            unrolled: false,
+            ..RendererOptions::default()
+        };
+        let renderer = Renderer::new(&gpu.device, options)
+            .unwrap_or_else(|e| panic!("Renderer::new failed: {e}"));
         Self { gpu, renderer }
     }
 
@@ -684,9 +687,12 @@ impl PipelineChecker {
     /// (`gpu_render::gpu::unrolled`): a module of its own for every case, as each
     /// names its primitives, so a few seconds of compiling per case on lavapipe.
     pub fn unrolled(gpu: HeadlessGpu) -> Self {
-        let renderer = GpuRenderer::new(&gpu.device)
-            .unwrap_or_else(|e| panic!("GpuRenderer::new failed: {e}"))
-            .with_specialisation(false);
+        let options = RendererOptions {
+            specialise: false,
+            ..RendererOptions::default()
+        };
+        let renderer = Renderer::new(&gpu.device, options)
+            .unwrap_or_else(|e| panic!("Renderer::new failed: {e}"));
         Self { gpu, renderer }
     }
 
@@ -696,7 +702,7 @@ impl PipelineChecker {
             .ok()
             .and_then(|scene| {
                 self.renderer
-                    .prepare(&self.gpu.device, &self.gpu.queue, &scene)
+                    .upload(&self.gpu.device, &self.gpu.queue, &scene)
                     .ok()
             })
             .is_some_and(|prepared| prepared.features().unrolled.is_some())

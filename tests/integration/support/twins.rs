@@ -4,7 +4,7 @@
 //! counted.
 
 use gpu_render::film::RenderStats;
-use gpu_render::gpu::{GpuRenderer, HeadlessGpu};
+use gpu_render::gpu::{HeadlessGpu, Renderer};
 use gpu_render::scene::Scene;
 
 use super::compare::{Comparison, Tolerance, assert_images_match};
@@ -34,7 +34,7 @@ pub fn assert_ray_counts_agree(label: &str, cpu: &RenderStats, gpu: &RenderStats
 /// agree within 1%; prints what it measured and returns it.
 pub fn assert_backends_agree(
     gpu: &HeadlessGpu,
-    renderer: &GpuRenderer,
+    renderer: &Renderer,
     label: &str,
     scene: &Scene,
     tolerance: Tolerance,

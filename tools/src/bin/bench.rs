@@ -25,7 +25,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use gpu_render::gpu::{AdapterChoice, GpuRenderer, HeadlessGpu, Schedule};
+use gpu_render::gpu::RendererOptions;
+use gpu_render::gpu::{AdapterChoice, HeadlessGpu, Renderer, Schedule};
 use gpu_render::scene::{RenderOverrides, load_scene};
 
 #[derive(Parser)]
@@ -58,14 +59,14 @@ struct Args {
     #[arg(long)]
     schedule: Option<String>,
     /// Keep the scene records in storage buffers, not in uniform buffers where they
-    /// fit on a CPU device (`GpuRenderer::with_uniform_records(false)`).
+    /// fit on a CPU device (`Renderer::with_uniform_records(false)`).
     #[arg(long)]
     storage_records: bool,
     /// Traversals never give way to finished lanes
-    /// (`GpuRenderer::with_refill_lanes(false)`).
+    /// (`Renderer::with_refill_lanes(false)`).
     #[arg(long)]
     no_refill: bool,
-    /// Small scenes walk their BVH too (`GpuRenderer::with_unrolled_primitives(false)`).
+    /// Small scenes walk their BVH too (`Renderer::with_unrolled_primitives(false)`).
     #[arg(long)]
     no_unrolled: bool,
     /// Path slots of the GPU trace (default: the adapter's, `default_slot_count`).
@@ -385,19 +386,23 @@ fn main() -> Result<()> {
     }
     instancing_figures(&scene);
     let gpu = HeadlessGpu::new(&AdapterChoice::Default).context("no GPU adapter")?;
-    let mut renderer = GpuRenderer::new(&gpu.device)?
-        .with_uniform_records(!args.storage_records)
-        .with_refill_lanes(!args.no_refill)
-        .with_unrolled_primitives(!args.no_unrolled);
-    if let Some(slots) = args.slots {
-        renderer = renderer.with_slot_count(slots);
-    }
-    match args.schedule.as_deref() {
-        None => {}
-        Some("fused") => renderer = renderer.with_schedule(Schedule::Fused),
-        Some("wavefront") => renderer = renderer.with_schedule(Schedule::Wavefront),
+    let schedule = match args.schedule.as_deref() {
+        None => None,
+        Some("fused") => Some(Schedule::Fused),
+        Some("wavefront") => Some(Schedule::Wavefront),
         Some(other) => anyhow::bail!("--schedule must be fused or wavefront, not {other}"),
-    }
+    };
+    let renderer = Renderer::new(
+        &gpu.device,
+        RendererOptions {
+            uniform_records: !args.storage_records,
+            refill_lanes: !args.no_refill,
+            unrolled: !args.no_unrolled,
+            slot_count: args.slots,
+            schedule,
+            ..RendererOptions::default()
+        },
+    )?;
     let info = gpu.adapter_info();
     println!(
         "scene {} at {}x{}, {} spp, max depth {}; adapter: {} ({:?}); CPU threads: {}",
@@ -418,7 +423,7 @@ fn main() -> Result<()> {
     }
     // Warm-up: the first dispatch compiles the pipeline (lavapipe runs LLVM then).
     renderer.render(&gpu.device, &gpu.queue, &scene, None)?;
-    let prepared = renderer.prepare(&gpu.device, &gpu.queue, &scene)?;
+    let prepared = renderer.upload(&gpu.device, &gpu.queue, &scene)?;
     let primitives = gpu_render::accel::SceneGeometry::new(&scene).bounded_count();
     println!(
         "GPU scene buffers: {} bytes for {primitives} bounded primitives ({:.1} bytes each, \
@@ -522,7 +527,13 @@ fn compare_specialisation(
     };
     let mut renderers = Vec::new();
     for (name, specialise) in [("specialised", true), ("general", false)] {
-        let renderer = GpuRenderer::new(&gpu.device)?.with_specialisation(specialise);
+        let renderer = Renderer::new(
+            &gpu.device,
+            RendererOptions {
+                specialise,
+                ..RendererOptions::default()
+            },
+        )?;
         let used = if specialise {
             features
         } else {
@@ -570,9 +581,15 @@ fn compare_schedules(
     runs: usize,
 ) -> Result<()> {
     let schedules = [Schedule::Fused, Schedule::Wavefront];
-    let renderers: Vec<GpuRenderer> = schedules
+    let renderers: Vec<Renderer> = schedules
         .iter()
-        .map(|&s| Ok(GpuRenderer::new(&gpu.device)?.with_schedule(s)))
+        .map(|&schedule| {
+            let options = RendererOptions {
+                schedule: Some(schedule),
+                ..RendererOptions::default()
+            };
+            Ok(Renderer::new(&gpu.device, options)?)
+        })
         .collect::<Result<_>>()?;
     for renderer in &renderers {
         renderer.render(&gpu.device, &gpu.queue, scene, None)?;

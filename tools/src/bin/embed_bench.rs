@@ -1,7 +1,7 @@
 //! The cost of a camera move in the frame loop (`Renderer::set_camera`, then the next
 //! `encode_samples`, which starts a pass and writes its trace constants) against a
 //! full re-upload of the scene with the new camera (what moving the camera cost
-//! before: `GpuRenderer::prepare` builds the geometry and BVH and uploads every buffer
+//! before: `Renderer::prepare` builds the geometry and BVH and uploads every buffer
 //! and image), in alternating runs, medians printed. Bytes are counted as written:
 //! the frame loop's through a `BufferWrites` wrapper, the re-upload's as the scene's
 //! buffer and image bytes.
@@ -14,9 +14,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
-use gpu_render::gpu::{
-    AdapterChoice, BufferWrites, GpuRenderer, HeadlessGpu, Renderer, RendererOptions,
-};
+use gpu_render::gpu::{AdapterChoice, BufferWrites, HeadlessGpu, Renderer, RendererOptions};
 use gpu_render::scene::{Camera, load_scene};
 
 /// Counts the bytes written through it and forwards them.
@@ -60,7 +58,7 @@ fn main() -> Result<()> {
     let scene = load_scene(path.as_ref())?;
     let gpu = HeadlessGpu::new(&AdapterChoice::Default)?;
     let renderer = Renderer::new(&gpu.device, RendererOptions::default())?;
-    let old = GpuRenderer::new(&gpu.device)?;
+    let old = Renderer::new(&gpu.device, RendererOptions::default())?;
     let mut gpu_scene = renderer.upload(&gpu.device, &gpu.queue, &scene)?;
     // A small film: only the pass start's host cost and bytes are measured, not the
     // tracing.
@@ -104,7 +102,7 @@ fn main() -> Result<()> {
             ..scene.clone()
         };
         let start = Instant::now();
-        let prepared = old.prepare(&gpu.device, &gpu.queue, &moved_scene)?;
+        let prepared = old.upload(&gpu.device, &gpu.queue, &moved_scene)?;
         gpu.queue.submit([]);
         wait_idle(&gpu)?;
         reupload.push(start.elapsed());
@@ -124,7 +122,7 @@ fn main() -> Result<()> {
         median(frame_loop).as_secs_f64() * 1e3
     );
     println!(
-        "full re-upload (GpuRenderer::prepare):     median {:>10.3} ms, {reupload_bytes} bytes written",
+        "full re-upload (Renderer::prepare):     median {:>10.3} ms, {reupload_bytes} bytes written",
         median(reupload).as_secs_f64() * 1e3
     );
     if frames > 0 {

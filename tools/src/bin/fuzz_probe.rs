@@ -15,7 +15,8 @@ use gpu_render::cpu::PreparedScene;
 use gpu_render::cpu::intersect::Ray;
 use gpu_render::cpu::trace::shade_hit;
 use gpu_render::cpu::traverse::intersect_scene;
-use gpu_render::gpu::{AdapterChoice, GpuRenderer, HeadlessGpu};
+use gpu_render::gpu::RendererOptions;
+use gpu_render::gpu::{AdapterChoice, HeadlessGpu, Renderer};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -35,9 +36,14 @@ fn main() {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{e}"));
     let scene = gpu_render::scene::parse_scene(&text, path).unwrap_or_else(|e| panic!("{e}"));
     let gpu = HeadlessGpu::new(&AdapterChoice::Default).expect("a GPU adapter");
-    let renderer = GpuRenderer::new(&gpu.device)
-        .expect("renderer")
-        .with_specialisation(false);
+    let renderer = Renderer::new(
+        &gpu.device,
+        RendererOptions {
+            specialise: false,
+            ..RendererOptions::default()
+        },
+    )
+    .expect("renderer");
     for depth in 0..=scene.render.max_depth {
         let mut s = scene.clone();
         s.render.max_depth = depth;

@@ -15,7 +15,8 @@
 use std::path::Path;
 
 use glam::DVec3;
-use gpu_render::gpu::{AdapterChoice, GpuRenderer, HeadlessGpu};
+use gpu_render::gpu::RendererOptions;
+use gpu_render::gpu::{AdapterChoice, HeadlessGpu, Renderer};
 use gpu_render::scene::{Scene, SceneWarning, parse_scene_with};
 
 const EYE: DVec3 = DVec3::new(0.0, 3.0, 4.0);
@@ -93,7 +94,8 @@ fn load(text: &str, warnings: &mut Vec<String>) -> Scene {
 
 fn main() {
     let gpu = HeadlessGpu::new(&AdapterChoice::Default).expect("a GPU adapter");
-    let renderer = GpuRenderer::new(&gpu.device).expect("the GPU renderer");
+    let renderer =
+        Renderer::new(&gpu.device, RendererOptions::default()).expect("the GPU renderer");
     let render_gpu = |scene: &Scene| {
         renderer
             .render(&gpu.device, &gpu.queue, scene, None)

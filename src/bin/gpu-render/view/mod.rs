@@ -726,7 +726,7 @@ impl Viewer {
             .renderer
             .upload(&self.device, &self.queue, &scene)
             .map_err(|e| anyhow!(e))?;
-        if gpu_scene.prepared().stack_size() > self.scene.prepared().stack_size() {
+        if gpu_scene.stack_size() > self.scene.stack_size() {
             let (film_width, film_height) = film_size(&self.config, self.scale);
             self.film =
                 self.renderer

@@ -1,28 +1,21 @@
-//! [`Renderer`]: the frame-loop API for applications that embed the tracer in their
-//! own wgpu program, in the shape of vello's and glyphon's renderers. The application
-//! owns the instance, adapter, device, queue, encoder and frame; the renderer uploads
-//! a scene once ([`Renderer::upload`]), changes its camera on the host
-//! ([`Renderer::set_camera`]), records samples into a [`Film`] without blocking
-//! ([`Renderer::encode_samples`]) and shows the film in a storage texture
+//! The frame loop of [`Renderer`]: samples recorded into a [`Film`] without blocking
+//! ([`Renderer::encode_samples`]), the film shown in a storage texture
 //! ([`Renderer::encode_display`]) or inside the application's render pass
-//! ([`Renderer::draw`]). `docs/embedding.md` walks through it.
+//! ([`Renderer::draw`]), and the blocking conveniences built on them (finishing a film,
+//! reading it back). `docs/embedding.md` walks through it.
 
-use super::draw::DrawPipelines;
-use super::film::Film;
-use super::gpu_scene::GpuScene;
-use super::layout::FLAG_STORE_SUM;
-use super::limits::{check_limits, required_limits};
-use super::pipelines::{DISPLAY_FORMAT, Pipelines};
-use super::readback::{read_texture, wait};
-use super::renderer::create_texture;
-use super::scene_buffers::{UploadOptions, upload_scene};
-use super::shaders::{SLOT_WORKGROUP_SIZE, WORKGROUP_SIZE};
-use super::wavefront::{Schedule, default_schedule, encode_rounds, iteration_budget_for};
-use super::{GpuError, RenderError};
-use crate::accel::SceneGeometry;
+use super::Renderer;
 use crate::film::LinearImage;
+use crate::gpu::RenderError;
+use crate::gpu::display::{TextureSize, check_texture};
+use crate::gpu::film::Film;
+use crate::gpu::gpu_scene::GpuScene;
+use crate::gpu::layout::FLAG_STORE_SUM;
+use crate::gpu::pipelines::DISPLAY_FORMAT;
+use crate::gpu::readback::{create_texture, read_texture, wait};
+use crate::gpu::shaders::{SLOT_WORKGROUP_SIZE, WORKGROUP_SIZE};
+use crate::gpu::wavefront::encode_rounds;
 use crate::noise::NoiseEstimate;
-use crate::scene::{Camera, Scene, view_problem};
 
 /// Where [`Renderer::encode_samples`] writes the few bytes a trace pass needs: a
 /// [`wgpu::Queue`], or in tests a wrapper that records each write and forwards it.
@@ -35,57 +28,6 @@ pub trait BufferWrites {
 impl BufferWrites for wgpu::Queue {
     fn write_buffer(&self, buffer: &wgpu::Buffer, offset: wgpu::BufferAddress, data: &[u8]) {
         wgpu::Queue::write_buffer(self, buffer, offset, data);
-    }
-}
-
-/// How a [`Renderer`] is built.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RendererOptions {
-    /// The colour format of the attachments [`Renderer::draw`] renders into (for
-    /// example the swapchain's `Bgra8UnormSrgb`); `None` builds no draw pipeline.
-    pub surface_format: Option<wgpu::TextureFormat>,
-    /// How the trace kernels are dispatched; `None`: the adapter's default
-    /// ([`super::default_schedule`]). The image does not depend on it.
-    pub schedule: Option<Schedule>,
-    /// Path slots per film; `None`: the adapter's default
-    /// ([`super::default_slot_count`]). The image does not depend on it.
-    pub slot_count: Option<u32>,
-    /// Loop iterations per invocation and dispatch; `None`: the adapter's
-    /// ([`super::iteration_budget_for`]). The image does not depend on it.
-    pub iteration_budget: Option<u32>,
-    /// Most rounds of the trace kernels one [`Renderer::encode_samples`] records:
-    /// bounds the GPU time one call adds to a frame.
-    pub max_rounds_per_call: u32,
-    /// Trace shaders specialised to each scene's features (`true`, faster) or the
-    /// general shader.
-    pub specialise: bool,
-    /// On CPU devices, bind the records of scenes small enough as uniform buffers
-    /// (`true`, faster there) or always as storage buffers. The image does not depend
-    /// on it.
-    pub uniform_records: bool,
-    /// Where the device has subgroup operations, let the fused kernel's traversals
-    /// give way to lanes whose rays finished (`true`, faster on lavapipe; see
-    /// [`super::ShaderFeatures::refill_lanes`]). The image does not depend on it.
-    pub refill_lanes: bool,
-    /// On CPU devices, test the primitives of scenes small enough unrolled instead of
-    /// walking their BVH (`true`, faster there; see [`super::ShaderFeatures::unrolled`]).
-    /// The image does not depend on it.
-    pub unrolled: bool,
-}
-
-impl Default for RendererOptions {
-    fn default() -> Self {
-        Self {
-            surface_format: None,
-            schedule: None,
-            slot_count: None,
-            iteration_budget: None,
-            max_rounds_per_call: 64,
-            specialise: true,
-            uniform_records: true,
-            refill_lanes: true,
-            unrolled: true,
-        }
     }
 }
 
@@ -104,196 +46,7 @@ pub struct FilmImage {
     pub rays_traced: u64,
 }
 
-/// The frame-loop renderer, built for one device: the bind group layouts and every
-/// pipeline but the trace kernels, which [`Renderer::upload`] builds for each scene.
-///
-/// A frame loop (the application owns the device, the encoder and the frame):
-///
-/// ```no_run
-/// use gpu_render::gpu::{Renderer, RendererOptions};
-/// # fn frame_loop(adapter: &wgpu::Adapter, scene: &gpu_render::scene::Scene,
-/// #               mut camera_for_frame: impl FnMut(u32) -> Option<gpu_render::scene::Camera>)
-/// #               -> Result<(), Box<dyn std::error::Error>> {
-/// let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-///     required_limits: Renderer::required_limits(&adapter.limits()),
-///     required_features: Renderer::optional_features(adapter.features()),
-///     ..Default::default()
-/// }))?;
-/// let renderer = Renderer::new(&device, RendererOptions::default())?;
-/// let mut gpu_scene = renderer.upload(&device, &queue, scene)?;
-/// let mut film = renderer.create_film(&device, &gpu_scene, 640, 360)?;
-/// for frame in 0..100 {
-///     if let Some(camera) = camera_for_frame(frame) {
-///         renderer.set_camera(&mut gpu_scene, &camera)?; // the film restarts by itself
-///     }
-///     let mut encoder = device.create_command_encoder(&Default::default());
-///     renderer.encode_samples(&device, &queue, &mut encoder, &gpu_scene, &mut film, 1)?;
-///     // ... renderer.draw(&mut render_pass, &gpu_scene, &film) into the swapchain ...
-///     queue.submit([encoder.finish()]);
-/// }
-/// # Ok(())
-/// # }
-/// ```
-#[derive(Debug)]
-pub struct Renderer {
-    pipelines: Pipelines,
-    draw: Option<DrawPipelines>,
-    options: RendererOptions,
-    schedule: Schedule,
-    iteration_budget: u32,
-}
-
 impl Renderer {
-    /// Checks `device`'s limits, then builds the layouts, the display pipeline and,
-    /// with [`RendererOptions::surface_format`], the draw pipelines.
-    ///
-    /// Errors: [`RenderError::Limit`] naming the first limit the device has too little
-    /// of (a device made with `wgpu::Limits::default()` binds 8 storage buffers per
-    /// stage, the trace kernels 16): request [`Renderer::required_limits`].
-    /// [`RenderError::Wgpu`] if a pipeline fails to build.
-    pub fn new(device: &wgpu::Device, options: RendererOptions) -> Result<Self, RenderError> {
-        check_limits(&device.limits())?;
-        let pipelines = Pipelines::new(device).map_err(RenderError::Wgpu)?;
-        let draw = options
-            .surface_format
-            .map(|format| DrawPipelines::new(device, format))
-            .transpose()
-            .map_err(RenderError::Wgpu)?;
-        let adapter = device.adapter_info();
-        Ok(Self {
-            pipelines,
-            draw,
-            schedule: options
-                .schedule
-                .unwrap_or_else(|| default_schedule(&adapter)),
-            iteration_budget: options
-                .iteration_budget
-                .unwrap_or_else(|| iteration_budget_for(&adapter))
-                .max(1),
-            options,
-        })
-    }
-
-    /// The limits to request when creating a device for the renderer:
-    /// `adapter_limits` raised to the renderer's minimums ([`super::limits`]).
-    pub fn required_limits(adapter_limits: &wgpu::Limits) -> wgpu::Limits {
-        required_limits(adapter_limits)
-    }
-
-    /// The features to request when creating a device for the renderer, where the
-    /// adapter has them ([`super::limits::optional_features`]): the renderer runs
-    /// without them, only slower.
-    pub fn optional_features(adapter_features: wgpu::Features) -> wgpu::Features {
-        super::limits::optional_features(adapter_features)
-    }
-
-    /// The options the renderer was built with.
-    pub fn options(&self) -> &RendererOptions {
-        &self.options
-    }
-
-    /// The bind group layout of the draw pipelines, if any.
-    pub(crate) fn draw_layout(&self) -> Option<&wgpu::BindGroupLayout> {
-        self.draw.as_ref().map(|draw| &draw.layout)
-    }
-
-    /// Builds `scene`'s geometry and BVH, uploads its buffers and images, and builds
-    /// the trace pipelines specialised to it (so that no encoding call compiles
-    /// anything). Pass the scene as loaded: it is converted to its lighting space
-    /// here.
-    ///
-    /// Errors: [`RenderError::Scene`] for invalid render settings or a scene larger
-    /// than the device holds; [`RenderError::Wgpu`] if an allocation or pipeline
-    /// fails.
-    pub fn upload(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        scene: &Scene,
-    ) -> Result<GpuScene, RenderError> {
-        let geometry = SceneGeometry::new(scene);
-        let prepared = upload_scene(
-            device,
-            queue,
-            scene,
-            &geometry,
-            UploadOptions {
-                specialise: self.options.specialise,
-                allow_uniform_records: self.options.uniform_records,
-                allow_refill_lanes: self.options.refill_lanes,
-                allow_unrolled: self.options.unrolled,
-            },
-        )
-        .map_err(|e| match e {
-            GpuError::Validation(_) | GpuError::DeviceLimit { .. } => RenderError::Scene(e),
-            other => RenderError::Wgpu(other),
-        })?;
-        let pipelines = self
-            .pipelines
-            .trace(device, &prepared.features)
-            .map_err(RenderError::Wgpu)?;
-        Ok(GpuScene::new(
-            device,
-            prepared,
-            pipelines,
-            scene.camera,
-            scene.dielectric_spheres(),
-        ))
-    }
-
-    /// Moves `scene`'s camera. Writes nothing to the device: the next trace pass of
-    /// each film writes the camera with the pass's other constants (one 192-byte
-    /// uniform record), and a film accumulating the old camera restarts at sample 0 in
-    /// its next [`Renderer::encode_samples`]. No scene buffer is touched.
-    ///
-    /// Errors: [`RenderError::InvalidCamera`] for an undefined view or a field of view
-    /// outside (0, 180) degrees (the scene keeps its camera).
-    pub fn set_camera(&self, scene: &mut GpuScene, camera: &Camera) -> Result<(), RenderError> {
-        let fov_ok = camera.fov_y_degrees > 0.0 && camera.fov_y_degrees < 180.0;
-        if !fov_ok || view_problem(camera.eye, camera.look_at, camera.up).is_some() {
-            return Err(RenderError::InvalidCamera(*camera));
-        }
-        if scene.camera != *camera {
-            scene.camera = *camera;
-            scene.camera_version += 1;
-        }
-        Ok(())
-    }
-
-    /// Creates a film of `width × height` pixels for `scene` (and any other scene
-    /// whose `stack_size` is at most `scene`'s), with its path slots.
-    ///
-    /// Errors: [`RenderError::Limit`] for a film the device cannot hold (texture side,
-    /// bytes of the per-pixel sums); [`RenderError::Wgpu`] if an allocation fails.
-    pub fn create_film(
-        &self,
-        device: &wgpu::Device,
-        scene: &GpuScene,
-        width: u32,
-        height: u32,
-    ) -> Result<Film, RenderError> {
-        let mut film = Film::new(
-            device,
-            self.draw_layout(),
-            self.options.slot_count,
-            scene.prepared.stack_size,
-            width,
-            height,
-        )?;
-        let bind_group = film
-            .slots
-            .bind_group(
-                device,
-                self.pipelines
-                    .trace_bind_group_layout(&scene.prepared.features),
-                &scene.prepared,
-                &film.view,
-            )
-            .map_err(RenderError::Wgpu)?;
-        film.binding = Some((scene.id, bind_group));
-        Ok(film)
-    }
-
     /// Adds `samples` samples per pixel to `film`'s running mean of `scene` (sample
     /// indices continue where the film's last samples ended, so the mean after any
     /// split of N samples into calls equals a one-shot render of N samples). Records
@@ -347,7 +100,7 @@ impl Renderer {
         film.collect_progress()?;
         film.queue_samples(samples);
         if let Some(pass) = film.start_pass() {
-            let frame = super::layout::FrameUniforms {
+            let frame = crate::gpu::layout::FrameUniforms {
                 first_sample: pass.first,
                 end_sample: pass.end,
                 slot_count: film.slot_count,
@@ -357,8 +110,8 @@ impl Renderer {
                 ..scene.frame_for(film.width(), film.height())
             };
             let pixels = u64::from(film.width()) * u64::from(film.height());
-            let frame = super::layout::FrameUniforms {
-                static_pixels: super::layout::static_pixels_for(&frame, pixels),
+            let frame = crate::gpu::layout::FrameUniforms {
+                static_pixels: crate::gpu::layout::static_pixels_for(&frame, pixels),
                 ..frame
             };
             queue.write_buffer(&film.slots.uniforms, 0, bytemuck::bytes_of(&frame));
@@ -405,28 +158,14 @@ impl Renderer {
         film: &Film,
         target: &wgpu::TextureView,
     ) -> Result<(), RenderError> {
-        let texture = target.texture();
-        if texture.format() != DISPLAY_FORMAT {
-            return Err(RenderError::TargetFormat {
-                expected: DISPLAY_FORMAT,
-                found: texture.format(),
-            });
-        }
-        if !texture
-            .usage()
-            .contains(wgpu::TextureUsages::STORAGE_BINDING)
-        {
-            return Err(RenderError::TargetUsage {
-                needed: wgpu::TextureUsages::STORAGE_BINDING,
-                found: texture.usage(),
-            });
-        }
-        if (texture.width(), texture.height()) != (film.width(), film.height()) {
-            return Err(RenderError::TargetSize {
-                film: (film.width(), film.height()),
-                target: (texture.width(), texture.height()),
-            });
-        }
+        check_texture(
+            target,
+            "display target",
+            DISPLAY_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING,
+            (film.width(), film.height()),
+            TextureSize::Exact,
+        )?;
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gpu-render film display bind group"),
             layout: &self.pipelines.display_bind_group_layout,
@@ -610,12 +349,12 @@ impl Renderer {
         film: &mut Film,
     ) -> Result<NoiseEstimate, RenderError> {
         self.finish(device, queue, scene, film)?;
-        Ok(film.slots.read_noise(
+        film.slots.read_noise(
             device,
             queue,
             (film.width(), film.height()),
             film.samples(),
             None,
-        )?)
+        )
     }
 }
