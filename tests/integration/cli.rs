@@ -959,6 +959,38 @@ fn a_broken_model_file_is_an_error_naming_it_and_keeps_the_old_output() {
 }
 
 #[test]
+fn estimate_frames_a_model_file_as_the_render_command_does() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let model = dir.path().join("model.obj");
+    std::fs::write(&model, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("write");
+    let model = model.to_string_lossy().into_owned();
+    let run = gpu_render(&[
+        "estimate",
+        &model,
+        "--backend",
+        "cpu",
+        "--width",
+        "16",
+        "--height",
+        "12",
+        "--spp",
+        "1",
+        "--tiles",
+        "2",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(!run.stderr.contains("TOML"), "{}", run.stderr);
+    assert!(run.stderr.contains("has no camera"), "{}", run.stderr);
+    for needle in ["model.obj: 16x12, 1 spp", "1/2", "whole frame:"] {
+        assert!(
+            run.stdout.contains(needle),
+            "stdout lacks {needle:?}:\n{}",
+            run.stdout
+        );
+    }
+}
+
+#[test]
 fn the_sandbox_refuses_model_files() {
     let ws = Workspace::new(TINY_SCENE);
     let vase = shipped_path("scenes/models/vase.gltf");

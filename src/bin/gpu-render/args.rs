@@ -210,7 +210,8 @@ pub struct MergeArgs {
 /// The arguments of `gpu-render estimate`.
 #[derive(Debug, Args)]
 pub struct EstimateArgs {
-    /// The scene file (TOML).
+    /// The scene file (TOML), or a model file (.obj, .gltf, .glb) framed as the render
+    /// command frames it.
     #[arg(value_name = "SCENE")]
     pub scene: PathBuf,
 
