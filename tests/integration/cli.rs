@@ -680,6 +680,29 @@ fn a_negative_width_says_it_must_be_positive() {
 }
 
 #[test]
+fn a_negative_tile_or_memory_cap_says_what_it_must_be() {
+    for (flag, value, needle) in [
+        ("--tile", "-1/4", "must be I/N"),
+        ("--crop", "-1,0,2,2", "must be x0,y0,x1,y1"),
+        ("--max-memory", "-1", "must be a number of GiB above 0"),
+        ("--frame", "-2", "must be a whole number"),
+    ] {
+        let run = gpu_render(&["scene.toml", "-o", "x.exr", flag, value]);
+        assert_eq!(run.status, Some(2), "{flag} {value}: {}", run.stderr);
+        assert!(
+            run.stderr.contains(flag) && run.stderr.contains(needle),
+            "{flag} {value}: {}",
+            run.stderr
+        );
+        assert!(
+            !run.stderr.contains("unexpected argument"),
+            "{}",
+            run.stderr
+        );
+    }
+}
+
+#[test]
 fn tradeoff_refuses_bad_counts_before_creating_its_folder() {
     let ws = Workspace::new(TINY_SCENE);
     let out_dir = ws.path("sweep");
