@@ -471,6 +471,18 @@ const BAD_OBJ: &[(&str, &str)] = &[
         "bad.obj:4:7: face corner 3: the position index -4 is out of range",
     ),
     (
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n",
+        "bad.obj:4:7: face corner 3: the position index 99999999999999999999 is out of range: 3 positions are defined before this line",
+    ),
+    (
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -99999999999999999999\n",
+        "bad.obj:4:7: face corner 3: the position index -99999999999999999999 is out of range",
+    ),
+    (
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/99999999999999999999 2/1 3/1\n",
+        "bad.obj:5:3: face corner 1: the texture coordinate index 99999999999999999999 is out of range: 1 texture coordinate is defined",
+    ),
+    (
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n",
         "bad.obj:4:3: face corner 1: the position index is 0 (OBJ counts from 1)",
     ),
@@ -531,6 +543,10 @@ const BAD_MTL: &[(&str, &str)] = &[
     (
         "newmtl a\nillum 11\n",
         "lib.mtl:2:7: illum 11 is not an illumination model",
+    ),
+    (
+        "newmtl a\nillum 99999999999999999999\n",
+        "lib.mtl:2:7: illum 99999999999999999999 is not an illumination model (0 to 10)",
     ),
     (
         "newmtl a\nmap_Kd\n",

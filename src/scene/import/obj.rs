@@ -31,6 +31,7 @@ use super::texture::Textures;
 use super::{
     ImportedMaterial, ImportedModel, MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES, error, read_file,
 };
+use crate::echo::echo;
 use crate::scene::{Material, SceneError};
 
 /// Diffuse albedo of a material whose MTL gives no `Kd` (and of geometry with no
@@ -776,10 +777,18 @@ fn corner(
         }
         let kind = kinds[slot];
         let fail = |message: String| at(path, line, column, format!("face corner {k}: {message}"));
-        let index: i64 = part
-            .parse()
-            .map_err(|_| fail(format!("the {kind} index `{part}` is not an integer")))?;
-        if index == 0 {
+        // `None`: an integer beyond any index (more digits than an i64 holds).
+        let index: Option<i64> = match part.parse() {
+            Ok(index) => Some(index),
+            Err(_) if is_integer(part) => None,
+            Err(_) => {
+                return Err(fail(format!(
+                    "the {kind} index `{}` is not an integer",
+                    echo(part)
+                )));
+            }
+        };
+        if index == Some(0) {
             return Err(fail(format!("the {kind} index is 0 (OBJ counts from 1)")));
         }
         let count = defined[slot];
@@ -787,22 +796,31 @@ fn corner(
             *dropped_normals = true;
             continue;
         }
-        let resolved = if index > 0 {
-            index.unsigned_abs().checked_sub(1)
-        } else {
-            (count as u64).checked_sub(index.unsigned_abs())
-        };
+        let resolved = index.and_then(|index| {
+            if index > 0 {
+                index.unsigned_abs().checked_sub(1)
+            } else {
+                (count as u64).checked_sub(index.unsigned_abs())
+            }
+        });
         match resolved {
             Some(resolved) if resolved < count as u64 => corner[slot] = resolved as u32,
             _ => {
                 return Err(fail(format!(
-                    "the {kind} index {index} is out of range: {count} {kind}{} defined before this line",
+                    "the {kind} index {} is out of range: {count} {kind}{} defined before this line",
+                    echo(part),
                     if count == 1 { " is" } else { "s are" }
                 )));
             }
         }
     }
     Ok(corner)
+}
+
+/// Whether `word` is an integer in decimal, of any size: an optional sign and digits.
+fn is_integer(word: &str) -> bool {
+    let digits = word.strip_prefix(['+', '-']).unwrap_or(word);
+    !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
 }
 
 /// The words of a line with their 1-based columns (in characters).

@@ -8,7 +8,8 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 
-use super::{DEFAULT_OBJ_ALBEDO, Notes, at, decode_text, finite, strip_comment, words};
+use super::{DEFAULT_OBJ_ALBEDO, Notes, at, decode_text, finite, is_integer, strip_comment, words};
+use crate::echo::echo;
 use crate::input::{InputError, read_input};
 use crate::scene::import::mesh::Budget;
 use crate::scene::import::texture::{Encoding, Textures};
@@ -291,20 +292,28 @@ fn scan_mtl(
             let [word] = values else {
                 return Err(at(path, n, column, "`illum` takes one number (0 to 10)"));
             };
-            let illum: i64 = word.1.parse().map_err(|_| {
-                at(
-                    path,
-                    n,
-                    word.0,
-                    format!("illum: `{}` is not an integer", word.1),
-                )
-            })?;
-            if !(0..=10).contains(&illum) {
+            let illum: Option<i64> = match word.1.parse() {
+                Ok(illum) => Some(illum),
+                // An integer of more digits than an i64 holds: no model either.
+                Err(_) if is_integer(word.1) => None,
+                Err(_) => {
+                    return Err(at(
+                        path,
+                        n,
+                        word.0,
+                        format!("illum: `{}` is not an integer", echo(word.1)),
+                    ));
+                }
+            };
+            if !illum.is_some_and(|illum| (0..=10).contains(&illum)) {
                 return Err(at(
                     path,
                     n,
                     word.0,
-                    format!("illum {illum} is not an illumination model (0 to 10)"),
+                    format!(
+                        "illum {} is not an illumination model (0 to 10)",
+                        echo(word.1)
+                    ),
                 ));
             }
         } else if keyword.starts_with("map_")
