@@ -483,3 +483,40 @@ fn progress_is_reported_through_the_hook() {
         })
     );
 }
+
+/// A Radiance HDR file whose first line is `#?RGBE`, as Mitsuba writes it, with the
+/// texels `(x, y) → [x/4, y/2, 0.5]`.
+fn write_rgbe_hdr(path: &Path) {
+    let image = image::Rgb32FImage::from_fn(4, 2, |x, y| {
+        image::Rgb([x as f32 / 4.0, y as f32 / 2.0, 0.5])
+    });
+    image::DynamicImage::ImageRgb32F(image)
+        .save(path)
+        .expect("write hdr");
+    let bytes = std::fs::read(path).expect("read hdr");
+    let rest = bytes
+        .strip_prefix(b"#?RADIANCE\n".as_slice())
+        .expect("the encoder's first line");
+    std::fs::write(path, [b"#?RGBE\n".as_slice(), rest].concat()).expect("rewrite hdr");
+}
+
+#[test]
+fn an_hdr_file_with_the_rgbe_header_loads_as_a_texture_and_an_environment_map() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    write_rgbe_hdr(&dir.path().join("sky.hdr"));
+    let path = dir.path().join("scene.toml");
+    let text = format!(
+        "{CAMERA}[environment]\nmap = \"sky.hdr\"\n\
+         [materials.wall]\ntype = \"lambert\"\nalbedo_texture = \"sky.hdr\"\n\
+         [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"wall\"\n"
+    );
+    std::fs::write(&path, text).expect("write scene");
+    let scene = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+    let map = scene.environment.map.as_ref().expect("an environment map");
+    let texture = scene.images.first().expect("a texture");
+    for image in [&map.image, texture] {
+        assert_eq!((image.width, image.height), (4, 2));
+        // RGBE holds these values exactly.
+        assert_eq!(image.texel(3, 1), [0.75, 0.5, 0.5, 1.0]);
+    }
+}
