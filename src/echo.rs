@@ -18,17 +18,31 @@
 
 use std::borrow::Cow;
 use std::fmt::{self, Write as _};
+use std::path::Path;
 
 /// The most characters [`echo`] shows (after escaping) before it cuts the text with
 /// `…`.
 pub const MAX_ECHO_CHARS: usize = 80;
 
+/// The most characters [`echo_path`] shows: a path is longer than a name, and its
+/// end (the file's name) matters.
+pub const MAX_ECHO_PATH_CHARS: usize = 240;
+
 /// `text` as a message quotes it: one line, control characters escaped, at most
 /// [`MAX_ECHO_CHARS`] characters and then `…`.
 pub fn echo(text: &str) -> Echo<'_> {
     Echo {
-        text,
+        text: Cow::Borrowed(text),
         limit: MAX_ECHO_CHARS,
+    }
+}
+
+/// A path that a file names (a texture, a library), as a message quotes it: as
+/// [`echo`], cut after [`MAX_ECHO_PATH_CHARS`].
+pub fn echo_path(path: &Path) -> Echo<'_> {
+    Echo {
+        text: path.to_string_lossy(),
+        limit: MAX_ECHO_PATH_CHARS,
     }
 }
 
@@ -40,7 +54,7 @@ pub fn escape_controls(text: &str) -> Cow<'_, str> {
     }
     Cow::Owned(
         Echo {
-            text,
+            text: Cow::Borrowed(text),
             limit: usize::MAX,
         }
         .to_string(),
@@ -52,10 +66,10 @@ pub fn short(value: f64) -> Short {
     Short(value)
 }
 
-/// Text shown by [`echo`].
-#[derive(Debug, Clone, Copy)]
+/// Text shown by [`echo`] or [`echo_path`].
+#[derive(Debug, Clone)]
 pub struct Echo<'a> {
-    text: &'a str,
+    text: Cow<'a, str>,
     /// The most characters written before `…`.
     limit: usize,
 }
@@ -180,6 +194,16 @@ mod tests {
         // An escape is never cut in the middle.
         let shown = echo(&format!("{}\u{1b}", "x".repeat(MAX_ECHO_CHARS - 3))).to_string();
         assert!(shown.ends_with("xxx…"), "{shown}");
+    }
+
+    #[test]
+    fn paths_are_cut_later_than_names() {
+        let long = format!("{}/wood\n.png", "d".repeat(100));
+        let shown = echo_path(Path::new(&long)).to_string();
+        assert_eq!(shown, format!("{}/wood\\n.png", "d".repeat(100)));
+        let longer = "d".repeat(1000);
+        let shown = echo_path(Path::new(&longer)).to_string();
+        assert_eq!(shown.chars().count(), MAX_ECHO_PATH_CHARS + 1);
     }
 
     #[test]

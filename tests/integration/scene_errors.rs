@@ -375,6 +375,53 @@ fn numbers_outside_32_bit_floats_are_rejected() {
     );
 }
 
+/// Asserts that `shown` is one line without control characters, of at most `most`
+/// characters.
+fn assert_one_short_line(shown: &str, most: usize) {
+    assert!(!shown.contains(char::is_control), "{shown:?}");
+    assert!(shown.chars().count() <= most, "{shown:?}");
+}
+
+#[test]
+fn names_and_words_from_the_file_are_quoted_escaped_and_cut() {
+    let long = "n".repeat(5_000);
+    for (rest, needle) in [
+        (
+            "[materials.\"a\\u0000b\\nc\"]\ntype = \"lambert\"\nalbedo = 2\n".to_owned(),
+            r"materials.a\0b\nc (lambert): albedo must be in [0, 1]",
+        ),
+        (
+            "[materials.m]\ntype = \"lam\\u001b[31mbert\"\n".to_owned(),
+            r"unknown material type `lam\u{1b}[31mbert`",
+        ),
+        (
+            "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n\
+             material = \"no\\u0000pe\"\n"
+                .to_owned(),
+            r"material `no\0pe` is not defined",
+        ),
+        (
+            "[materials.grey2]\ntype = \"lambert\"\nalbedo = 0.5\n\"x\\u0000y\" = 1\n".to_owned(),
+            r"unknown field `x\0y`",
+        ),
+        (
+            format!("[[lights]]\ntype = \"{long}\"\n"),
+            "unknown light type `nnnnnnnnnn",
+        ),
+        (
+            format!("[materials.{long}]\ntype = \"lambert\"\nalbedo = 2\n"),
+            "nnn… (lambert): albedo must be in [0, 1]",
+        ),
+        (
+            format!("[materials.t]\ntype = \"lambert\"\nalbedo_texture = \"{long}\\u0007.png\"\n"),
+            "albedo_texture `nnnnnnnnnn",
+        ),
+    ] {
+        let err = error(&scene(&rest), &[needle]);
+        assert_one_short_line(&err.to_string(), 700);
+    }
+}
+
 #[test]
 fn duplicate_key_names_the_key() {
     let err = error(

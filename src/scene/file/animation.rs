@@ -6,6 +6,7 @@ use toml::Spanned;
 use super::check::Source;
 use super::raw::RawAnimation;
 use super::settings::view_problem;
+use crate::echo::echo;
 use crate::scene::{Camera, CameraKey, CameraPath, Interpolation, MAX_FRAMES, SceneError};
 
 /// `[animation]` with its keyframes, checked: at least one keyframe, times finite
@@ -30,7 +31,8 @@ pub fn animation(
         Some("catmull_rom") => Interpolation::CatmullRom,
         Some(other) => {
             return Err(item.fail(format_args!(
-                "unknown interpolation {other:?}; use \"linear\" or \"catmull_rom\""
+                "unknown interpolation \"{}\"; use \"linear\" or \"catmull_rom\"",
+                echo(other)
             )));
         }
     };

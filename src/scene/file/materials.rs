@@ -9,6 +9,7 @@ use super::LoadOptions;
 use super::check::{ColourRange, Item, Source};
 use super::paths::confined_path;
 use super::raw::RawMaterial;
+use crate::echo::{echo, echo_path};
 use crate::scene::{
     FresnelModel, Image, Material, MaterialKind, MicrofacetDistribution, SceneError,
     TextureMapping, load_confined_image, load_image,
@@ -153,13 +154,15 @@ impl<'a> ImageTable<'a> {
         }
         if self.images.len() >= MAX_SCENE_IMAGES {
             return Err(item.fail(format_args!(
-                "{field} `{file}`: a scene may use at most {MAX_SCENE_IMAGES} different image files"
+                "{field} `{}`: a scene may use at most {MAX_SCENE_IMAGES} different image files",
+                echo_path(Path::new(file))
             )));
         }
         let fail = |message: String| {
             item.fail(format_args!(
-                "{field} `{file}` ({}): {message}",
-                path.display()
+                "{field} `{}` ({}): {message}",
+                echo_path(Path::new(file)),
+                echo_path(&path)
             ))
         };
         let mut image = if self.options.sandbox {
@@ -183,9 +186,10 @@ impl<'a> ImageTable<'a> {
             && let Some(warn) = self.options.warning
         {
             warn(&item.warning(format_args!(
-                "{field} `{file}` ({}): {} texels have a channel above 1 (largest {} at \
+                "{field} `{}` ({}): {} texels have a channel above 1 (largest {} at \
                  ({}, {})); clamped to 1, as a surface reflects at most the light it receives",
-                path.display(),
+                echo_path(Path::new(file)),
+                echo_path(&path),
                 clamped.count,
                 clamped.largest,
                 clamped.at.0,
@@ -256,9 +260,10 @@ pub fn material(
 ) -> Result<Material, SceneError> {
     let span = raw.span();
     let raw = raw.into_inner();
+    let name = echo(name);
     let untyped = source.item(format!("materials.{name}"), Some(span.clone()));
     let kind = untyped.require("type", raw.kind.clone())?;
-    let item = source.item(format!("materials.{name} ({kind})"), Some(span));
+    let item = source.item(format!("materials.{name} ({})", echo(&kind)), Some(span));
     let given = raw.given_fields();
     let mut material = match kind.as_str() {
         "lambert" => {
@@ -298,7 +303,8 @@ pub fn material(
             tabulated(&item, &raw, images)
         }
         other => Err(untyped.fail(format_args!(
-            "unknown material type `{other}` (expected one of: {KINDS})"
+            "unknown material type `{}` (expected one of: {KINDS})",
+            echo(other)
         ))),
     }?;
     if let Some(two_sided) = raw.two_sided {
@@ -363,7 +369,8 @@ fn cook_torrance(
         Some("beckmann") => MicrofacetDistribution::Beckmann,
         Some(other) => {
             return Err(item.fail(format_args!(
-                "unknown distribution `{other}` (expected ggx or beckmann)"
+                "unknown distribution `{}` (expected ggx or beckmann)",
+                echo(other)
             )));
         }
     };
@@ -372,7 +379,8 @@ fn cook_torrance(
         Some("schlick") => FresnelModel::Schlick,
         Some(other) => {
             return Err(item.fail(format_args!(
-                "unknown fresnel `{other}` (expected exact or schlick)"
+                "unknown fresnel `{}` (expected exact or schlick)",
+                echo(other)
             )));
         }
     };
@@ -389,7 +397,8 @@ fn cook_torrance(
             let Some((_, eta, k)) = CONDUCTOR_PRESETS.iter().find(|(n, _, _)| n == name) else {
                 let names: Vec<&str> = CONDUCTOR_PRESETS.iter().map(|p| p.0).collect();
                 return Err(item.fail(format_args!(
-                    "unknown conductor `{name}` (expected one of: {})",
+                    "unknown conductor `{}` (expected one of: {})",
+                    echo(name),
                     names.join(", ")
                 )));
             };
@@ -491,9 +500,10 @@ fn tabulated(
     let image = &images.images[index as usize].0;
     if image.width != image.height || image.width < 2 {
         return Err(item.fail(format_args!(
-            "brdf_map `{file}` ({}): the map must be square and at least 2x2 (θi across, \
+            "brdf_map `{}` ({}): the map must be square and at least 2x2 (θi across, \
              θr down), got {}x{}",
-            image.path.display(),
+            echo_path(Path::new(file)),
+            echo_path(&image.path),
             image.width,
             image.height
         )));
@@ -523,7 +533,8 @@ fn texture(
         Some("spherical") => TextureMapping::Spherical,
         Some(other) => {
             return Err(item.fail(format_args!(
-                "unknown texture_mapping `{other}` (expected planar or spherical)"
+                "unknown texture_mapping `{}` (expected planar or spherical)",
+                echo(other)
             )));
         }
     };

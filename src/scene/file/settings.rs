@@ -10,6 +10,7 @@ use super::LoadOptions;
 use super::check::{ColourRange, Item, Source};
 use super::paths::confined_path;
 use super::raw::{RawCamera, RawEnvironment, RawIntegrator, RawLighting, RawRender};
+use crate::echo::echo_path;
 use crate::scene::{
     Camera, Environment, EnvironmentMap, Image, Integrator, LightingSpace, RenderSettings,
     SceneError, load_confined_image, load_image,
@@ -138,8 +139,9 @@ pub fn environment(
                 .fold(0.0, f64::max);
             if brightest > f64::from(f32::MAX) {
                 return Err(item.fail(format_args!(
-                    "map `{file}` times scale reaches {brightest:e}, beyond the largest f32 \
+                    "map `{}` times scale reaches {brightest:e}, beyond the largest f32 \
                      ({:e}); lower scale",
+                    echo_path(Path::new(file)),
                     f32::MAX
                 )));
             }
@@ -182,8 +184,13 @@ fn environment_image(
     } else {
         base.join(file)
     };
-    let fail =
-        |message: String| item.fail(format_args!("map `{file}` ({}): {message}", path.display()));
+    let fail = |message: String| {
+        item.fail(format_args!(
+            "map `{}` ({}): {message}",
+            echo_path(Path::new(file)),
+            echo_path(&path)
+        ))
+    };
     let image = if options.sandbox {
         // Opened beneath the folder: the check above and the open are one step.
         load_confined_image(base, Path::new(file))
