@@ -982,6 +982,41 @@ fn a_broken_model_file_is_an_error_naming_it_and_keeps_the_old_output() {
 }
 
 #[test]
+fn text_from_a_model_file_reaches_the_terminal_escaped_and_cut() {
+    let ws = Workspace::new(TINY_SCENE);
+    let mut obj = vec![0u8; 10_000];
+    obj.extend_from_slice(b"\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\x1b[31mred\nf 1 2 3\n");
+    std::fs::write(ws.path("nul.obj"), obj).expect("write");
+    let run = gpu_render(&[
+        &ws.arg("nul.obj"),
+        "-o",
+        &ws.arg("nul.png"),
+        "--backend",
+        "cpu",
+        "--width",
+        "8",
+        "--height",
+        "6",
+        "--spp",
+        "1",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    for line in run.stderr.lines() {
+        assert!(
+            !line.contains(|c: char| c.is_control() && c != '\r'),
+            "{line:?}"
+        );
+        assert!(line.chars().count() < 300, "{line:?}");
+    }
+    assert!(run.stderr.contains(r"`\0\0\0"), "{}", run.stderr);
+    assert!(
+        run.stderr.contains(r"usemtl a\u{1b}[31mred"),
+        "{}",
+        run.stderr
+    );
+}
+
+#[test]
 fn estimate_frames_a_model_file_as_the_render_command_does() {
     let dir = tempfile::tempdir().expect("tempdir");
     let model = dir.path().join("model.obj");

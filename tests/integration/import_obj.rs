@@ -601,6 +601,62 @@ fn missing_and_unreadable_files_are_named() {
     );
 }
 
+/// Asserts that `message` holds no control character and is at most `most` characters.
+fn assert_one_short_line(message: &str, most: usize) {
+    assert!(!message.contains(char::is_control), "{message:?}");
+    assert!(
+        message.chars().count() <= most,
+        "{} characters: {message:?}",
+        message.chars().count()
+    );
+}
+
+#[test]
+fn text_from_the_file_is_quoted_escaped_and_cut() {
+    let nuls = "\0".repeat(10_000);
+    let obj = format!(
+        "{nuls}\nmtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\u{1}b\u{1b}[31mred\nf 1 2 3\n\
+         o \u{202e}desrever\nusemtl shiny\u{7}\nf 1 2 3\n"
+    );
+    let mtl = "newmtl shiny\u{7}\nKd 0.5 0.5 0.5\nmap_\u{0}odd x.png\n";
+    let (_dir, result) = import(&[("odd.obj", obj.as_str()), ("lib.mtl", mtl)]);
+    let model = result.unwrap_or_else(|e| panic!("{e}"));
+    for warning in &model.warnings {
+        assert_one_short_line(warning, 300);
+    }
+    let warnings = model.warnings.join("\n");
+    let expected_nuls = format!(":1: `{}…`: not supported", r"\0".repeat(40));
+    for needle in [
+        expected_nuls.as_str(),
+        r"usemtl a\u{1}b\u{1b}[31mred: no material library defines it",
+        r"material 'shiny\u{7}': map_\0odd is not supported",
+    ] {
+        assert!(warnings.contains(needle), "{needle:?} not in {warnings}");
+    }
+    let names: Vec<&str> = model.meshes.iter().map(|m| m.name.as_str()).collect();
+    assert!(
+        names.contains(&r"object '\u{202e}desrever' (material 'shiny\u{7}')"),
+        "{names:?}"
+    );
+
+    let long = "x".repeat(5_000);
+    for (text, needle) in [
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\u{0}\n".to_string(),
+            r"the position index `3\0` is not an integer",
+        ),
+        (format!("v 0 0 {long}\n"), "position z: `xxxxxxxxxx"),
+        (
+            format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 {long}\n"),
+            "the position index `xxxxxxxxxx",
+        ),
+    ] {
+        let message = failure(&[("bad.obj", text.as_str())]);
+        assert_one_short_line(&message, 300);
+        assert!(message.contains(needle), "{needle:?} not in {message}");
+    }
+}
+
 #[test]
 fn a_byte_order_mark_is_skipped() {
     let bytes = "\u{feff}v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".as_bytes();

@@ -367,7 +367,7 @@ pub fn load_model(
     let scene = model.into_scene(render);
     if !quiet {
         for warning in &model.warnings {
-            eprintln!("warning: {warning}");
+            eprintln!("warning: {}", gpu_render::echo::escape_controls(warning));
         }
         if model.camera.is_none() {
             eprintln!(

@@ -104,7 +104,8 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError>
         };
         let name = format!(
             "object '{}' (material '{}')",
-            group.object, model.materials[material as usize].name
+            echo(&group.object),
+            echo(&model.materials[material as usize].name)
         );
         budget
             .charge_mesh(group.vertices.len(), group.triangles.len())
@@ -179,8 +180,9 @@ fn check_material_uses(
             ),
         };
         warnings.push(format!(
-            "{}:{line}: usemtl {name}: no material library defines it{others}; the default material is used",
-            path.display()
+            "{}:{line}: usemtl {}: no material library defines it{others}; the default material is used",
+            path.display(),
+            echo(name)
         ));
     }
     let early: Vec<(&str, usize, usize)> = used
@@ -196,8 +198,9 @@ fn check_material_uses(
             more => format!(" (and {more} more material{})", plural(more)),
         };
         warnings.push(format!(
-            "{}:{line}: usemtl {name} comes before the mtllib on line {mtllib_line} that defines it{others}; it is used, but other readers may show their default material",
-            path.display()
+            "{}:{line}: usemtl {} comes before the mtllib on line {mtllib_line} that defines it{others}; it is used, but other readers may show their default material",
+            path.display(),
+            echo(name)
         ));
     }
 }
@@ -207,11 +210,16 @@ fn plural(count: usize) -> &'static str {
     if count == 1 { "" } else { "s" }
 }
 
-/// The first few of `names`, comma-separated, with `…` when there are more.
+/// The first few of `names` ([`echo`]ed), comma-separated, with `…` when there are
+/// more.
 fn list<'a>(names: impl Iterator<Item = &'a str>) -> String {
     const SHOWN: usize = 5;
     let names: Vec<&str> = names.collect();
-    let mut text = names[..names.len().min(SHOWN)].join(", ");
+    let shown: Vec<String> = names[..names.len().min(SHOWN)]
+        .iter()
+        .map(|name| echo(name).to_string())
+        .collect();
+    let mut text = shown.join(", ");
     if names.len() > SHOWN {
         text.push_str(", …");
     }
@@ -388,7 +396,8 @@ impl Notes {
                 more => format!(" ({more} more such number{})", plural(more)),
             };
             warnings.push(format!(
-                "{file}:{line}:{column}: `{word}` is read as {value}, the number it starts with, as tinyobjloader and assimp read it{more}"
+                "{file}:{line}:{column}: `{}` is read as {value}, the number it starts with, as tinyobjloader and assimp read it{more}",
+                echo(&word)
             ));
         }
         if let Some(line) = self.short_faces.first {
@@ -446,7 +455,8 @@ impl Notes {
                 _ => "not supported",
             };
             warnings.push(format!(
-                "{file}:{line}: `{keyword}`: {what}; ignored (here and on any later line)"
+                "{file}:{line}: `{}`: {what}; ignored (here and on any later line)",
+                echo(keyword)
             ));
         }
         if let Some(line) = self.ignored_others.first {
@@ -758,7 +768,10 @@ fn corner(
             path,
             line,
             column,
-            format!("face corner {k} `{word}` has more than three indices (v/vt/vn)"),
+            format!(
+                "face corner {k} `{}` has more than three indices (v/vt/vn)",
+                echo(word)
+            ),
         ));
     }
     let kinds = ["position", "texture coordinate", "normal"];
@@ -770,7 +783,7 @@ fn corner(
                     path,
                     line,
                     column,
-                    format!("face corner {k} `{word}` has no position index"),
+                    format!("face corner {k} `{}` has no position index", echo(word)),
                 ));
             }
             continue;
@@ -882,7 +895,7 @@ fn number(
             path,
             line,
             column,
-            format!("{what}: `{word}` is not a number"),
+            format!("{what}: `{}` is not a number", echo(word)),
         )),
     }
 }
@@ -933,7 +946,7 @@ fn finite(
             path,
             line,
             word.0,
-            format!("{what} is not a finite number ({})", word.1),
+            format!("{what} is not a finite number ({})", echo(word.1)),
         ));
     }
     Ok(value)

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 
 use super::{DEFAULT_OBJ_ALBEDO, Notes, at, decode_text, finite, is_integer, strip_comment, words};
-use crate::echo::echo;
+use crate::echo::{echo, echo_path};
 use crate::input::{InputError, read_input};
 use crate::scene::import::mesh::Budget;
 use crate::scene::import::texture::{Encoding, Textures};
@@ -76,7 +76,7 @@ impl Libraries {
                     continue;
                 }
                 let message = |e: InputError| {
-                    format!("cannot read the material library {}: {e}", file.display())
+                    format!("cannot read the material library {}: {e}", echo_path(&file))
                 };
                 match read_input(&file, MAX_MODEL_FILE_BYTES) {
                     Ok(bytes) => libraries.parse(&file, &bytes, *line, warnings)?,
@@ -86,7 +86,12 @@ impl Libraries {
                     // A FIFO, a device or a huge file is not a library that went missing
                     // but one that must not be read (src/input.rs).
                     Err(e) => {
-                        return Err(at(obj, *line, 1, format!("mtllib {name}: {}", message(e))));
+                        return Err(at(
+                            obj,
+                            *line,
+                            1,
+                            format!("mtllib {}: {}", echo(&name), message(e)),
+                        ));
                     }
                 }
             }
@@ -98,14 +103,15 @@ impl Libraries {
                         " (nor can {}, named on the same line)",
                         unread[1..]
                             .iter()
-                            .map(|(name, _)| name.as_str())
+                            .map(|(name, _)| echo(name).to_string())
                             .collect::<Vec<_>>()
                             .join(", ")
                     ),
                 };
                 warnings.push(format!(
-                    "{}:{line}: mtllib {name}: {message}{others}; the materials it would define are replaced by the default material",
-                    obj.display()
+                    "{}:{line}: mtllib {}: {message}{others}; the materials it would define are replaced by the default material",
+                    obj.display(),
+                    echo(name)
                 ));
             }
         }
@@ -324,7 +330,7 @@ fn scan_mtl(
                     path,
                     n,
                     column,
-                    format!("`{keyword}` needs a file name"),
+                    format!("`{}` needs a file name", echo(keyword)),
                 ));
             }
             if keyword == "map_Kd" || keyword == "map_Ke" {
@@ -376,7 +382,7 @@ pub(super) fn map_material(
         "{}:{}: material '{}'",
         source.library.display(),
         source.line,
-        m.name
+        echo(&m.name)
     );
     let mut warn = |message: String| warnings.push(format!("{place}: {message}"));
     let colour = |c: Option<[f64; 3]>| c.map(|[r, g, b]| DVec3::new(r, g, b));
@@ -394,7 +400,7 @@ pub(super) fn map_material(
         if !ignored.is_empty() {
             warn(format!(
                 "{key} options {} are not supported; ignored",
-                ignored.join(" ")
+                echo(&ignored.join(" "))
             ));
         }
         let directory = source.library.parent().unwrap_or(Path::new(""));
@@ -407,7 +413,7 @@ pub(super) fn map_material(
             // shared without their textures: the geometry is still worth seeing.
             warn(format!(
                 "{key}: the texture {} does not exist; the material is used without it",
-                file_path.display()
+                echo_path(&file_path)
             ));
             return Ok(None);
         }
@@ -418,7 +424,7 @@ pub(super) fn map_material(
                     &source.library,
                     line,
                     column,
-                    format!("material '{}': {key}: {e}", m.name),
+                    format!("material '{}': {key}: {e}", echo(&m.name)),
                 )
             })?;
         Ok(Some(TextureRef {
@@ -452,7 +458,7 @@ pub(super) fn map_material(
         .collect();
     others.sort();
     for key in others {
-        warn(format!("{key} is not supported; ignored"));
+        warn(format!("{} is not supported; ignored", echo(key)));
     }
 
     let default_albedo = if base_color_texture.is_some() {
