@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use super::file::hex;
 use super::{PixelWindow, Tile, TileError, TileInfo, read_tile, read_tile_header};
+use crate::echo::echo;
 use crate::film::LinearImage;
 
 /// The whole image assembled from its tiles.
@@ -104,20 +105,21 @@ fn check_same_render(
         info.frame
             .map_or("none (a still)".to_owned(), |f| f.to_string())
     }
+    // The words a tile records are quoted as text from a file.
     fn backend(info: &TileInfo) -> String {
-        info.backend.clone()
+        echo(&info.backend).to_string()
     }
     fn settings(info: &TileInfo) -> String {
         format!(
             "{} (hash {})",
-            info.settings,
+            echo(&info.settings),
             hex(info.fingerprint.settings)
         )
     }
     fn scene(info: &TileInfo) -> String {
         match info.scene_name.as_str() {
             "" => format!("hash {}", hex(info.fingerprint.scene)),
-            name => format!("hash {} (of {name})", hex(info.fingerprint.scene)),
+            name => format!("hash {} (of {})", hex(info.fingerprint.scene), echo(name)),
         }
     }
     // What differs, and how each tile shows it.
@@ -415,6 +417,24 @@ mod tests {
         ];
         let merged = merge_tiles(&paths).expect("the same scene hash merges");
         assert_eq!(merged.info.scene_name, "s.toml");
+    }
+
+    #[test]
+    fn the_words_a_tile_records_are_quoted_escaped() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let mut odd = band(1, 2);
+        odd.fingerprint.scene = 7;
+        odd.scene_name = "two\nlines\u{1b}[2J.toml".into();
+        let paths = vec![
+            write(dir.path(), "a.exr", band(0, 2)),
+            write(dir.path(), "b.exr", odd),
+        ];
+        let message = merge_tiles(&paths).expect_err("mismatch").to_string();
+        assert!(!message.contains(char::is_control), "{message:?}");
+        assert!(
+            message.contains(r"(of two\nlines\u{1b}[2J.toml) here"),
+            "{message}"
+        );
     }
 
     #[test]
