@@ -62,8 +62,27 @@ pub fn escape_controls(text: &str) -> Cow<'_, str> {
 }
 
 /// `value` in a short form (see [`Short`]).
-pub fn short(value: f64) -> Short {
+pub fn short<T: Number>(value: T) -> Short<T> {
     Short(value)
+}
+
+/// A floating-point number that [`short`] shows: `f64`, or `f32` (a texel), each with
+/// the shortest digits of its own precision.
+pub trait Number: fmt::Display + fmt::LowerExp + Copy {
+    /// The value, for its magnitude.
+    fn to_f64(self) -> f64;
+}
+
+impl Number for f64 {
+    fn to_f64(self) -> f64 {
+        self
+    }
+}
+
+impl Number for f32 {
+    fn to_f64(self) -> f64 {
+        f64::from(self)
+    }
 }
 
 /// Text shown by [`echo`] or [`echo_path`].
@@ -127,11 +146,11 @@ fn escape(c: char, out: &mut String) {
 /// (`1e300`, `2.5e-8`) outside that range, where the plain form would run to hundreds
 /// of digits; `NaN`, `inf` and `-inf` as they are.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Short(pub f64);
+pub struct Short<T = f64>(pub T);
 
-impl fmt::Display for Short {
+impl<T: Number> fmt::Display for Short<T> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let magnitude = self.0.abs();
+        let magnitude = self.0.to_f64().abs();
         if magnitude == 0.0 || !magnitude.is_finite() || (1e-5..1e16).contains(&magnitude) {
             write!(f, "{}", self.0)
         } else {
@@ -240,5 +259,7 @@ mod tests {
             assert_eq!(shown.parse::<f64>().ok(), Some(value), "{shown}");
         }
         assert_eq!(short3([0.5, 1e300, 0.0]).to_string(), "[0.5, 1e300, 0]");
+        assert_eq!(short(f32::MAX).to_string(), "3.4028235e38");
+        assert_eq!(short(-0.5f32).to_string(), "-0.5");
     }
 }

@@ -658,6 +658,27 @@ fn text_from_the_file_is_quoted_escaped_and_cut() {
 }
 
 #[test]
+fn numbers_from_the_file_are_quoted_short() {
+    let obj = "mtllib lib.mtl\nv 0 0 1e300x\nv 1 0 0\nv 0 1 0\nv 0 0 0\n\
+               usemtl huge\nf 2 3 4\nusemtl tiny\nf 2 3 4\n";
+    let mtl = "newmtl huge\nKd 0.5 0.5 0.5\nKs 0.5 0.5 0.5\nNs 1e300\n\
+               newmtl tiny\nKd 1e300 0.5 -1e-300\nNi -1e-300\nillum 3\n";
+    let model = imported(&[("n.obj", obj), ("lib.mtl", mtl)]);
+    for warning in &model.warnings {
+        assert_one_short_line(warning, 300);
+    }
+    let warnings = model.warnings.join("\n");
+    for needle in [
+        "`1e300x` is read as 1e300, the number it starts with",
+        "material 'huge': Ns 1e300 is outside [0, 1000000]; clamped",
+        "material 'tiny': Kd [1e300, 0.5, -1e-300] is outside [0, 1]; clamped",
+        "material 'tiny': Ni -1e-300 is not positive",
+    ] {
+        assert!(warnings.contains(needle), "{needle:?} not in {warnings}");
+    }
+}
+
+#[test]
 fn a_byte_order_mark_is_skipped() {
     let bytes = "\u{feff}v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".as_bytes();
     let model = parse_obj(bytes, Path::new("bom.obj")).expect("imports");

@@ -423,6 +423,29 @@ fn names_and_words_from_the_file_are_quoted_escaped_and_cut() {
 }
 
 #[test]
+fn numbers_from_the_file_are_quoted_short() {
+    for (rest, needle) in [
+        (
+            "[materials.m]\ntype = \"lambert\"\nalbedo = -3e38\n",
+            "albedo must be in [0, 1], got -3e38",
+        ),
+        (
+            "[materials.m]\ntype = \"blinn_phong\"\ndiffuse = 0.1\nspecular = 0.1\n\
+             shininess = 3e38\n",
+            "shininess must be at most 1e6, got 3e38",
+        ),
+        (
+            "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = -2.5e-30\n\
+             material = \"grey\"\n",
+            "radius must be > 0, got -2.5e-30",
+        ),
+    ] {
+        let err = error(&scene(rest), &[needle]);
+        assert_one_short_line(&err.to_string(), 200);
+    }
+}
+
+#[test]
 fn duplicate_key_names_the_key() {
     let err = error(
         "[camera]\neye = [0, 1, 5]\neye = [1, 2, 3]\nlook_at = [0, 0.5, 0]\n",

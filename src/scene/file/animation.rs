@@ -6,7 +6,7 @@ use toml::Spanned;
 use super::check::Source;
 use super::raw::RawAnimation;
 use super::settings::view_problem;
-use crate::echo::echo;
+use crate::echo::{echo, short};
 use crate::scene::{Camera, CameraKey, CameraPath, Interpolation, MAX_FRAMES, SceneError};
 
 /// `[animation]` with its keyframes, checked: at least one keyframe, times finite
@@ -24,7 +24,7 @@ pub fn animation(
     let raw = raw.into_inner();
     let fps = item.number("fps", item.require("fps", raw.fps)?)?;
     if fps <= 0.0 {
-        return Err(item.fail(format_args!("fps must be > 0, got {fps}")));
+        return Err(item.fail(format_args!("fps must be > 0, got {}", short(fps))));
     }
     let interpolation = match raw.interpolation.as_deref() {
         None | Some("linear") => Interpolation::Linear,

@@ -9,7 +9,7 @@ use super::LoadOptions;
 use super::check::{ColourRange, Item, Source};
 use super::paths::confined_path;
 use super::raw::RawMaterial;
-use crate::echo::{echo, echo_path};
+use crate::echo::{echo, echo_path, short, short3};
 use crate::scene::{
     FresnelModel, Image, Material, MaterialKind, MicrofacetDistribution, SceneError,
     TextureMapping, load_confined_image, load_image,
@@ -178,7 +178,8 @@ impl<'a> ImageTable<'a> {
                 ImageRole::BrdfMap => "a BRDF (π·f) cannot be negative",
             };
             return Err(fail(format!(
-                "texel ({x}, {y}) has {channel} = {value}; texels must be >= 0 ({why})"
+                "texel ({x}, {y}) has {channel} = {}; texels must be >= 0 ({why})",
+                short(value)
             )));
         }
         if role == ImageRole::Albedo
@@ -191,7 +192,7 @@ impl<'a> ImageTable<'a> {
                 echo_path(Path::new(file)),
                 echo_path(&path),
                 clamped.count,
-                clamped.largest,
+                short(clamped.largest),
                 clamped.at.0,
                 clamped.at.1
             )));
@@ -353,7 +354,10 @@ fn albedo(
 fn roughness(item: &Item<'_>, value: f64) -> Result<f64, SceneError> {
     let value = item.number("roughness", value)?;
     if !(0.0..=1.0).contains(&value) {
-        return Err(item.fail(format_args!("roughness must be in [0, 1], got {value}")));
+        return Err(item.fail(format_args!(
+            "roughness must be in [0, 1], got {}",
+            short(value)
+        )));
     }
     Ok(value)
 }
@@ -415,14 +419,14 @@ fn cook_torrance(
             if material.eta.min_element() <= 0.0 {
                 return Err(item.fail(format_args!(
                     "every channel of eta must be > 0, got {}",
-                    material.eta
+                    short3(material.eta)
                 )));
             }
         }
         (None, false, Some(ior)) => {
             let ior = item.number("ior", ior)?;
             if ior <= 0.0 {
-                return Err(item.fail(format_args!("ior must be > 0, got {ior}")));
+                return Err(item.fail(format_args!("ior must be > 0, got {}", short(ior))));
             }
             material.ior = ior;
             material.diffuse = match raw.diffuse {
@@ -458,7 +462,8 @@ fn oren_nayar(
     )?;
     if sigma > 90.0 {
         return Err(item.fail(format_args!(
-            "sigma_degrees must be in [0, 90], got {sigma}"
+            "sigma_degrees must be in [0, 90], got {}",
+            short(sigma)
         )));
     }
     let material = Material {
@@ -478,7 +483,10 @@ fn pbr(
     // glTF 2.0 defaults: metallicFactor = roughnessFactor = 1.
     let metallic = item.non_negative("metallic", raw.metallic.unwrap_or(1.0))?;
     if metallic > 1.0 {
-        return Err(item.fail(format_args!("metallic must be in [0, 1], got {metallic}")));
+        return Err(item.fail(format_args!(
+            "metallic must be in [0, 1], got {}",
+            short(metallic)
+        )));
     }
     let material = Material {
         diffuse: albedo(item, "base_color", raw.base_color, raw)?,
@@ -541,7 +549,10 @@ fn texture(
     if let Some(scale) = raw.texture_scale {
         let scale = item.number("texture_scale", scale)?;
         if scale <= 0.0 {
-            return Err(item.fail(format_args!("texture_scale must be > 0, got {scale}")));
+            return Err(item.fail(format_args!(
+                "texture_scale must be > 0, got {}",
+                short(scale)
+            )));
         }
         material.texture_scale = scale;
     }
@@ -565,7 +576,8 @@ fn blinn_phong(item: &Item<'_>, raw: &RawMaterial) -> Result<Material, SceneErro
     let shininess = item.non_negative("shininess", item.require("shininess", raw.shininess)?)?;
     if shininess > MAX_SHININESS {
         return Err(item.fail(format_args!(
-            "shininess must be at most {MAX_SHININESS:e}, got {shininess}"
+            "shininess must be at most {MAX_SHININESS:e}, got {}",
+            short(shininess)
         )));
     }
     Ok(Material {
@@ -608,7 +620,7 @@ fn mirror(item: &Item<'_>, raw: &RawMaterial) -> Result<Material, SceneError> {
 fn dielectric(item: &Item<'_>, raw: &RawMaterial) -> Result<Material, SceneError> {
     let ior = item.number("ior", item.require("ior", raw.ior)?)?;
     if ior <= 0.0 {
-        return Err(item.fail(format_args!("ior must be > 0, got {ior}")));
+        return Err(item.fail(format_args!("ior must be > 0, got {}", short(ior))));
     }
     Ok(Material {
         ior,
@@ -637,7 +649,8 @@ fn coat_ior(item: &Item<'_>, value: Option<f64>) -> Result<f64, SceneError> {
     let value = item.number("coat_ior", value)?;
     if value < 1.0 {
         return Err(item.fail(format_args!(
-            "coat_ior must be >= 1 (1 is an invisible coat; leave it out for none), got {value}"
+            "coat_ior must be >= 1 (1 is an invisible coat; leave it out for none), got {}",
+            short(value)
         )));
     }
     Ok(value)

@@ -8,7 +8,7 @@ use toml::Spanned;
 use super::LoadOptions;
 use super::check::{Item, Source};
 use super::raw::{RawColor, RawObject, RawVec3};
-use crate::echo::{echo, echo_path};
+use crate::echo::{echo, echo_path, short, short3};
 use crate::scene::import::{ImportedModel, ModelPlacement, import_model};
 use crate::scene::{
     FAR_WALL_PRECISION_LIMIT, Light, SPHERE_PRECISION_LIMIT, SceneError, Shape, coincident_spheres,
@@ -161,7 +161,8 @@ pub fn model(
     };
     if scale.cmpeq(DVec3::ZERO).any() {
         return Err(item.fail(format_args!(
-            "scale must not be 0 on any axis (it would flatten the model), got {scale}"
+            "scale must not be 0 on any axis (it would flatten the model), got {}",
+            short3(scale)
         )));
     }
     let transform = ModelPlacement::trs(translate, rotate, scale);
@@ -202,7 +203,7 @@ fn sphere(item: &Item<'_>, raw: &RawObject, material: u32) -> Result<Shape, Scen
     let center = item.vector("center", item.require("center", raw.center)?)?;
     let radius = item.number("radius", item.require("radius", raw.radius)?)?;
     if radius <= 0.0 {
-        return Err(item.fail(format_args!("radius must be > 0, got {radius}")));
+        return Err(item.fail(format_args!("radius must be > 0, got {}", short(radius))));
     }
     Ok(Shape::Sphere {
         center,

@@ -31,7 +31,7 @@ use super::texture::Textures;
 use super::{
     ImportedMaterial, ImportedModel, MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES, error, read_file,
 };
-use crate::echo::echo;
+use crate::echo::{echo, short};
 use crate::scene::{Material, SceneError};
 
 /// Diffuse albedo of a material whose MTL gives no `Kd` (and of geometry with no
@@ -396,8 +396,9 @@ impl Notes {
                 more => format!(" ({more} more such number{})", plural(more)),
             };
             warnings.push(format!(
-                "{file}:{line}:{column}: `{}` is read as {value}, the number it starts with, as tinyobjloader and assimp read it{more}",
-                echo(&word)
+                "{file}:{line}:{column}: `{}` is read as {}, the number it starts with, as tinyobjloader and assimp read it{more}",
+                echo(&word),
+                short(value)
             ));
         }
         if let Some(line) = self.short_faces.first {

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 
 use super::{DEFAULT_OBJ_ALBEDO, Notes, at, decode_text, finite, is_integer, strip_comment, words};
-use crate::echo::{echo, echo_path};
+use crate::echo::{echo, echo_path, short, short3};
 use crate::input::{InputError, read_input};
 use crate::scene::import::mesh::Budget;
 use crate::scene::import::texture::{Encoding, Textures};
@@ -482,19 +482,20 @@ pub(super) fn map_material(
     let unit = |name: &str, c: DVec3, warn: &mut dyn FnMut(String)| {
         let clamped = c.clamp(DVec3::ZERO, DVec3::ONE);
         if clamped != c {
-            warn(format!("{name} {c} is outside [0, 1]; clamped"));
+            warn(format!("{name} {} is outside [0, 1]; clamped", short3(c)));
         }
         clamped
     };
     let emission = ke.max(DVec3::ZERO);
     if emission != ke {
-        warn(format!("Ke {ke} is negative; clamped to 0"));
+        warn(format!("Ke {} is negative; clamped to 0", short3(ke)));
     }
     let ior_or_default = |warn: &mut dyn FnMut(String), what: &str| match ni {
         Some(ni) if ni > 0.0 => ni,
         Some(ni) => {
             warn(format!(
-                "Ni {ni} is not positive; {what} uses {DEFAULT_IOR}"
+                "Ni {} is not positive; {what} uses {DEFAULT_IOR}",
+                short(ni)
             ));
             DEFAULT_IOR
         }
@@ -518,7 +519,7 @@ pub(super) fn map_material(
         }
         let clamp01 = |name: &str, v: f64, warn: &mut dyn FnMut(String)| {
             if !(0.0..=1.0).contains(&v) {
-                warn(format!("{name} {v} is outside [0, 1]; clamped"));
+                warn(format!("{name} {} is outside [0, 1]; clamped", short(v)));
             }
             v.clamp(0.0, 1.0)
         };
@@ -538,7 +539,9 @@ pub(super) fn map_material(
         let sum = (kd + ks).max_element();
         if sum > 1.0 {
             warn(format!(
-                "Kd + Ks reaches {sum} in a channel; both are scaled by 1/{sum} so that the surface does not reflect more light than it receives"
+                "Kd + Ks reaches {} in a channel; both are scaled by 1/{} so that the surface does not reflect more light than it receives",
+                short(sum),
+                short(sum)
             ));
             kd /= sum;
             ks /= sum;
@@ -546,7 +549,10 @@ pub(super) fn map_material(
         let coat_ior = if matches!(illum, 3 | 5 | 8) {
             let ior = ior_or_default(&mut warn, "the coat");
             if ior < 1.0 {
-                warn(format!("Ni {ior} is below 1; the coat uses {DEFAULT_IOR}"));
+                warn(format!(
+                    "Ni {} is below 1; the coat uses {DEFAULT_IOR}",
+                    short(ior)
+                ));
                 DEFAULT_IOR
             } else {
                 ior
@@ -564,7 +570,11 @@ pub(super) fn map_material(
             let shininess = if (0.0..=MAX_SHININESS).contains(&ns) {
                 ns
             } else {
-                warn(format!("Ns {ns} is outside [0, {MAX_SHININESS}]; clamped"));
+                warn(format!(
+                    "Ns {} is outside [0, {}]; clamped",
+                    short(ns),
+                    short(MAX_SHININESS)
+                ));
                 ns.clamp(0.0, MAX_SHININESS)
             };
             Material {
@@ -579,7 +589,8 @@ pub(super) fn map_material(
     };
     if dissolve < 1.0 && material.kind != MaterialKind::Dielectric {
         warn(format!(
-            "d {dissolve} (partial transparency) is not supported; the material is opaque"
+            "d {} (partial transparency) is not supported; the material is opaque",
+            short(dissolve)
         ));
     }
     Ok(ImportedMaterial {
