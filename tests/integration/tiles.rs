@@ -371,7 +371,10 @@ fn tile_and_crop_arguments_are_checked_before_rendering() {
     let png = arg(&dir.path().join("t.png"));
     let named = arg(&dir.path().join("t{tile}.exr"));
     let cases: [(Vec<&str>, &[&str]); 5] = [
-        (vec!["--tile", "1/4", "-o", &png], &["must be an .exr"]),
+        (
+            vec!["--tile", "1/4", "-o", &png],
+            &["records its window (for `gpu-render merge`), so the output must be an .exr"],
+        ),
         (
             vec!["--tile", "5/40", "-o", &out],
             &["--tile 5/40", "the image has 16"],
