@@ -11,6 +11,8 @@
 //! - [`cpu`]: the reference tracer (f64).
 //! - [`gpu`]: the wgpu backend, built from the caller's `Device` and `Queue`.
 //! - [`noise`]: the per-pixel noise estimate (standard error of each pixel's mean).
+//! - [`echo`]: text and numbers read from files, as messages quote them (control
+//!   characters escaped, long text cut, numbers short).
 //! - [`input`]: opening the files a render reads (regular files only, confined in a
 //!   sandbox without a race).
 //! - [`output`]: writing PNG, EXR and HDR files atomically.
@@ -28,6 +30,7 @@ pub mod accel;
 pub mod camera;
 pub mod color;
 pub mod cpu;
+pub mod echo;
 pub mod film;
 pub mod gpu;
 pub mod input;

@@ -1,7 +1,9 @@
 //! Errors about scene files: each names the file, the place and the problem.
 
 use std::fmt;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+use crate::echo::escape_controls;
 
 /// A problem with a scene file: unreadable, malformed, or describing an impossible scene.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -16,17 +18,24 @@ pub struct SceneError {
 
 impl fmt::Display for SceneError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.location {
-            Some((line, column)) => write!(
-                f,
-                "{}:{}:{}: {}",
-                self.path.display(),
-                line,
-                column,
-                self.message
-            ),
-            None => write!(f, "{}: {}", self.path.display(), self.message),
-        }
+        located(f, &self.path, self.location, &self.message)
+    }
+}
+
+/// `path:line:column: message`, on one line: control characters that reached the path
+/// or the message from a file (a name quoted whole, a parser's words) are escaped
+/// ([`escape_controls`]).
+fn located(
+    f: &mut fmt::Formatter<'_>,
+    path: &Path,
+    location: Option<(usize, usize)>,
+    message: &str,
+) -> fmt::Result {
+    let path = path.display().to_string();
+    let (path, message) = (escape_controls(&path), escape_controls(message));
+    match location {
+        Some((line, column)) => write!(f, "{path}:{line}:{column}: {message}"),
+        None => write!(f, "{path}: {message}"),
     }
 }
 
@@ -44,16 +53,6 @@ pub struct SceneWarning {
 
 impl fmt::Display for SceneWarning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.location {
-            Some((line, column)) => write!(
-                f,
-                "{}:{}:{}: {}",
-                self.path.display(),
-                line,
-                column,
-                self.message
-            ),
-            None => write!(f, "{}: {}", self.path.display(), self.message),
-        }
+        located(f, &self.path, self.location, &self.message)
     }
 }

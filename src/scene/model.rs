@@ -535,7 +535,7 @@ impl RenderSettings {
         if !(0.0..=1.0).contains(&self.min_ray_weight) {
             return Err(format!(
                 "min_ray_weight must be between 0 and 1, got {}",
-                self.min_ray_weight
+                crate::echo::short(self.min_ray_weight)
             ));
         }
         if self.stack_size == 0 || self.stack_size > MAX_STACK_SIZE {

@@ -32,7 +32,7 @@ pub enum TileError {
     NoTiles,
     /// A tile belongs to another render than the first tile.
     #[error(
-        "{}: {what} differs from that of {}: {this} here, {first} there; tiles of one image \
+        "{}: not the same {what} as {}: {this} here, {first} there; tiles of one image \
          must come from the same scene, frame, settings and backend",
         .path.display(),
         .first_path.display()
@@ -42,7 +42,7 @@ pub enum TileError {
         path: PathBuf,
         /// The first tile, which the others are compared with.
         first_path: PathBuf,
-        /// What differs ("the scene hash", "the image size", ...).
+        /// What differs (`scene`, `image size`, `render settings`, ...).
         what: &'static str,
         /// Its value in `path`.
         this: String,

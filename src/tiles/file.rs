@@ -462,9 +462,9 @@ impl Attributes<'_> {
             return Err(not_a_tile(
                 self.path,
                 format!(
-                    "its display window {:?} + {:?} is not the {image_width}x{image_height} \
-                     image its `{IMAGE_SIZE}` records",
-                    display.position, display.size
+                    "its display window, {}, is not the {image_width}x{image_height} image its \
+                     `{IMAGE_SIZE}` records",
+                    pixels_from(display.position, display.size)
                 ),
             ));
         }
@@ -484,9 +484,9 @@ impl Attributes<'_> {
                 not_a_tile(
                     self.path,
                     format!(
-                        "its data window at {:?} of {:?} pixels does not lie inside the \
+                        "its data window, {}, does not lie inside the \
                          {image_width}x{image_height} image",
-                        position, size
+                        pixels_from(position, size)
                     ),
                 )
             })?;
@@ -523,6 +523,17 @@ impl Attributes<'_> {
 }
 
 const TILE_FORMAT_VERSION_U32: u32 = TILE_FORMAT_VERSION as u32;
+
+/// A window of a header as people read it: `64x65 pixels from pixel (0, 36)`.
+fn pixels_from(position: Vec2<i32>, size: Vec2<usize>) -> String {
+    format!(
+        "{}x{} pixels from pixel ({}, {})",
+        size.x(),
+        size.y(),
+        position.x(),
+        position.y()
+    )
+}
 
 /// A hash as the 16 hexadecimal digits a tile records.
 pub(crate) fn hex(hash: u64) -> String {
@@ -670,5 +681,59 @@ mod tests {
         let err = write_tile(&path, &outside).expect_err("outside");
         assert!(err.to_string().contains("does not lie inside"), "{err}");
         assert!(!path.exists());
+    }
+
+    /// The record of the tile `tile(window)` writes, as its header's attributes.
+    fn attributes(info: &TileInfo) -> Vec<(Text, AttributeValue)> {
+        let mut attributes = vec![
+            (Text::from(FORMAT), AttributeValue::I32(TILE_FORMAT_VERSION)),
+            (
+                Text::from(IMAGE_SIZE),
+                AttributeValue::IntVec2(Vec2(info.image_width as i32, info.image_height as i32)),
+            ),
+        ];
+        for (name, value) in [
+            (SCENE_HASH, hex(info.fingerprint.scene)),
+            (SETTINGS_HASH, hex(info.fingerprint.settings)),
+            (SETTINGS, info.settings.clone()),
+            (BACKEND, info.backend.clone()),
+            (DEVICE, info.device.clone()),
+        ] {
+            attributes.push((Text::from(name), AttributeValue::Text(text(&value))));
+        }
+        attributes
+    }
+
+    #[test]
+    fn windows_outside_the_image_are_named_in_pixels() {
+        let info = tile(PixelWindow {
+            columns: 0..9,
+            rows: 0..7,
+        })
+        .info;
+        let owned = attributes(&info);
+        let path = Path::new("t.exr");
+        let header = Attributes {
+            path,
+            attributes: owned.iter().map(|(name, value)| (name, value)).collect(),
+        };
+        let whole = IntegerBounds::from_dimensions(Vec2(9, 7));
+        let err = header
+            .info(Vec2(0, 3), Vec2(9, 5), whole)
+            .expect_err("rows 3..8 of 7");
+        assert_eq!(
+            err.to_string(),
+            "t.exr: not a gpu-render tile: its data window, 9x5 pixels from pixel (0, 3), does \
+             not lie inside the 9x7 image"
+        );
+        let other = IntegerBounds::new(Vec2(0, 1), Vec2(9, 7));
+        let err = header
+            .info(Vec2(0, 0), Vec2(9, 7), other)
+            .expect_err("another display window");
+        assert!(
+            err.to_string()
+                .contains("its display window, 9x7 pixels from pixel (0, 1), is not the 9x7 image"),
+            "{err}"
+        );
     }
 }

@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use super::file::hex;
 use super::{PixelWindow, Tile, TileError, TileInfo, read_tile, read_tile_header};
+use crate::echo::echo;
 use crate::film::LinearImage;
 
 /// The whole image assembled from its tiles.
@@ -88,45 +89,67 @@ fn place(tile: &Tile, image: &mut LinearImage, display_rgba8: &mut [u8]) {
     }
 }
 
-/// Refuses a tile of another render than the first.
+/// Refuses a tile of another render than the first. The hashes are compared, not the
+/// words beside them: the scene file's name is recorded for people, and tiles of the
+/// same scene rendered from files of other names (or folders) belong together.
 fn check_same_render(
     first_path: &Path,
     first: &TileInfo,
     path: &Path,
     info: &TileInfo,
 ) -> Result<(), TileError> {
-    let frame = |frame: Option<u32>| frame.map_or("none (a still)".to_owned(), |f| f.to_string());
-    let size = |info: &TileInfo| format!("{}x{}", info.image_width, info.image_height);
-    let checks: [(&'static str, String, String); 5] = [
-        ("the image size", size(info), size(first)),
-        ("the frame", frame(info.frame), frame(first.frame)),
-        ("the backend", info.backend.clone(), first.backend.clone()),
+    fn size(info: &TileInfo) -> String {
+        format!("{}x{}", info.image_width, info.image_height)
+    }
+    fn frame(info: &TileInfo) -> String {
+        info.frame
+            .map_or("none (a still)".to_owned(), |f| f.to_string())
+    }
+    // The words a tile records are quoted as text from a file.
+    fn backend(info: &TileInfo) -> String {
+        echo(&info.backend).to_string()
+    }
+    fn settings(info: &TileInfo) -> String {
+        format!(
+            "{} (hash {})",
+            echo(&info.settings),
+            hex(info.fingerprint.settings)
+        )
+    }
+    fn scene(info: &TileInfo) -> String {
+        match info.scene_name.as_str() {
+            "" => format!("hash {}", hex(info.fingerprint.scene)),
+            name => format!("hash {} (of {})", hex(info.fingerprint.scene), echo(name)),
+        }
+    }
+    // What differs, and how each tile shows it.
+    type Check = (&'static str, bool, fn(&TileInfo) -> String);
+    let checks: [Check; 5] = [
         (
-            "the render settings",
-            format!(
-                "{} (hash {})",
-                info.settings,
-                hex(info.fingerprint.settings)
-            ),
-            format!(
-                "{} (hash {})",
-                first.settings,
-                hex(first.fingerprint.settings)
-            ),
+            "image size",
+            (info.image_width, info.image_height) != (first.image_width, first.image_height),
+            size,
+        ),
+        ("frame", info.frame != first.frame, frame),
+        ("backend", info.backend != first.backend, backend),
+        (
+            "render settings",
+            info.fingerprint.settings != first.fingerprint.settings,
+            settings,
         ),
         (
-            "the scene hash",
-            format!("{} of {}", hex(info.fingerprint.scene), info.scene_name),
-            format!("{} of {}", hex(first.fingerprint.scene), first.scene_name),
+            "scene",
+            info.fingerprint.scene != first.fingerprint.scene,
+            scene,
         ),
     ];
-    match checks.into_iter().find(|(_, this, other)| this != other) {
-        Some((what, this, first)) => Err(TileError::Mismatch {
+    match checks.into_iter().find(|(_, differs, _)| *differs) {
+        Some((what, _, show)) => Err(TileError::Mismatch {
             path: path.to_path_buf(),
             first_path: first_path.to_path_buf(),
             what,
-            this,
-            first,
+            this: show(info),
+            first: show(first),
         }),
         None => Ok(()),
     }
@@ -352,12 +375,15 @@ mod tests {
         let err = merge_tiles(&[a.clone(), b]).expect_err("mismatch");
         let message = err.to_string();
         assert!(
-            message.contains("b.exr: the scene hash differs"),
+            message.contains("b.exr: not the same scene as "),
             "{message}"
         );
         assert!(message.contains("a.exr"), "{message}");
         assert!(
-            message.contains("0000000000000063 of other.toml"),
+            message.contains(
+                "hash 0000000000000063 (of other.toml) here, hash 0000000000000001 (of s.toml) \
+                 there"
+            ),
             "{message}"
         );
 
@@ -366,13 +392,60 @@ mod tests {
         samples.settings = "6x4, 2 spp".into();
         let c = write(dir.path(), "c.exr", samples);
         let err = merge_tiles(&[a.clone(), c]).expect_err("mismatch");
+        assert!(
+            err.to_string().contains("not the same render settings as"),
+            "{err}"
+        );
         assert!(err.to_string().contains("6x4, 2 spp (hash"), "{err}");
 
         let mut frame = band(1, 2);
         frame.frame = Some(3);
         let d = write(dir.path(), "d.exr", frame);
         let err = merge_tiles(&[a, d]).expect_err("mismatch");
-        assert!(err.to_string().contains("the frame differs"), "{err}");
+        assert!(err.to_string().contains("not the same frame as"), "{err}");
         assert!(matches!(merge_tiles(&[]), Err(TileError::NoTiles)));
+    }
+
+    #[test]
+    fn tiles_of_one_scene_from_files_of_other_names_merge() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let mut renamed = band(1, 2);
+        renamed.scene_name = "copy of s.toml".into();
+        let paths = vec![
+            write(dir.path(), "a.exr", band(0, 2)),
+            write(dir.path(), "b.exr", renamed),
+        ];
+        let merged = merge_tiles(&paths).expect("the same scene hash merges");
+        assert_eq!(merged.info.scene_name, "s.toml");
+    }
+
+    #[test]
+    fn the_words_a_tile_records_are_quoted_escaped() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let mut odd = band(1, 2);
+        odd.fingerprint.scene = 7;
+        odd.scene_name = "two\nlines\u{1b}[2J.toml".into();
+        let paths = vec![
+            write(dir.path(), "a.exr", band(0, 2)),
+            write(dir.path(), "b.exr", odd),
+        ];
+        let message = merge_tiles(&paths).expect_err("mismatch").to_string();
+        assert!(!message.contains(char::is_control), "{message:?}");
+        assert!(
+            message.contains(r"(of two\nlines\u{1b}[2J.toml) here"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn settings_words_do_not_count_but_their_hash_does() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let mut reworded = band(1, 2);
+        reworded.settings = "6x4, 1 spp, as an older version put it".into();
+        let paths = vec![
+            write(dir.path(), "a.exr", band(0, 2)),
+            write(dir.path(), "b.exr", reworded),
+        ];
+        merge_tiles(&paths).expect("the same settings hash merges");
     }
 }

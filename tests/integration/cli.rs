@@ -680,6 +680,29 @@ fn a_negative_width_says_it_must_be_positive() {
 }
 
 #[test]
+fn a_negative_tile_or_memory_cap_says_what_it_must_be() {
+    for (flag, value, needle) in [
+        ("--tile", "-1/4", "must be I/N"),
+        ("--crop", "-1,0,2,2", "must be x0,y0,x1,y1"),
+        ("--max-memory", "-1", "must be a number of GiB above 0"),
+        ("--frame", "-2", "must be a whole number"),
+    ] {
+        let run = gpu_render(&["scene.toml", "-o", "x.exr", flag, value]);
+        assert_eq!(run.status, Some(2), "{flag} {value}: {}", run.stderr);
+        assert!(
+            run.stderr.contains(flag) && run.stderr.contains(needle),
+            "{flag} {value}: {}",
+            run.stderr
+        );
+        assert!(
+            !run.stderr.contains("unexpected argument"),
+            "{}",
+            run.stderr
+        );
+    }
+}
+
+#[test]
 fn tradeoff_refuses_bad_counts_before_creating_its_folder() {
     let ws = Workspace::new(TINY_SCENE);
     let out_dir = ws.path("sweep");
@@ -956,6 +979,73 @@ fn a_broken_model_file_is_an_error_naming_it_and_keeps_the_old_output() {
     assert_fails_with(&run, &["broken.glb"]);
     std::fs::remove_file(ws.path("broken.glb")).expect("remove");
     ws.assert_old_output_kept();
+}
+
+#[test]
+fn text_from_a_model_file_reaches_the_terminal_escaped_and_cut() {
+    let ws = Workspace::new(TINY_SCENE);
+    let mut obj = vec![0u8; 10_000];
+    obj.extend_from_slice(b"\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\x1b[31mred\nf 1 2 3\n");
+    std::fs::write(ws.path("nul.obj"), obj).expect("write");
+    let run = gpu_render(&[
+        &ws.arg("nul.obj"),
+        "-o",
+        &ws.arg("nul.png"),
+        "--backend",
+        "cpu",
+        "--width",
+        "8",
+        "--height",
+        "6",
+        "--spp",
+        "1",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    for line in run.stderr.lines() {
+        assert!(
+            !line.contains(|c: char| c.is_control() && c != '\r'),
+            "{line:?}"
+        );
+        assert!(line.chars().count() < 300, "{line:?}");
+    }
+    assert!(run.stderr.contains(r"`\0\0\0"), "{}", run.stderr);
+    assert!(
+        run.stderr.contains(r"usemtl a\u{1b}[31mred"),
+        "{}",
+        run.stderr
+    );
+}
+
+#[test]
+fn estimate_frames_a_model_file_as_the_render_command_does() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let model = dir.path().join("model.obj");
+    std::fs::write(&model, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("write");
+    let model = model.to_string_lossy().into_owned();
+    let run = gpu_render(&[
+        "estimate",
+        &model,
+        "--backend",
+        "cpu",
+        "--width",
+        "16",
+        "--height",
+        "12",
+        "--spp",
+        "1",
+        "--tiles",
+        "2",
+    ]);
+    assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+    assert!(!run.stderr.contains("TOML"), "{}", run.stderr);
+    assert!(run.stderr.contains("has no camera"), "{}", run.stderr);
+    for needle in ["model.obj: 16x12, 1 spp", "1/2", "whole frame:"] {
+        assert!(
+            run.stdout.contains(needle),
+            "stdout lacks {needle:?}:\n{}",
+            run.stdout
+        );
+    }
 }
 
 #[test]

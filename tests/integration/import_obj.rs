@@ -471,6 +471,18 @@ const BAD_OBJ: &[(&str, &str)] = &[
         "bad.obj:4:7: face corner 3: the position index -4 is out of range",
     ),
     (
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n",
+        "bad.obj:4:7: face corner 3: the position index 99999999999999999999 is out of range: 3 positions are defined before this line",
+    ),
+    (
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -99999999999999999999\n",
+        "bad.obj:4:7: face corner 3: the position index -99999999999999999999 is out of range",
+    ),
+    (
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/99999999999999999999 2/1 3/1\n",
+        "bad.obj:5:3: face corner 1: the texture coordinate index 99999999999999999999 is out of range: 1 texture coordinate is defined",
+    ),
+    (
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n",
         "bad.obj:4:3: face corner 1: the position index is 0 (OBJ counts from 1)",
     ),
@@ -533,6 +545,10 @@ const BAD_MTL: &[(&str, &str)] = &[
         "lib.mtl:2:7: illum 11 is not an illumination model",
     ),
     (
+        "newmtl a\nillum 99999999999999999999\n",
+        "lib.mtl:2:7: illum 99999999999999999999 is not an illumination model (0 to 10)",
+    ),
+    (
         "newmtl a\nmap_Kd\n",
         "lib.mtl:2:1: `map_Kd` needs a file name",
     ),
@@ -583,6 +599,83 @@ fn missing_and_unreadable_files_are_named() {
         message.contains("must end in .obj, .gltf or .glb"),
         "{message}"
     );
+}
+
+/// Asserts that `message` holds no control character and is at most `most` characters.
+fn assert_one_short_line(message: &str, most: usize) {
+    assert!(!message.contains(char::is_control), "{message:?}");
+    assert!(
+        message.chars().count() <= most,
+        "{} characters: {message:?}",
+        message.chars().count()
+    );
+}
+
+#[test]
+fn text_from_the_file_is_quoted_escaped_and_cut() {
+    let nuls = "\0".repeat(10_000);
+    let obj = format!(
+        "{nuls}\nmtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\u{1}b\u{1b}[31mred\nf 1 2 3\n\
+         o \u{202e}desrever\nusemtl shiny\u{7}\nf 1 2 3\n"
+    );
+    let mtl = "newmtl shiny\u{7}\nKd 0.5 0.5 0.5\nmap_\u{0}odd x.png\n";
+    let (_dir, result) = import(&[("odd.obj", obj.as_str()), ("lib.mtl", mtl)]);
+    let model = result.unwrap_or_else(|e| panic!("{e}"));
+    for warning in &model.warnings {
+        assert_one_short_line(warning, 300);
+    }
+    let warnings = model.warnings.join("\n");
+    let expected_nuls = format!(":1: `{}…`: not supported", r"\0".repeat(40));
+    for needle in [
+        expected_nuls.as_str(),
+        r"usemtl a\u{1}b\u{1b}[31mred: no material library defines it",
+        r"material 'shiny\u{7}': map_\0odd is not supported",
+    ] {
+        assert!(warnings.contains(needle), "{needle:?} not in {warnings}");
+    }
+    let names: Vec<&str> = model.meshes.iter().map(|m| m.name.as_str()).collect();
+    assert!(
+        names.contains(&r"object '\u{202e}desrever' (material 'shiny\u{7}')"),
+        "{names:?}"
+    );
+
+    let long = "x".repeat(5_000);
+    for (text, needle) in [
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\u{0}\n".to_string(),
+            r"the position index `3\0` is not an integer",
+        ),
+        (format!("v 0 0 {long}\n"), "position z: `xxxxxxxxxx"),
+        (
+            format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 {long}\n"),
+            "the position index `xxxxxxxxxx",
+        ),
+    ] {
+        let message = failure(&[("bad.obj", text.as_str())]);
+        assert_one_short_line(&message, 300);
+        assert!(message.contains(needle), "{needle:?} not in {message}");
+    }
+}
+
+#[test]
+fn numbers_from_the_file_are_quoted_short() {
+    let obj = "mtllib lib.mtl\nv 0 0 1e300x\nv 1 0 0\nv 0 1 0\nv 0 0 0\n\
+               usemtl huge\nf 2 3 4\nusemtl tiny\nf 2 3 4\n";
+    let mtl = "newmtl huge\nKd 0.5 0.5 0.5\nKs 0.5 0.5 0.5\nNs 1e300\n\
+               newmtl tiny\nKd 1e300 0.5 -1e-300\nNi -1e-300\nillum 3\n";
+    let model = imported(&[("n.obj", obj), ("lib.mtl", mtl)]);
+    for warning in &model.warnings {
+        assert_one_short_line(warning, 300);
+    }
+    let warnings = model.warnings.join("\n");
+    for needle in [
+        "`1e300x` is read as 1e300, the number it starts with",
+        "material 'huge': Ns 1e300 is outside [0, 1000000]; clamped",
+        "material 'tiny': Kd [1e300, 0.5, -1e-300] is outside [0, 1]; clamped",
+        "material 'tiny': Ni -1e-300 is not positive",
+    ] {
+        assert!(warnings.contains(needle), "{needle:?} not in {warnings}");
+    }
 }
 
 #[test]

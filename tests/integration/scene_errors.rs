@@ -375,6 +375,76 @@ fn numbers_outside_32_bit_floats_are_rejected() {
     );
 }
 
+/// Asserts that `shown` is one line without control characters, of at most `most`
+/// characters.
+fn assert_one_short_line(shown: &str, most: usize) {
+    assert!(!shown.contains(char::is_control), "{shown:?}");
+    assert!(shown.chars().count() <= most, "{shown:?}");
+}
+
+#[test]
+fn names_and_words_from_the_file_are_quoted_escaped_and_cut() {
+    let long = "n".repeat(5_000);
+    for (rest, needle) in [
+        (
+            "[materials.\"a\\u0000b\\nc\"]\ntype = \"lambert\"\nalbedo = 2\n".to_owned(),
+            r"materials.a\0b\nc (lambert): albedo must be in [0, 1]",
+        ),
+        (
+            "[materials.m]\ntype = \"lam\\u001b[31mbert\"\n".to_owned(),
+            r"unknown material type `lam\u{1b}[31mbert`",
+        ),
+        (
+            "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n\
+             material = \"no\\u0000pe\"\n"
+                .to_owned(),
+            r"material `no\0pe` is not defined",
+        ),
+        (
+            "[materials.grey2]\ntype = \"lambert\"\nalbedo = 0.5\n\"x\\u0000y\" = 1\n".to_owned(),
+            r"unknown field `x\0y`",
+        ),
+        (
+            format!("[[lights]]\ntype = \"{long}\"\n"),
+            "unknown light type `nnnnnnnnnn",
+        ),
+        (
+            format!("[materials.{long}]\ntype = \"lambert\"\nalbedo = 2\n"),
+            "nnn… (lambert): albedo must be in [0, 1]",
+        ),
+        (
+            format!("[materials.t]\ntype = \"lambert\"\nalbedo_texture = \"{long}\\u0007.png\"\n"),
+            "albedo_texture `nnnnnnnnnn",
+        ),
+    ] {
+        let err = error(&scene(&rest), &[needle]);
+        assert_one_short_line(&err.to_string(), 700);
+    }
+}
+
+#[test]
+fn numbers_from_the_file_are_quoted_short() {
+    for (rest, needle) in [
+        (
+            "[materials.m]\ntype = \"lambert\"\nalbedo = -3e38\n",
+            "albedo must be in [0, 1], got -3e38",
+        ),
+        (
+            "[materials.m]\ntype = \"blinn_phong\"\ndiffuse = 0.1\nspecular = 0.1\n\
+             shininess = 3e38\n",
+            "shininess must be at most 1e6, got 3e38",
+        ),
+        (
+            "[[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = -2.5e-30\n\
+             material = \"grey\"\n",
+            "radius must be > 0, got -2.5e-30",
+        ),
+    ] {
+        let err = error(&scene(rest), &[needle]);
+        assert_one_short_line(&err.to_string(), 200);
+    }
+}
+
 #[test]
 fn duplicate_key_names_the_key() {
     let err = error(
@@ -482,4 +552,41 @@ fn progress_is_reported_through_the_hook() {
             total: 11
         })
     );
+}
+
+/// A Radiance HDR file whose first line is `#?RGBE`, as Mitsuba writes it, with the
+/// texels `(x, y) → [x/4, y/2, 0.5]`.
+fn write_rgbe_hdr(path: &Path) {
+    let image = image::Rgb32FImage::from_fn(4, 2, |x, y| {
+        image::Rgb([x as f32 / 4.0, y as f32 / 2.0, 0.5])
+    });
+    image::DynamicImage::ImageRgb32F(image)
+        .save(path)
+        .expect("write hdr");
+    let bytes = std::fs::read(path).expect("read hdr");
+    let rest = bytes
+        .strip_prefix(b"#?RADIANCE\n".as_slice())
+        .expect("the encoder's first line");
+    std::fs::write(path, [b"#?RGBE\n".as_slice(), rest].concat()).expect("rewrite hdr");
+}
+
+#[test]
+fn an_hdr_file_with_the_rgbe_header_loads_as_a_texture_and_an_environment_map() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    write_rgbe_hdr(&dir.path().join("sky.hdr"));
+    let path = dir.path().join("scene.toml");
+    let text = format!(
+        "{CAMERA}[environment]\nmap = \"sky.hdr\"\n\
+         [materials.wall]\ntype = \"lambert\"\nalbedo_texture = \"sky.hdr\"\n\
+         [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"wall\"\n"
+    );
+    std::fs::write(&path, text).expect("write scene");
+    let scene = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+    let map = scene.environment.map.as_ref().expect("an environment map");
+    let texture = scene.images.first().expect("a texture");
+    for image in [&map.image, texture] {
+        assert_eq!((image.width, image.height), (4, 2));
+        // RGBE holds these values exactly.
+        assert_eq!(image.texel(3, 1), [0.75, 0.5, 0.5, 1.0]);
+    }
 }

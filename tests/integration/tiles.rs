@@ -290,10 +290,10 @@ fn merge_refuses_a_tile_of_another_scene_or_settings() {
     fails_with(
         &run,
         &[
-            "other-2.exr: the scene hash differs from that of ",
+            "other-2.exr: not the same scene as ",
             "s-0.exr",
-            "of other.toml here",
-            "of s.toml there",
+            "(of other.toml) here, hash ",
+            "(of s.toml) there",
         ],
     );
     let more = four_tiles(
@@ -313,7 +313,7 @@ fn merge_refuses_a_tile_of_another_scene_or_settings() {
     fails_with(
         &run,
         &[
-            "more-1.exr: the render settings differ",
+            "more-1.exr: not the same render settings as ",
             "20x16, 3 spp",
             "20x16, 1 spp",
         ],
@@ -336,6 +336,32 @@ fn merge_refuses_a_tile_of_another_scene_or_settings() {
 }
 
 #[test]
+fn tiles_of_one_scene_in_files_of_other_names_merge_into_the_whole_render() {
+    // docs/distributed.md: paths are not part of the scene hash; nor is the file's name.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let elsewhere = dir.path().join("elsewhere");
+    std::fs::create_dir(&elsewhere).expect("folder");
+    let a = four_tiles(dir.path(), SMALL, "a");
+    let b = four_tiles(&elsewhere, SMALL, "copy of a");
+    let merged = dir.path().join("merged.png");
+    let run = succeeds(merge_into(
+        &merged,
+        &[a[0].clone(), b[1].clone(), a[2].clone(), b[3].clone()],
+    ));
+    assert!(run.stderr.contains("merged 4 tiles"), "{}", run.stderr);
+    let whole = dir.path().join("whole.png");
+    succeeds(gpu_render(&[
+        arg(&dir.path().join("a.toml")),
+        "--backend".into(),
+        "cpu".into(),
+        "-o".into(),
+        arg(&whole),
+        "-q".into(),
+    ]));
+    assert_same_bytes(&merged, &whole);
+}
+
+#[test]
 fn tile_and_crop_arguments_are_checked_before_rendering() {
     let dir = tempfile::tempdir().expect("tempdir");
     let scene = dir.path().join("s.toml");
@@ -345,7 +371,10 @@ fn tile_and_crop_arguments_are_checked_before_rendering() {
     let png = arg(&dir.path().join("t.png"));
     let named = arg(&dir.path().join("t{tile}.exr"));
     let cases: [(Vec<&str>, &[&str]); 5] = [
-        (vec!["--tile", "1/4", "-o", &png], &["must be an .exr"]),
+        (
+            vec!["--tile", "1/4", "-o", &png],
+            &["records its window (for `gpu-render merge`), so the output must be an .exr"],
+        ),
         (
             vec!["--tile", "5/40", "-o", &out],
             &["--tile 5/40", "the image has 16"],
@@ -455,7 +484,10 @@ fn tiles_of_two_frames_do_not_merge() {
         arg(&out)
     };
     let run = merge_into(&dir.path().join("out.png"), &[tile("3", 0), tile("4", 1)]);
-    fails_with(&run, &["f4-1.exr: the frame differs", "4 here, 3 there"]);
+    fails_with(
+        &run,
+        &["f4-1.exr: not the same frame as ", "4 here, 3 there"],
+    );
     let same = merge_into(&dir.path().join("out.png"), &[tile("3", 0), tile("3", 1)]);
     let same = succeeds(same);
     assert!(same.stderr.contains("frame 3"), "{}", same.stderr);

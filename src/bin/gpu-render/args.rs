@@ -210,22 +210,35 @@ pub struct MergeArgs {
 /// The arguments of `gpu-render estimate`.
 #[derive(Debug, Args)]
 pub struct EstimateArgs {
-    /// The scene file (TOML).
+    /// The scene file (TOML), or a model file (.obj, .gltf, .glb) framed as the render
+    /// command frames it.
     #[arg(value_name = "SCENE")]
     pub scene: PathBuf,
 
     /// Estimate each of this many tiles (the split of --tile).
-    #[arg(long, value_name = "N", default_value_t = 1, value_parser = parse_in_range::<1, MAX_IMAGE_DIMENSION>)]
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 1,
+        allow_negative_numbers = true,
+        value_parser = parse_in_range::<1, MAX_IMAGE_DIMENSION>
+    )]
     pub tiles: u32,
 
     /// Estimate this frame of the scene's animation [default: the still camera, or for
     /// an animated scene up to 5 frames spread over it].
-    #[arg(long, value_name = "K", value_parser = parse_whole)]
+    #[arg(long, value_name = "K", allow_negative_numbers = true, value_parser = parse_whole)]
     pub frame: Option<u32>,
 
     /// Pixels of the calibration render, a scaled-down copy of the image (at least
     /// one row per tile); the whole image if it has fewer.
-    #[arg(long, value_name = "N", default_value_t = 16_384, value_parser = parse_in_range::<1, 134_217_728>)]
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 16_384,
+        allow_negative_numbers = true,
+        value_parser = parse_in_range::<1, 134_217_728>
+    )]
     pub calibration_pixels: u32,
 
     /// Image size, samples, depth and lighting, over the scene's.
@@ -254,6 +267,7 @@ pub struct ViewArgs {
         long,
         value_name = "N",
         default_value_t = 1,
+        allow_negative_numbers = true,
         value_parser = parse_in_range::<1, MAX_SAMPLES_PER_PIXEL>
     )]
     pub samples_per_frame: u32,
@@ -264,13 +278,19 @@ pub struct ViewArgs {
         long,
         value_name = "N",
         default_value_t = 4096,
+        allow_negative_numbers = true,
         value_parser = parse_in_range::<1, MAX_SAMPLES_PER_PIXEL>
     )]
     pub max_samples: u32,
 
     /// Render this many frames, finish their samples, show the result and exit (with
     /// the frame rate on stderr).
-    #[arg(long, value_name = "N", value_parser = parse_in_range::<1, 1_000_000>)]
+    #[arg(
+        long,
+        value_name = "N",
+        allow_negative_numbers = true,
+        value_parser = parse_in_range::<1, 1_000_000>
+    )]
     pub frames: Option<u32>,
 
     /// With --frames: write what the window shows at the end to this PNG.
@@ -289,7 +309,13 @@ pub struct ViewArgs {
 
     /// Trace a film this fraction of the window's size and draw it scaled up (nearest
     /// texel): 0.5 traces a quarter of the pixels, for a faster preview.
-    #[arg(long, value_name = "F", default_value_t = 1.0, value_parser = parse_view_scale)]
+    #[arg(
+        long,
+        value_name = "F",
+        default_value_t = 1.0,
+        allow_hyphen_values = true,
+        value_parser = parse_view_scale
+    )]
     pub scale: f64,
 
     /// The GPU adapter to show the window with: an index from the list the viewer
@@ -418,18 +444,37 @@ pub struct RenderArgs {
     /// (rounded down), every column. Writes a linear EXR tile (give an .exr output)
     /// that records its window, for `gpu-render merge`. `{tile}` in the output name
     /// becomes I, zero-padded to the digits of N - 1.
-    #[arg(long, value_name = "I/N", value_parser = parse_tile, conflicts_with = "crop", help_heading = "Pieces")]
+    #[arg(
+        long,
+        value_name = "I/N",
+        allow_hyphen_values = true,
+        value_parser = parse_tile,
+        conflicts_with = "crop",
+        help_heading = "Pieces"
+    )]
     pub tile: Option<TileArg>,
 
     /// Render only the pixels x0 <= x < x1, y0 <= y < y1 (0,0 is the top-left pixel).
     /// Writes a linear EXR tile like --tile.
-    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_crop, help_heading = "Pieces")]
+    #[arg(
+        long,
+        value_name = "X0,Y0,X1,Y1",
+        allow_hyphen_values = true,
+        value_parser = parse_crop,
+        help_heading = "Pieces"
+    )]
     pub crop: Option<PixelWindow>,
 
     /// Render frame K (0-based) of the scene's [animation] camera path instead of its
     /// [camera]. `{frame}` in the output name becomes K, zero-padded to at least 4
     /// digits (more when the animation has more frames).
-    #[arg(long, value_name = "K", value_parser = parse_whole, help_heading = "Pieces")]
+    #[arg(
+        long,
+        value_name = "K",
+        allow_negative_numbers = true,
+        value_parser = parse_whole,
+        help_heading = "Pieces"
+    )]
     pub frame: Option<u32>,
 
     /// Confine the files the scene names (textures, BRDF maps) to the scene file's
@@ -444,6 +489,7 @@ pub struct RenderArgs {
         long,
         value_name = "GIB",
         default_value_t = DEFAULT_MAX_MEMORY_GIB,
+        allow_hyphen_values = true,
         value_parser = parse_gib
     )]
     pub max_memory: f64,
@@ -535,7 +581,7 @@ pub struct SettingsArgs {
         long,
         value_name = "W",
         help_heading = "Render settings",
-        allow_negative_numbers = true
+        allow_hyphen_values = true
     )]
     pub min_ray_weight: Option<f64>,
 
@@ -580,13 +626,25 @@ pub struct DeviceArgs {
     /// GPU only: the most loop iterations one shader invocation runs per dispatch
     /// [default: the adapter's; on llvmpipe its loop limit over its SIMD lanes]. The
     /// image does not depend on it.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..), help_heading = "Device")]
+    #[arg(
+        long,
+        value_name = "N",
+        allow_negative_numbers = true,
+        value_parser = parse_in_range::<1, { u32::MAX }>,
+        help_heading = "Device"
+    )]
     pub iteration_budget: Option<u32>,
 
     /// GPU only: give up with an error when one wait for the GPU takes longer than
     /// this many seconds [default: wait as long as it takes; each submission's work is
     /// bounded, and a hung device is reported lost by its driver].
-    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds, help_heading = "Device")]
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        allow_hyphen_values = true,
+        value_parser = parse_seconds,
+        help_heading = "Device"
+    )]
     pub gpu_timeout: Option<std::time::Duration>,
 }
 
@@ -746,6 +804,9 @@ fn parse_count(text: &str, what: &str) -> Result<u32, String> {
 /// A count within `LOW..=HIGH`.
 fn parse_in_range<const LOW: u32, const HIGH: u32>(text: &str) -> Result<u32, String> {
     let value = parse_count(text, "a whole number")?;
+    if value < LOW && HIGH == u32::MAX {
+        return Err(format!("must be at least {LOW}, got {value}"));
+    }
     if !(LOW..=HIGH).contains(&value) {
         return Err(format!("must be between {LOW} and {HIGH}, got {value}"));
     }
@@ -854,6 +915,92 @@ mod tests {
         let err = Cli::try_parse_from(["gpu-render", "tradeoff", "s.toml", "--repeats", "0"])
             .expect_err("refused");
         assert!(err.to_string().contains("--repeats"), "{err}");
+    }
+
+    /// Every option that takes a number, a tile or a window, with a value of `-1`: the
+    /// value parser sees it (and says what the value must be), where clap alone would
+    /// take `-1` for a flag and answer "unexpected argument".
+    #[test]
+    fn a_negative_value_reaches_every_value_parser() {
+        let command = Cli::command();
+        // What each command needs besides the option, so that only the option fails.
+        let mut commands: Vec<(Vec<&str>, &clap::Command)> =
+            vec![(vec!["s.toml", "-o", "o.exr"], &command)];
+        for sub in command.get_subcommands() {
+            let needs = match sub.get_name() {
+                "merge" => vec!["t.exr", "-o", "o.png"],
+                _ => vec!["s.toml"],
+            };
+            commands.push((needs, sub));
+        }
+        let mut checked = Vec::new();
+        for (needs, command) in commands {
+            for option in command.get_arguments() {
+                let Some(long) = option.get_long() else {
+                    continue;
+                };
+                let takes_a_value = option.get_action().takes_values();
+                let value_name = option
+                    .get_value_names()
+                    .and_then(|names| names.first())
+                    .map(|name| name.as_str())
+                    .unwrap_or("");
+                // Paths, names and lists of words are not numbers.
+                let not_numeric = option.get_value_parser().possible_values().is_some()
+                    || value_name.contains("PATH")
+                    || value_name.contains("DIR")
+                    || value_name.contains("NAME");
+                if !takes_a_value || not_numeric {
+                    continue;
+                }
+                let flag = format!("--{long}");
+                let mut argv = vec!["gpu-render"];
+                if command.get_name() != "gpu-render" {
+                    argv.push(command.get_name());
+                }
+                argv.extend(&needs);
+                argv.extend([flag.as_str(), "-1"]);
+                let values = option.get_num_args().map_or(1, |n| n.min_values());
+                argv.extend(std::iter::repeat_n("-1", values.saturating_sub(1)));
+                match Cli::try_parse_from(&argv) {
+                    // A value checked later, against the scene (--min-ray-weight).
+                    Ok(_) => {}
+                    Err(err) => {
+                        assert_eq!(
+                            err.kind(),
+                            clap::error::ErrorKind::ValueValidation,
+                            "{argv:?}: {err}"
+                        );
+                        assert!(err.to_string().contains(&flag), "{argv:?}: {err}");
+                    }
+                }
+                checked.push(format!("{} {flag}", command.get_name()));
+            }
+        }
+        for expected in [
+            "gpu-render --tile",
+            "gpu-render --crop",
+            "gpu-render --max-memory",
+            "gpu-render --frame",
+            "gpu-render --iteration-budget",
+            "gpu-render --gpu-timeout",
+            "gpu-render --width",
+            "estimate --tiles",
+            "estimate --calibration-pixels",
+            "tradeoff --repeats",
+        ] {
+            assert!(
+                checked.iter().any(|c| c == expected),
+                "{expected} not checked: {checked:?}"
+            );
+        }
+        let err = Cli::try_parse_from(["gpu-render", "s.toml", "-o", "t.exr", "--tile", "-1/4"])
+            .expect_err("refused");
+        assert!(err.to_string().contains("must be I/N"), "{err}");
+        let err =
+            Cli::try_parse_from(["gpu-render", "s.toml", "-o", "o.png", "--max-memory", "-1"])
+                .expect_err("refused");
+        assert!(err.to_string().contains("must be a number of GiB"), "{err}");
     }
 
     #[test]

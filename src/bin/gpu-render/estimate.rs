@@ -16,6 +16,7 @@
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow, bail};
+use gpu_render::scene::{RenderSettings, import};
 use gpu_render::tiles::{PixelWindow, tile_window};
 
 use crate::args::{BackendArg, EstimateArgs};
@@ -31,14 +32,22 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
     }
     crate::apply_overrides(&args.settings, crate::minimal_settings(), None)?;
     let started = Instant::now();
-    let file = crate::load(&args.scene, args.sandbox, false)?;
+    // A model file is framed as a scene of its own, as the render command frames it.
+    let (mut scene, camera_path) = if import::is_model_path(&args.scene) {
+        let render =
+            crate::apply_overrides(&args.settings, RenderSettings::default(), Some(&args.scene))?;
+        let scene = crate::load_model(&args.scene, render, args.sandbox, false)?;
+        (scene, None)
+    } else {
+        let file = crate::load(&args.scene, args.sandbox, false)?;
+        (file.scene, file.camera_path)
+    };
     let load_time = started.elapsed();
-    let mut scene = file.scene;
     scene.render = crate::apply_overrides(&args.settings, scene.render, Some(&args.scene))?;
     let (width, height) = (scene.render.width, scene.render.height);
     tile_window(0, args.tiles, width, height)
         .map_err(|e| anyhow!("--tiles {}: {e}", args.tiles))?;
-    let frames: Vec<Option<u32>> = match (args.frame, &file.camera_path) {
+    let frames: Vec<Option<u32>> = match (args.frame, &camera_path) {
         (Some(frame), Some(path)) if frame < path.frame_count => vec![Some(frame)],
         (Some(frame), Some(path)) => bail!(
             "{}: --frame {frame}: the animation has {} frames (0 to {})",
@@ -114,7 +123,7 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
     let mut longest_tile = 0.0_f64;
     for frame in &frames {
         let mut frame_scene = calibration.clone();
-        if let (Some(frame), Some(path)) = (frame, &file.camera_path) {
+        if let (Some(frame), Some(path)) = (frame, &camera_path) {
             frame_scene.camera = path.frame_camera(&scene.camera, *frame);
         }
         let mut total = 0.0;
@@ -137,7 +146,7 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
     }
     let mean = frame_totals.iter().sum::<f64>() / frame_totals.len() as f64;
     let processes = u64::from(args.tiles);
-    match &file.camera_path {
+    match &camera_path {
         Some(path) if args.frame.is_none() => {
             let frames = u64::from(path.frame_count);
             println!(

@@ -135,7 +135,7 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
     let format = OutputFormat::from_path(output_pattern)?;
     if piece && format != OutputFormat::Exr {
         bail!(
-            "{}: --tile and --crop write a linear EXR tile that records its window (for              `gpu-render merge`), so the output must be an .exr",
+            "{}: --tile and --crop write a linear EXR tile that records its window (for `gpu-render merge`), so the output must be an .exr",
             output_pattern.display()
         );
     }
@@ -368,7 +368,7 @@ pub fn load_model(
     let scene = model.into_scene(render);
     if !quiet {
         for warning in &model.warnings {
-            eprintln!("warning: {warning}");
+            eprintln!("warning: {}", gpu_render::echo::escape_controls(warning));
         }
         if model.camera.is_none() {
             eprintln!(

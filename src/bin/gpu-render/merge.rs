@@ -2,6 +2,7 @@
 //! assembled into the whole image, written as the whole render would have been.
 
 use anyhow::Result;
+use gpu_render::echo::echo;
 use gpu_render::output;
 use gpu_render::tiles::merge_tiles;
 
@@ -20,11 +21,17 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     if !args.quiet {
         crate::warn_clamped(&args.output, written);
         if merged.devices.len() > 1 {
+            // The devices' names, as every word a tile records, are quoted from files.
+            let devices: Vec<String> = merged
+                .devices
+                .iter()
+                .map(|device| echo(device).to_string())
+                .collect();
             eprintln!(
                 "warning: the tiles were rendered on {} different devices ({}); GPUs of other \
                  makes may round the last bits of a pixel differently",
                 merged.devices.len(),
-                merged.devices.join(", ")
+                devices.join(", ")
             );
         }
         let info = &merged.info;
@@ -36,9 +43,9 @@ pub fn run(args: &MergeArgs) -> Result<()> {
             args.tiles.len(),
             info.image_width,
             info.image_height,
-            info.scene_name,
-            info.settings,
-            info.backend,
+            echo(&info.scene_name),
+            echo(&info.settings),
+            echo(&info.backend),
             args.output.display()
         );
     }

@@ -6,6 +6,7 @@ use toml::Spanned;
 use super::check::Source;
 use super::raw::RawAnimation;
 use super::settings::view_problem;
+use crate::echo::{echo, short};
 use crate::scene::{Camera, CameraKey, CameraPath, Interpolation, MAX_FRAMES, SceneError};
 
 /// `[animation]` with its keyframes, checked: at least one keyframe, times finite
@@ -23,14 +24,15 @@ pub fn animation(
     let raw = raw.into_inner();
     let fps = item.number("fps", item.require("fps", raw.fps)?)?;
     if fps <= 0.0 {
-        return Err(item.fail(format_args!("fps must be > 0, got {fps}")));
+        return Err(item.fail(format_args!("fps must be > 0, got {}", short(fps))));
     }
     let interpolation = match raw.interpolation.as_deref() {
         None | Some("linear") => Interpolation::Linear,
         Some("catmull_rom") => Interpolation::CatmullRom,
         Some(other) => {
             return Err(item.fail(format_args!(
-                "unknown interpolation {other:?}; use \"linear\" or \"catmull_rom\""
+                "unknown interpolation \"{}\"; use \"linear\" or \"catmull_rom\"",
+                echo(other)
             )));
         }
     };

@@ -12,6 +12,7 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::raw::{RawColor, RawVec3};
+use crate::echo::short;
 use crate::scene::{SceneError, SceneWarning};
 
 /// The scene text and its path, for building located errors.
@@ -151,7 +152,7 @@ impl Item<'_> {
     pub fn non_negative(&self, field: &str, value: f64) -> Result<f64, SceneError> {
         let value = self.number(field, value)?;
         if value < 0.0 {
-            return Err(self.fail(format_args!("{field} must be >= 0, got {value}")));
+            return Err(self.fail(format_args!("{field} must be >= 0, got {}", short(value))));
         }
         Ok(value)
     }
@@ -204,7 +205,10 @@ impl Item<'_> {
                 ColourRange::Fraction => "in [0, 1]",
                 ColourRange::Radiance => ">= 0",
             };
-            return Err(self.fail(format_args!("{field} must be {accepted}, got {value}")));
+            return Err(self.fail(format_args!(
+                "{field} must be {accepted}, got {}",
+                short(value)
+            )));
         }
         Ok(value)
     }

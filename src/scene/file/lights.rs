@@ -5,6 +5,7 @@ use toml::Spanned;
 
 use super::check::{ColourRange, Item, Source};
 use super::raw::RawLight;
+use crate::echo::echo;
 use crate::scene::{Light, SceneError};
 
 const POINT_FIELDS: &[&str] = &["position", "intensity", "color"];
@@ -32,7 +33,8 @@ pub fn light(
             directional(&item, &raw)
         }
         other => Err(untyped.fail(format_args!(
-            "unknown light type `{other}` (expected one of: point, directional)"
+            "unknown light type `{}` (expected one of: point, directional)",
+            echo(other)
         ))),
     }
 }

@@ -9,6 +9,7 @@ use super::LoadOptions;
 use super::check::{ColourRange, Item, Source};
 use super::paths::confined_path;
 use super::raw::RawMaterial;
+use crate::echo::{echo, echo_path, short, short3};
 use crate::scene::{
     FresnelModel, Image, Material, MaterialKind, MicrofacetDistribution, SceneError,
     TextureMapping, load_confined_image, load_image,
@@ -153,13 +154,15 @@ impl<'a> ImageTable<'a> {
         }
         if self.images.len() >= MAX_SCENE_IMAGES {
             return Err(item.fail(format_args!(
-                "{field} `{file}`: a scene may use at most {MAX_SCENE_IMAGES} different image files"
+                "{field} `{}`: a scene may use at most {MAX_SCENE_IMAGES} different image files",
+                echo_path(Path::new(file))
             )));
         }
         let fail = |message: String| {
             item.fail(format_args!(
-                "{field} `{file}` ({}): {message}",
-                path.display()
+                "{field} `{}` ({}): {message}",
+                echo_path(Path::new(file)),
+                echo_path(&path)
             ))
         };
         let mut image = if self.options.sandbox {
@@ -175,7 +178,8 @@ impl<'a> ImageTable<'a> {
                 ImageRole::BrdfMap => "a BRDF (π·f) cannot be negative",
             };
             return Err(fail(format!(
-                "texel ({x}, {y}) has {channel} = {value}; texels must be >= 0 ({why})"
+                "texel ({x}, {y}) has {channel} = {}; texels must be >= 0 ({why})",
+                short(value)
             )));
         }
         if role == ImageRole::Albedo
@@ -183,11 +187,12 @@ impl<'a> ImageTable<'a> {
             && let Some(warn) = self.options.warning
         {
             warn(&item.warning(format_args!(
-                "{field} `{file}` ({}): {} texels have a channel above 1 (largest {} at \
+                "{field} `{}` ({}): {} texels have a channel above 1 (largest {} at \
                  ({}, {})); clamped to 1, as a surface reflects at most the light it receives",
-                path.display(),
+                echo_path(Path::new(file)),
+                echo_path(&path),
                 clamped.count,
-                clamped.largest,
+                short(clamped.largest),
                 clamped.at.0,
                 clamped.at.1
             )));
@@ -256,9 +261,10 @@ pub fn material(
 ) -> Result<Material, SceneError> {
     let span = raw.span();
     let raw = raw.into_inner();
+    let name = echo(name);
     let untyped = source.item(format!("materials.{name}"), Some(span.clone()));
     let kind = untyped.require("type", raw.kind.clone())?;
-    let item = source.item(format!("materials.{name} ({kind})"), Some(span));
+    let item = source.item(format!("materials.{name} ({})", echo(&kind)), Some(span));
     let given = raw.given_fields();
     let mut material = match kind.as_str() {
         "lambert" => {
@@ -298,7 +304,8 @@ pub fn material(
             tabulated(&item, &raw, images)
         }
         other => Err(untyped.fail(format_args!(
-            "unknown material type `{other}` (expected one of: {KINDS})"
+            "unknown material type `{}` (expected one of: {KINDS})",
+            echo(other)
         ))),
     }?;
     if let Some(two_sided) = raw.two_sided {
@@ -347,7 +354,10 @@ fn albedo(
 fn roughness(item: &Item<'_>, value: f64) -> Result<f64, SceneError> {
     let value = item.number("roughness", value)?;
     if !(0.0..=1.0).contains(&value) {
-        return Err(item.fail(format_args!("roughness must be in [0, 1], got {value}")));
+        return Err(item.fail(format_args!(
+            "roughness must be in [0, 1], got {}",
+            short(value)
+        )));
     }
     Ok(value)
 }
@@ -363,7 +373,8 @@ fn cook_torrance(
         Some("beckmann") => MicrofacetDistribution::Beckmann,
         Some(other) => {
             return Err(item.fail(format_args!(
-                "unknown distribution `{other}` (expected ggx or beckmann)"
+                "unknown distribution `{}` (expected ggx or beckmann)",
+                echo(other)
             )));
         }
     };
@@ -372,7 +383,8 @@ fn cook_torrance(
         Some("schlick") => FresnelModel::Schlick,
         Some(other) => {
             return Err(item.fail(format_args!(
-                "unknown fresnel `{other}` (expected exact or schlick)"
+                "unknown fresnel `{}` (expected exact or schlick)",
+                echo(other)
             )));
         }
     };
@@ -389,7 +401,8 @@ fn cook_torrance(
             let Some((_, eta, k)) = CONDUCTOR_PRESETS.iter().find(|(n, _, _)| n == name) else {
                 let names: Vec<&str> = CONDUCTOR_PRESETS.iter().map(|p| p.0).collect();
                 return Err(item.fail(format_args!(
-                    "unknown conductor `{name}` (expected one of: {})",
+                    "unknown conductor `{}` (expected one of: {})",
+                    echo(name),
                     names.join(", ")
                 )));
             };
@@ -406,14 +419,14 @@ fn cook_torrance(
             if material.eta.min_element() <= 0.0 {
                 return Err(item.fail(format_args!(
                     "every channel of eta must be > 0, got {}",
-                    material.eta
+                    short3(material.eta)
                 )));
             }
         }
         (None, false, Some(ior)) => {
             let ior = item.number("ior", ior)?;
             if ior <= 0.0 {
-                return Err(item.fail(format_args!("ior must be > 0, got {ior}")));
+                return Err(item.fail(format_args!("ior must be > 0, got {}", short(ior))));
             }
             material.ior = ior;
             material.diffuse = match raw.diffuse {
@@ -449,7 +462,8 @@ fn oren_nayar(
     )?;
     if sigma > 90.0 {
         return Err(item.fail(format_args!(
-            "sigma_degrees must be in [0, 90], got {sigma}"
+            "sigma_degrees must be in [0, 90], got {}",
+            short(sigma)
         )));
     }
     let material = Material {
@@ -469,7 +483,10 @@ fn pbr(
     // glTF 2.0 defaults: metallicFactor = roughnessFactor = 1.
     let metallic = item.non_negative("metallic", raw.metallic.unwrap_or(1.0))?;
     if metallic > 1.0 {
-        return Err(item.fail(format_args!("metallic must be in [0, 1], got {metallic}")));
+        return Err(item.fail(format_args!(
+            "metallic must be in [0, 1], got {}",
+            short(metallic)
+        )));
     }
     let material = Material {
         diffuse: albedo(item, "base_color", raw.base_color, raw)?,
@@ -491,9 +508,10 @@ fn tabulated(
     let image = &images.images[index as usize].0;
     if image.width != image.height || image.width < 2 {
         return Err(item.fail(format_args!(
-            "brdf_map `{file}` ({}): the map must be square and at least 2x2 (θi across, \
+            "brdf_map `{}` ({}): the map must be square and at least 2x2 (θi across, \
              θr down), got {}x{}",
-            image.path.display(),
+            echo_path(Path::new(file)),
+            echo_path(&image.path),
             image.width,
             image.height
         )));
@@ -523,14 +541,18 @@ fn texture(
         Some("spherical") => TextureMapping::Spherical,
         Some(other) => {
             return Err(item.fail(format_args!(
-                "unknown texture_mapping `{other}` (expected planar or spherical)"
+                "unknown texture_mapping `{}` (expected planar or spherical)",
+                echo(other)
             )));
         }
     };
     if let Some(scale) = raw.texture_scale {
         let scale = item.number("texture_scale", scale)?;
         if scale <= 0.0 {
-            return Err(item.fail(format_args!("texture_scale must be > 0, got {scale}")));
+            return Err(item.fail(format_args!(
+                "texture_scale must be > 0, got {}",
+                short(scale)
+            )));
         }
         material.texture_scale = scale;
     }
@@ -554,7 +576,8 @@ fn blinn_phong(item: &Item<'_>, raw: &RawMaterial) -> Result<Material, SceneErro
     let shininess = item.non_negative("shininess", item.require("shininess", raw.shininess)?)?;
     if shininess > MAX_SHININESS {
         return Err(item.fail(format_args!(
-            "shininess must be at most {MAX_SHININESS:e}, got {shininess}"
+            "shininess must be at most {MAX_SHININESS:e}, got {}",
+            short(shininess)
         )));
     }
     Ok(Material {
@@ -597,7 +620,7 @@ fn mirror(item: &Item<'_>, raw: &RawMaterial) -> Result<Material, SceneError> {
 fn dielectric(item: &Item<'_>, raw: &RawMaterial) -> Result<Material, SceneError> {
     let ior = item.number("ior", item.require("ior", raw.ior)?)?;
     if ior <= 0.0 {
-        return Err(item.fail(format_args!("ior must be > 0, got {ior}")));
+        return Err(item.fail(format_args!("ior must be > 0, got {}", short(ior))));
     }
     Ok(Material {
         ior,
@@ -626,7 +649,8 @@ fn coat_ior(item: &Item<'_>, value: Option<f64>) -> Result<f64, SceneError> {
     let value = item.number("coat_ior", value)?;
     if value < 1.0 {
         return Err(item.fail(format_args!(
-            "coat_ior must be >= 1 (1 is an invisible coat; leave it out for none), got {value}"
+            "coat_ior must be >= 1 (1 is an invisible coat; leave it out for none), got {}",
+            short(value)
         )));
     }
     Ok(value)

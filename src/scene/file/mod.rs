@@ -25,6 +25,7 @@ pub use self::paths::confined_path;
 use self::raw::RawScene;
 pub(crate) use self::settings::view_problem;
 use super::{CameraPath, Scene, SceneError, SceneWarning};
+use crate::echo::echo;
 
 /// Largest scene file accepted, in bytes (64 MiB).
 pub const MAX_SCENE_FILE_BYTES: u64 = 64 * 1024 * 1024;
@@ -259,10 +260,14 @@ fn duplicate_key_message(text: &str, span: std::ops::Range<usize>) -> String {
     if line.starts_with('[') {
         let header = line.split('#').next().unwrap_or(line).trim();
         format!(
-            "duplicate table `{header}` (each table may be defined once; use [[...]] for a list)"
+            "duplicate table `{}` (each table may be defined once; use [[...]] for a list)",
+            echo(header)
         )
     } else {
-        format!("duplicate key `{key}` (each key may be given once per table)")
+        format!(
+            "duplicate key `{}` (each key may be given once per table)",
+            echo(key)
+        )
     }
 }
 

@@ -8,6 +8,7 @@ use toml::Spanned;
 use super::LoadOptions;
 use super::check::{Item, Source};
 use super::raw::{RawColor, RawObject, RawVec3};
+use crate::echo::{echo, echo_path, short, short3};
 use crate::scene::import::{ImportedModel, ModelPlacement, import_model};
 use crate::scene::{
     FAR_WALL_PRECISION_LIMIT, Light, SPHERE_PRECISION_LIMIT, SceneError, Shape, coincident_spheres,
@@ -50,10 +51,17 @@ impl<'a> MaterialTable<'a> {
         let defined = if self.names.is_empty() {
             "no materials are defined".to_owned()
         } else {
-            let quoted: Vec<String> = self.names.iter().map(|n| format!("`{n}`")).collect();
+            let quoted: Vec<String> = self
+                .names
+                .iter()
+                .map(|n| format!("`{}`", echo(n)))
+                .collect();
             format!("defined materials: {}", quoted.join(", "))
         };
-        Err(item.fail(format_args!("material `{name}` is not defined ({defined})")))
+        Err(item.fail(format_args!(
+            "material `{}` is not defined ({defined})",
+            echo(name)
+        )))
     }
 }
 
@@ -76,8 +84,9 @@ pub fn object(
         "triangle" => TRIANGLE_FIELDS,
         other => {
             return Err(untyped.fail(format_args!(
-                "unknown object type `{other}` (expected one of: sphere, plane, polygon, \
-                 triangle, model)"
+                "unknown object type `{}` (expected one of: sphere, plane, polygon, \
+                 triangle, model)",
+                echo(other)
             )));
         }
     };
@@ -127,8 +136,9 @@ pub fn model(
         // buffers and images) without confinement, so a sandboxed scene may not load
         // models at all rather than let them name files outside its folder.
         return Err(item.fail(format_args!(
-            "file `{file}`: model objects are not accepted in sandboxed scenes (the files a \
-             model names itself are not confined to the scene's folder)"
+            "file `{}`: model objects are not accepted in sandboxed scenes (the files a \
+             model names itself are not confined to the scene's folder)",
+            echo_path(std::path::Path::new(file))
         )));
     }
     let material = raw
@@ -151,7 +161,8 @@ pub fn model(
     };
     if scale.cmpeq(DVec3::ZERO).any() {
         return Err(item.fail(format_args!(
-            "scale must not be 0 on any axis (it would flatten the model), got {scale}"
+            "scale must not be 0 on any axis (it would flatten the model), got {}",
+            short3(scale)
         )));
     }
     let transform = ModelPlacement::trs(translate, rotate, scale);
@@ -162,8 +173,12 @@ pub fn model(
     let model = match cache.get(&key) {
         Some(model) => model.clone(),
         None => {
-            let model = import_model(&path)
-                .map_err(|err| item.fail(format_args!("file `{file}`: {err}")))?;
+            let model = import_model(&path).map_err(|err| {
+                item.fail(format_args!(
+                    "file `{}`: {err}",
+                    echo_path(std::path::Path::new(file))
+                ))
+            })?;
             if let Some(warn) = options.warning {
                 for message in &model.warnings {
                     warn(&item.warning(message));
@@ -188,7 +203,7 @@ fn sphere(item: &Item<'_>, raw: &RawObject, material: u32) -> Result<Shape, Scen
     let center = item.vector("center", item.require("center", raw.center)?)?;
     let radius = item.number("radius", item.require("radius", raw.radius)?)?;
     if radius <= 0.0 {
-        return Err(item.fail(format_args!("radius must be > 0, got {radius}")));
+        return Err(item.fail(format_args!("radius must be > 0, got {}", short(radius))));
     }
     Ok(Shape::Sphere {
         center,

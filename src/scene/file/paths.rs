@@ -3,6 +3,8 @@
 
 use std::path::{Component, Path, PathBuf};
 
+use crate::echo::echo_path;
+
 /// The path of `file`, as a scene file in folder `scene_dir` names it, confined to that
 /// folder: `file` must be relative, must not contain `..` (or a drive or root), and
 /// must not lead out of `scene_dir` through a symbolic link. Returns the joined path
@@ -23,19 +25,22 @@ pub fn confined_path(scene_dir: &Path, file: &str) -> Result<PathBuf, String> {
     let relative = Path::new(file);
     if relative.is_absolute() || relative.has_root() {
         return Err(format!(
-            "`{file}` is an absolute path; a sandboxed scene may only name files inside its folder"
+            "`{}` is an absolute path; a sandboxed scene may only name files inside its folder",
+            echo_path(relative)
         ));
     }
     for component in relative.components() {
         match component {
             Component::ParentDir => {
                 return Err(format!(
-                    "`{file}` contains `..`; a sandboxed scene may only name files inside its folder"
+                    "`{}` contains `..`; a sandboxed scene may only name files inside its folder",
+                    echo_path(relative)
                 ));
             }
             Component::Prefix(_) | Component::RootDir => {
                 return Err(format!(
-                    "`{file}` names a drive or root; a sandboxed scene may only name files inside its folder"
+                    "`{}` names a drive or root; a sandboxed scene may only name files inside its folder",
+                    echo_path(relative)
                 ));
             }
             Component::CurDir | Component::Normal(_) => {}
@@ -53,9 +58,10 @@ pub fn confined_path(scene_dir: &Path, file: &str) -> Result<PathBuf, String> {
         && !resolved.starts_with(&base)
     {
         return Err(format!(
-            "`{file}` leads out of the scene's folder (to {}) through a symbolic link; \
+            "`{}` leads out of the scene's folder (to {}) through a symbolic link; \
              a sandboxed scene may only name files inside its folder",
-            resolved.display()
+            echo_path(relative),
+            echo_path(&resolved)
         ));
     }
     Ok(joined)

@@ -10,6 +10,7 @@ use super::LoadOptions;
 use super::check::{ColourRange, Item, Source};
 use super::paths::confined_path;
 use super::raw::{RawCamera, RawEnvironment, RawIntegrator, RawLighting, RawRender};
+use crate::echo::{echo_path, short};
 use crate::scene::{
     Camera, Environment, EnvironmentMap, Image, Integrator, LightingSpace, RenderSettings,
     SceneError, load_confined_image, load_image,
@@ -73,7 +74,8 @@ pub fn camera(source: &Source<'_>, raw: Option<Spanned<RawCamera>>) -> Result<Ca
     )?;
     if !(fov_y_degrees > 0.0 && fov_y_degrees < 180.0) {
         return Err(item.fail(format_args!(
-            "fov_y_degrees must be in (0, 180), got {fov_y_degrees}"
+            "fov_y_degrees must be in (0, 180), got {}",
+            short(fov_y_degrees)
         )));
     }
     if let Some(problem) = view_problem(eye, look_at, up) {
@@ -138,8 +140,9 @@ pub fn environment(
                 .fold(0.0, f64::max);
             if brightest > f64::from(f32::MAX) {
                 return Err(item.fail(format_args!(
-                    "map `{file}` times scale reaches {brightest:e}, beyond the largest f32 \
+                    "map `{}` times scale reaches {brightest:e}, beyond the largest f32 \
                      ({:e}); lower scale",
+                    echo_path(Path::new(file)),
                     f32::MAX
                 )));
             }
@@ -182,8 +185,13 @@ fn environment_image(
     } else {
         base.join(file)
     };
-    let fail =
-        |message: String| item.fail(format_args!("map `{file}` ({}): {message}", path.display()));
+    let fail = |message: String| {
+        item.fail(format_args!(
+            "map `{}` ({}): {message}",
+            echo_path(Path::new(file)),
+            echo_path(&path)
+        ))
+    };
     let image = if options.sandbox {
         // Opened beneath the folder: the check above and the open are one step.
         load_confined_image(base, Path::new(file))
@@ -196,7 +204,8 @@ fn environment_image(
             if value < 0.0 {
                 let (x, y) = (i as u32 % image.width, i as u32 / image.width);
                 return Err(fail(format!(
-                    "texel ({x}, {y}) has {channel} = {value}; texels must be >= 0 (a radiance cannot be negative)"
+                    "texel ({x}, {y}) has {channel} = {}; texels must be >= 0 (a radiance cannot be negative)",
+                    short(value)
                 )));
             }
         }

@@ -31,6 +31,7 @@ use super::texture::Textures;
 use super::{
     ImportedMaterial, ImportedModel, MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES, error, read_file,
 };
+use crate::echo::{echo, short};
 use crate::scene::{Material, SceneError};
 
 /// Diffuse albedo of a material whose MTL gives no `Kd` (and of geometry with no
@@ -103,7 +104,8 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError>
         };
         let name = format!(
             "object '{}' (material '{}')",
-            group.object, model.materials[material as usize].name
+            echo(&group.object),
+            echo(&model.materials[material as usize].name)
         );
         budget
             .charge_mesh(group.vertices.len(), group.triangles.len())
@@ -178,8 +180,9 @@ fn check_material_uses(
             ),
         };
         warnings.push(format!(
-            "{}:{line}: usemtl {name}: no material library defines it{others}; the default material is used",
-            path.display()
+            "{}:{line}: usemtl {}: no material library defines it{others}; the default material is used",
+            path.display(),
+            echo(name)
         ));
     }
     let early: Vec<(&str, usize, usize)> = used
@@ -195,8 +198,9 @@ fn check_material_uses(
             more => format!(" (and {more} more material{})", plural(more)),
         };
         warnings.push(format!(
-            "{}:{line}: usemtl {name} comes before the mtllib on line {mtllib_line} that defines it{others}; it is used, but other readers may show their default material",
-            path.display()
+            "{}:{line}: usemtl {} comes before the mtllib on line {mtllib_line} that defines it{others}; it is used, but other readers may show their default material",
+            path.display(),
+            echo(name)
         ));
     }
 }
@@ -206,11 +210,16 @@ fn plural(count: usize) -> &'static str {
     if count == 1 { "" } else { "s" }
 }
 
-/// The first few of `names`, comma-separated, with `…` when there are more.
+/// The first few of `names` ([`echo`]ed), comma-separated, with `…` when there are
+/// more.
 fn list<'a>(names: impl Iterator<Item = &'a str>) -> String {
     const SHOWN: usize = 5;
     let names: Vec<&str> = names.collect();
-    let mut text = names[..names.len().min(SHOWN)].join(", ");
+    let shown: Vec<String> = names[..names.len().min(SHOWN)]
+        .iter()
+        .map(|name| echo(name).to_string())
+        .collect();
+    let mut text = shown.join(", ");
     if names.len() > SHOWN {
         text.push_str(", …");
     }
@@ -387,7 +396,9 @@ impl Notes {
                 more => format!(" ({more} more such number{})", plural(more)),
             };
             warnings.push(format!(
-                "{file}:{line}:{column}: `{word}` is read as {value}, the number it starts with, as tinyobjloader and assimp read it{more}"
+                "{file}:{line}:{column}: `{}` is read as {}, the number it starts with, as tinyobjloader and assimp read it{more}",
+                echo(&word),
+                short(value)
             ));
         }
         if let Some(line) = self.short_faces.first {
@@ -445,7 +456,8 @@ impl Notes {
                 _ => "not supported",
             };
             warnings.push(format!(
-                "{file}:{line}: `{keyword}`: {what}; ignored (here and on any later line)"
+                "{file}:{line}: `{}`: {what}; ignored (here and on any later line)",
+                echo(keyword)
             ));
         }
         if let Some(line) = self.ignored_others.first {
@@ -757,7 +769,10 @@ fn corner(
             path,
             line,
             column,
-            format!("face corner {k} `{word}` has more than three indices (v/vt/vn)"),
+            format!(
+                "face corner {k} `{}` has more than three indices (v/vt/vn)",
+                echo(word)
+            ),
         ));
     }
     let kinds = ["position", "texture coordinate", "normal"];
@@ -769,17 +784,25 @@ fn corner(
                     path,
                     line,
                     column,
-                    format!("face corner {k} `{word}` has no position index"),
+                    format!("face corner {k} `{}` has no position index", echo(word)),
                 ));
             }
             continue;
         }
         let kind = kinds[slot];
         let fail = |message: String| at(path, line, column, format!("face corner {k}: {message}"));
-        let index: i64 = part
-            .parse()
-            .map_err(|_| fail(format!("the {kind} index `{part}` is not an integer")))?;
-        if index == 0 {
+        // `None`: an integer beyond any index (more digits than an i64 holds).
+        let index: Option<i64> = match part.parse() {
+            Ok(index) => Some(index),
+            Err(_) if is_integer(part) => None,
+            Err(_) => {
+                return Err(fail(format!(
+                    "the {kind} index `{}` is not an integer",
+                    echo(part)
+                )));
+            }
+        };
+        if index == Some(0) {
             return Err(fail(format!("the {kind} index is 0 (OBJ counts from 1)")));
         }
         let count = defined[slot];
@@ -787,22 +810,31 @@ fn corner(
             *dropped_normals = true;
             continue;
         }
-        let resolved = if index > 0 {
-            index.unsigned_abs().checked_sub(1)
-        } else {
-            (count as u64).checked_sub(index.unsigned_abs())
-        };
+        let resolved = index.and_then(|index| {
+            if index > 0 {
+                index.unsigned_abs().checked_sub(1)
+            } else {
+                (count as u64).checked_sub(index.unsigned_abs())
+            }
+        });
         match resolved {
             Some(resolved) if resolved < count as u64 => corner[slot] = resolved as u32,
             _ => {
                 return Err(fail(format!(
-                    "the {kind} index {index} is out of range: {count} {kind}{} defined before this line",
+                    "the {kind} index {} is out of range: {count} {kind}{} defined before this line",
+                    echo(part),
                     if count == 1 { " is" } else { "s are" }
                 )));
             }
         }
     }
     Ok(corner)
+}
+
+/// Whether `word` is an integer in decimal, of any size: an optional sign and digits.
+fn is_integer(word: &str) -> bool {
+    let digits = word.strip_prefix(['+', '-']).unwrap_or(word);
+    !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
 }
 
 /// The words of a line with their 1-based columns (in characters).
@@ -864,7 +896,7 @@ fn number(
             path,
             line,
             column,
-            format!("{what}: `{word}` is not a number"),
+            format!("{what}: `{}` is not a number", echo(word)),
         )),
     }
 }
@@ -915,7 +947,7 @@ fn finite(
             path,
             line,
             word.0,
-            format!("{what} is not a finite number ({})", word.1),
+            format!("{what} is not a finite number ({})", echo(word.1)),
         ));
     }
     Ok(value)

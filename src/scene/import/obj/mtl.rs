@@ -8,7 +8,8 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 
-use super::{DEFAULT_OBJ_ALBEDO, Notes, at, decode_text, finite, strip_comment, words};
+use super::{DEFAULT_OBJ_ALBEDO, Notes, at, decode_text, finite, is_integer, strip_comment, words};
+use crate::echo::{echo, echo_path, short, short3};
 use crate::input::{InputError, read_input};
 use crate::scene::import::mesh::Budget;
 use crate::scene::import::texture::{Encoding, Textures};
@@ -75,7 +76,7 @@ impl Libraries {
                     continue;
                 }
                 let message = |e: InputError| {
-                    format!("cannot read the material library {}: {e}", file.display())
+                    format!("cannot read the material library {}: {e}", echo_path(&file))
                 };
                 match read_input(&file, MAX_MODEL_FILE_BYTES) {
                     Ok(bytes) => libraries.parse(&file, &bytes, *line, warnings)?,
@@ -85,7 +86,12 @@ impl Libraries {
                     // A FIFO, a device or a huge file is not a library that went missing
                     // but one that must not be read (src/input.rs).
                     Err(e) => {
-                        return Err(at(obj, *line, 1, format!("mtllib {name}: {}", message(e))));
+                        return Err(at(
+                            obj,
+                            *line,
+                            1,
+                            format!("mtllib {}: {}", echo(&name), message(e)),
+                        ));
                     }
                 }
             }
@@ -97,14 +103,15 @@ impl Libraries {
                         " (nor can {}, named on the same line)",
                         unread[1..]
                             .iter()
-                            .map(|(name, _)| name.as_str())
+                            .map(|(name, _)| echo(name).to_string())
                             .collect::<Vec<_>>()
                             .join(", ")
                     ),
                 };
                 warnings.push(format!(
-                    "{}:{line}: mtllib {name}: {message}{others}; the materials it would define are replaced by the default material",
-                    obj.display()
+                    "{}:{line}: mtllib {}: {message}{others}; the materials it would define are replaced by the default material",
+                    obj.display(),
+                    echo(name)
                 ));
             }
         }
@@ -291,20 +298,28 @@ fn scan_mtl(
             let [word] = values else {
                 return Err(at(path, n, column, "`illum` takes one number (0 to 10)"));
             };
-            let illum: i64 = word.1.parse().map_err(|_| {
-                at(
-                    path,
-                    n,
-                    word.0,
-                    format!("illum: `{}` is not an integer", word.1),
-                )
-            })?;
-            if !(0..=10).contains(&illum) {
+            let illum: Option<i64> = match word.1.parse() {
+                Ok(illum) => Some(illum),
+                // An integer of more digits than an i64 holds: no model either.
+                Err(_) if is_integer(word.1) => None,
+                Err(_) => {
+                    return Err(at(
+                        path,
+                        n,
+                        word.0,
+                        format!("illum: `{}` is not an integer", echo(word.1)),
+                    ));
+                }
+            };
+            if !illum.is_some_and(|illum| (0..=10).contains(&illum)) {
                 return Err(at(
                     path,
                     n,
                     word.0,
-                    format!("illum {illum} is not an illumination model (0 to 10)"),
+                    format!(
+                        "illum {} is not an illumination model (0 to 10)",
+                        echo(word.1)
+                    ),
                 ));
             }
         } else if keyword.starts_with("map_")
@@ -315,7 +330,7 @@ fn scan_mtl(
                     path,
                     n,
                     column,
-                    format!("`{keyword}` needs a file name"),
+                    format!("`{}` needs a file name", echo(keyword)),
                 ));
             }
             if keyword == "map_Kd" || keyword == "map_Ke" {
@@ -367,7 +382,7 @@ pub(super) fn map_material(
         "{}:{}: material '{}'",
         source.library.display(),
         source.line,
-        m.name
+        echo(&m.name)
     );
     let mut warn = |message: String| warnings.push(format!("{place}: {message}"));
     let colour = |c: Option<[f64; 3]>| c.map(|[r, g, b]| DVec3::new(r, g, b));
@@ -385,7 +400,7 @@ pub(super) fn map_material(
         if !ignored.is_empty() {
             warn(format!(
                 "{key} options {} are not supported; ignored",
-                ignored.join(" ")
+                echo(&ignored.join(" "))
             ));
         }
         let directory = source.library.parent().unwrap_or(Path::new(""));
@@ -398,7 +413,7 @@ pub(super) fn map_material(
             // shared without their textures: the geometry is still worth seeing.
             warn(format!(
                 "{key}: the texture {} does not exist; the material is used without it",
-                file_path.display()
+                echo_path(&file_path)
             ));
             return Ok(None);
         }
@@ -409,7 +424,7 @@ pub(super) fn map_material(
                     &source.library,
                     line,
                     column,
-                    format!("material '{}': {key}: {e}", m.name),
+                    format!("material '{}': {key}: {e}", echo(&m.name)),
                 )
             })?;
         Ok(Some(TextureRef {
@@ -443,7 +458,7 @@ pub(super) fn map_material(
         .collect();
     others.sort();
     for key in others {
-        warn(format!("{key} is not supported; ignored"));
+        warn(format!("{} is not supported; ignored", echo(key)));
     }
 
     let default_albedo = if base_color_texture.is_some() {
@@ -467,19 +482,20 @@ pub(super) fn map_material(
     let unit = |name: &str, c: DVec3, warn: &mut dyn FnMut(String)| {
         let clamped = c.clamp(DVec3::ZERO, DVec3::ONE);
         if clamped != c {
-            warn(format!("{name} {c} is outside [0, 1]; clamped"));
+            warn(format!("{name} {} is outside [0, 1]; clamped", short3(c)));
         }
         clamped
     };
     let emission = ke.max(DVec3::ZERO);
     if emission != ke {
-        warn(format!("Ke {ke} is negative; clamped to 0"));
+        warn(format!("Ke {} is negative; clamped to 0", short3(ke)));
     }
     let ior_or_default = |warn: &mut dyn FnMut(String), what: &str| match ni {
         Some(ni) if ni > 0.0 => ni,
         Some(ni) => {
             warn(format!(
-                "Ni {ni} is not positive; {what} uses {DEFAULT_IOR}"
+                "Ni {} is not positive; {what} uses {DEFAULT_IOR}",
+                short(ni)
             ));
             DEFAULT_IOR
         }
@@ -503,7 +519,7 @@ pub(super) fn map_material(
         }
         let clamp01 = |name: &str, v: f64, warn: &mut dyn FnMut(String)| {
             if !(0.0..=1.0).contains(&v) {
-                warn(format!("{name} {v} is outside [0, 1]; clamped"));
+                warn(format!("{name} {} is outside [0, 1]; clamped", short(v)));
             }
             v.clamp(0.0, 1.0)
         };
@@ -523,7 +539,9 @@ pub(super) fn map_material(
         let sum = (kd + ks).max_element();
         if sum > 1.0 {
             warn(format!(
-                "Kd + Ks reaches {sum} in a channel; both are scaled by 1/{sum} so that the surface does not reflect more light than it receives"
+                "Kd + Ks reaches {} in a channel; both are scaled by 1/{} so that the surface does not reflect more light than it receives",
+                short(sum),
+                short(sum)
             ));
             kd /= sum;
             ks /= sum;
@@ -531,7 +549,10 @@ pub(super) fn map_material(
         let coat_ior = if matches!(illum, 3 | 5 | 8) {
             let ior = ior_or_default(&mut warn, "the coat");
             if ior < 1.0 {
-                warn(format!("Ni {ior} is below 1; the coat uses {DEFAULT_IOR}"));
+                warn(format!(
+                    "Ni {} is below 1; the coat uses {DEFAULT_IOR}",
+                    short(ior)
+                ));
                 DEFAULT_IOR
             } else {
                 ior
@@ -549,7 +570,11 @@ pub(super) fn map_material(
             let shininess = if (0.0..=MAX_SHININESS).contains(&ns) {
                 ns
             } else {
-                warn(format!("Ns {ns} is outside [0, {MAX_SHININESS}]; clamped"));
+                warn(format!(
+                    "Ns {} is outside [0, {}]; clamped",
+                    short(ns),
+                    short(MAX_SHININESS)
+                ));
                 ns.clamp(0.0, MAX_SHININESS)
             };
             Material {
@@ -564,7 +589,8 @@ pub(super) fn map_material(
     };
     if dissolve < 1.0 && material.kind != MaterialKind::Dielectric {
         warn(format!(
-            "d {dissolve} (partial transparency) is not supported; the material is opaque"
+            "d {} (partial transparency) is not supported; the material is opaque",
+            short(dissolve)
         ));
     }
     Ok(ImportedMaterial {
