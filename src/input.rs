@@ -90,6 +90,12 @@ pub fn read_confined(dir: &Path, relative: &Path, limit: u64) -> Result<Vec<u8>,
     read_limited(open_confined(dir, relative)?, limit)
 }
 
+/// Reads the whole of `file` (opened by [`open_input`] or [`open_confined`]),
+/// refusing one larger than `limit` bytes.
+pub fn read_opened(file: File, limit: u64) -> Result<Vec<u8>, InputError> {
+    read_limited(file, limit)
+}
+
 fn read_limited(file: File, limit: u64) -> Result<Vec<u8>, InputError> {
     let len = file.metadata().map_err(InputError::Io)?.len();
     if len > limit {

@@ -43,27 +43,46 @@ pub fn load_confined_image(dir: &Path, file: &Path) -> Result<Image, String> {
     decode_image(&dir.join(file), &bytes)
 }
 
+/// The width and height the image file `bytes` (read from or named `path`) declares in
+/// its header, checked as [`load_image`] checks them, without decoding its texels: for
+/// callers that count the memory an image will take before it is decoded.
+pub fn image_dimensions(path: &Path, bytes: &[u8]) -> Result<(u32, u32), String> {
+    let bytes = radiance_header(bytes);
+    let dimensions = image_reader(path, &bytes)?
+        .into_dimensions()
+        .map_err(|e| format!("not a readable image: {e}"))?;
+    check_dimensions(dimensions)?;
+    Ok(dimensions)
+}
+
+/// A reader of the image file `bytes`, its format from the bytes or else from `path`'s
+/// extension.
+fn image_reader<'b>(path: &Path, bytes: &'b [u8]) -> Result<ImageReader<Cursor<&'b [u8]>>, String> {
+    let mut reader = ImageReader::new(Cursor::new(bytes));
+    if let Ok(format) = ImageFormat::from_path(path) {
+        reader.set_format(format);
+    }
+    reader
+        .with_guessed_format()
+        .map_err(|e| format!("cannot read the file: {e}"))
+}
+
 /// Decodes the image file `bytes` (read from `path`, or embedded in a model and named
 /// `path`) as [`load_image`] does. The format comes from the bytes, or where they do
 /// not tell, from `path`'s extension.
 pub fn decode_image(path: &Path, bytes: &[u8]) -> Result<Image, String> {
+    let (width, height) = image_dimensions(path, bytes)?;
     let bytes = radiance_header(bytes);
-    let reader = || {
-        let mut reader = ImageReader::new(Cursor::new(bytes.as_ref()));
-        if let Ok(format) = ImageFormat::from_path(path) {
-            reader.set_format(format);
-        }
-        reader
-            .with_guessed_format()
-            .map_err(|e| format!("cannot read the file: {e}"))
-    };
-    let dimensions = reader()?
-        .into_dimensions()
-        .map_err(|e| format!("not a readable image: {e}"))?;
-    check_dimensions(dimensions)?;
-    let decoded = reader()?
+    let decoded = image_reader(path, &bytes)?
         .decode()
         .map_err(|e| format!("not a readable image: {e}"))?;
+    if (decoded.width(), decoded.height()) != (width, height) {
+        return Err(format!(
+            "the image decodes to {}x{}, not the {width}x{height} its header declares",
+            decoded.width(),
+            decoded.height()
+        ));
+    }
     let (width, height) = (decoded.width(), decoded.height());
     let texels: Vec<[f32; 4]> = match &decoded {
         DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_) => {

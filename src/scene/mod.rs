@@ -20,7 +20,8 @@ pub use file::{
     load_scene, load_scene_file, load_scene_with, parse_scene, parse_scene_file, parse_scene_with,
 };
 pub use image::{
-    MAX_IMAGE_FILE_BYTES, MAX_IMAGE_SIDE, decode_image, load_confined_image, load_image,
+    MAX_IMAGE_FILE_BYTES, MAX_IMAGE_SIDE, decode_image, image_dimensions, load_confined_image,
+    load_image,
 };
 pub use medium::{MEDIUM_STACK_SIZE, MediumStack};
 pub use model::*;

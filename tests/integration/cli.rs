@@ -1016,6 +1016,46 @@ fn text_from_a_model_file_reaches_the_terminal_escaped_and_cut() {
     );
 }
 
+/// `--max-memory` bounds a model's import, not only the render: a model file larger
+/// than the cap is refused by its size before it is read, and one whose arrays would
+/// grow past the cap while it is read is refused then (the library's unit tests check
+/// where), both with the flag named.
+#[test]
+fn max_memory_refuses_a_model_before_it_takes_the_memory() {
+    let ws = Workspace::new(TINY_SCENE);
+    let mut obj = String::new();
+    for i in 0..120_000u64 {
+        obj.push_str(&format!("v {i} {} 0.25\n", (i * i) % 7));
+    }
+    obj.push_str("f 1 2 3\n");
+    std::fs::write(ws.path("big.obj"), &obj).expect("write");
+    let render = |cap: &str| {
+        gpu_render(&[
+            &ws.arg("big.obj"),
+            "-o",
+            &ws.arg("out.png"),
+            "--backend",
+            "cpu",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--max-memory",
+            cap,
+        ])
+    };
+    // 0.001 GiB is about 1 MiB; the file is about 2 MiB.
+    let run = render("0.001");
+    assert_fails_with(&run, &["big.obj", "the model file", "--max-memory"]);
+    // 0.004 GiB holds the file but not its positions and vertices as they are read.
+    let run = render("0.004");
+    assert_fails_with(&run, &["big.obj", "by line", "--max-memory"]);
+    assert_eq!(std::fs::read(ws.path("out.png")).expect("read"), OLD_OUTPUT);
+    // With room, it renders.
+    let run = render("1");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+}
+
 #[test]
 fn estimate_frames_a_model_file_as_the_render_command_does() {
     let dir = tempfile::tempdir().expect("tempdir");

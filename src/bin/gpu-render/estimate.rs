@@ -36,10 +36,10 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
     let (mut scene, camera_path) = if import::is_model_path(&args.scene) {
         let render =
             crate::apply_overrides(&args.settings, RenderSettings::default(), Some(&args.scene))?;
-        let scene = crate::load_model(&args.scene, render, args.sandbox, false)?;
+        let scene = crate::load_model(&args.scene, render, args.sandbox, false, None)?;
         (scene, None)
     } else {
-        let file = crate::load(&args.scene, args.sandbox, false)?;
+        let file = crate::load(&args.scene, args.sandbox, false, None)?;
         (file.scene, file.camera_path)
     };
     let load_time = started.elapsed();

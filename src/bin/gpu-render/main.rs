@@ -30,7 +30,7 @@ use anyhow::{Context, Result, anyhow, bail};
 use clap::{CommandFactory, Parser, error::ErrorKind};
 use gpu_render::output::{self, HDR_MAX, OutputFormat, Written};
 use gpu_render::scene::{
-    self, LightingSpace, LoadOptions, RenderSettings, Scene, SceneFile, SceneWarning,
+    self, LightingSpace, LoadOptions, LoadProgress, RenderSettings, Scene, SceneFile, SceneWarning,
 };
 use gpu_render::tiles::{Fingerprint, PixelWindow, Tile, TileInfo, tile_window};
 
@@ -163,13 +163,15 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
     }
     // Values out of range whatever the scene says (`--width 0`) fail before loading it.
     apply_overrides(&args.settings, minimal_settings(), None)?;
+    // A model is refused while it is read once it would hold more than --max-memory.
+    let cap = Some((args.max_memory * f64::from(1u32 << 30)) as u64);
 
     let (mut scene, camera_path) = if scene::import::is_model_path(scene_path) {
         let render = apply_overrides(&args.settings, RenderSettings::default(), Some(scene_path))?;
-        let scene = load_model(scene_path, render, args.sandbox, args.quiet)?;
+        let scene = load_model(scene_path, render, args.sandbox, args.quiet, cap)?;
         (scene, None)
     } else {
-        let file = load(scene_path, args.sandbox, args.quiet)?;
+        let file = load(scene_path, args.sandbox, args.quiet, cap)?;
         (file.scene, file.camera_path)
     };
     scene.render = apply_overrides(&args.settings, scene.render, Some(scene_path))?;
@@ -332,8 +334,14 @@ fn piece_window(args: &RenderArgs, settings: &RenderSettings) -> Result<Option<P
 
 /// Loads the scene file (and its camera path, if it has one), with progress after a
 /// second and warnings on stderr (unless `quiet`), confined to its folder with
-/// `sandbox`.
-pub fn load(scene_path: &Path, sandbox: bool, quiet: bool) -> Result<SceneFile> {
+/// `sandbox`, each model it places refused once importing it would hold more than
+/// `max_memory` bytes.
+pub fn load(
+    scene_path: &Path,
+    sandbox: bool,
+    quiet: bool,
+    max_memory: Option<u64>,
+) -> Result<SceneFile> {
     let warn = |warning: &SceneWarning| eprintln!("warning: {warning}");
     let label = scene_path.display().to_string();
     let scene = progress::while_loading(&label, !quiet, |progress| {
@@ -341,6 +349,7 @@ pub fn load(scene_path: &Path, sandbox: bool, quiet: bool) -> Result<SceneFile> 
             sandbox,
             progress: Some(progress),
             warning: (!quiet).then_some(&warn as &(dyn Fn(&SceneWarning) + Sync)),
+            max_model_bytes: max_memory,
         };
         scene::load_scene_file(scene_path, &options)
     })?;
@@ -349,13 +358,15 @@ pub fn load(scene_path: &Path, sandbox: bool, quiet: bool) -> Result<SceneFile> 
 
 /// Imports a model file and frames it as a scene of its own
 /// ([`gpu_render::scene::import::ImportedModel::into_scene`]) with `render`'s settings;
-/// warnings on stderr unless `quiet`. A model's own references (material libraries,
-/// buffers, images) cannot be confined, so `sandbox` refuses model files.
+/// warnings on stderr unless `quiet`, progress after a second; refused once importing
+/// it would hold more than `max_memory` bytes. A model's own references (material
+/// libraries, buffers, images) cannot be confined, so `sandbox` refuses model files.
 pub fn load_model(
     path: &Path,
     render: RenderSettings,
     sandbox: bool,
     quiet: bool,
+    max_memory: Option<u64>,
 ) -> Result<Scene> {
     if sandbox {
         bail!(
@@ -364,7 +375,15 @@ pub fn load_model(
             path.display()
         );
     }
-    let model = scene::import::import_model(path)?;
+    let label = path.display().to_string();
+    let model = progress::while_loading(&label, !quiet, |progress| {
+        let report = |done: u64, total: u64| progress(LoadProgress::Importing { done, total });
+        let options = scene::import::ImportOptions {
+            max_bytes: max_memory,
+            progress: Some(&report),
+        };
+        scene::import::import_model_with(path, &options)
+    })?;
     let scene = model.into_scene(render);
     if !quiet {
         for warning in &model.warnings {

@@ -189,7 +189,9 @@ fn watch_loading(
 /// Tenths of the checking stage done (0 for the other stages).
 fn load_step(progress: LoadProgress) -> u64 {
     match progress {
-        LoadProgress::Checking { done, total } => done * 10 / total.max(1),
+        LoadProgress::Checking { done, total } | LoadProgress::Importing { done, total } => {
+            done * 10 / total.max(1)
+        }
         _ => 0,
     }
 }
@@ -202,6 +204,12 @@ fn describe_load(progress: LoadProgress) -> String {
         LoadProgress::Checking { done, total } => format!(
             "checking items {:3}% ({done}/{total})",
             done * 100 / total.max(1)
+        ),
+        LoadProgress::Importing { done, total } => format!(
+            "reading the model {:3}% ({:.1} of {:.1} MB)",
+            done * 100 / total.max(1),
+            megabytes(done),
+            megabytes(total)
         ),
         _ => "working".to_owned(),
     }
@@ -232,6 +240,13 @@ mod tests {
         assert_eq!(
             describe_load(LoadProgress::Checking { done: 1, total: 4 }),
             "checking items  25% (1/4)"
+        );
+        assert_eq!(
+            describe_load(LoadProgress::Importing {
+                done: 50_000_000,
+                total: 200_000_000
+            }),
+            "reading the model  25% (50.0 of 200.0 MB)"
         );
         assert_eq!(
             load_step(LoadProgress::Checking {

@@ -30,7 +30,7 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
             args.out_dir.display()
         );
     }
-    let scene = crate::load(&args.scene, args.sandbox, false)?.scene;
+    let scene = crate::load(&args.scene, args.sandbox, false, None)?.scene;
     let height = (u64::from(scene.render.height) * u64::from(args.width)
         / u64::from(scene.render.width))
     .max(1) as u32;

@@ -56,6 +56,10 @@ pub struct LoadOptions<'a> {
     /// Told about each suspicious input that was accepted, and what was done about it
     /// (an albedo texel above 1, clamped to 1).
     pub warning: Option<&'a (dyn Fn(&SceneWarning) + Sync)>,
+    /// The most bytes importing each model file the scene places may hold
+    /// ([`crate::scene::import::ImportOptions::max_bytes`]): a model too large is
+    /// refused before it takes the memory. `None`: the fixed limits only.
+    pub max_model_bytes: Option<u64>,
 }
 
 impl std::fmt::Debug for LoadOptions<'_> {
@@ -64,6 +68,7 @@ impl std::fmt::Debug for LoadOptions<'_> {
             .field("sandbox", &self.sandbox)
             .field("progress", &self.progress.is_some())
             .field("warning", &self.warning.is_some())
+            .field("max_model_bytes", &self.max_model_bytes)
             .finish()
     }
 }
@@ -81,6 +86,14 @@ pub enum LoadProgress {
     Parsing {
         /// The text's size.
         bytes: u64,
+    },
+    /// Reading a model file (one placed by the scene, or the model rendered on its
+    /// own): `done` of its `total` bytes.
+    Importing {
+        /// Bytes read so far.
+        done: u64,
+        /// The file's bytes.
+        total: u64,
     },
     /// Checking the items (materials, lights, objects): `done` of `total`.
     Checking {

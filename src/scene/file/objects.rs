@@ -9,7 +9,7 @@ use super::LoadOptions;
 use super::check::{Item, Source};
 use super::raw::{RawColor, RawObject, RawVec3};
 use crate::echo::{echo, echo_path, short, short3};
-use crate::scene::import::{ImportedModel, ModelPlacement, import_model};
+use crate::scene::import::{ImportOptions, ImportedModel, ModelPlacement, import_model_with};
 use crate::scene::{
     FAR_WALL_PRECISION_LIMIT, Light, SPHERE_PRECISION_LIMIT, SceneError, Shape, coincident_spheres,
     far_wall_precision, sphere_precision,
@@ -173,7 +173,14 @@ pub fn model(
     let model = match cache.get(&key) {
         Some(model) => model.clone(),
         None => {
-            let model = import_model(&path).map_err(|err| {
+            let report = |done: u64, total: u64| {
+                options.report(crate::scene::LoadProgress::Importing { done, total });
+            };
+            let import = ImportOptions {
+                max_bytes: options.max_model_bytes,
+                progress: Some(&report),
+            };
+            let model = import_model_with(&path, &import).map_err(|err| {
                 item.fail(format_args!(
                     "file `{}`: {err}",
                     echo_path(std::path::Path::new(file))

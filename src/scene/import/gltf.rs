@@ -20,8 +20,8 @@ use super::accessor::{Expect, Normalized, read, view_bytes};
 use super::mesh::{Budget, RawMesh, finish_mesh};
 use super::texture::{Encoding, Textures};
 use super::{
-    ImportedCamera, ImportedMaterial, ImportedMesh, ImportedModel, MAX_MODEL_TRIANGLES,
-    MAX_MODEL_VERTICES, TextureRef, WrapMode, error, read_file,
+    ImportOptions, ImportedCamera, ImportedMaterial, ImportedMesh, ImportedModel,
+    MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES, TextureRef, WrapMode, error, read_file,
 };
 use crate::scene::{Camera, Light, Material, MaterialKind, SceneError};
 
@@ -83,13 +83,35 @@ const QUOTED_PROBLEMS: usize = 5;
 /// transform, a node matrix that is projective or given beside translation, rotation or
 /// scale, a texture that does not load, or a model beyond the size limits.
 pub fn import_gltf(path: &Path) -> Result<ImportedModel, SceneError> {
-    let bytes = read_file(path, path, "the model file")?;
-    parse_gltf(&bytes, path)
+    import_gltf_with(path, &ImportOptions::default())
+}
+
+/// [`import_gltf`] with `options`: the file, its buffers, meshes and textures are
+/// counted against [`ImportOptions::max_bytes`] before they are allocated.
+pub fn import_gltf_with(
+    path: &Path,
+    options: &ImportOptions<'_>,
+) -> Result<ImportedModel, SceneError> {
+    let mut budget = Budget::new(options.max_bytes);
+    let bytes = read_file(path, path, "the model file", &mut budget)?;
+    if let Some(progress) = options.progress {
+        progress(bytes.len() as u64, bytes.len() as u64);
+    }
+    parse_gltf_within(&bytes, path, budget)
 }
 
 /// Reads glTF or GLB from `bytes`; `path` names the file in messages and its directory
 /// is where external buffers and images are looked up.
 pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError> {
+    parse_gltf_within(bytes, path, Budget::default())
+}
+
+/// [`parse_gltf`] counting what it reads against `budget`.
+fn parse_gltf_within(
+    bytes: &[u8],
+    path: &Path,
+    budget: Budget,
+) -> Result<ImportedModel, SceneError> {
     // glTF JSON must not start with a byte-order mark (§3.2), but some writers add one.
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     if bytes.is_empty() {
@@ -130,7 +152,7 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError
         document: &gltf.document,
         buffers: Vec::new(),
         model: ImportedModel::empty(path),
-        budget: Budget::default(),
+        budget,
         textures: Textures::default(),
         materials: HashMap::new(),
         warned: BTreeSet::new(),
@@ -150,6 +172,7 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError
         gltf.blob.as_deref(),
         path,
         &importer.directory,
+        &mut importer.budget,
     )?;
     importer.import()?;
     let mut model = importer.model;
@@ -417,6 +440,7 @@ fn load_buffers(
     blob: Option<&[u8]>,
     path: &Path,
     directory: &Path,
+    budget: &mut Budget,
 ) -> Result<Vec<Vec<u8>>, SceneError> {
     let mut buffers = Vec::new();
     for buffer in document.buffers() {
@@ -432,10 +456,16 @@ fn load_buffers(
                 })?
                 .to_vec(),
             ::gltf::buffer::Source::Uri(uri) => match data_uri(uri) {
-                Some(decoded) => decoded.map_err(fail)?,
+                Some(decoded) => {
+                    let bytes = decoded.map_err(fail)?;
+                    budget
+                        .charge_bytes(bytes.len() as u64, &name)
+                        .map_err(|e| error(path, e))?;
+                    bytes
+                }
                 None => {
                     let file = uri_file(directory, uri).map_err(fail)?;
-                    read_file(&file, path, &format!("{name} {}", file.display()))?
+                    read_file(&file, path, &format!("{name} {}", file.display()), budget)?
                 }
             },
         };

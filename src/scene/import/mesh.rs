@@ -144,19 +144,59 @@ pub(super) fn finish_mesh(
     }))
 }
 
-/// The model-wide totals, checked against the limits as the importers go.
+/// Bytes an imported vertex may hold: its position and normal (`DVec3`, 24 bytes
+/// each) and texture coordinates (`DVec2`, 16 bytes).
+pub(super) const BYTES_PER_VERTEX: u64 = 64;
+/// Bytes of an imported triangle (three `u32` indices).
+pub(super) const BYTES_PER_TRIANGLE: u64 = 12;
+/// Bytes of a decoded texel (linear RGBA `f32`).
+pub(super) const BYTES_PER_TEXEL: u64 = 16;
+
+/// The model-wide totals, checked against the limits as the importers go: the fixed
+/// limits on counts, and the caller's cap on the bytes the import holds
+/// ([`super::ImportOptions::max_bytes`]).
 #[derive(Debug, Default)]
 pub(super) struct Budget {
     vertices: usize,
     triangles: usize,
     instances: usize,
     texels: u64,
+    bytes: u64,
+    max_bytes: Option<u64>,
 }
 
 impl Budget {
+    /// A budget capped at `max_bytes` (none: the fixed count limits only).
+    pub fn new(max_bytes: Option<u64>) -> Self {
+        Self {
+            max_bytes,
+            ..Self::default()
+        }
+    }
+
+    /// The bytes the budget still allows, if it is capped.
+    pub fn bytes_left(&self) -> Option<u64> {
+        self.max_bytes.map(|max| max.saturating_sub(self.bytes))
+    }
+
+    /// Counts `bytes` more held by the import (`what` names them in the message), before
+    /// they are allocated where the caller can.
+    pub fn charge_bytes(&mut self, bytes: u64, what: &str) -> Result<(), String> {
+        self.bytes = self.bytes.saturating_add(bytes);
+        match self.max_bytes {
+            Some(max) if self.bytes > max => Err(memory_cap_message(self.bytes, max, what)),
+            _ => Ok(()),
+        }
+    }
+
     /// Counts a mesh of `vertices` vertices and `triangles` triangles (before it is read,
     /// so that an absurd count is refused without allocating).
     pub fn charge_mesh(&mut self, vertices: usize, triangles: usize) -> Result<(), String> {
+        self.charge_bytes(
+            (vertices as u64).saturating_mul(BYTES_PER_VERTEX)
+                + (triangles as u64).saturating_mul(BYTES_PER_TRIANGLE),
+            "its meshes",
+        )?;
         self.vertices = self.vertices.saturating_add(vertices);
         self.triangles = self.triangles.saturating_add(triangles);
         if self.vertices > MAX_MODEL_VERTICES {
@@ -185,6 +225,8 @@ impl Budget {
 
     /// Counts a texture of `width × height` texels.
     pub fn charge_texels(&mut self, width: u32, height: u32) -> Result<(), String> {
+        let texels = u64::from(width) * u64::from(height);
+        self.charge_bytes(texels.saturating_mul(BYTES_PER_TEXEL), "its textures")?;
         self.texels = self
             .texels
             .saturating_add(u64::from(width) * u64::from(height));
@@ -195,6 +237,19 @@ impl Budget {
         }
         Ok(())
     }
+}
+
+/// The message for an import that needs `bytes` with `what`, more than the cap `max`.
+pub(super) fn memory_cap_message(bytes: u64, max: u64, what: &str) -> String {
+    const GIB: f64 = (1u64 << 30) as f64;
+    format!(
+        "reading the model with {what} needs more than {:.2} GiB of memory (at least {:.2} \
+         GiB so far), more than the {:.2} GiB allowed (--max-memory); raise the cap if the \
+         machine has the memory",
+        max as f64 / GIB,
+        bytes as f64 / GIB,
+        max as f64 / GIB
+    )
 }
 
 #[cfg(test)]

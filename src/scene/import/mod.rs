@@ -45,8 +45,9 @@ use std::path::{Path, PathBuf};
 use glam::{DMat4, DVec2, DVec3};
 
 pub use self::framing::{DEFAULT_FOV_Y_DEGREES, default_camera, default_lights};
-pub use self::gltf::{LUMENS_PER_WATT, import_gltf, parse_gltf};
-pub use self::obj::{DEFAULT_OBJ_ALBEDO, import_obj, parse_obj};
+pub use self::gltf::{LUMENS_PER_WATT, import_gltf, import_gltf_with, parse_gltf};
+use self::mesh::Budget;
+pub use self::obj::{DEFAULT_OBJ_ALBEDO, import_obj, import_obj_with, parse_obj};
 pub use self::place::{MODEL_BACKGROUND, ModelPlacement, is_model_path};
 use super::{Camera, Image, Light, Material, SceneError};
 
@@ -295,16 +296,50 @@ impl ImportedModel {
     }
 }
 
+/// How a model is imported ([`import_model_with`]): a cap on the memory the import
+/// may take, and a progress hook for long reads.
+#[derive(Clone, Copy, Default)]
+pub struct ImportOptions<'a> {
+    /// The most bytes the import may hold at once: the file and its buffers as read,
+    /// the meshes' arrays as they are built (64 bytes a vertex, 12 a triangle) and the
+    /// textures as decoded (16 bytes a texel). Checked before each large allocation
+    /// (a file by its size before it is read, a texture by its header before it is
+    /// decoded) and as an OBJ file's arrays grow, so that a model too large is refused
+    /// before it takes the memory. `None`: only the fixed limits
+    /// ([`MAX_MODEL_VERTICES`], ...).
+    pub max_bytes: Option<u64>,
+    /// Called as the model file is read, with the bytes read so far and the file's size
+    /// (at most every mebibyte).
+    pub progress: Option<&'a (dyn Fn(u64, u64) + Sync)>,
+}
+
+impl std::fmt::Debug for ImportOptions<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ImportOptions")
+            .field("max_bytes", &self.max_bytes)
+            .field("progress", &self.progress.is_some())
+            .finish()
+    }
+}
+
 /// Reads the model at `path`, choosing the importer by the file extension
 /// (case-insensitive): `.obj` ([`import_obj`]), `.gltf` or `.glb` ([`import_gltf`]).
 pub fn import_model(path: &Path) -> Result<ImportedModel, SceneError> {
+    import_model_with(path, &ImportOptions::default())
+}
+
+/// [`import_model`] with `options`: a memory cap and a progress hook.
+pub fn import_model_with(
+    path: &Path,
+    options: &ImportOptions<'_>,
+) -> Result<ImportedModel, SceneError> {
     let extension = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     match extension.as_deref() {
-        Some("obj") => import_obj(path),
-        Some("gltf" | "glb") => import_gltf(path),
+        Some("obj") => import_obj_with(path, options),
+        Some("gltf" | "glb") => import_gltf_with(path, options),
         _ => Err(error(
             path,
             "not a model file this program reads: the name must end in .obj, .gltf or .glb",
@@ -323,10 +358,24 @@ fn error(path: &Path, message: impl Into<String>) -> SceneError {
 
 /// Reads a whole file (a model, a material library or a buffer), refusing anything
 /// but a regular file (judged on the opened file: a FIFO or a device behind any name
-/// is refused at once) and files larger than [`MAX_MODEL_FILE_BYTES`]. `what` names the
+/// is refused at once) and files larger than [`MAX_MODEL_FILE_BYTES`] or than what
+/// `budget` has left (checked by the file's size before it is read). `what` names the
 /// file's role in the message ("the model file", "the material library lib.mtl",
 /// ...); errors are reported against `report` (the model being imported).
-fn read_file(path: &Path, report: &Path, what: &str) -> Result<Vec<u8>, SceneError> {
-    crate::input::read_input(path, MAX_MODEL_FILE_BYTES)
-        .map_err(|e| error(report, format!("cannot read {what}: {e}")))
+fn read_file(
+    path: &Path,
+    report: &Path,
+    what: &str,
+    budget: &mut Budget,
+) -> Result<Vec<u8>, SceneError> {
+    let fail = |e: crate::input::InputError| error(report, format!("cannot read {what}: {e}"));
+    let file = crate::input::open_input(path).map_err(fail)?;
+    let length = file
+        .metadata()
+        .map_err(|e| fail(crate::input::InputError::Io(e)))?
+        .len();
+    budget
+        .charge_bytes(length, &format!("{what} ({length} bytes)"))
+        .map_err(|e| error(report, e))?;
+    crate::input::read_opened(file, MAX_MODEL_FILE_BYTES).map_err(fail)
 }

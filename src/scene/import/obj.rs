@@ -26,10 +26,11 @@ use glam::{DVec2, DVec3};
 
 use self::face::{Cut, FaceCutter};
 use self::mtl::{Libraries, map_material};
-use super::mesh::{Budget, RawMesh, finish_mesh};
+use super::mesh::{Budget, RawMesh, finish_mesh, memory_cap_message};
 use super::texture::Textures;
 use super::{
-    ImportedMaterial, ImportedModel, MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES, error, read_file,
+    ImportOptions, ImportedMaterial, ImportedModel, MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES, error,
+    read_file,
 };
 use crate::echo::{echo, short};
 use crate::scene::{Material, SceneError};
@@ -44,6 +45,9 @@ const NONE: u32 = u32::MAX;
 /// The name of faces before any `o` or `g` (and of an `o` or `g` without a name), as
 /// tobj names them.
 const UNNAMED: &str = "unnamed_object";
+/// Lines between two checks of the memory an OBJ file's arrays hold (and two progress
+/// reports).
+const CHECK_EVERY_LINES: usize = 1 << 16;
 
 /// How many kinds of unsupported statement are named one by one in the warnings; the
 /// rest are counted together.
@@ -60,24 +64,51 @@ const MAX_NAMED_STATEMENTS: usize = 16;
 /// is a warning (the default material, or the material without the texture, is used);
 /// degenerate triangles are skipped and counted in a warning.
 pub fn import_obj(path: &Path) -> Result<ImportedModel, SceneError> {
-    let bytes = read_file(path, path, "the model file")?;
-    parse_obj(&bytes, path)
+    import_obj_with(path, &ImportOptions::default())
+}
+
+/// [`import_obj`] with `options`: the file is counted against
+/// [`ImportOptions::max_bytes`] by its size before it is read, the arrays it makes as
+/// they grow, and the textures by their headers before they are decoded; the reading
+/// reports its progress.
+pub fn import_obj_with(
+    path: &Path,
+    options: &ImportOptions<'_>,
+) -> Result<ImportedModel, SceneError> {
+    let mut budget = Budget::new(options.max_bytes);
+    let bytes = read_file(path, path, "the model file", &mut budget)?;
+    parse_obj_within(&bytes, path, budget, options.progress)
 }
 
 /// Reads OBJ text from `bytes` (UTF-8, or UTF-16 with a byte-order mark); `path` names
 /// the file in messages and its directory is where the material libraries are looked
 /// up.
 pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<ImportedModel, SceneError> {
+    parse_obj_within(bytes, path, Budget::default(), None)
+}
+
+/// [`parse_obj`] counting what it builds against `budget`, reporting progress.
+fn parse_obj_within(
+    bytes: &[u8],
+    path: &Path,
+    mut budget: Budget,
+    progress: Option<&(dyn Fn(u64, u64) + Sync)>,
+) -> Result<ImportedModel, SceneError> {
     let mut model = ImportedModel::empty(path);
     let text = decode_text(bytes, path, &mut model.warnings);
+    if let Cow::Owned(decoded) = &text {
+        budget
+            .charge_bytes(decoded.len() as u64, "its text decoded")
+            .map_err(|e| error(path, e))?;
+    }
     let mut notes = Notes::default();
-    let mut file = ObjReader::new(path).read(&text, &mut notes)?;
+    let reader = ObjReader::new(path, budget.bytes_left(), progress);
+    let mut file = reader.read(&text, &mut notes)?;
     notes.report(path, &mut model.warnings);
     let directory = path.parent().unwrap_or(Path::new(""));
     let libraries = Libraries::load(&file.libraries, directory, path, &mut model.warnings)?;
     check_material_uses(&file.used_materials, &libraries, path, &mut model.warnings);
 
-    let mut budget = Budget::default();
     let mut textures = Textures::default();
     for source in &libraries.materials {
         let imported = map_material(source, &mut textures, &mut budget, &mut model.warnings)?;
@@ -490,12 +521,24 @@ struct ObjReader<'p> {
     corners: Vec<[u32; 3]>,
     points: Vec<DVec3>,
     cut: Vec<[u32; 3]>,
+    /// The most bytes the arrays may hold ([`super::ImportOptions::max_bytes`] less the
+    /// file).
+    max_bytes: Option<u64>,
+    progress: Option<&'p (dyn Fn(u64, u64) + Sync)>,
 }
 
 impl<'p> ObjReader<'p> {
-    fn new(path: &'p Path) -> Self {
+    /// A reader of the file at `path` that may hold at most `max_bytes` more (none:
+    /// the fixed limits only) and reports its progress to `progress`.
+    fn new(
+        path: &'p Path,
+        max_bytes: Option<u64>,
+        progress: Option<&'p (dyn Fn(u64, u64) + Sync)>,
+    ) -> Self {
         Self {
             path,
+            max_bytes,
+            progress,
             file: ObjFile {
                 positions: Vec::new(),
                 texcoords: Vec::new(),
@@ -521,12 +564,59 @@ impl<'p> ObjReader<'p> {
         }
     }
 
-    /// Reads every line of `text`.
+    /// Reads every line of `text`, checking the memory its arrays hold and reporting
+    /// progress every [`CHECK_EVERY_LINES`] lines.
     fn read(mut self, text: &str, notes: &mut Notes) -> Result<ObjFile, SceneError> {
-        for (index, line) in text.lines().enumerate() {
-            self.statement(index + 1, strip_comment(line), notes)?;
+        let total = text.len() as u64;
+        let (mut done, mut lines) = (0u64, 0);
+        for line in text.lines() {
+            lines += 1;
+            self.statement(lines, strip_comment(line), notes)?;
+            done += line.len() as u64 + 1;
+            if lines % CHECK_EVERY_LINES == 0 {
+                self.check_memory(lines)?;
+                if let Some(progress) = self.progress {
+                    progress(done.min(total), total);
+                }
+            }
+        }
+        self.check_memory(lines)?;
+        if let Some(progress) = self.progress {
+            progress(total, total);
         }
         Ok(self.file)
+    }
+
+    /// Refuses the file once the arrays read so far hold more than the cap allows
+    /// (line `n` names where).
+    fn check_memory(&self, n: usize) -> Result<(), SceneError> {
+        let Some(max) = self.max_bytes else {
+            return Ok(());
+        };
+        let file = &self.file;
+        let groups: (u64, u64) = file.groups.iter().fold((0, 0), |(v, t), group| {
+            (
+                v + group.vertices.len() as u64,
+                t + group.triangles.len() as u64,
+            )
+        });
+        // A group's vertex is its index triple and its lookup entry (about 48 bytes
+        // with the table's overhead); a triangle three indices.
+        let held = file.positions.len() as u64 * 24
+            + file.normals.len() as u64 * 24
+            + file.texcoords.len() as u64 * 16
+            + groups.0 * 48
+            + groups.1 * 12;
+        if held > max {
+            return Err(error(
+                self.path,
+                format!(
+                    "by line {n}: {}",
+                    memory_cap_message(held, max, "the arrays read so far")
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// Reads the statement on line `n` (its comment already cut off).
@@ -956,6 +1046,42 @@ fn finite(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An OBJ of `vertices` positions and one triangle.
+    fn many_vertices(vertices: usize) -> String {
+        let mut text = String::with_capacity(vertices * 20);
+        for i in 0..vertices {
+            text.push_str(&format!("v {i} {} 0.25\n", (i * i) % 7));
+        }
+        text.push_str("f 1 2 3\n");
+        text
+    }
+
+    #[test]
+    fn a_capped_import_is_refused_while_its_arrays_grow_past_the_cap() {
+        let text = many_vertices(400_000);
+        let path = Path::new("big.obj");
+        // Unbounded, it imports.
+        assert!(parse_obj(text.as_bytes(), path).is_ok());
+        // 2 MiB for the arrays: positions of 24 bytes reach it by about line 87,000,
+        // and the check every 65,536 lines refuses at the first check past it.
+        let cap = 2 << 20;
+        let err = parse_obj_within(text.as_bytes(), path, Budget::new(Some(cap)), None)
+            .expect_err("over the cap")
+            .to_string();
+        assert!(
+            err.contains("by line 131072") && err.contains("--max-memory"),
+            "{err}"
+        );
+        // The progress hook hears about every checked stretch and the end.
+        let heard = std::sync::Mutex::new(Vec::new());
+        let hook = |done: u64, total: u64| heard.lock().expect("lock").push((done, total));
+        parse_obj_within(text.as_bytes(), path, Budget::default(), Some(&hook)).expect("imports");
+        let heard = heard.into_inner().expect("lock");
+        assert_eq!(heard.len(), 400_001 / CHECK_EVERY_LINES + 1, "{heard:?}");
+        assert_eq!(heard.last(), Some(&(text.len() as u64, text.len() as u64)));
+        assert!(heard.windows(2).all(|pair| pair[0].0 < pair[1].0));
+    }
 
     #[test]
     fn words_know_their_columns() {

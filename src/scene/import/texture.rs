@@ -5,7 +5,8 @@ use std::path::Path;
 
 use super::mesh::Budget;
 use crate::color::srgb_encode;
-use crate::scene::{Image, decode_image, load_image};
+use crate::input::read_input;
+use crate::scene::{Image, MAX_IMAGE_FILE_BYTES, decode_image, image_dimensions};
 
 /// How a texture's values are meant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -37,9 +38,11 @@ impl Textures {
         if let Some(&index) = self.loaded.get(&key) {
             return Ok(index);
         }
-        let image = load_image(path)
-            .map_err(|e| format!("the texture {} does not load: {e}", path.display()))?;
-        self.add(key, image, encoding, budget)
+        let fail = |e: String| format!("the texture {} does not load: {e}", path.display());
+        let bytes = read_input(path, MAX_IMAGE_FILE_BYTES)
+            .map_err(|e| fail(format!("cannot read the file: {e}")))?;
+        self.decode(key, path, &bytes, encoding, budget)
+            .map_err(|e| e.message(fail))
     }
 
     /// The index of the texture decoded from `bytes` (an image embedded in the model),
@@ -55,19 +58,27 @@ impl Textures {
         if let Some(&index) = self.loaded.get(&key) {
             return Ok(index);
         }
-        let image = decode_image(Path::new(name), bytes)
-            .map_err(|e| format!("the texture {name} does not load: {e}"))?;
-        self.add(key, image, encoding, budget)
+        let fail = |e: String| format!("the texture {name} does not load: {e}");
+        self.decode(key, Path::new(name), bytes, encoding, budget)
+            .map_err(|e| e.message(fail))
     }
 
-    fn add(
+    /// Decodes the image file `bytes` (read from or named `path`) and adds it, after
+    /// charging its texels to `budget` from its header, before its texels are
+    /// allocated.
+    fn decode(
         &mut self,
         key: (String, Encoding),
-        mut image: Image,
+        path: &Path,
+        bytes: &[u8],
         encoding: Encoding,
         budget: &mut Budget,
-    ) -> Result<u32, String> {
-        budget.charge_texels(image.width, image.height)?;
+    ) -> Result<u32, TextureFailure> {
+        let (width, height) = image_dimensions(path, bytes).map_err(TextureFailure::Decode)?;
+        budget
+            .charge_texels(width, height)
+            .map_err(TextureFailure::Budget)?;
+        let mut image = decode_image(path, bytes).map_err(TextureFailure::Decode)?;
         if encoding == Encoding::Data {
             // `load_image` linearised the 8/16-bit values as sRGB; glTF images are PNG or
             // JPEG (glTF 2.0 §3.8.3), never float, so encoding again restores the
@@ -82,5 +93,23 @@ impl Textures {
         self.images.push(image);
         self.loaded.insert(key, index);
         Ok(index)
+    }
+}
+
+/// Why a texture was not added.
+enum TextureFailure {
+    /// The file does not decode (the caller names the texture).
+    Decode(String),
+    /// The model's budget refuses its texels (a message of its own).
+    Budget(String),
+}
+
+impl TextureFailure {
+    /// The message: a decoding failure through `name_it`, the budget's as it is.
+    fn message(self, name_it: impl FnOnce(String) -> String) -> String {
+        match self {
+            TextureFailure::Decode(why) => name_it(why),
+            TextureFailure::Budget(why) => why,
+        }
     }
 }

@@ -89,9 +89,9 @@ fn load_view_scene(args: &ViewArgs) -> Result<Scene> {
     let path = args.scene.as_path();
     let mut scene = if scene::import::is_model_path(path) {
         let render = crate::apply_overrides(&args.settings, RenderSettings::default(), Some(path))?;
-        crate::load_model(path, render, args.sandbox, args.quiet)?
+        crate::load_model(path, render, args.sandbox, args.quiet, None)?
     } else {
-        crate::load(path, args.sandbox, args.quiet)?.scene
+        crate::load(path, args.sandbox, args.quiet, None)?.scene
     };
     scene.render = crate::apply_overrides(&args.settings, scene.render, Some(path))?;
     Ok(scene)
@@ -711,9 +711,9 @@ impl Viewer {
         let mut scene = if scene::import::is_model_path(path) {
             let render =
                 crate::apply_overrides(&args.settings, RenderSettings::default(), Some(path))?;
-            crate::load_model(path, render, args.sandbox, args.quiet)?
+            crate::load_model(path, render, args.sandbox, args.quiet, None)?
         } else {
-            crate::load(path, args.sandbox, args.quiet)?.scene
+            crate::load(path, args.sandbox, args.quiet, None)?.scene
         };
         scene.render = crate::apply_overrides(&args.settings, scene.render, Some(path))?;
         let file_camera = scene.camera;
