@@ -9,6 +9,8 @@
 //! - [`camera`], [`color`], [`film`]: the pinhole camera and sample pattern, the sRGB
 //!   curve, and the image a render produces.
 //! - [`cpu`]: the reference tracer (f64).
+//! - [`denoise`]: the edge-avoiding à-trous denoiser guided by albedo, normal, depth
+//!   and variance (CPU twin of the GPU filter).
 //! - [`gpu`]: the wgpu backend, built from the caller's `Device` and `Queue`.
 //! - [`noise`]: the per-pixel noise estimate (standard error of each pixel's mean).
 //! - [`echo`]: text and numbers read from files, as messages quote them (control
@@ -30,6 +32,7 @@ pub mod accel;
 pub mod camera;
 pub mod color;
 pub mod cpu;
+pub mod denoise;
 pub mod echo;
 pub mod film;
 pub mod gpu;
