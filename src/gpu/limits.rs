@@ -111,9 +111,14 @@ pub fn required_limits(adapter_limits: &wgpu::Limits) -> wgpu::Limits {
 /// ([`crate::film::RenderStats::gpu_time`]), and [`wgpu::Features::SUBGROUP`] lets the
 /// fused kernel's traversals give way to finished lanes
 /// ([`super::ShaderFeatures::refill_lanes`]; the 1920x1080 showcase traced 17-20%
-/// faster with it on lavapipe).
+/// faster with it on lavapipe), and [`wgpu::Features::PIPELINE_CACHE`] lets an
+/// application keep compiled kernels between runs
+/// ([`super::RendererOptions::pipeline_cache`]).
 pub fn optional_features(adapter_features: wgpu::Features) -> wgpu::Features {
-    adapter_features & (wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::SUBGROUP)
+    adapter_features
+        & (wgpu::Features::TIMESTAMP_QUERY
+            | wgpu::Features::SUBGROUP
+            | wgpu::Features::PIPELINE_CACHE)
 }
 
 /// Checks that `needed` bytes fit one storage binding of a device with `limits`.

@@ -12,6 +12,7 @@ use super::shaders::{
     display_shader_source, trace_shader_source,
 };
 use super::uniform_records::{UNIFORM_BUFFERS, device_allows, is_uniform_record};
+use super::wavefront::Schedule;
 
 /// Format of the linear radiance texture the trace writes.
 pub const LINEAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -52,15 +53,39 @@ pub(crate) mod binding {
 /// Storage buffers the trace kernels bind in one stage.
 pub const TRACE_STORAGE_BUFFERS: u32 = 18;
 
-/// The kernels of one trace module.
+/// The kernels of one trace module for one schedule: only the entry points the
+/// schedule dispatches are built, since drivers compile each pipeline (real ones at
+/// creation, lavapipe at its first dispatch) and a kernel never dispatched is compile
+/// time for nothing.
 #[derive(Debug, Clone)]
-pub struct TracePipelines {
-    /// `shade_paths` (wavefront schedule).
-    pub shade: wgpu::ComputePipeline,
-    /// `trace_rays` (wavefront schedule).
-    pub trace: wgpu::ComputePipeline,
-    /// `trace_paths` (fused schedule).
-    pub fused: wgpu::ComputePipeline,
+pub enum TracePipelines {
+    /// `trace_paths`, shading and traversal in one loop ([`Schedule::Fused`]).
+    Fused(wgpu::ComputePipeline),
+    /// `shade_paths` and `trace_rays`, dispatched in turn ([`Schedule::Wavefront`]).
+    Wavefront {
+        /// `shade_paths`.
+        shade: wgpu::ComputePipeline,
+        /// `trace_rays`.
+        trace: wgpu::ComputePipeline,
+    },
+}
+
+impl TracePipelines {
+    /// The schedule these kernels run.
+    pub fn schedule(&self) -> Schedule {
+        match self {
+            TracePipelines::Fused(_) => Schedule::Fused,
+            TracePipelines::Wavefront { .. } => Schedule::Wavefront,
+        }
+    }
+
+    /// The kernels of one round, in dispatch order.
+    pub(crate) fn round(&self) -> Vec<&wgpu::ComputePipeline> {
+        match self {
+            TracePipelines::Fused(fused) => vec![fused],
+            TracePipelines::Wavefront { shade, trace } => vec![shade, trace],
+        }
+    }
 }
 
 /// The bind group and pipeline layout of the trace modules of one kind of record
@@ -138,8 +163,10 @@ pub(crate) struct Pipelines {
     uniform_layout: Option<TraceLayout>,
     pub display_bind_group_layout: wgpu::BindGroupLayout,
     pub display: wgpu::ComputePipeline,
-    /// Trace pipelines by feature set, built on first use.
-    trace: Mutex<HashMap<ShaderFeatures, TracePipelines>>,
+    /// Trace pipelines by feature set and schedule, built on first use.
+    trace: Mutex<HashMap<(ShaderFeatures, Schedule), TracePipelines>>,
+    /// The driver's cache of compiled pipelines every pipeline goes through, if any.
+    cache: Option<wgpu::PipelineCache>,
 }
 
 fn compute_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
@@ -201,8 +228,13 @@ fn float_texture_entry(
 }
 
 impl Pipelines {
-    /// Builds the layouts and the display pipeline (trace pipelines come on demand).
-    pub fn new(device: &wgpu::Device) -> Result<Self, RenderError> {
+    /// Builds the layouts and the display pipeline (trace pipelines come on demand),
+    /// every pipeline through `cache` if given (a driver's cache of compiled code,
+    /// [`super::RendererOptions::pipeline_cache`]).
+    pub fn new(
+        device: &wgpu::Device,
+        cache: Option<wgpu::PipelineCache>,
+    ) -> Result<Self, RenderError> {
         let storage_layout = TraceLayout::new(device, false)?;
         let uniform_layout = if device_allows(&device.limits()) {
             Some(TraceLayout::new(device, true)?)
@@ -230,6 +262,7 @@ impl Pipelines {
             display_shader_source(),
             &display_pipeline_layout,
             &[DISPLAY_ENTRY_POINT],
+            cache.as_ref(),
         )?
         .remove(0);
         Ok(Self {
@@ -238,17 +271,19 @@ impl Pipelines {
             display_bind_group_layout,
             display,
             trace: Mutex::new(HashMap::new()),
+            cache,
         })
     }
 
-    /// The trace pipelines for `features`, built and cached on first use.
+    /// The trace pipelines of `schedule` for `features`, built and cached on first use.
     pub fn trace(
         &self,
         device: &wgpu::Device,
         features: &ShaderFeatures,
+        schedule: Schedule,
     ) -> Result<TracePipelines, RenderError> {
         let mut cache = self.trace.lock().unwrap_or_else(PoisonError::into_inner);
-        if let Some(pipelines) = cache.get(features) {
+        if let Some(pipelines) = cache.get(&(*features, schedule)) {
             return Ok(pipelines.clone());
         }
         let layout = self.trace_layout(device, features)?;
@@ -258,28 +293,36 @@ impl Pipelines {
                 module: label.clone(),
                 message,
             })?;
+        let entry_points: &[&str] = match schedule {
+            Schedule::Fused => &[FUSED_ENTRY_POINT],
+            Schedule::Wavefront => &[SHADE_ENTRY_POINT, TRACE_ENTRY_POINT],
+        };
         let mut built = build_pipelines(
             device,
             &label,
             source,
             &layout.pipeline,
-            &[SHADE_ENTRY_POINT, TRACE_ENTRY_POINT, FUSED_ENTRY_POINT],
+            entry_points,
+            self.cache.as_ref(),
         )?;
-        let pipelines = TracePipelines {
-            fused: built.remove(2),
-            trace: built.remove(1),
-            shade: built.remove(0),
+        let pipelines = match schedule {
+            Schedule::Fused => TracePipelines::Fused(built.remove(0)),
+            Schedule::Wavefront => TracePipelines::Wavefront {
+                trace: built.remove(1),
+                shade: built.remove(0),
+            },
         };
-        cache.insert(*features, pipelines.clone());
+        cache.insert((*features, schedule), pipelines.clone());
         Ok(pipelines)
     }
 
-    /// Whether the trace pipelines for `features` are built and cached already.
-    pub(crate) fn has_trace(&self, features: &ShaderFeatures) -> bool {
+    /// Whether the trace pipelines of `schedule` for `features` are built and cached
+    /// already.
+    pub(crate) fn has_trace(&self, features: &ShaderFeatures, schedule: Schedule) -> bool {
         self.trace
             .lock()
             .unwrap_or_else(PoisonError::into_inner)
-            .contains_key(features)
+            .contains_key(&(*features, schedule))
     }
 
     /// The layouts of the trace modules for `features` (their record bindings are
@@ -331,6 +374,7 @@ fn build_pipelines(
     source: String,
     layout: &wgpu::PipelineLayout,
     entry_points: &[&str],
+    cache: Option<&wgpu::PipelineCache>,
 ) -> Result<Vec<wgpu::ComputePipeline>, RenderError> {
     capture(device, &format!("{name} shader"), Caught::Shader, || {
         let desc = wgpu::ShaderModuleDescriptor {
@@ -347,7 +391,7 @@ fn build_pipelines(
                     module: &module,
                     entry_point: Some(entry_point),
                     compilation_options: wgpu::PipelineCompilationOptions::default(),
-                    cache: None,
+                    cache,
                 })
             })
             .collect()

@@ -37,7 +37,7 @@ pub use frame_loop::{BufferWrites, FilmImage};
 
 /// How a [`Renderer`] is built. Every field but `surface_format` only trades speed,
 /// memory or waiting: the image does not depend on them.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct RendererOptions {
     /// The colour format of the attachments [`Renderer::draw`] renders into (for
     /// example the swapchain's `Bgra8UnormSrgb`); `None` builds no draw pipeline.
@@ -85,6 +85,12 @@ pub struct RendererOptions {
     /// [`super::driver_loop_limit`]), so that the kernels report it and every trace
     /// fails with [`RenderError::TraceIncomplete`] instead of returning a short image.
     pub simulate_loop_cut: bool,
+    /// A driver cache of compiled pipelines (`wgpu::Device::create_pipeline_cache`, on
+    /// devices with [`wgpu::Features::PIPELINE_CACHE`]) that every pipeline of the
+    /// renderer is built through: created from the data an earlier run saved
+    /// ([`wgpu::PipelineCache::get_data`]), it spares recompiling the kernels. The
+    /// application owns the cache and saves its data; `None` builds without one.
+    pub pipeline_cache: Option<wgpu::PipelineCache>,
 }
 
 impl Default for RendererOptions {
@@ -102,6 +108,7 @@ impl Default for RendererOptions {
             refill_lanes: true,
             unrolled: true,
             simulate_loop_cut: false,
+            pipeline_cache: None,
         }
     }
 }
@@ -170,7 +177,7 @@ impl Renderer {
     /// [`RenderError::Shader`] if a pipeline fails to build.
     pub fn new(device: &wgpu::Device, options: RendererOptions) -> Result<Self, RenderError> {
         check_limits(&device.limits())?;
-        let pipelines = Pipelines::new(device)?;
+        let pipelines = Pipelines::new(device, options.pipeline_cache.clone())?;
         let draw = options
             .surface_format
             .map(|format| DrawPipelines::new(device, format))
@@ -224,9 +231,10 @@ impl Renderer {
         self.pipelines.cached_trace_count()
     }
 
-    /// The trace pipelines for `features`, built and cached on first use (uploaded
-    /// scenes carry their features: [`GpuScene::features`]). For measurements of the
-    /// compile time; [`Renderer::upload`] builds what a scene needs.
+    /// The trace pipelines of this renderer's schedule for `features`, built and
+    /// cached on first use (uploaded scenes carry their features:
+    /// [`GpuScene::features`]). For measurements of the compile time;
+    /// [`Renderer::upload`] builds what a scene needs.
     ///
     /// Errors: [`RenderError::Shader`] if the composed trace shader does not compile.
     pub fn trace_pipelines(
@@ -234,7 +242,7 @@ impl Renderer {
         device: &wgpu::Device,
         features: &ShaderFeatures,
     ) -> Result<TracePipelines, RenderError> {
-        self.pipelines.trace(device, features)
+        self.pipelines.trace(device, features, self.schedule)
     }
 
     /// The bind group layout of the draw pipelines, if any.
@@ -282,9 +290,11 @@ impl Renderer {
                 allow_unrolled: self.options.unrolled,
             },
         )?;
-        let cached = self.pipelines.has_trace(&prepared.features);
+        let cached = self.pipelines.has_trace(&prepared.features, self.schedule);
         let started = Instant::now();
-        let pipelines = self.pipelines.trace(device, &prepared.features)?;
+        let pipelines = self
+            .pipelines
+            .trace(device, &prepared.features, self.schedule)?;
         if !cached {
             let layout = self.pipelines.trace_bind_group_layout(&prepared.features);
             warm_up(

@@ -364,7 +364,6 @@ pub(crate) fn trace_region(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     pipelines: &TracePipelines,
-    schedule: Schedule,
     slots: &SlotBuffers,
     bind_group: &wgpu::BindGroup,
     frame: &FrameUniforms,
@@ -410,7 +409,7 @@ pub(crate) fn trace_region(
                     }
                 }),
             });
-            encode_rounds(&mut pass, pipelines, schedule, bind_group, groups, rounds);
+            encode_rounds(&mut pass, pipelines, bind_group, groups, rounds);
         }
         encoder.copy_buffer_to_buffer(
             &slots.counters,
@@ -461,29 +460,21 @@ pub(crate) fn trace_region(
 pub(crate) fn encode_rounds(
     pass: &mut wgpu::ComputePass<'_>,
     pipelines: &TracePipelines,
-    schedule: Schedule,
     bind_group: &wgpu::BindGroup,
     groups: u32,
     rounds: u32,
 ) {
     pass.set_bind_group(0, bind_group, &[]);
+    let round = pipelines.round();
     for _ in 0..rounds {
-        match schedule {
-            Schedule::Wavefront => {
-                pass.set_pipeline(&pipelines.shade);
-                pass.dispatch_workgroups(groups, 1, 1);
-                pass.set_pipeline(&pipelines.trace);
-                pass.dispatch_workgroups(groups, 1, 1);
-            }
-            Schedule::Fused => {
-                pass.set_pipeline(&pipelines.fused);
-                pass.dispatch_workgroups(groups, 1, 1);
-            }
+        for pipeline in &round {
+            pass.set_pipeline(pipeline);
+            pass.dispatch_workgroups(groups, 1, 1);
         }
     }
 }
 
-/// Runs each trace kernel of `pipelines` once over no slots (`slot_count` 0: every
+/// Runs each trace kernel of `pipelines` (those of its schedule) once over no slots (`slot_count` 0: every
 /// invocation returns at once), so that a driver that compiles a pipeline at its first
 /// dispatch rather than at its creation (lavapipe: LLVM, seconds for a trace module)
 /// compiles it now, at upload, and neither the first trace's time nor the first frame
@@ -521,7 +512,7 @@ pub(crate) fn warm_up(
             timestamp_writes: None,
         });
         pass.set_bind_group(0, &bind_group, &[]);
-        for pipeline in [&pipelines.shade, &pipelines.trace, &pipelines.fused] {
+        for pipeline in pipelines.round() {
             pass.set_pipeline(pipeline);
             pass.dispatch_workgroups(1, 1, 1);
         }

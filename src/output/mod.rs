@@ -412,8 +412,8 @@ pub fn write_png_rgba8(
     })
 }
 
-/// Writes `bytes` (a file encoded in memory: a tile) to `path`, atomically.
-pub(crate) fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+/// Writes `bytes` (a file encoded in memory: a tile, a cache) to `path`, atomically.
+pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
     write_atomically(path, |writer| {
         writer.write_all(bytes).map_err(EncodeFailure::Io)
     })

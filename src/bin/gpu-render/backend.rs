@@ -12,6 +12,7 @@ use gpu_render::scene::{Integrator, Scene};
 use gpu_render::tiles::PixelWindow;
 
 use crate::args::{AdapterArg, BackendArg};
+use crate::pipeline_cache::PipelineCacheFile;
 
 /// A render as the command line needs it: both images and the statistics.
 pub struct Frame {
@@ -63,9 +64,11 @@ pub enum Backend {
         /// Instance, adapter, device and queue.
         gpu: Box<HeadlessGpu>,
         /// The renderer built for the device.
-        renderer: Renderer,
+        renderer: Box<Renderer>,
         /// The adapter's name, for the summary.
         adapter_name: String,
+        /// The pipeline cache kept between runs, where the device has one.
+        pipeline_cache: Option<PipelineCacheFile>,
     },
     /// The CPU reference tracer.
     Cpu {
@@ -136,19 +139,33 @@ impl Backend {
 
     fn with_device(gpu: HeadlessGpu, options: &GpuOptions) -> Result<Self> {
         let adapter_name = gpu.adapter_info().name;
+        let pipeline_cache = PipelineCacheFile::open(&gpu.device, &gpu.adapter_info());
         let options = RendererOptions {
             iteration_budget: options.iteration_budget,
             poll_timeout: options.timeout,
             noise_estimate: options.noise,
+            pipeline_cache: pipeline_cache.as_ref().map(PipelineCacheFile::cache),
             ..RendererOptions::default()
         };
         let renderer = Renderer::new(&gpu.device, options)
             .with_context(|| format!("cannot set up the GPU tracer on {adapter_name}"))?;
         Ok(Backend::Gpu {
             gpu: Box::new(gpu),
-            renderer,
+            renderer: Box::new(renderer),
             adapter_name,
+            pipeline_cache,
         })
+    }
+
+    /// Saves the GPU's pipeline cache for the next run, if it has one and it changed.
+    pub fn save_pipeline_cache(&self, quiet: bool) {
+        if let Backend::Gpu {
+            pipeline_cache: Some(cache),
+            ..
+        } = self
+        {
+            cache.save(quiet);
+        }
     }
 
     /// A short description for the summary: `GPU (name)` or `CPU reference`, with

@@ -14,6 +14,7 @@ mod estimate;
 mod memory;
 mod merge;
 mod naming;
+mod pipeline_cache;
 mod progress;
 mod signals;
 mod summary;
@@ -256,6 +257,7 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
         render_pass(&backend, &scene, None, args.quiet)?
     };
     let wall = started.elapsed();
+    backend.save_pipeline_cache(args.quiet);
 
     let written = match &window {
         Some(window) => {

@@ -485,7 +485,6 @@ impl Renderer {
             device,
             queue,
             &scene.pipelines,
-            self.schedule(),
             &slots,
             &bind_group,
             &frame,

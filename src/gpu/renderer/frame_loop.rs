@@ -132,7 +132,6 @@ impl Renderer {
             encode_rounds(
                 &mut pass,
                 &scene.pipelines,
-                self.schedule,
                 bind_group,
                 film.slot_count.div_ceil(SLOT_WORKGROUP_SIZE),
                 rounds,
