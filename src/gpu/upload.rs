@@ -3,7 +3,7 @@
 //! Nothing here touches wgpu, so it is unit-tested on any machine. Call it with the
 //! scene as the tracers shade it ([`Scene::in_lighting_space`]); the renderer does.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use super::layout::{
     DISTRIBUTION_BECKMANN, DISTRIBUTION_GGX, FRESNEL_EXACT, FRESNEL_SCHLICK, FrameUniforms,
@@ -387,6 +387,32 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
     }
 }
 
+/// A triangle's texture coordinates moved, on each axis, by a whole even number of
+/// texture repeats towards the origin, where the triangle lies wholly beyond 2 (or
+/// wholly below −1): in `f32` a coordinate near 1e5 keeps only 1/128 of a repeat (16%
+/// of the pixels of a textured quad were wrong at that offset). An even shift leaves
+/// every wrap mode's lookup as it was (repeat and mirrored repeat are periodic in 2,
+/// glTF 2.0 §5.26), and the shifted coordinates stay beyond 1 (or below 0), so
+/// clamping gives the same edge texel. The CPU reference keeps the coordinates as
+/// they are, in `f64`, which holds them.
+pub fn uvs_near_origin(uvs: [DVec2; 3]) -> [DVec2; 3] {
+    let shift = |values: [f64; 3]| {
+        let (low, high) = (
+            values.iter().copied().fold(f64::INFINITY, f64::min),
+            values.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        );
+        if low >= 2.0 {
+            2.0 * (low / 2.0).floor() - 2.0
+        } else if high <= -1.0 {
+            2.0 * (high / 2.0).ceil() + 2.0
+        } else {
+            0.0
+        }
+    };
+    let offset = DVec2::new(shift(uvs.map(|uv| uv.x)), shift(uvs.map(|uv| uv.y)));
+    uvs.map(|uv| uv - offset)
+}
+
 /// The `WRAP_*` code of a wrap mode.
 fn wrap_code(wrap: TextureWrap) -> u32 {
     match wrap {
@@ -396,10 +422,12 @@ fn wrap_code(wrap: TextureWrap) -> u32 {
     }
 }
 
-/// The record of one mesh triangle's shading attributes (zeros where absent).
+/// The record of one mesh triangle's shading attributes (zeros where absent), its
+/// texture coordinates moved near the origin ([`uvs_near_origin`]) so that `f32`
+/// keeps their fraction.
 pub fn triangle_attributes_record(attributes: &TriangleAttributes) -> GpuTriangleAttributes {
     let normals = attributes.normals.unwrap_or([DVec3::ZERO; 3]);
-    let uvs = attributes.uvs.unwrap_or_default();
+    let uvs = uvs_near_origin(attributes.uvs.unwrap_or_default());
     GpuTriangleAttributes {
         n0: vec3(normals[0]),
         has_normals: u32::from(attributes.normals.is_some()),
@@ -850,5 +878,31 @@ mod tests {
             "object_to_world's x column"
         );
         assert_eq!(second[2].max, [0.0, 0.5, 0.0], "world_to_object's y column");
+    }
+
+    #[test]
+    fn far_texture_coordinates_move_by_even_repeats_and_keep_their_side() {
+        let v = |x: f64, y: f64| DVec2::new(x, y);
+        // Near the origin nothing moves.
+        let near = [v(-0.5, 0.2), v(1.5, 1.9), v(0.0, -0.9)];
+        assert_eq!(uvs_near_origin(near), near);
+        for offset in [1e5, 1e7, 3.5, -1e5, -2.25] {
+            let far = [
+                v(offset, offset),
+                v(offset + 0.5, offset),
+                v(offset, offset + 0.25),
+            ];
+            let moved = uvs_near_origin(far);
+            for (a, b) in far.iter().zip(&moved) {
+                let shift = *a - *b;
+                // A whole even number of repeats...
+                assert_eq!(shift.x % 2.0, 0.0, "{offset}: {shift}");
+                assert_eq!(shift.y % 2.0, 0.0, "{offset}: {shift}");
+                // ... to within a few repeats of the origin, on the same side of [0, 1].
+                assert!(b.x.abs() < 5.0 && b.y.abs() < 5.0, "{offset}: {b}");
+                assert_eq!(a.x > 1.0, b.x > 1.0, "{offset}");
+                assert_eq!(a.x < 0.0, b.x < 0.0, "{offset}");
+            }
+        }
     }
 }

@@ -135,6 +135,38 @@ fn uv_textures_wrap_alike_on_both_backends() {
     assert_images_match("uv-wrap", &cpu.image, &gpu_image.image, TOLERANCE);
 }
 
+/// Texture coordinates offset by 1e5 and by 1e7 repeats (an even number, so that
+/// repeating and mirroring modes show the pattern they show at the origin, clamping
+/// the edge texel): the GPU keeps the fraction that `f32` would lose at that size
+/// (`gpu::upload::uvs_near_origin`) and renders what the CPU reference renders in
+/// `f64`.
+#[test]
+fn far_texture_coordinates_keep_their_precision_on_the_gpu() {
+    let Some(gpu) = crate::support::gpu::headless_gpu() else {
+        return;
+    };
+    let renderer = crate::support::gpu::renderer(&gpu);
+    let near = scene();
+    for offset in [1e5, 1e7] {
+        let mut far = near.clone();
+        for mesh in &mut far.meshes {
+            for uv in mesh.uvs.iter_mut().flatten() {
+                *uv += DVec2::splat(offset);
+            }
+        }
+        let cpu = gpu_render::cpu::render(&far, None);
+        let gpu_image = renderer
+            .render(&gpu.device, &gpu.queue, &far, None)
+            .unwrap_or_else(|e| panic!("GPU render failed: {e}"));
+        assert_images_match(
+            &format!("uv-far-{offset:e}"),
+            &cpu.image,
+            &gpu_image.image,
+            TOLERANCE,
+        );
+    }
+}
+
 /// The UV scene with metal/roughness materials whose roughness and metalness come from
 /// the texture's green and blue channels (glTF's `metallicRoughnessTexture`), under a
 /// point light that makes the highlights depend on the roughness.
