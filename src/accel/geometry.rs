@@ -7,10 +7,7 @@ use super::bvh::{Aabb32, BuildMethod, Bvh};
 use super::instance::{Instance, InstancedMesh, mesh_groups};
 use crate::scene::{Mesh, PolygonPlane, Scene, Shape, polygon_plane, project_to_plane};
 
-/// Polygons with more vertices than this are triangulated when the geometry is built
-/// (with earcut), so that no single primitive test runs more than this many loop
-/// iterations on the GPU (see `docs/model.md`, "Bounded work").
-pub const MAX_POLYGON_VERTICES: usize = 32;
+pub use crate::scene::outline::MAX_POLYGON_VERTICES;
 
 /// Most infinite planes a GPU scene may have: every ray tests every plane, so their
 /// count bounds the work of one traversal step.

@@ -9,6 +9,7 @@ mod image;
 pub mod import;
 mod medium;
 mod model;
+pub mod outline;
 mod sphere;
 
 pub use animation::{CameraKey, CameraPath, Interpolation, MAX_FRAMES};

@@ -590,3 +590,55 @@ fn an_hdr_file_with_the_rgbe_header_loads_as_a_texture_and_an_environment_map() 
         assert_eq!(image.texel(3, 1), [0.75, 0.5, 0.5, 1.0]);
     }
 }
+
+/// One fill rule for polygons: the even-odd crossing test. A self-crossing outline of
+/// at most 32 vertices is filled by it; where the tracers would fill it otherwise (a
+/// larger outline is triangulated, an emitter's area is sampled by its triangles) it is
+/// refused with the crossing edges named, whatever its vertex count.
+#[test]
+fn self_crossing_polygons_are_refused_where_they_would_not_fill_by_the_even_odd_rule() {
+    let polygon = |material: &str, vertices: &[(f64, f64)]| {
+        let list: Vec<String> = vertices
+            .iter()
+            .map(|(x, y)| format!("[{x}, {y}, 0]"))
+            .collect();
+        format!(
+            "[materials.lamp]\ntype = \"emissive\"\nradiance = 1\n\
+             [[objects]]\ntype = \"polygon\"\nmaterial = \"{material}\"\nvertices = [{}]\n",
+            list.join(", ")
+        )
+    };
+    // Lobes of unequal size, so that the outline encloses some signed area.
+    let bow_tie = [(0.0, 0.0), (3.0, 2.0), (3.0, 0.0), (0.0, 1.0)];
+    // Small and not emitting: accepted, filled by the even-odd rule.
+    parse_scene(&scene(&polygon("grey", &bow_tie)), Path::new(FILE)).expect("accepted");
+    // Emitting: refused, naming the edges that cross.
+    error(
+        &scene(&polygon("lamp", &bow_tie)),
+        &[
+            "objects[0] (polygon)",
+            "crosses itself",
+            "edge 0",
+            "edge 2",
+            "emitting",
+        ],
+    );
+    // 40 corners whose outline crosses (a zigzag closed back over itself).
+    let mut zigzag: Vec<(f64, f64)> = (0..39)
+        .map(|i| (f64::from(i), if i % 2 == 0 { 0.0 } else { 1.0 }))
+        .collect();
+    zigzag.push((19.0, 2.0));
+    error(
+        &scene(&polygon("grey", &zigzag)),
+        &["crosses itself", "more than 32 vertices", "triangulated"],
+    );
+    // A simple outline of 40 corners: accepted.
+    let comb: Vec<(f64, f64)> = (0..40)
+        .map(|i| {
+            let a = f64::from(i) / 40.0 * std::f64::consts::TAU;
+            let r = if i % 2 == 0 { 2.0 } else { 1.0 };
+            (r * a.cos(), r * a.sin())
+        })
+        .collect();
+    parse_scene(&scene(&polygon("grey", &comb)), Path::new(FILE)).expect("accepted");
+}

@@ -360,7 +360,7 @@ fn build_scene(
             lights::light(source, i, light)
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let table = MaterialTable::new(&material_names);
+    let table = MaterialTable::new(&material_names, &materials);
     let base = source.path.parent().unwrap_or(std::path::Path::new(""));
     let mut shapes = Vec::with_capacity(raw.objects.len());
     // Each shape's object index and span, for the warnings that judge shapes together.

@@ -10,6 +10,7 @@ use super::check::{Item, Source};
 use super::raw::{RawColor, RawObject, RawVec3};
 use crate::echo::{echo, echo_path, short, short3};
 use crate::scene::import::{ImportOptions, ImportedModel, ModelPlacement, import_model_with};
+use crate::scene::outline::MAX_POLYGON_VERTICES;
 use crate::scene::{
     FAR_WALL_PRECISION_LIMIT, Light, SPHERE_PRECISION_LIMIT, SceneError, Shape, coincident_spheres,
     far_wall_precision, sphere_precision,
@@ -31,17 +32,32 @@ const DEGENERACY_TOLERANCE: f64 = 1e-12;
 pub struct MaterialTable<'a> {
     indices: HashMap<&'a str, u32>,
     names: &'a [String],
+    /// Whether each material emits light (an emitter's outline must be simple).
+    emissive: Vec<bool>,
 }
 
 impl<'a> MaterialTable<'a> {
-    /// The table for `names`, whose positions are the material indices.
-    pub fn new(names: &'a [String]) -> Self {
+    /// The table for `names`, whose positions are the indices of `materials`.
+    pub fn new(names: &'a [String], materials: &[crate::scene::Material]) -> Self {
         let indices = names
             .iter()
             .enumerate()
             .filter_map(|(i, n)| Some((n.as_str(), u32::try_from(i).ok()?)))
             .collect();
-        Self { indices, names }
+        let emissive = materials
+            .iter()
+            .map(|m| m.emission != DVec3::ZERO)
+            .collect();
+        Self {
+            indices,
+            names,
+            emissive,
+        }
+    }
+
+    /// Whether material `index` emits light.
+    fn emits(&self, index: u32) -> bool {
+        self.emissive.get(index as usize).copied().unwrap_or(false)
     }
 
     fn resolve(&self, item: &Item<'_>, name: &str) -> Result<u32, SceneError> {
@@ -96,7 +112,7 @@ pub fn object(
     match kind.as_str() {
         "sphere" => sphere(&item, &raw, material),
         "plane" => plane(&item, &raw, material),
-        "polygon" => polygon(&item, &raw, material),
+        "polygon" => polygon(&item, &raw, material, materials.emits(material)),
         _ => triangle(&item, &raw, material),
     }
 }
@@ -376,7 +392,12 @@ fn vertices(item: &Item<'_>, raw: &RawObject) -> Result<Vec<DVec3>, SceneError> 
         .collect()
 }
 
-fn polygon(item: &Item<'_>, raw: &RawObject, material: u32) -> Result<Shape, SceneError> {
+fn polygon(
+    item: &Item<'_>,
+    raw: &RawObject,
+    material: u32,
+    emissive: bool,
+) -> Result<Shape, SceneError> {
     let vertices = vertices(item, raw)?;
     if vertices.len() < 3 {
         return Err(item.fail(format_args!(
@@ -384,8 +405,46 @@ fn polygon(item: &Item<'_>, raw: &RawObject, material: u32) -> Result<Shape, Sce
             vertices.len()
         )));
     }
-    check_planar_polygon(item, &vertices)?;
+    let normal = check_planar_polygon(item, &vertices)?;
+    check_simple_outline(item, &vertices, normal, emissive)?;
     Ok(Shape::Polygon { vertices, material })
+}
+
+/// Refuses an outline that crosses or touches itself where the tracers would not fill
+/// it by the even-odd rule: beyond [`MAX_POLYGON_VERTICES`] vertices (where it is
+/// triangulated) or on an emitter (whose area is sampled by its triangles). Smaller
+/// outlines are filled by the even-odd crossing test, self-crossing or not.
+fn check_simple_outline(
+    item: &Item<'_>,
+    vertices: &[DVec3],
+    normal: DVec3,
+    emissive: bool,
+) -> Result<(), SceneError> {
+    let large = vertices.len() > MAX_POLYGON_VERTICES;
+    if !(large || emissive) {
+        return Ok(());
+    }
+    let Some((i, j)) = crate::scene::outline::self_crossing(vertices, normal) else {
+        return Ok(());
+    };
+    let why = if large {
+        format!(
+            "a polygon of more than {MAX_POLYGON_VERTICES} vertices is triangulated, which \
+             needs a simple outline"
+        )
+    } else {
+        "an emitting polygon's area is sampled by its triangles, which need a simple \
+         outline"
+            .to_owned()
+    };
+    Err(item.fail(format_args!(
+        "the polygon's outline crosses itself: edge {i} (vertices {i}-{}) meets edge {j} \
+         (vertices {j}-{}); {why}. Split it into polygons whose outlines do not cross \
+         (polygons of at most {MAX_POLYGON_VERTICES} vertices that emit nothing are \
+         filled by the even-odd rule whatever their outline)",
+        (i + 1) % vertices.len(),
+        (j + 1) % vertices.len()
+    )))
 }
 
 fn triangle(item: &Item<'_>, raw: &RawObject, material: u32) -> Result<Shape, SceneError> {
@@ -406,8 +465,9 @@ fn triangle(item: &Item<'_>, raw: &RawObject, material: u32) -> Result<Shape, Sc
     Ok(Shape::Triangle { vertices, material })
 }
 
-/// Rejects degenerate polygons and those whose vertices do not lie on one plane.
-fn check_planar_polygon(item: &Item<'_>, vertices: &[DVec3]) -> Result<(), SceneError> {
+/// Rejects degenerate polygons and those whose vertices do not lie on one plane;
+/// returns the unit normal (Newell's).
+fn check_planar_polygon(item: &Item<'_>, vertices: &[DVec3]) -> Result<DVec3, SceneError> {
     let centroid = vertices.iter().sum::<DVec3>() / vertices.len() as f64;
     let (min, max) = vertices
         .iter()
@@ -435,7 +495,7 @@ fn check_planar_polygon(item: &Item<'_>, vertices: &[DVec3]) -> Result<(), Scene
              through the centroid (tolerance {tolerance:e})"
         )));
     }
-    Ok(())
+    Ok(normal)
 }
 
 /// Whether an area is (nearly) zero relative to `scale`, a squared length; also true
