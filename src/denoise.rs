@@ -332,12 +332,12 @@ mod tests {
         }
         let variance = vec![0.01 / 12.0; n];
         let out = denoise(&image, &variance, &guides, &DenoiseSettings::default());
-        for i in 0..n {
-            let a = guides.albedo[i][0];
+        for (i, (pixel, albedo)) in out.iter().zip(&guides.albedo).enumerate() {
+            let a = albedo[0];
             assert!(
-                (out[i][0] - a).abs() < 0.05 * a + 0.01,
+                (pixel[0] - a).abs() < 0.05 * a + 0.01,
                 "pixel {i}: {} for albedo {a}",
-                out[i][0]
+                pixel[0]
             );
         }
         // A depth edge: the left half at depth 1 in light 1, the right half at depth
@@ -352,13 +352,13 @@ mod tests {
             image.push([light * (1.0 + 0.1 * (noise(i) - 0.5)); 3]);
         }
         let out = denoise(&image, &variance, &guides, &DenoiseSettings::default());
-        for i in 0..n {
+        for (i, pixel) in out.iter().enumerate() {
             let left = (i as u32 % w) < w / 2;
             let light = if left { 1.0 } else { 0.2 };
             assert!(
-                (out[i][0] - light).abs() < 0.06 * light,
+                (pixel[0] - light).abs() < 0.06 * light,
                 "pixel {i}: {} for {light}",
-                out[i][0]
+                pixel[0]
             );
         }
     }
