@@ -26,8 +26,10 @@ use image::{ExtendedColorType, ImageEncoder, Rgb};
 
 use crate::film::LinearImage;
 
+mod layers;
 mod temporary;
 
+pub use layers::{AuxPass, write_exr_with_passes};
 use temporary::Temporary;
 pub use temporary::cancel_pending_writes;
 
