@@ -162,7 +162,7 @@ mod tests {
                 .channel_data
                 .list
                 .iter()
-                .find(|c| c.name == name)
+                .find(|c| c.name == *name)
                 .expect("channel");
             match &channel.sample_data {
                 FlatSamples::F32(v) => v.clone(),
