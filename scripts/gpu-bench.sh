@@ -63,8 +63,9 @@
 #
 # Cold compile: the driver's shader cache is pointed at an empty folder
 # (XDG_CACHE_HOME, MESA_SHADER_CACHE_DIR for Mesa, __GL_SHADER_DISK_CACHE_PATH for
-# NVIDIA), and the warm row renders the same again with that folder filled. The other
-# rows use the machine's own cache; their trace times never include the compile
+# NVIDIA), and the warm row renders the same again with that folder filled. The
+# showcase row uses that folder too (its kernels are those, whatever the image size),
+# the other rows the machine's own cache; trace times never include the compile
 # (uploads compile the kernels; the summary line reports that apart).
 set -euo pipefail
 
@@ -293,17 +294,18 @@ median() {
     printf '%s\n' "$@" | sort -g | awk '{ v[NR] = $1 } END { print v[int(NR / 2) + 1] }'
 }
 
-# Renders with gpu-render RUNS times; sets `measured` to the summary lines, one per
+# Renders with gpu-render RUNS times, under `render_env` (a command prefix, or empty); sets `measured` to the summary lines, one per
 # run, or returns non-zero (and counts a failure) when a run fails or prints none.
 # Arguments: NAME, then gpu-render's arguments (the output path is added).
 measured=()
+render_env=()
 render_runs() {
     local name="$1"
     shift
     local run line
     measured=()
     for ((run = 1; run <= runs; run++)); do
-        run_logged "$logs/$name-$run.txt" "$gpu_render" "$@" --backend gpu \
+        run_logged "$logs/$name-$run.txt" "${render_env[@]}" "$gpu_render" "$@" --backend gpu \
             -o "$images/$name.png" || return 1
         line="$(summary_line "$logs/$name-$run.txt")"
         if [[ -z "$line" || -z "$(summary_field "$line" rate)" ]]; then
@@ -403,7 +405,12 @@ adapter_row="| adapter | $adapter_name | ${adapter_detail%;*} | ${adapter_detail
 args=(scenes/showcase.toml "${showcase_size[@]}")
 command="$(shown "$gpu_render" "${args[@]}") --backend gpu -o showcase.png"
 setting="$(size_text "${showcase_size[@]}"), depth 8"
-if render_runs showcase "${args[@]}"; then
+# In the compile rows' cache, where its kernels already are.
+render_env=("${compile_env[@]}")
+showcase_ok=0
+render_runs showcase "${args[@]}" && showcase_ok=1
+render_env=()
+if ((showcase_ok)); then
     IFS='|' read -r rate trace source rays compile <<<"$(render_figures)"
     row "showcase" "$setting" "**$rate M rays/s**" \
         "trace $trace s ($source), $rays rays, $(runs_text); kernel compile $compile s (first run)" \
