@@ -57,6 +57,16 @@ pub fn list_adapters() -> Vec<wgpu::AdapterInfo> {
     adapters.iter().map(wgpu::Adapter::get_info).collect()
 }
 
+/// [`list_adapters`] with the features each adapter offers (for `gpu-render --adapter
+/// list`, which names the ones the tracer uses or could use).
+pub fn list_adapters_with_features() -> Vec<(wgpu::AdapterInfo, wgpu::Features)> {
+    let (_instance, adapters) = instance_with_adapters();
+    adapters
+        .iter()
+        .map(|adapter| (adapter.get_info(), adapter.features()))
+        .collect()
+}
+
 /// `adapters` numbered as [`AdapterChoice::Index`] counts them, for error messages:
 /// `available: 0: NAME (BACKEND), ...`, or `no adapters found`.
 pub fn adapter_listing(adapters: &[wgpu::Adapter]) -> String {

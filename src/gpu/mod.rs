@@ -50,7 +50,10 @@ pub mod unrolled;
 pub mod upload;
 mod wavefront;
 
-pub use context::{AdapterChoice, HeadlessGpu, adapter_listing, list_adapters, select_adapter};
+pub use context::{
+    AdapterChoice, HeadlessGpu, adapter_listing, list_adapters, list_adapters_with_features,
+    select_adapter,
+};
 pub use error::{RenderError, TraceFailure};
 pub use features::ShaderFeatures;
 pub use film::Film;

@@ -19,6 +19,7 @@ mod extremes;
 mod frame_loop;
 mod fuzz_pipeline;
 mod fuzz_scenes;
+mod gpu_bench;
 mod gpu_memory;
 mod gpu_smoke;
 mod gpu_vs_cpu;

@@ -352,25 +352,65 @@ fn sphere_only_the_cpu_places(scene: &Scene) -> Option<f64> {
     })
 }
 
-/// Prints the GPU adapters wgpu can see, one a line, on stdout.
+/// The adapter features the tracer uses where they exist (timestamps for GPU time,
+/// subgroups) or that decide what it could use (ray queries for hardware traversal, a
+/// driver pipeline cache), as `--adapter list` names them.
+const LISTED_FEATURES: [(&str, wgpu::Features); 4] = [
+    ("SUBGROUP", wgpu::Features::SUBGROUP),
+    ("TIMESTAMP_QUERY", wgpu::Features::TIMESTAMP_QUERY),
+    (
+        "EXPERIMENTAL_RAY_QUERY",
+        wgpu::Features::EXPERIMENTAL_RAY_QUERY,
+    ),
+    ("PIPELINE_CACHE", wgpu::Features::PIPELINE_CACHE),
+];
+
+/// One line of `--adapter list`: `0: NAME (vulkan, DiscreteGpu, driver NVIDIA
+/// 570.1; SUBGROUP yes, TIMESTAMP_QUERY yes, EXPERIMENTAL_RAY_QUERY no, PIPELINE_CACHE
+/// yes)`.
+fn adapter_line(index: usize, info: &wgpu::AdapterInfo, features: wgpu::Features) -> String {
+    let driver = [info.driver.trim(), info.driver_info.trim()]
+        .into_iter()
+        .filter(|part| !part.is_empty())
+        .collect::<Vec<_>>()
+        .join(" ");
+    let driver = if driver.is_empty() {
+        String::new()
+    } else {
+        format!(", driver {driver}")
+    };
+    let listed = LISTED_FEATURES
+        .iter()
+        .map(|(name, feature)| {
+            let offered = if features.contains(*feature) {
+                "yes"
+            } else {
+                "no"
+            };
+            format!("{name} {offered}")
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    format!(
+        "{index}: {} ({}, {:?}{driver}; {listed})",
+        info.name, info.backend, info.device_type
+    )
+}
+
+/// Prints the GPU adapters wgpu can see, one a line, on stdout, with their drivers
+/// and the features of [`LISTED_FEATURES`].
 pub fn print_adapters() -> Result<()> {
-    let adapters = gpu::list_adapters();
+    let adapters = gpu::list_adapters_with_features();
     let mut out = std::io::stdout().lock();
     let result = if adapters.is_empty() {
         writeln!(out, "no GPU adapters found")
     } else {
-        adapters.iter().enumerate().try_for_each(|(index, info)| {
-            let driver = if info.driver.is_empty() {
-                String::new()
-            } else {
-                format!(", driver {}", info.driver)
-            };
-            writeln!(
-                out,
-                "{index}: {} ({}, {:?}{driver})",
-                info.name, info.backend, info.device_type
-            )
-        })
+        adapters
+            .iter()
+            .enumerate()
+            .try_for_each(|(index, (info, features))| {
+                writeln!(out, "{}", adapter_line(index, info, *features))
+            })
     };
     match result.and_then(|()| out.flush()) {
         // `gpu-render --adapter list | head -1` is fine.
@@ -381,7 +421,7 @@ pub fn print_adapters() -> Result<()> {
 
 #[cfg(test)]
 mod tests {
-    use super::auto_rule;
+    use super::{adapter_line, auto_rule};
 
     fn adapter(name: &str, device_type: wgpu::DeviceType) -> wgpu::AdapterInfo {
         wgpu::AdapterInfo {
@@ -490,5 +530,29 @@ mod tests {
                 "{kind:?}"
             );
         }
+    }
+
+    #[test]
+    fn adapter_line_names_driver_and_features() {
+        let info = wgpu::AdapterInfo {
+            name: "NVIDIA H200".into(),
+            driver: "NVIDIA".into(),
+            driver_info: "570.133.20".into(),
+            ..wgpu::AdapterInfo::new(wgpu::DeviceType::DiscreteGpu, wgpu::Backend::Vulkan)
+        };
+        let features = wgpu::Features::SUBGROUP | wgpu::Features::TIMESTAMP_QUERY;
+        assert_eq!(
+            adapter_line(0, &info, features),
+            "0: NVIDIA H200 (vulkan, DiscreteGpu, driver NVIDIA 570.133.20; SUBGROUP yes, \
+             TIMESTAMP_QUERY yes, EXPERIMENTAL_RAY_QUERY no, PIPELINE_CACHE no)"
+        );
+        let bare = wgpu::AdapterInfo {
+            name: "Some GPU".into(),
+            ..wgpu::AdapterInfo::new(wgpu::DeviceType::Other, wgpu::Backend::Gl)
+        };
+        assert!(
+            adapter_line(3, &bare, wgpu::Features::empty())
+                .starts_with("3: Some GPU (gl, Other; SUBGROUP no,")
+        );
     }
 }
