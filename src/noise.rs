@@ -19,14 +19,8 @@
 
 use glam::DVec3;
 
-use crate::accel::luminance;
+use crate::color::luminance;
 use crate::film::LinearImage;
-
-/// Luminance weights of linear Rec. 709 / sRGB primaries (ITU-R BT.709-6, item 3.3;
-/// IEC 61966-2-1): `Y = 0.2126 R + 0.7152 G + 0.0722 B`, the weights of
-/// [`crate::accel::luminance`], which the estimate uses. Twin of `LUMINANCE_WEIGHTS` in
-/// `shaders/noise.wgsl`.
-pub const LUMINANCE_WEIGHTS: [f64; 3] = [0.2126, 0.7152, 0.0722];
 
 /// Welford's update of a pixel's `m2` for its sample number `index` (0-based) of
 /// luminance `luminance`: `sum_before` is the radiance sum of the samples before it,
@@ -42,9 +36,9 @@ pub fn luminance_m2_step(
     let mean_before = if index == 0 {
         0.0
     } else {
-        crate::accel::luminance(sum_before) / f64::from(index)
+        crate::color::luminance(sum_before) / f64::from(index)
     };
-    let mean_after = crate::accel::luminance(sum_after) / (f64::from(index) + 1.0);
+    let mean_after = crate::color::luminance(sum_after) / (f64::from(index) + 1.0);
     m2 + (luminance - mean_before) * (luminance - mean_after)
 }
 
@@ -203,15 +197,10 @@ mod tests {
         assert!((se - (two_pass / (n - 1.0) / n).sqrt()).abs() < 1e-12);
     }
 
+    // Grey's own luminance, once part of this test, is tested with `luminance` in
+    // src/color.rs.
     #[test]
-    fn grey_has_its_own_luminance_and_one_sample_is_unknown() {
-        assert!((luminance(DVec3::splat(0.25)) - 0.25).abs() < 1e-12);
-        // The weights the WGSL twin is checked against are the function's.
-        for (i, weight) in LUMINANCE_WEIGHTS.iter().enumerate() {
-            let mut primary = DVec3::ZERO;
-            primary[i] = 1.0;
-            assert_eq!(luminance(primary), *weight);
-        }
+    fn one_sample_and_a_non_finite_m2_are_unknown() {
         assert!(standard_error(1.0, 1).is_infinite());
         assert!(standard_error(f64::NAN, 8).is_infinite());
         assert_eq!(standard_error(-1e-20, 8), 0.0);

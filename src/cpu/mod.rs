@@ -208,7 +208,7 @@ fn trace_window(
                             1.0,
                         ];
                         if let Some((mean, error)) = &mut row_noise {
-                            mean[i] = crate::accel::luminance(result.radiance) as f32;
+                            mean[i] = crate::color::luminance(result.radiance) as f32;
                             error[i] = standard_error(result.luminance_m2, samples) as f32;
                         }
                         row_rays += result.rays;

@@ -36,7 +36,8 @@ use super::trace::{
 };
 use super::traverse::{intersect_scene, occluded};
 use crate::accel::area_lights::{Emitter, EmitterShape};
-use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight, PrimKind, luminance};
+use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight, PrimKind};
+use crate::color::luminance;
 use crate::scene::{Material, MaterialKind, MediumStack, MicrofacetDistribution};
 
 /// Bounces after which Russian roulette may end a path.

@@ -175,7 +175,7 @@ pub fn trace_pixel(scene: &PreparedScene, x: u32, y: u32) -> PixelResult {
             luminance_m2,
             before,
             sum,
-            crate::accel::luminance(radiance),
+            crate::color::luminance(radiance),
             index,
         );
         rays += sample_rays;

@@ -519,7 +519,7 @@ fn wgsl_constants_equal_their_rust_twins() {
         gpu_render::cpu::path::ROULETTE_DEPTH
     );
     assert!(path.lines().any(|l| l == roulette), "{roulette}");
-    let [r, g, b] = gpu_render::noise::LUMINANCE_WEIGHTS.map(|w| w as f32);
+    let [r, g, b] = gpu_render::color::LUMINANCE_WEIGHTS.map(|w| w as f32);
     let weights = format!("const LUMINANCE_WEIGHTS: vec3<f32> = vec3<f32>({r:?}, {g:?}, {b:?});");
     assert!(
         gpu_render::gpu::shaders::NOISE_WGSL
