@@ -1,6 +1,6 @@
 //#if PATH
 // The path-tracing integrator (`integrator = "path"`): the WGSL twin of
-// src/cpu/path.rs (path_radiance) and of its samplers, src/cpu/sample.rs, documented
+// src/cpu/path.rs (path_radiance) and of its samplers, src/sample.rs, documented
 // in docs/path-tracing.md. It runs in the wavefront engine of shaders/trace.wgsl, one
 // bounce per shading step, when frame.flags has FLAG_PATH:
 //
@@ -48,7 +48,7 @@ fn path_mode() -> bool {
 // A uniform number in [0, 1) for dimension `dimension` of sample `sample` of image
 // pixel `pixel`: the three counters hashed in turn by PCG's RXS-M-XS permutation
 // (Jarzynski and Olano, JCGT 9(3), 2020; pcg_hash in shaders/sampling.wgsl), the top
-// 24 bits scaled by 2^-24, exact in f32. Twin of random_number (src/cpu/sample.rs).
+// 24 bits scaled by 2^-24, exact in f32. Twin of random_number (src/sample.rs).
 fn random_number(pixel: u32, sample: u32, dimension: u32) -> f32 {
     return unit_from_hash(pcg_hash(pcg_hash(pcg_hash(pixel) ^ sample) ^ dimension));
 }

@@ -37,6 +37,7 @@ pub mod output;
 pub mod plausibility;
 #[cfg(feature = "cli")]
 pub mod quality;
+pub mod sample;
 pub mod scene;
 pub mod tiles;
 #[cfg(feature = "cli")]

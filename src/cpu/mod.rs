@@ -8,7 +8,6 @@
 pub mod bxdf;
 pub mod intersect;
 pub mod path;
-pub mod sample;
 pub mod tabulated;
 pub mod texture;
 pub mod trace;

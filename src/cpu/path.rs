@@ -10,8 +10,8 @@
 //! or the environment map by its luminance (`crate::accel::EnvironmentLight`),
 //! combined with the BRDF-sampled hits of emitters and escapes to the map by multiple
 //! importance sampling (the power heuristic; Veach's thesis, 1997, ch. 9). Then it
-//! continues in a
-//! direction drawn from the BRDF's importance sampler (`sample.rs`), and Russian
+//! continues in a direction drawn from the BRDF's importance sampler (`sample_brdf`,
+//! over `crate::sample` and the lobe samplers of `super::bxdf`), and Russian
 //! roulette ends it in proportion to its throughput after [`ROULETTE_DEPTH`] bounces.
 //! Random numbers come from the counter-based generator [`random_number`] of the
 //! pixel, the sample and the dimension, so the GPU twin can draw the same ones.
@@ -19,16 +19,11 @@
 use glam::{DVec2, DVec3};
 
 use super::bxdf::{
-    eval_brdf, has_base_brdf, microfacet_alpha, reflect_direction, surface_response,
+    eval_brdf, has_base_brdf, microfacet_alpha, pdf_beckmann_normal, pdf_blinn_phong_half,
+    pdf_ggx_visible_normal, reflect_direction, sample_beckmann_normal, sample_blinn_phong_half,
+    sample_ggx_visible_normal, surface_response,
 };
 use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
-use super::sample::{
-    ShadingFrame, area_to_solid_angle_pdf, pdf_beckmann_normal, pdf_blinn_phong_half,
-    pdf_cosine_hemisphere, pdf_ggx_visible_normal, pdf_sphere_cone, power_heuristic, random_number,
-    reflect_about, reflected_pdf, sample_beckmann_normal, sample_blinn_phong_half,
-    sample_cosine_hemisphere, sample_ggx_visible_normal, sample_sphere_cone,
-    sample_triangle_barycentrics,
-};
 use super::tabulated::{pdf_tabulated, sample_tabulated};
 use super::texture::{shading_emission, shading_material};
 use super::trace::{
@@ -38,6 +33,11 @@ use super::traverse::{intersect_scene, occluded};
 use crate::accel::area_lights::{Emitter, EmitterShape};
 use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight, PrimKind};
 use crate::color::luminance;
+use crate::sample::{
+    ShadingFrame, area_to_solid_angle_pdf, pdf_cosine_hemisphere, pdf_sphere_cone, power_heuristic,
+    random_number, reflect_about, reflected_pdf, sample_cosine_hemisphere, sample_sphere_cone,
+    sample_triangle_barycentrics,
+};
 use crate::scene::{Material, MaterialKind, MediumStack, MicrofacetDistribution};
 
 /// Bounces after which Russian roulette may end a path.
