@@ -1,4 +1,4 @@
-// Texture coordinates and bilinear image lookups. CPU twin: src/cpu/texture.rs (same
+// Texture coordinates and bilinear image lookups. CPU twin: src/texture.rs (same
 // function names and conventions, documented there and in docs/materials.md).
 // Every image of the scene (albedo textures and BRDF maps) is one layer of `images`,
 // in the layer's top-left corner; texels are read with textureLoad (Rgba32Float is not
@@ -102,7 +102,7 @@ fn sample_brdf_map(layer: u32, size: u32, theta_i: f32, theta_r: f32) -> vec3<f3
 // shading_emission, and its metalness and perceptual roughness times the blue and green
 // channels of the metallic/roughness texture where there is one (glTF 2.0 §3.9.2),
 // looked up at the albedo texture's coordinates. Twin of shading_material
-// (src/cpu/texture.rs).
+// (src/texture.rs).
 fn shading_material(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> Material {
     var shaded = material;
     shaded.diffuse = shading_albedo(material, position, normal, uv);
@@ -138,7 +138,7 @@ fn shading_albedo(material: Material, position: vec3<f32>, normal: vec3<f32>, uv
 // The emitted radiance at a point at `position` with geometric normal `normal` and mesh
 // texture coordinates `uv`: material.emission, times the emission texture where there
 // is one (glTF 2.0 §3.9.3: emissiveFactor times the texel), at the albedo texture's
-// coordinates. Twin of shading_emission (src/cpu/texture.rs).
+// coordinates. Twin of shading_emission (src/texture.rs).
 fn shading_emission(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> vec3<f32> {
     //#if TEXTURES
     if material.emission_layer != NO_IMAGE {

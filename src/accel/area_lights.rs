@@ -8,7 +8,7 @@ use glam::DVec3;
 
 use super::{HitKey, PrimKind, PrimRef, SceneGeometry};
 use crate::color::luminance;
-use crate::cpu::texture::mean_texel;
+use crate::texture::mean_texel;
 use crate::scene::{Image, Material, project_to_plane};
 
 /// An emissive shape that next-event estimation samples.

@@ -5,7 +5,7 @@ use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
 
-use super::texture::sample_brdf_map;
+use crate::texture::sample_brdf_map;
 use crate::scene::{FresnelModel, Image, Material, MaterialKind, MicrofacetDistribution};
 
 /// Smallest microfacet `alpha`: roughness 0 is clamped here so that the distribution's
@@ -341,7 +341,7 @@ pub fn brdf_pbr(material: &Material, n: DVec3, wi: DVec3, wo: DVec3) -> DVec3 {
 /// The BRDF of `material`'s base layer for light arriving from `wi` and leaving
 /// towards `wo`, both unit and on the side of the unit normal `n`. `images` are the
 /// scene's (for tabulated maps); `material.diffuse` is the albedo at the hit (see
-/// [`super::texture::shading_albedo`]).
+/// [`crate::texture::shading_albedo`]).
 pub fn eval_brdf(material: &Material, images: &[Image], n: DVec3, wi: DVec3, wo: DVec3) -> DVec3 {
     match material.kind {
         MaterialKind::Lambert => brdf_lambert(material.diffuse),

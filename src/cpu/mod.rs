@@ -9,7 +9,6 @@ pub mod bxdf;
 pub mod intersect;
 pub mod path;
 pub mod tabulated;
-pub mod texture;
 pub mod trace;
 pub mod traverse;
 

@@ -25,7 +25,7 @@ use super::bxdf::{
 };
 use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
 use super::tabulated::{pdf_tabulated, sample_tabulated};
-use super::texture::{shading_emission, shading_material};
+use crate::texture::{shading_emission, shading_material};
 use super::trace::{
     PreparedScene, direct_light, finite_radiance, keep_on_side, shading_frame_normal,
 };

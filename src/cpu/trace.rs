@@ -7,7 +7,7 @@ use glam::DVec3;
 use super::bxdf::{eval_brdf, has_base_brdf, reflect_direction, surface_response};
 use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
 use super::path::path_radiance;
-use super::texture::shading_material;
+use crate::texture::shading_material;
 use super::traverse::{intersect_scene, occluded};
 use crate::accel::SceneGeometry;
 use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight};

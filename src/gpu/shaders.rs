@@ -17,7 +17,7 @@ pub const SAMPLING_WGSL: &str = include_str!("../../shaders/sampling.wgsl");
 /// Ray/shape intersection.
 pub const INTERSECT_WGSL: &str = include_str!("../../shaders/intersect.wgsl");
 /// Texture coordinates and bilinear lookups (the `images` binding), twin of
-/// [`crate::cpu::texture`].
+/// [`crate::texture`].
 pub const TEXTURE_WGSL: &str = include_str!("../../shaders/texture.wgsl");
 /// Materials.
 pub const BXDF_WGSL: &str = include_str!("../../shaders/bxdf.wgsl");

@@ -7,7 +7,7 @@
 
 use crate::support::compare::{Tolerance, assert_images_match};
 use glam::{DMat4, DVec2, DVec3};
-use gpu_render::cpu::texture::wrap_index;
+use gpu_render::texture::wrap_index;
 use gpu_render::scene::{
     Camera, Environment, Image, Light, Material, Mesh, RenderSettings, Scene, TextureMapping,
     TextureWrap,
