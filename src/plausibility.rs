@@ -10,8 +10,8 @@
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use crate::texture::sample_brdf_map;
 use crate::scene::Image;
+use crate::texture::sample_brdf_map;
 
 /// Steps of the midpoint rule over `θr` in the energy integral. With a bilinear map
 /// the integrand is smooth between grid lines; 4096 steps integrate a constant map

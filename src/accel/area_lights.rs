@@ -8,8 +8,8 @@ use glam::DVec3;
 
 use super::{HitKey, PrimKind, PrimRef, SceneGeometry};
 use crate::color::luminance;
-use crate::texture::mean_texel;
 use crate::scene::{Image, Material, project_to_plane};
+use crate::texture::mean_texel;
 
 /// An emissive shape that next-event estimation samples.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -5,8 +5,8 @@ use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
 
-use crate::texture::sample_brdf_map;
 use crate::scene::{FresnelModel, Image, Material, MaterialKind, MicrofacetDistribution};
+use crate::texture::sample_brdf_map;
 
 /// Smallest microfacet `alpha`: roughness 0 is clamped here so that the distribution's
 /// peak `1/(π α²)` stays finite (≈ 3.2e5, far inside `f32`) instead of becoming a

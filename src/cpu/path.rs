@@ -25,7 +25,6 @@ use super::bxdf::{
 };
 use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
 use super::tabulated::{pdf_tabulated, sample_tabulated};
-use crate::texture::{shading_emission, shading_material};
 use super::trace::{
     PreparedScene, direct_light, finite_radiance, keep_on_side, shading_frame_normal,
 };
@@ -39,6 +38,7 @@ use crate::sample::{
     sample_triangle_barycentrics,
 };
 use crate::scene::{Material, MaterialKind, MediumStack, MicrofacetDistribution};
+use crate::texture::{shading_emission, shading_material};
 
 /// Bounces after which Russian roulette may end a path.
 pub const ROULETTE_DEPTH: u32 = 3;

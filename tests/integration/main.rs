@@ -25,6 +25,7 @@ mod import_fuzz;
 mod import_gltf;
 mod import_obj;
 mod instancing;
+mod layering;
 mod layout;
 mod load_time;
 mod material_errors;
