@@ -252,7 +252,7 @@ impl Pipelines {
             return Ok(pipelines.clone());
         }
         let layout = self.trace_layout(device, features)?;
-        let source = trace_shader_source(features).map_err(GpuError::Shader)?;
+        let source = trace_shader_source(features).map_err(|e| GpuError::Shader(e.to_string()))?;
         let mut built = build_pipelines(
             device,
             &format!("trace ({})", features.label()),

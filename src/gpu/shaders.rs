@@ -2,6 +2,12 @@
 //! concatenated in dependency order; every source file is embedded at compile time.
 //! Optional code is kept or dropped by [`specialise`] (see [`super::features`]).
 
+mod compose;
+
+use std::borrow::Cow;
+
+pub use compose::ComposeError;
+
 use super::features::{ShaderFeatures, specialise};
 
 /// The shared records (`FrameUniforms`, `Sphere`, ...), twins of [`super::layout`].
@@ -66,7 +72,7 @@ pub const WORKGROUP_SIZE: u32 = 8;
 /// trace, path and the tabulated BRDF sampler, then for an unrolled scene its
 /// `unrolled_closest_hit` ([`super::unrolled`]).
 ///
-/// Errors: a message if the sources' feature directives are malformed.
+/// Errors: [`ComposeError`] if the sources' feature directives are malformed.
 ///
 /// ```
 /// use gpu_render::gpu::ShaderFeatures;
@@ -75,20 +81,20 @@ pub const WORKGROUP_SIZE: u32 = 8;
 /// assert!(src.contains("fn refract_direction"));
 /// assert!(src.contains("fn shade_paths") && src.contains("fn trace_rays"));
 /// ```
-pub fn trace_shader_source(features: &ShaderFeatures) -> Result<String, String> {
+pub fn trace_shader_source(features: &ShaderFeatures) -> Result<String, ComposeError> {
     let parts = [
-        TYPES_WGSL,
-        PATH_TYPES_WGSL,
-        SAMPLING_WGSL,
-        INTERSECT_WGSL,
-        TEXTURE_WGSL,
-        BXDF_WGSL,
-        ENVIRONMENT_WGSL,
-        TRAVERSE_WGSL,
-        NOISE_WGSL,
-        TRACE_WGSL,
-        PATH_WGSL,
-        TABULATED_WGSL,
+        ("types", TYPES_WGSL),
+        ("path_types", PATH_TYPES_WGSL),
+        ("sampling", SAMPLING_WGSL),
+        ("intersect", INTERSECT_WGSL),
+        ("texture", TEXTURE_WGSL),
+        ("bxdf", BXDF_WGSL),
+        ("environment", ENVIRONMENT_WGSL),
+        ("traverse", TRAVERSE_WGSL),
+        ("noise", NOISE_WGSL),
+        ("trace", TRACE_WGSL),
+        ("path", PATH_WGSL),
+        ("tabulated", TABULATED_WGSL),
     ];
     let mut source = format!(
         "const MAX_BVH_DEPTH: u32 = {}u;\nconst MAX_POLYGON_VERTICES: u32 = {}u;\n",
@@ -98,8 +104,13 @@ pub fn trace_shader_source(features: &ShaderFeatures) -> Result<String, String> 
     source.push_str(&super::uniform_records::declarations(
         features.uniform_records,
     ));
-    for part in parts {
-        source.push_str(&specialise(part, features)?);
+    for (module, part) in parts {
+        source.push_str(
+            &specialise(part, features).map_err(|source| ComposeError::Directive {
+                module: module.to_string(),
+                source,
+            })?,
+        );
     }
     if let Some(unrolled) = &features.unrolled {
         source.push_str(&unrolled.wgsl());
@@ -152,4 +163,43 @@ pub fn draw_shader_source() -> String {
         }
     }
     source
+}
+
+/// A WGSL source of the caller's (a test's kernel) composed with the modules its
+/// `#import` lines name, specialised to `features`.
+///
+/// Errors: [`ComposeError`] for a missing module, an import cycle or malformed
+/// directives.
+pub fn compose_source(source: &str, features: &ShaderFeatures) -> Result<String, ComposeError> {
+    compose::compose("<source>", source, &shipped_module, features)
+}
+
+/// The source of the module of `shaders/` called `name`.
+fn shipped_module(name: &str) -> Option<Cow<'static, str>> {
+    let sources = [
+        ("types", TYPES_WGSL),
+        ("path_types", PATH_TYPES_WGSL),
+        ("sampling", SAMPLING_WGSL),
+        ("intersect", INTERSECT_WGSL),
+        ("texture", TEXTURE_WGSL),
+        ("bxdf", BXDF_WGSL),
+        ("environment", ENVIRONMENT_WGSL),
+        ("traverse", TRAVERSE_WGSL),
+        ("noise", NOISE_WGSL),
+        ("trace", TRACE_WGSL),
+        ("path", PATH_WGSL),
+        ("tabulated", TABULATED_WGSL),
+    ];
+    sources
+        .iter()
+        .find(|(module, _)| *module == name)
+        .map(|(_, source)| Cow::Borrowed(*source))
+}
+
+/// The modules a WGSL source imports, in the order of its `#import` lines, with
+/// `features` deciding its `//#if` blocks.
+///
+/// Errors: [`ComposeError`] for malformed directives or imports.
+pub fn imports(source: &str, features: &ShaderFeatures) -> Result<Vec<String>, ComposeError> {
+    compose::imports_of("<source>", source, features)
 }
