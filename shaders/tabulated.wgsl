@@ -1,11 +1,13 @@
-//#if PATH
-//#if TABULATED
 // Importance sampling of tabulated BRDF maps by inverse CDF, for the path integrator.
 // CPU twin: src/cpu/tabulated.rs (same function names; the sampler and its density
 // are derived there), over the tables of src/accel/brdf_map_cdf.rs: texel (x, y) of
 // the inverse-CDF table of an N×N map is the cumulative probability of the bands
 // θi < θ_x for the outgoing angle θr = θ_y, in the alpha channel of the map's own
-// layer of `images` (shaders/texture.wgsl), the same f32 values the CPU reads.
+// layer of `images` (texture.wgsl), the same f32 values the CPU reads.
+
+#import math
+#import texture
+#import sample
 
 // The probability of drawing from the cosine distribution instead of the map's. Twin
 // of TABULATED_COSINE_PROBABILITY.
@@ -129,5 +131,3 @@ fn pdf_tabulated(layer: u32, n: u32, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     return TABULATED_COSINE_PROBABILITY * pdf_cosine_hemisphere(wi)
         + (1.0 - TABULATED_COSINE_PROBABILITY) * pdf_brdf_map_direction(layer, n, wo.z, wi);
 }
-//#endif
-//#endif

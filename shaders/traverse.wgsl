@@ -2,24 +2,14 @@
 // same rules: planes first, then the tree nearest child first; at equal distance the
 // smaller primitive reference wins, so the result does not depend on the visit order).
 //
-// MAX_BVH_DEPTH and MAX_POLYGON_VERTICES are prepended by the host from the Rust
-// constants (src/gpu/shaders.rs).
-//
-// Bounded work: every loop iteration of an invocation is charged to `iterations`
-// (a polygon test by its vertex count), and a traversal that would pass
-// frame.iteration_budget stops between two steps with its state (current node, leaf
-// cursor, best hit, stack depth) saved in its TraceRay and its stack in
-// `traversal_stack`; the next dispatch resumes it. llvmpipe ends every loop of an
-// invocation once the vector of invocations it runs together has made 65,535 loop
-// iterations in all (LP_MAX_TGSI_LOOP_ITERATIONS in Mesa's gallivm). A vector iterates
-// only while one of its lanes does, so its count is at most the sum of its lanes'
-// counts: the host gives each lane the limit divided by the lanes per vector. A loop
-// that ends without reaching one of its exits was cut by the driver all the same: that
-// sets ERROR_LOOP_CUT for the host, which then refuses the image.
+// MAX_BVH_DEPTH and MAX_POLYGON_VERTICES come from the Rust constants (the module
+// `limits`, src/gpu/shaders.rs). Every step is charged to the invocation's budget
+// (budget.wgsl).
+
 
 // Unrolled scenes: a scene of a few primitives (src/gpu/unrolled.rs says which) gets
-// no tree walk at all. The host writes unrolled_closest_hit, one call of the helpers
-// below per primitive with its record index (and a polygon's vertices) as literals, so
+// no tree walk at all. The host writes unrolled_closest_hit (the module
+// `unrolled_scene`), one call of the helpers of unrolled.wgsl per primitive with its record index (and a polygon's vertices) as literals, so
 // every record is read at a constant offset: llvmpipe loads such a record once for all
 // lanes, where a per-lane index costs a load per lane and component, and the
 // primitive's kind is known at compile time. The nearest hit, ties to the smaller
@@ -27,6 +17,17 @@
 // so the image is the same; glass.toml traced 34% faster (BENCHMARKS.md, "Unrolled
 // scenes"). Its work is bounded by the scene: at most
 // MAX_UNROLLED_PRIMITIVES records, charged to `iterations` like the tree's tests.
+
+#import limits
+#import types
+#import records
+#import bindings
+#import budget
+#import intersect
+#import instance
+//#if UNROLLED
+#import unrolled_scene
+//#endif
 
 // Direction components smaller than this are replaced by it (with their sign; -0
 // counts as positive) before the slab test divides by them: a ray parallel to a slab
@@ -67,9 +68,6 @@ const MAX_STEP_COST: u32 = 1u + MAX_POLYGON_VERTICES;
 const MAX_STEP_COST: u32 = 1u;
 //#endif
 
-// Loop iterations this invocation has run (see above).
-var<private> iterations: u32;
-
 fn inverse_direction(d: vec3<f32>) -> vec3<f32> {
     let tiny = select(vec3<f32>(MIN_DIRECTION_COMPONENT), vec3<f32>(-MIN_DIRECTION_COMPONENT),
                       d < vec3<f32>(0.0));
@@ -87,23 +85,6 @@ fn slab_enter(index: u32, origin: vec3<f32>, inverse: vec3<f32>, t_max: f32) -> 
     let near = max(max(max(near_axes.x, near_axes.y), near_axes.z), 0.0);
     let far = min(min(min(far_axes.x, far_axes.y), far_axes.z), t_max) * FAR_SLAB_SCALE;
     return select(NO_HIT, near, near <= far);
-}
-
-// The exclusive distance limit for testing `prim` against the best hit so far: the
-// best distance, or just beyond it for a smaller reference, which wins exact ties.
-fn tie_limit(prim: u32, best_t: f32, best_prim: u32) -> f32 {
-    return tie_limit_in(prim, NO_INSTANCE, best_t, best_prim, NO_INSTANCE);
-}
-
-// tie_limit for surfaces with instances: the key (instance, prim) decides ties, the
-// scene's own primitives (NO_INSTANCE) after every instance. CPU twin: HitKey's order.
-fn tie_limit_in(prim: u32, instance: u32, best_t: f32, best_prim: u32, best_instance: u32) -> f32 {
-    let smaller = instance < best_instance || (instance == best_instance && prim < best_prim);
-    if best_prim != NO_PRIM && smaller && best_t < bitcast<f32>(0x7f800000u) {
-        // The next f32 up: best_t is positive and finite.
-        return bitcast<f32>(bitcast<u32>(best_t) + 1u);
-    }
-    return best_t;
 }
 
 //#if INSTANCES
@@ -394,72 +375,3 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) 
     //#endif
     return TRAVERSAL_SUSPENDED;
 }
-
-//#if UNROLLED
-//#if SPHERES
-// Unrolled test of sphere record `i` (a literal) against the best hit so far.
-fn unrolled_sphere(i: u32, ray: Ray, best_t: ptr<function, f32>, best_prim: ptr<function, u32>) {
-    let prim = (PRIM_SPHERE << PRIM_KIND_SHIFT) | i;
-    iterations += 1u;
-    let sphere = spheres[i];
-    let t = intersect_sphere(ray, sphere.anchor, sphere.normal, sphere.radius,
-                             tie_limit(prim, *best_t, *best_prim));
-    if t != NO_HIT {
-        *best_t = t;
-        *best_prim = prim;
-    }
-}
-//#endif
-
-//#if PLANES
-// Unrolled test of plane record `i` (a literal).
-fn unrolled_plane(i: u32, ray: Ray, best_t: ptr<function, f32>, best_prim: ptr<function, u32>) {
-    let prim = (PRIM_PLANE << PRIM_KIND_SHIFT) | i;
-    iterations += 1u;
-    let plane = planes[i];
-    let t = intersect_plane(ray, plane.normal, plane.offset, tie_limit(prim, *best_t, *best_prim));
-    if t != NO_HIT {
-        *best_t = t;
-        *best_prim = prim;
-    }
-}
-//#endif
-
-//#if POLYGONS
-// Unrolled test of polygon record `i` whose `count` vertices start at `first` in
-// polygon_points (literals, as upload wrote them): intersect_polygon with the
-// vertices read at constant offsets.
-fn unrolled_polygon(i: u32, first: u32, count: u32, ray: Ray, best_t: ptr<function, f32>,
-                    best_prim: ptr<function, u32>) {
-    let prim = (PRIM_POLYGON << PRIM_KIND_SHIFT) | i;
-    iterations += 1u;
-    let polygon = polygons[i];
-    let t = intersect_plane(ray, polygon.normal, polygon.offset, tie_limit(prim, *best_t, *best_prim));
-    if t == NO_HIT {
-        return;
-    }
-    // The same rule and charge as point_in_polygon (shaders/intersect.wgsl).
-    iterations += count;
-    if inside_polygon_points(project_to_plane(ray_at(ray, t), polygon.dropped_axis), first, count) {
-        *best_t = t;
-        *best_prim = prim;
-    }
-}
-//#endif
-
-//#if TRIANGLES
-// Unrolled test of triangle record `i` (a literal).
-fn unrolled_triangle(i: u32, sheared: ShearedRay, best_t: ptr<function, f32>,
-                     best_prim: ptr<function, u32>) {
-    let prim = (PRIM_TRIANGLE << PRIM_KIND_SHIFT) | i;
-    iterations += 1u;
-    let triangle = triangles[i];
-    let t = intersect_triangle(sheared, triangle.v0, triangle.v1, triangle.v2,
-                               tie_limit(prim, *best_t, *best_prim));
-    if t != NO_HIT {
-        *best_t = t;
-        *best_prim = prim;
-    }
-}
-//#endif
-//#endif

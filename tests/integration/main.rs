@@ -40,6 +40,7 @@ mod sampling_bias;
 mod sampling_gpu_twin;
 mod scene_errors;
 mod scene_models;
+mod shader_modules;
 mod shading_normals;
 mod specialisation;
 mod stress_scenes;
