@@ -32,5 +32,5 @@
 @group(0) @binding(17) var<storage, read_write> traversal_stack: array<u32>;
 // Vertex normals and texture coordinates of mesh triangles (Triangle.attributes).
 @group(0) @binding(18) var<storage, read> triangle_attributes: array<TriangleAttributes>;
-// binding 19: `emitters`, declared by path.wgsl.
+// binding 19: `emitters`, declared by area_lights.wgsl.
 // binding 20: `environment`, declared by environment.wgsl.

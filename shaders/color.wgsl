@@ -26,10 +26,6 @@ fn srgb_encode(linear: f32) -> f32 {
     return 1.055 * pow(c, 1.0 / 2.4) - 0.055;
 }
 
-fn srgb_encode3(linear: vec3<f32>) -> vec3<f32> {
-    return vec3<f32>(srgb_encode(linear.x), srgb_encode(linear.y), srgb_encode(linear.z));
-}
-
 // Inverse of srgb_encode (IEC 61966-2-1:1999, section 5.2), twin of `srgb_decode` in
 // src/color.rs; input in [0, 1].
 fn srgb_decode(encoded: f32) -> f32 {

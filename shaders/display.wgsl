@@ -17,7 +17,7 @@ fn encode_display(@builtin(global_invocation_id) id: vec3<u32>) {
     let linear = textureLoad(linear_input, vec2<i32>(id.xy), 0).rgb;
     var encoded: vec3<f32>;
     if (display.encode_srgb == 1u) {
-        encoded = srgb_encode3(linear);
+        encoded = vec3<f32>(srgb_encode(linear.x), srgb_encode(linear.y), srgb_encode(linear.z));
     } else {
         // Naive gamma mode: the values already are display values; clamp only.
         encoded = vec3<f32>(clamp_unit(linear.x), clamp_unit(linear.y), clamp_unit(linear.z));

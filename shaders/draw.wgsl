@@ -44,7 +44,7 @@ fn draw_film(vertex: DrawVertex) -> @location(0) vec4<f32> {
     let value = textureLoad(film_mean, xy, 0).rgb;
     var c = vec3<f32>(clamp_unit(value.x), clamp_unit(value.y), clamp_unit(value.z));
     if (DRAW_MODE == 1u) {
-        c = srgb_encode3(value);
+        c = vec3<f32>(srgb_encode(value.x), srgb_encode(value.y), srgb_encode(value.z));
     } else if (DRAW_MODE == 2u) {
         c = vec3<f32>(srgb_decode(c.x), srgb_decode(c.y), srgb_decode(c.z));
     }

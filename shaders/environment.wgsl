@@ -104,7 +104,7 @@ struct CellSample {
     x: f32,
 }
 
-fn environment_sample_1d(offset: u32, n: u32, u: f32) -> CellSample {
+fn distribution_1d_sample(offset: u32, n: u32, u: f32) -> CellSample {
     // The first index of [0, n + 1) whose value exceeds u.
     var low = 0u;
     var high = n + 1u;
@@ -144,8 +144,8 @@ fn environment_sample(u: vec2<f32>) -> EnvironmentSample {
     }
     let w = environment.header.width;
     let h = environment.header.height;
-    let row = environment_sample_1d(environment_marginal_offset(), h, u.y);
-    let column = environment_sample_1d(environment_conditional_offset() + row.cell * (w + 1u), w, u.x);
+    let row = distribution_1d_sample(environment_marginal_offset(), h, u.y);
+    let column = distribution_1d_sample(environment_conditional_offset() + row.cell * (w + 1u), w, u.x);
     let texel = row.cell * w + column.cell;
     let pdf_uv = environment.data[environment_function_offset() + texel] / integral;
     let sin_theta = sin(PI * row.x);

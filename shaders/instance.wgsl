@@ -48,7 +48,7 @@ fn instance_normal(instance: Instance, n: vec3<f32>) -> vec3<f32> {
 // stores it: corners moved, corners 1 and 2 swapped under a mirroring transform (which
 // keeps the winding normal facing out), the instance's material. CPU twin:
 // Instance::world_triangle.
-fn instance_triangle(index: u32, record: u32) -> Triangle {
+fn instance_world_triangle(index: u32, record: u32) -> Triangle {
     let instance = load_instance(record);
     var triangle = triangles[index];
     let v1 = instance_point(instance, triangle.v1);

@@ -49,7 +49,7 @@ fn flat_hit(prim: u32, t: f32, normal: vec3<f32>, material: u32, position: vec3<
 fn world_triangle(prim: u32, instance: u32) -> Triangle {
     //#if INSTANCES
     if instance != NO_INSTANCE {
-        return instance_triangle(prim_index(prim), instance);
+        return instance_world_triangle(prim_index(prim), instance);
     }
     //#endif
     return triangles[prim_index(prim)];
@@ -477,12 +477,12 @@ fn triangle_hit(prim: u32, instance: u32, triangle: Triangle, p: vec3<f32>, t: f
 
 // hit_record of the surface (`prim`, `instance`): for an instanced mesh's triangle,
 // made from the triangle moved to world space (instance_triangle) at the world point.
-// CPU twin: hit_record_keyed.
-fn hit_record_in(prim: u32, instance: u32, ray: Ray, t: f32) -> Hit {
+// Twin of hit_record_keyed.
+fn hit_record_keyed(prim: u32, instance: u32, ray: Ray, t: f32) -> Hit {
     //#if INSTANCES
     //#if TRIANGLES
     if instance != NO_INSTANCE {
-        return triangle_hit(prim, instance, instance_triangle(prim_index(prim), instance),
+        return triangle_hit(prim, instance, instance_world_triangle(prim_index(prim), instance),
                             ray_at(ray, t), t);
     }
     //#endif
@@ -545,15 +545,12 @@ fn offset_ray_origin(p: vec3<f32>, n: vec3<f32>, scale: f32) -> vec3<f32> {
     return select(moved, p + ((1.0 / 65536.0) * scale) * n, abs(p) < vec3<f32>((1.0 / 32.0) * scale));
 }
 
-// The exclusive distance limit for testing `prim` against the best hit so far: the
-// best distance, or just beyond it for a smaller reference, which wins exact ties.
-fn tie_limit(prim: u32, best_t: f32, best_prim: u32) -> f32 {
-    return tie_limit_in(prim, NO_INSTANCE, best_t, best_prim, NO_INSTANCE);
-}
-
-// tie_limit for surfaces with instances: the key (instance, prim) decides ties, the
-// scene's own primitives (NO_INSTANCE) after every instance. CPU twin: HitKey's order.
-fn tie_limit_in(prim: u32, instance: u32, best_t: f32, best_prim: u32, best_instance: u32) -> f32 {
+// The exclusive distance limit for testing the surface (`instance`, `prim`) against
+// the best hit so far: the best distance, or just beyond it for a smaller key, which
+// wins exact ties; the key orders by instance, the scene's own primitives
+// (NO_INSTANCE) after every instance, then by prim (HitKey's order). Twin of
+// limit_for.
+fn limit_for(prim: u32, instance: u32, best_t: f32, best_prim: u32, best_instance: u32) -> f32 {
     let smaller = instance < best_instance || (instance == best_instance && prim < best_prim);
     if best_prim != NO_PRIM && smaller && best_t < bitcast<f32>(0x7f800000u) {
         // The next f32 up: best_t is positive and finite.

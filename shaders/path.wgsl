@@ -33,6 +33,7 @@
 #import texture
 #import bxdf
 #import slot
+#import area_lights
 #import trace
 //#if ENVIRONMENT_MAP
 #import environment
@@ -40,10 +41,6 @@
 //#if TABULATED
 #import tabulated
 //#endif
-
-// The emitters of the AreaLights distribution (src/gpu/area_lights.rs), in the CPU's
-// order; one EMITTER_NONE record when the scene has none.
-@group(0) @binding(19) var<storage, read> emitters: array<Emitter>;
 
 // Bounces after which Russian roulette may end a path. Twin of ROULETTE_DEPTH.
 const ROULETTE_DEPTH: u32 = 3u;
@@ -159,10 +156,10 @@ fn pdf_half_vector(material: Material, wo: vec3<f32>, h: vec3<f32>) -> f32 {
 // specular lobe with its probability, else the cosine sampler. Twin of sample_brdf.
 fn sample_brdf(material: Material, n: vec3<f32>, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> vec3<f32> {
     let basis = shading_frame(n);
-    let wo_local = frame_to_local(basis, wo);
+    let wo_local = shading_frame_to_local(basis, wo);
     //#if TABULATED
     if material.kind == MATERIAL_TABULATED && material.brdf_map_layer != NO_IMAGE {
-        return frame_to_world(basis, sample_tabulated(material.brdf_map_layer,
+        return shading_frame_to_world(basis, sample_tabulated(material.brdf_map_layer,
                                                       material.brdf_map_size, wo_local, u_lobe, u));
     }
     //#endif
@@ -170,15 +167,15 @@ fn sample_brdf(material: Material, n: vec3<f32>, wo: vec3<f32>, u_lobe: f32, u: 
     if u_lobe < specular_lobe_probability(material) {
         local = reflect_about(wo_local, sample_half_vector(material, wo_local, u));
     }
-    return frame_to_world(basis, local);
+    return shading_frame_to_world(basis, local);
 }
 
 // The density per steradian of sample_brdf producing `wi`: the mixture of its lobes'.
 // Twin of pdf_brdf.
 fn pdf_brdf(material: Material, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     let basis = shading_frame(n);
-    let wo_local = frame_to_local(basis, wo);
-    let wi_local = frame_to_local(basis, wi);
+    let wo_local = shading_frame_to_local(basis, wo);
+    let wi_local = shading_frame_to_local(basis, wi);
     //#if TABULATED
     if material.kind == MATERIAL_TABULATED && material.brdf_map_layer != NO_IMAGE {
         return pdf_tabulated(material.brdf_map_layer, material.brdf_map_size, wo_local, wi_local);
@@ -195,66 +192,13 @@ fn pdf_brdf(material: Material, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f
     return pdf;
 }
 
-// How many emitters the scene has (the padding record of none is EMITTER_NONE).
-fn emitter_count() -> u32 {
-    if emitters[0].kind == EMITTER_NONE {
-        return 0u;
-    }
-    return arrayLength(&emitters);
-}
-
-// The emitter chosen by u ∈ [0, 1): the first whose cumulative probability exceeds u,
-// at most the last (CPU: AreaLights::choose, partition_point(c <= u·total)); binary
-// search, at most 32 steps.
-fn choose_emitter(u: f32, count: u32) -> u32 {
-    var low = 0u;
-    var high = count;
-    for (var step = 0u; step < 32u && low < high; step += 1u) {
-        let middle = (low + high) / 2u;
-        if emitters[middle].cdf <= u {
-            low = middle + 1u;
-        } else {
-            high = middle;
-        }
-    }
-    return min(low, count - 1u);
-}
-
-// Whether emitter record `index` comes before the surface (instance, prim) in the
-// records' order: ascending instance (NO_INSTANCE, the scene's own, last), then prim.
-fn emitter_before(index: u32, prim: u32, instance: u32) -> bool {
-    let e = emitters[index];
-    return e.instance < instance || (e.instance == instance && e.prim < prim);
-}
-
-// The first emitter record of primitive `prim` in instance `instance` (NO_INSTANCE for
-// the scene's own), or NO_PRIM when it is no sampled emitter (CPU:
-// AreaLights::first_of); binary search over the records' ascending (instance, prim).
-fn first_emitter_of(prim: u32, instance: u32) -> u32 {
-    let count = emitter_count();
-    var low = 0u;
-    var high = count;
-    for (var step = 0u; step < 32u && low < high; step += 1u) {
-        let middle = (low + high) / 2u;
-        if emitter_before(middle, prim, instance) {
-            low = middle + 1u;
-        } else {
-            high = middle;
-        }
-    }
-    if low < count && emitters[low].prim == prim && emitters[low].instance == instance {
-        return low;
-    }
-    return NO_PRIM;
-}
-
 // The density per steradian with which next-event estimation from `point` samples the
 // direction towards `hit`, made in instance `instance` (0 if `hit` is on no sampled
 // emitter): a sphere's cone
 // density times its selection probability, a flat emitter's selection / area per unit
 // area converted to solid angle. Twin of AreaLights::pdf.
 fn emitter_pdf(point: vec3<f32>, hit: Hit, instance: u32) -> f32 {
-    let index = first_emitter_of(hit.prim, instance);
+    let index = area_lights_first_piece(hit.prim, instance);
     if index == NO_PRIM {
         return 0.0;
     }
@@ -319,7 +263,7 @@ fn path_emitter_sample(path: ptr<function, PathState>) -> EmitterSample {
     if count == 0u {
         return sample;
     }
-    sample.emitter = choose_emitter((u_light - p_environment) / (1.0 - p_environment), count);
+    sample.emitter = area_lights_choose((u_light - p_environment) / (1.0 - p_environment), count);
     let emitter = emitters[sample.emitter];
     sample.radiance = emitter.radiance;
     if emitter.kind == EMITTER_SPHERE {
@@ -397,7 +341,7 @@ fn path_closest_hit(path: ptr<function, PathState>, trace: TraceRay) {
         (*path).phase = PHASE_POP;
         return;
     }
-    let hit = hit_record_in(trace.best_prim, trace.best_instance, ray, trace.best_t);
+    let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
     let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv);
     // Emission, weighted against next-event estimation where that could have found it;
     // shadow_origin still holds the previous hit's, where that estimation sampled from.
@@ -553,7 +497,7 @@ fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
         // A textured emitter's radiance at the point the shadow ray reaches (the
         // sampled point), looked up at that hit's texture coordinates.
         if sample.emitter != ENVIRONMENT_EMITTER {
-            let light_hit = hit_record_in(trace.best_prim, trace.best_instance,
+            let light_hit = hit_record_keyed(trace.best_prim, trace.best_instance,
                                           Ray((*path).shadow_origin, sample.wi), trace.best_t);
             let light_material = materials[light_hit.material];
             if light_material.emission_layer != NO_IMAGE {

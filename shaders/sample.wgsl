@@ -43,11 +43,11 @@ fn shading_frame(n: vec3<f32>) -> ShadingFrame {
                         vec3<f32>(b, sign + n.y * n.y * a, -n.y), n);
 }
 
-fn frame_to_local(f: ShadingFrame, v: vec3<f32>) -> vec3<f32> {
+fn shading_frame_to_local(f: ShadingFrame, v: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(dot(v, f.x), dot(v, f.y), dot(v, f.z));
 }
 
-fn frame_to_world(f: ShadingFrame, v: vec3<f32>) -> vec3<f32> {
+fn shading_frame_to_world(f: ShadingFrame, v: vec3<f32>) -> vec3<f32> {
     return f.x * v.x + f.y * v.y + f.z * v.z;
 }
 
@@ -124,7 +124,7 @@ fn sample_sphere_cone(point: vec3<f32>, center: vec3<f32>, radius: f32, u: vec2<
     let phi = 2.0 * PI * u.y;
     let basis = shading_frame(to_center / sqrt(distance_squared));
     let local = vec3<f32>(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
-    sample.wi = frame_to_world(basis, local);
+    sample.wi = shading_frame_to_world(basis, local);
     sample.pdf = 1.0 / (2.0 * PI * one_minus_cos_max);
     sample.found = true;
     return sample;

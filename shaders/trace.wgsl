@@ -128,7 +128,7 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
         (*path).phase = PHASE_POP;
         return;
     }
-    let hit = hit_record_in(trace.best_prim, trace.best_instance, ray, trace.best_t);
+    let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
     let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv);
     let entering = dot(ray.direction, hit.normal) < 0.0;
     // Shading happens on the side the ray came from.

@@ -189,7 +189,7 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) 
             iterations += 1u;
             let prim = (PRIM_PLANE << PRIM_KIND_SHIFT) | i;
             let t = intersect_prim(prim, ray, sheared,
-                                   tie_limit_in(prim, NO_INSTANCE, best_t, best_prim, best_instance));
+                                   limit_for(prim, NO_INSTANCE, best_t, best_prim, best_instance));
             if t != NO_HIT {
                 best_t = t;
                 best_prim = prim;
@@ -280,7 +280,7 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) 
             //#endif
             if !entered {
                 let t = intersect_prim(prim, ray, sheared,
-                                       tie_limit_in(prim, instance, best_t, best_prim, best_instance));
+                                       limit_for(prim, instance, best_t, best_prim, best_instance));
                 if t != NO_HIT {
                     best_t = t;
                     best_prim = prim;

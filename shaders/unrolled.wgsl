@@ -14,7 +14,7 @@ fn unrolled_sphere(i: u32, ray: Ray, best_t: ptr<function, f32>, best_prim: ptr<
     iterations += 1u;
     let sphere = spheres[i];
     let t = intersect_sphere(ray, sphere.anchor, sphere.normal, sphere.radius,
-                             tie_limit(prim, *best_t, *best_prim));
+                             limit_for(prim, NO_INSTANCE, *best_t, *best_prim, NO_INSTANCE));
     if t != NO_HIT {
         *best_t = t;
         *best_prim = prim;
@@ -28,7 +28,7 @@ fn unrolled_plane(i: u32, ray: Ray, best_t: ptr<function, f32>, best_prim: ptr<f
     let prim = (PRIM_PLANE << PRIM_KIND_SHIFT) | i;
     iterations += 1u;
     let plane = planes[i];
-    let t = intersect_plane(ray, plane.normal, plane.offset, tie_limit(prim, *best_t, *best_prim));
+    let t = intersect_plane(ray, plane.normal, plane.offset, limit_for(prim, NO_INSTANCE, *best_t, *best_prim, NO_INSTANCE));
     if t != NO_HIT {
         *best_t = t;
         *best_prim = prim;
@@ -45,7 +45,7 @@ fn unrolled_polygon(i: u32, first: u32, count: u32, ray: Ray, best_t: ptr<functi
     let prim = (PRIM_POLYGON << PRIM_KIND_SHIFT) | i;
     iterations += 1u;
     let polygon = polygons[i];
-    let t = intersect_plane(ray, polygon.normal, polygon.offset, tie_limit(prim, *best_t, *best_prim));
+    let t = intersect_plane(ray, polygon.normal, polygon.offset, limit_for(prim, NO_INSTANCE, *best_t, *best_prim, NO_INSTANCE));
     if t == NO_HIT {
         return;
     }
@@ -66,7 +66,7 @@ fn unrolled_triangle(i: u32, sheared: ShearedRay, best_t: ptr<function, f32>,
     iterations += 1u;
     let triangle = triangles[i];
     let t = intersect_triangle(sheared, triangle.v0, triangle.v1, triangle.v2,
-                               tie_limit(prim, *best_t, *best_prim));
+                               limit_for(prim, NO_INSTANCE, *best_t, *best_prim, NO_INSTANCE));
     if t != NO_HIT {
         *best_t = t;
         *best_prim = prim;

@@ -202,16 +202,19 @@ pub fn fresnel_schlick(cos: f64, f0: DVec3) -> DVec3 {
 /// The Fresnel reflectance a Cook-Torrance material uses at `cos` (conductor or
 /// dielectric, exact or Schlick with the exact `F0`).
 pub fn microfacet_fresnel(material: &Material, cos: f64) -> DVec3 {
-    let exact = |c: f64| {
-        if material.conductor {
-            fresnel_conductor(c, material.eta, material.k)
-        } else {
-            DVec3::splat(fresnel_dielectric(c, 1.0, material.ior))
-        }
-    };
     match material.fresnel {
-        FresnelModel::Exact => exact(cos),
-        FresnelModel::Schlick => fresnel_schlick(cos, exact(1.0)),
+        FresnelModel::Exact => microfacet_fresnel_exact(material, cos),
+        FresnelModel::Schlick => fresnel_schlick(cos, microfacet_fresnel_exact(material, 1.0)),
+    }
+}
+
+/// The exact Fresnel reflectance of a Cook-Torrance material at `cos`: the
+/// conductor's, or the dielectric's from air.
+pub fn microfacet_fresnel_exact(material: &Material, cos: f64) -> DVec3 {
+    if material.conductor {
+        fresnel_conductor(cos, material.eta, material.k)
+    } else {
+        DVec3::splat(fresnel_dielectric(cos, 1.0, material.ior))
     }
 }
 

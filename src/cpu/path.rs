@@ -26,7 +26,8 @@ use super::bxdf::{
 use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
 use super::tabulated::{pdf_tabulated, sample_tabulated};
 use super::trace::{
-    PreparedScene, direct_light, finite_radiance, keep_on_side, shading_frame_normal,
+    PreparedScene, add_contribution, direct_light, finite_radiance, keep_on_side,
+    shading_frame_normal,
 };
 use super::traverse::{intersect_scene, occluded};
 use crate::accel::area_lights::{Emitter, EmitterShape};
@@ -212,7 +213,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
                 }
                 None => scene.background,
             };
-            add(&mut radiance, throughput * background);
+            add_contribution(&mut radiance, throughput * background);
             break;
         };
         let material = shading_material(
@@ -235,7 +236,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
                 ),
                 None => 1.0,
             };
-            add(&mut radiance, throughput * material.emission * weight);
+            add_contribution(&mut radiance, throughput * material.emission * weight);
         }
         let entering = ray.direction.dot(hit.normal) < 0.0;
         let ng = if entering { hit.normal } else { -hit.normal };
@@ -275,7 +276,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
             for light in &scene.lights {
                 let (lit, traced) = direct_light(scene, light, &material, shadow_origin, n, wo);
                 rays += traced;
-                add(&mut radiance, event_weight * lit);
+                add_contribution(&mut radiance, event_weight * lit);
             }
             // One light: the environment with its selection probability, else an
             // emitter chosen by power with the rest of the numbers' range.
@@ -295,7 +296,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
                     continues,
                 );
                 rays += traced;
-                add(&mut radiance, event_weight * lit);
+                add_contribution(&mut radiance, event_weight * lit);
             } else if let Some((emitter, selection)) = scene
                 .area_lights
                 .choose((u_light - p_environment) / (1.0 - p_environment))
@@ -312,7 +313,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
                     continues,
                 );
                 rays += traced;
-                add(&mut radiance, event_weight * lit);
+                add_contribution(&mut radiance, event_weight * lit);
             }
             if !continues {
                 break;
@@ -383,13 +384,6 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
         }
     }
     (radiance, rays)
-}
-
-/// Adds a contribution to `radiance` when it is finite (as the Whitted tracer does).
-fn add(radiance: &mut DVec3, contribution: DVec3) {
-    if finite_radiance(contribution) {
-        *radiance += contribution;
-    }
 }
 
 /// Next-event estimation of one emitter (chosen with probability `selection`) from

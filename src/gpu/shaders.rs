@@ -42,7 +42,7 @@ macro_rules! shader_modules {
 }
 
 /// Every module of `shaders/`, the lower ones first.
-pub const SHADER_MODULES: [ShaderModule; 25] = shader_modules![
+pub const SHADER_MODULES: [ShaderModule; 27] = shader_modules![
     "types",
     "path_types",
     "math",
@@ -60,7 +60,9 @@ pub const SHADER_MODULES: [ShaderModule; 25] = shader_modules![
     "unrolled",
     "traverse",
     "environment",
+    "brdf_map_cdf",
     "tabulated",
+    "area_lights",
     "slot",
     "trace",
     "path",

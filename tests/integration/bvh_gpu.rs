@@ -55,9 +55,9 @@ fn traverse_rays(@builtin(global_invocation_id) id: vec3<u32>) {
     results[slot] = vec2<u32>(bitcast<u32>(trace.best_t), trace.best_prim);
 }
 
-fn consider(prim: u32, ray: Ray, best: ptr<function, vec2<u32>>) {
+fn brute_force_consider(prim: u32, ray: Ray, best: ptr<function, vec2<u32>>) {
     let t = intersect_prim(prim, ray, shear_ray(ray),
-                           tie_limit(prim, bitcast<f32>((*best).x), (*best).y));
+                           limit_for(prim, NO_INSTANCE, bitcast<f32>((*best).x), (*best).y, NO_INSTANCE));
     if t != NO_HIT {
         *best = vec2<u32>(bitcast<u32>(t), prim);
     }
@@ -73,16 +73,16 @@ fn brute_force_rays(@builtin(global_invocation_id) id: vec3<u32>) {
     let ray = Ray(trace.origin, trace.direction);
     var best = vec2<u32>(bitcast<u32>(trace.t_max), NO_PRIM);
     for (var i = 0u; i < arrayLength(&spheres); i += 1u) {
-        consider((PRIM_SPHERE << PRIM_KIND_SHIFT) | i, ray, &best);
+        brute_force_consider((PRIM_SPHERE << PRIM_KIND_SHIFT) | i, ray, &best);
     }
     for (var i = 0u; i < frame.plane_count; i += 1u) {
-        consider((PRIM_PLANE << PRIM_KIND_SHIFT) | i, ray, &best);
+        brute_force_consider((PRIM_PLANE << PRIM_KIND_SHIFT) | i, ray, &best);
     }
     for (var i = 0u; i < arrayLength(&polygons); i += 1u) {
-        consider((PRIM_POLYGON << PRIM_KIND_SHIFT) | i, ray, &best);
+        brute_force_consider((PRIM_POLYGON << PRIM_KIND_SHIFT) | i, ray, &best);
     }
     for (var i = 0u; i < arrayLength(&triangles); i += 1u) {
-        consider((PRIM_TRIANGLE << PRIM_KIND_SHIFT) | i, ray, &best);
+        brute_force_consider((PRIM_TRIANGLE << PRIM_KIND_SHIFT) | i, ray, &best);
     }
     results[slot] = best;
 }
