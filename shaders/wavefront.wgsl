@@ -296,7 +296,7 @@ fn trace_rays(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     iterations = 0u;
-    if advance_traversal(slot, &trace, false) == TRAVERSAL_FINISHED {
+    if traverse(slot, &trace, false) == TRAVERSAL_FINISHED {
         trace.status = TRACE_DONE;
     }
     traces[slot] = trace;
@@ -325,7 +325,7 @@ fn trace_paths(@builtin(global_invocation_id) id: vec3<u32>) {
     var exited = false;
     loop {
         if trace_in_flight(trace) {
-            let outcome = advance_traversal(slot, &trace, give_way);
+            let outcome = traverse(slot, &trace, give_way);
             if outcome == TRAVERSAL_SUSPENDED {
                 exited = true;
                 break;

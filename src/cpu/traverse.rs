@@ -199,7 +199,7 @@ pub fn object_ray(instance: &Instance, ray: &Ray) -> Ray {
     }
 }
 
-/// The traversal both queries share, twin of `advance_traversal` in
+/// The traversal both queries share, twin of `traverse` in
 /// `shaders/traverse.wgsl` (without its budget: the CPU never suspends a traversal):
 /// the planes, then the tree nearest child first, each leaf's primitives in order
 /// (an instance's mesh traversed in its own space where the leaf names it), each

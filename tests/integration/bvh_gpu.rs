@@ -48,7 +48,7 @@ fn traverse_rays(@builtin(global_invocation_id) id: vec3<u32>) {
     var trace = test_trace(slot);
     loop {
         iterations = 0u;
-        if advance_traversal(slot, &trace, false) == TRAVERSAL_FINISHED {
+        if traverse(slot, &trace, false) == TRAVERSAL_FINISHED {
             break;
         }
     }
