@@ -1,13 +1,15 @@
 //! The WGSL modules of `shaders/` declare what they use: each imports exactly the
 //! modules whose declarations it names (no fewer, which composing it alone would hide
-//! when another import brings them, and no more), and the import graph has no cycle.
-//! That each module composed alone validates is tested beside the composer
-//! (`src/gpu/shaders.rs`).
+//! when another import brings them, and no more), the import graph has no cycle, and
+//! every WGSL function has a Rust twin of the same name in the Rust file of the same
+//! name, but for the short list below. That each module composed alone validates is
+//! tested beside the composer (`src/gpu/shaders.rs`).
 
 use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
 
 use gpu_render::gpu::ShaderFeatures;
-use gpu_render::gpu::shaders::{HOST_MODULES, SHADER_MODULES, host_module, imports};
+use gpu_render::gpu::shaders::{HOST_MODULES, SHADER_MODULES, host_module, imports, shader_module};
 use gpu_render::gpu::unrolled::UnrolledPrimitives;
 
 /// `source` without its `//` comments (the feature directives among them).
@@ -287,4 +289,299 @@ fn the_import_graph_has_no_cycle() {
     let cycle = find_cycle(&with_cycle).expect("a cycle through types");
     assert_eq!(cycle.first(), cycle.last());
     assert!(cycle.contains(&"types".to_string()) && cycle.contains(&"wavefront".to_string()));
+}
+
+/// WGSL functions without a Rust function of the same name in the Rust file of the
+/// same name, and why: (module, functions or `*` for the whole module, reason). Keep it
+/// short: a new function gets a twin, or a reason as good as these.
+const WITHOUT_RUST_TWIN: &[(&str, &[&str], &str)] = &[
+    (
+        "wavefront",
+        &["*"],
+        "the trace kernels and their schedule of slots, phases and dispatches: the CPU \
+         traces a pixel's rays in one loop (src/cpu/trace.rs); the host is \
+         src/gpu/wavefront.rs",
+    ),
+    (
+        "slot",
+        &["*"],
+        "a slot's bounce stack, trace record and pixel kept between dispatches: the CPU \
+         keeps them in the locals of its loop",
+    ),
+    (
+        "unrolled",
+        &["*"],
+        "the unrolled primitive tests of small scenes on lavapipe, a GPU-only strategy \
+         (src/gpu/unrolled.rs writes the calls)",
+    ),
+    (
+        "draw",
+        &["*"],
+        "the raster pass that draws a film into the caller's attachment (src/gpu/draw.rs)",
+    ),
+    (
+        "bxdf_eval",
+        &["*"],
+        "the test kernel of tests/integration/bxdf_gpu_twin.rs",
+    ),
+    (
+        "math",
+        &["*"],
+        "what std and glam give the CPU: f64::is_nan, max_element, normalize_or_zero, \
+         indexing a vector by a number",
+    ),
+    (
+        "traverse",
+        &[
+            "traversal_ray",
+            "resumed_ray",
+            "start_traversal",
+            "test_planes",
+            "traversal_done",
+            "next_leaf_prim",
+            "leave_instance",
+            "open_if_leaf",
+            "traversal_stack_index",
+            "pop_node",
+            "visit_inner_node",
+            "node_step",
+        ],
+        "the steps of the resumable, budgeted traversal, whose state lives in a TraceRay \
+         and the slot's stack: the CPU walks a tree in one call (Query::walk) and \
+         recurses into instances",
+    ),
+    (
+        "trace",
+        &["consume_closest_hit", "consume_shadow_ray", "finish_lights"],
+        "shade_hit and direct_light cut at each shadow ray into the wavefront's steps",
+    ),
+    (
+        "path",
+        &[
+            "path_random",
+            "path_emitter_sample",
+            "path_continue",
+            "path_closest_hit",
+            "path_consume_shadow_ray",
+            "path_start_emitter",
+            "path_consume_emitter",
+        ],
+        "path_radiance's loop body cut at each shadow ray into the wavefront's steps, \
+         with the path's random numbers and state in its slot",
+    ),
+    (
+        "intersect",
+        &["prim_kind", "prim_index"],
+        "PrimRef::kind and PrimRef::index (src/accel/geometry.rs), on the bit layout \
+         whose constants types.wgsl holds",
+    ),
+    (
+        "intersect",
+        &["inside_polygon_points"],
+        "point_in_polygon's even-odd loop over the vertices projected at upload \
+         (polygon_points); the CPU projects them as it goes",
+    ),
+    (
+        "intersect",
+        &["world_attributes"],
+        "the attributes half of Instance::world_triangle, which the GPU reads apart \
+         from the corners",
+    ),
+    (
+        "instance",
+        &["load_instance", "instance_point", "instance_normal"],
+        "a placement unpacked from the bvh_nodes records src/gpu/upload.rs packs it in, \
+         and its transforms: glam's DAffine3 and normal matrix on the CPU",
+    ),
+    (
+        "environment",
+        &[
+            "environment_present",
+            "environment_texel_radiance",
+            "environment_function_offset",
+            "environment_conditional_offset",
+            "environment_marginal_offset",
+        ],
+        "reads of the one buffer src/gpu/environment.rs packs the map, its sampling \
+         function and its CDFs in; the CPU holds an Option of the map and its \
+         distributions",
+    ),
+    (
+        "area_lights",
+        &["emitter_count", "emitter_before"],
+        "the emitter records as the GPU holds them (one EMITTER_NONE record for none) \
+         and their order for the binary search: a Vec and partition_point on the CPU",
+    ),
+];
+
+/// The Rust files under `src/`.
+fn rust_files(path: &Path) -> Vec<PathBuf> {
+    if path.is_dir() {
+        let mut files = Vec::new();
+        for entry in std::fs::read_dir(path).expect("a folder") {
+            files.extend(rust_files(&entry.expect("entry").path()));
+        }
+        files
+    } else if path.extension().is_some_and(|e| e == "rs") {
+        vec![path.to_path_buf()]
+    } else {
+        Vec::new()
+    }
+}
+
+/// `CamelCase` as `snake_case`, a digit run a word of its own (`Distribution1D`:
+/// `distribution_1d`).
+fn snake_case(name: &str) -> String {
+    let mut snake = String::new();
+    let mut previous: Option<char> = None;
+    for c in name.chars() {
+        if let Some(p) = previous {
+            let new_word = (c.is_ascii_uppercase() && p.is_ascii_lowercase())
+                || (c.is_ascii_digit() && p.is_ascii_alphabetic());
+            if new_word {
+                snake.push('_');
+            }
+        }
+        snake.push(c.to_ascii_lowercase());
+        previous = Some(c);
+    }
+    snake
+}
+
+/// The names under which a WGSL function may twin the Rust file `text`: its
+/// functions, the names it re-exports (`pub use path::name;`), and each method `m` of
+/// a type `T` as `t_m` (and `T::new` as `t`), since WGSL has neither methods nor
+/// namespaces.
+fn rust_names(text: &str) -> BTreeSet<String> {
+    let mut names = BTreeSet::new();
+    let mut impl_type: Option<String> = None;
+    // Tests are no twins: they follow the code, at the end of the file.
+    let code_end = text.find("#[cfg(test)]").unwrap_or(text.len());
+    for line in text[..code_end].lines() {
+        let code = line.split("//").next().unwrap_or("");
+        if let Some(rest) = code.strip_prefix("impl") {
+            // `impl<T> Trait for Type {` or `impl Type {`: the type is the last word.
+            let head = rest.split('{').next().unwrap_or("");
+            let head = head.rsplit(" for ").next().unwrap_or(head);
+            impl_type = head
+                .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                .rfind(|w| w.starts_with(|c: char| c.is_ascii_uppercase()))
+                .map(snake_case);
+        } else if code.starts_with('}') {
+            impl_type = None;
+        }
+        if let Some(at) = code.find("fn ") {
+            let before = &code[..at];
+            if before.is_empty() || before.ends_with(' ') || before.ends_with('(') {
+                let name = identifier_at(&code[at + 3..]).to_string();
+                if let (Some(t), true) = (&impl_type, line.starts_with("    ")) {
+                    names.insert(format!("{t}_{name}"));
+                    if name == "new" {
+                        names.insert(t.clone());
+                    }
+                }
+                names.insert(name);
+            }
+        }
+        if let Some(rest) = code.trim().strip_prefix("pub use ") {
+            for word in rest.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')) {
+                names.insert(word.to_string());
+            }
+        }
+    }
+    names
+}
+
+/// The names under which a function of the module `name` has a Rust twin in
+/// `rust_files`: those of its Rust files of the same name.
+fn twin_names(name: &str, rust_files: &[PathBuf]) -> BTreeSet<String> {
+    let mut names = BTreeSet::new();
+    for file in rust_files
+        .iter()
+        .filter(|f| f.file_stem().is_some_and(|s| s == name))
+    {
+        names.extend(rust_names(
+            &std::fs::read_to_string(file).expect("a source"),
+        ));
+    }
+    names
+}
+
+/// Whether `function` of the module `module` is among `names`, as it is or without the
+/// module's name as its prefix (`environment_to_local`: `EnvironmentMap::to_local`).
+fn has_twin(module: &str, function: &str, names: &BTreeSet<String>) -> bool {
+    names.contains(function)
+        || function
+            .strip_prefix(&format!("{module}_"))
+            .is_some_and(|rest| names.contains(rest))
+}
+
+/// The functions declared in `source`.
+fn functions(source: &str) -> Vec<String> {
+    declarations(source)
+        .into_iter()
+        .filter(|name| code_of(source).contains(&format!("fn {name}(")))
+        .collect()
+}
+
+/// Whether the list excuses `function` of module `module`.
+fn allowed(module: &str, function: &str) -> bool {
+    WITHOUT_RUST_TWIN.iter().any(|(m, functions, _)| {
+        *m == module && functions.iter().any(|f| *f == "*" || *f == function)
+    })
+}
+
+/// The functions of the module `name` (text `source`) without a twin in `rust_files`
+/// that the list does not excuse.
+fn functions_without_twin(name: &str, source: &str, rust_files: &[PathBuf]) -> Vec<String> {
+    let names = twin_names(name, rust_files);
+    functions(source)
+        .into_iter()
+        .filter(|function| !has_twin(name, function, &names) && !allowed(name, function))
+        .collect()
+}
+
+#[test]
+fn every_wgsl_function_has_a_rust_twin_of_the_same_name() {
+    let files = rust_files(&crate::support::repo_root().join("src"));
+    let missing: Vec<String> = SHADER_MODULES
+        .iter()
+        .flat_map(|module| {
+            functions_without_twin(module.name, module.source, &files)
+                .into_iter()
+                .map(move |function| format!("shaders/{}.wgsl: {function}", module.name))
+        })
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "WGSL functions without a Rust twin of the same name in a Rust file of the \
+         module's name (rename one side, or move it to the file of the right name):\n  {}",
+        missing.join("\n  ")
+    );
+    // A new function is found: `luminance` has its twin in src/color.rs, `glitter`
+    // none.
+    let added = "fn luminance(c: vec3<f32>) -> f32 { return c.x; }\nfn glitter() {}\n";
+    assert_eq!(functions_without_twin("color", added, &files), ["glitter"]);
+}
+
+/// Every function on the list exists and has no twin, so that the list only shrinks.
+#[test]
+fn the_list_of_functions_without_a_twin_is_current() {
+    let files = rust_files(&crate::support::repo_root().join("src"));
+    for (module, listed, reason) in WITHOUT_RUST_TWIN {
+        assert!(!reason.is_empty(), "{module}: no reason");
+        let source = shader_module(module).unwrap_or_else(|| panic!("no module {module}"));
+        let declared = functions(source);
+        let names = twin_names(module, &files);
+        for function in listed.iter().filter(|f| **f != "*") {
+            assert!(
+                declared.iter().any(|d| d == function),
+                "{module}::{function} is on the list but is no WGSL function"
+            );
+            assert!(
+                !has_twin(module, function, &names),
+                "{module}::{function} has a Rust twin: take it off the list"
+            );
+        }
+    }
 }
