@@ -1,6 +1,6 @@
 //! The pinhole camera and the pixel sample pattern, shared by both backends.
-//! The GPU twin is `shaders/sampling.wgsl` (`camera_ray`, `sample_offset`); the hash is
-//! [`crate::sample::pcg_hash`].
+//! The GPU twin is `shaders/camera.wgsl` (`sample_offset`, `ray_direction` as
+//! `camera_ray_direction`); the hash is [`crate::sample::pcg_hash`].
 
 use glam::DVec3;
 

@@ -1,6 +1,7 @@
 //! The Whitted tracer with an explicit bounce stack: the CPU twin of
-//! `shaders/trace.wgsl` (same function names and the same stack discipline, so the two
-//! agree even when a small stack drops branches).
+//! `shaders/trace.wgsl` (same function names) and of the slots of
+//! `shaders/wavefront.wgsl` (the same stack discipline, so the two agree even when a
+//! small stack drops branches).
 
 use glam::DVec3;
 
