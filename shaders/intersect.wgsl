@@ -295,7 +295,7 @@ fn edge_crosses(point: vec2<f32>, previous: vec2<f32>, current: vec2<f32>) -> bo
 // over the vertices with indices clamped to the last one, so a triangle's fourth edge
 // joins its last vertex to itself and cannot cross (the even-odd count is unchanged).
 fn point_in_polygon(p: vec3<f32>, polygon: Polygon) -> bool {
-    // Its edges count against the invocation's budget (traverse.wgsl).
+    // Its edges count against the invocation's budget (budget.wgsl).
     iterations += polygon.vertex_count;
     return inside_polygon_points(project_to_plane(p, polygon.dropped_axis), polygon.first_vertex,
                                  polygon.vertex_count);
