@@ -1,7 +1,9 @@
 // Reflection models and the laws of reflection and refraction.
 // CPU twin: src/cpu/bxdf.rs (same function names).
 
-const PI: f32 = 3.14159265358979323846;
+#import types
+#import math
+#import texture
 
 // Mirror reflection of the incident direction u about the unit normal n
 // (lecture: R = u - 2(u·N)N).
@@ -434,3 +436,82 @@ fn surface_response(material: Material, direction: vec3<f32>, n: vec3<f32>, ente
     }
     return response;
 }
+
+// The importance samplers of the lobes' distributions and their densities, for the
+// path integrator.
+//#if COOK_TORRANCE || PBR
+// A microfacet normal of the isotropic GGX distribution visible from the local `wo`:
+// Heitz, "Sampling the GGX Distribution of Visible Normals", JCGT 7(4), 2018, listing
+// 1. Twin of sample_ggx_visible_normal.
+fn sample_ggx_visible_normal(wo: vec3<f32>, alpha: f32, u: vec2<f32>) -> vec3<f32> {
+    // The view direction stretched to alpha = 1, and a basis around it (T1 horizontal).
+    let vh = normalize(vec3<f32>(alpha * wo.x, alpha * wo.y, wo.z));
+    let length_squared = vh.x * vh.x + vh.y * vh.y;
+    var t1 = vec3<f32>(1.0, 0.0, 0.0);
+    if length_squared > 0.0 {
+        t1 = vec3<f32>(-vh.y, vh.x, 0.0) / sqrt(length_squared);
+    }
+    let t2 = cross(vh, t1);
+    // A point of the projected area: a disk, its far half squeezed by vh.z.
+    let r = sqrt(u.x);
+    let phi = 2.0 * PI * u.y;
+    let p1 = r * cos(phi);
+    let s = 0.5 * (1.0 + vh.z);
+    let p2 = (1.0 - s) * sqrt(max(1.0 - p1 * p1, 0.0)) + s * r * sin(phi);
+    // Onto the hemisphere, and back to the ellipsoid configuration.
+    let nh = t1 * p1 + t2 * p2 + vh * sqrt(max(1.0 - p1 * p1 - p2 * p2, 0.0));
+    return normalize(vec3<f32>(alpha * nh.x, alpha * nh.y, max(nh.z, 0.0)));
+}
+
+// Its density per steradian of normals, D_wo(h) = G1(wo)·max(0, wo·h)·D(h) / wo.z
+// (Heitz 2018, eq. 1). Twin of pdf_ggx_visible_normal.
+fn pdf_ggx_visible_normal(wo: vec3<f32>, h: vec3<f32>, alpha: f32) -> f32 {
+    if wo.z <= 0.0 || h.z <= 0.0 {
+        return 0.0;
+    }
+    let g1 = 1.0 / (1.0 + smith_lambda_ggx(wo.z, alpha));
+    return g1 * max(dot(wo, h), 0.0) * distribution_ggx(h.z, alpha) / wo.z;
+}
+//#endif
+
+//#if COOK_TORRANCE
+// A microfacet normal of the Beckmann distribution with density D(h)·cos θ_h:
+// tan² θ_h = -α² ln(1 - u₁), φ = 2π u₂ (Walter et al., "Microfacet Models for
+// Refraction through Rough Surfaces", EGSR 2007, eq. 28). Twin of
+// sample_beckmann_normal.
+fn sample_beckmann_normal(alpha: f32, u: vec2<f32>) -> vec3<f32> {
+    let tan_squared = -alpha * alpha * log(1.0 - u.x);
+    let cos_theta = 1.0 / sqrt(1.0 + tan_squared);
+    let sin_theta = sqrt(max(1.0 - cos_theta * cos_theta, 0.0));
+    let phi = 2.0 * PI * u.y;
+    return vec3<f32>(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
+}
+
+// Its density per steradian of normals. Twin of pdf_beckmann_normal.
+fn pdf_beckmann_normal(h: vec3<f32>, alpha: f32) -> f32 {
+    if h.z <= 0.0 {
+        return 0.0;
+    }
+    return distribution_beckmann(h.z, alpha) * h.z;
+}
+//#endif
+
+//#if BLINN_PHONG
+// A half vector of the normalized Blinn-Phong lobe of exponent n, density
+// (n + 2)/(2π)·cos^(n+1) θ_h: cos θ_h = (1 - u₁)^(1/(n+2)), φ = 2π u₂ (inverting its
+// CDF in cos θ_h). Twin of sample_blinn_phong_half.
+fn sample_blinn_phong_half(n: f32, u: vec2<f32>) -> vec3<f32> {
+    let cos_theta = pow(1.0 - u.x, 1.0 / (n + 2.0));
+    let sin_theta = sqrt(max(1.0 - cos_theta * cos_theta, 0.0));
+    let phi = 2.0 * PI * u.y;
+    return vec3<f32>(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
+}
+
+// Its density per steradian of half vectors. Twin of pdf_blinn_phong_half.
+fn pdf_blinn_phong_half(h: vec3<f32>, n: f32) -> f32 {
+    if h.z <= 0.0 {
+        return 0.0;
+    }
+    return (n + 2.0) / (2.0 * PI) * pow(h.z, n + 1.0);
+}
+//#endif

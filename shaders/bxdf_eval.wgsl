@@ -1,6 +1,9 @@
 // Test kernel: evaluates eval_brdf for a list of cases, so that tests can compare the
 // WGSL BRDFs with their CPU twins (tests/integration/bxdf_gpu_twin.rs). Not part of the renderer.
 
+#import types
+#import bxdf
+
 struct BrdfCase {
     // Index into `eval_materials`.
     material: u32,

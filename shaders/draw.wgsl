@@ -2,7 +2,7 @@
 // covers the pass's viewport, which the film fills, each framebuffer pixel showing the
 // film texel under its centre (nearest texel). A viewport of the film's size shows
 // film pixel (x, y) at viewport pixel (x, y); a larger one scales the film up.
-// Composed as color.wgsl + draw.wgsl; DRAW_MODE is chosen on the host from the
+// DRAW_MODE is chosen on the host from the
 // scene's sRGB rule and the attachment's format (src/gpu/draw.rs, DrawMode):
 //   0: clamp only (linear radiance into an *Srgb attachment, which encodes it; or
 //      naive-gamma display values into a linear-unorm attachment);
@@ -10,18 +10,11 @@
 //   2: sRGB decode (naive-gamma display values into an *Srgb attachment, whose
 //      encoding then gives the values back: no double encoding).
 
+#import color
+
 override DRAW_MODE: u32 = 0u;
 
 @group(0) @binding(0) var film_mean: texture_2d<f32>;
-
-// Inverse of srgb_encode (IEC 61966-2-1:1999, section 5.2), twin of `srgb_decode` in
-// src/color.rs; input in [0, 1].
-fn srgb_decode(encoded: f32) -> f32 {
-    if (encoded <= 0.04045) {
-        return encoded / 12.92;
-    }
-    return pow((encoded + 0.055) / 1.055, 2.4);
-}
 
 // The triangle's corner and where it falls on the film, in [0, 1]² over the viewport
 // (u to the right, v down: film row 0 is the top row).
@@ -51,7 +44,7 @@ fn draw_film(vertex: DrawVertex) -> @location(0) vec4<f32> {
     let value = textureLoad(film_mean, xy, 0).rgb;
     var c = vec3<f32>(clamp_unit(value.x), clamp_unit(value.y), clamp_unit(value.z));
     if (DRAW_MODE == 1u) {
-        c = srgb_encode3(value);
+        c = vec3<f32>(srgb_encode(value.x), srgb_encode(value.y), srgb_encode(value.z));
     } else if (DRAW_MODE == 2u) {
         c = vec3<f32>(srgb_decode(c.x), srgb_decode(c.y), srgb_decode(c.z));
     }

@@ -3,10 +3,12 @@
 // EnvironmentMap (src/scene/environment.rs, which documents the direction-to-(u, v)
 // mapping, Mitsuba 3's `envmap`) and EnvironmentLight (src/accel/environment.rs:
 // pbrt-v4's PiecewiseConstant2D over luminance · sin θ, density per steradian
-// p(u, v) / (2π² sin θ)). Without the ENVIRONMENT_MAP feature the background is the
-// constant frame.background.
+// p(u, v) / (2π² sin θ)). Imported only by modules with the ENVIRONMENT_MAP feature;
+// without it the background is the constant frame.background.
 
-//#if ENVIRONMENT_MAP
+#import path_types
+#import math
+
 // The header and data described in src/gpu/environment.rs: texels (rgb), the sampling
 // function per texel, the rows' conditional CDFs, the marginal CDF.
 struct EnvironmentBuffer {
@@ -102,7 +104,7 @@ struct CellSample {
     x: f32,
 }
 
-fn environment_sample_1d(offset: u32, n: u32, u: f32) -> CellSample {
+fn distribution_1d_sample(offset: u32, n: u32, u: f32) -> CellSample {
     // The first index of [0, n + 1) whose value exceeds u.
     var low = 0u;
     var high = n + 1u;
@@ -142,8 +144,8 @@ fn environment_sample(u: vec2<f32>) -> EnvironmentSample {
     }
     let w = environment.header.width;
     let h = environment.header.height;
-    let row = environment_sample_1d(environment_marginal_offset(), h, u.y);
-    let column = environment_sample_1d(environment_conditional_offset() + row.cell * (w + 1u), w, u.x);
+    let row = distribution_1d_sample(environment_marginal_offset(), h, u.y);
+    let column = distribution_1d_sample(environment_conditional_offset() + row.cell * (w + 1u), w, u.x);
     let texel = row.cell * w + column.cell;
     let pdf_uv = environment.data[environment_function_offset() + texel] / integral;
     let sin_theta = sin(PI * row.x);
@@ -172,27 +174,4 @@ fn environment_pdf(wi: vec3<f32>) -> f32 {
     let texel = environment_texel_at(environment_direction_to_uv(local));
     let f = environment.data[environment_function_offset() + texel];
     return f / integral / (2.0 * PI * PI * sin_theta);
-}
-//#endif
-
-// The probability that next-event estimation picks the environment rather than an
-// area light: 0 without a map. Twin of environment_selection (src/cpu/path.rs).
-fn environment_selection() -> f32 {
-    //#if ENVIRONMENT_MAP
-    return environment.header.selection;
-    //#else
-    return 0.0;
-    //#endif
-}
-
-// The radiance a ray escaping along the unit `direction` sees: the map's texel times
-// its scale, or the constant background. Twin of background_radiance
-// (src/cpu/trace.rs).
-fn background_radiance(direction: vec3<f32>) -> vec3<f32> {
-    //#if ENVIRONMENT_MAP
-    if environment_present() {
-        return environment_radiance(direction);
-    }
-    //#endif
-    return frame.background;
 }

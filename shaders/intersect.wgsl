@@ -1,6 +1,13 @@
 // Ray/primitive intersection. CPU twin: src/cpu/intersect.rs (same function names).
 // Every routine returns the ray parameter of the nearest hit in (0, t_max), or NO_HIT.
 
+#import types
+#import records
+#import bindings
+#import budget
+#import math
+#import instance
+
 const NO_HIT: f32 = -1.0;
 
 struct Ray {
@@ -36,70 +43,13 @@ fn flat_hit(prim: u32, t: f32, normal: vec3<f32>, material: u32, position: vec3<
                vec3<f32>(1.0, 0.0, 0.0), NO_INSTANCE);
 }
 
-//#if INSTANCES
-// A placement of an instanced mesh (twin of accel::Instance), unpacked from the four
-// bvh_nodes records the host stores it in (instance_records in src/gpu/upload.rs):
-// the columns of object_to_world and of world_to_object (the images of x, y and z,
-// then the translation), the root node of its mesh's tree, its material and whether
-// it mirrors.
-struct Instance {
-    o2w_x: vec3<f32>,
-    o2w_y: vec3<f32>,
-    o2w_z: vec3<f32>,
-    o2w_t: vec3<f32>,
-    w2o_x: vec3<f32>,
-    w2o_y: vec3<f32>,
-    w2o_z: vec3<f32>,
-    w2o_t: vec3<f32>,
-    root: u32,
-    material: u32,
-    mirrored: bool,
-}
-
-fn load_instance(record: u32) -> Instance {
-    let a = bvh_nodes[record];
-    let b = bvh_nodes[record + 1u];
-    let c = bvh_nodes[record + 2u];
-    let d = bvh_nodes[record + 3u];
-    return Instance(a.min, a.max, b.min, b.max, c.min, c.max, d.min, d.max, a.first, a.count,
-                    b.first != 0u);
-}
-
-// A mesh-space point in world space.
-fn instance_point(instance: Instance, p: vec3<f32>) -> vec3<f32> {
-    return instance.o2w_x * p.x + instance.o2w_y * p.y + instance.o2w_z * p.z + instance.o2w_t;
-}
-
-// A mesh-space normal in world space, not normalised: through the inverse transpose
-// of the linear part, which is the transpose of world_to_object's.
-fn instance_normal(instance: Instance, n: vec3<f32>) -> vec3<f32> {
-    return vec3<f32>(dot(instance.w2o_x, n), dot(instance.w2o_y, n), dot(instance.w2o_z, n));
-}
-
-// Mesh triangle `index` of instance `record` in world space, as a flattened placement
-// stores it: corners moved, corners 1 and 2 swapped under a mirroring transform (which
-// keeps the winding normal facing out), the instance's material. CPU twin:
-// Instance::world_triangle.
-fn instance_triangle(index: u32, record: u32) -> Triangle {
-    let instance = load_instance(record);
-    var triangle = triangles[index];
-    let v1 = instance_point(instance, triangle.v1);
-    let v2 = instance_point(instance, triangle.v2);
-    triangle.v0 = instance_point(instance, triangle.v0);
-    triangle.v1 = select(v1, v2, instance.mirrored);
-    triangle.v2 = select(v2, v1, instance.mirrored);
-    triangle.material = instance.material;
-    return triangle;
-}
-//#endif
-
 //#if MESH_ATTRIBUTES
 // The triangle a hit is on, in world space: the scene's own, or an instanced mesh's
 // moved by its instance.
 fn world_triangle(prim: u32, instance: u32) -> Triangle {
     //#if INSTANCES
     if instance != NO_INSTANCE {
-        return instance_triangle(prim_index(prim), instance);
+        return instance_world_triangle(prim_index(prim), instance);
     }
     //#endif
     return triangles[prim_index(prim)];
@@ -345,7 +295,7 @@ fn edge_crosses(point: vec2<f32>, previous: vec2<f32>, current: vec2<f32>) -> bo
 // over the vertices with indices clamped to the last one, so a triangle's fourth edge
 // joins its last vertex to itself and cannot cross (the even-odd count is unchanged).
 fn point_in_polygon(p: vec3<f32>, polygon: Polygon) -> bool {
-    // Its edges count against the invocation's budget (traverse.wgsl).
+    // Its edges count against the invocation's budget (budget.wgsl).
     iterations += polygon.vertex_count;
     return inside_polygon_points(project_to_plane(p, polygon.dropped_axis), polygon.first_vertex,
                                  polygon.vertex_count);
@@ -396,11 +346,6 @@ struct ShearedRay {
     axes: vec3<u32>,
     // shear_x, shear_y, shear_z.
     shear: vec3<f32>,
-}
-
-// Component `k` (0, 1 or 2) of `v`, picked with selects rather than a dynamic index.
-fn vector_component(v: vec3<f32>, k: u32) -> f32 {
-    return select(select(v.x, v.y, k == 1u), v.z, k == 2u);
 }
 
 // `v` with its components reordered to (kx, ky, kz).
@@ -532,12 +477,12 @@ fn triangle_hit(prim: u32, instance: u32, triangle: Triangle, p: vec3<f32>, t: f
 
 // hit_record of the surface (`prim`, `instance`): for an instanced mesh's triangle,
 // made from the triangle moved to world space (instance_triangle) at the world point.
-// CPU twin: hit_record_keyed.
-fn hit_record_in(prim: u32, instance: u32, ray: Ray, t: f32) -> Hit {
+// Twin of hit_record_keyed.
+fn hit_record_keyed(prim: u32, instance: u32, ray: Ray, t: f32) -> Hit {
     //#if INSTANCES
     //#if TRIANGLES
     if instance != NO_INSTANCE {
-        return triangle_hit(prim, instance, instance_triangle(prim_index(prim), instance),
+        return triangle_hit(prim, instance, instance_world_triangle(prim_index(prim), instance),
                             ray_at(ray, t), t);
     }
     //#endif
@@ -598,4 +543,18 @@ fn offset_ray_origin(p: vec3<f32>, n: vec3<f32>, scale: f32) -> vec3<f32> {
     let ulps = vec3<i32>(256.0 * n);
     let moved = bitcast<vec3<f32>>(bitcast<vec3<i32>>(p) + select(ulps, -ulps, p < vec3<f32>(0.0)));
     return select(moved, p + ((1.0 / 65536.0) * scale) * n, abs(p) < vec3<f32>((1.0 / 32.0) * scale));
+}
+
+// The exclusive distance limit for testing the surface (`instance`, `prim`) against
+// the best hit so far: the best distance, or just beyond it for a smaller key, which
+// wins exact ties; the key orders by instance, the scene's own primitives
+// (NO_INSTANCE) after every instance, then by prim (HitKey's order). Twin of
+// limit_for.
+fn limit_for(prim: u32, instance: u32, best_t: f32, best_prim: u32, best_instance: u32) -> f32 {
+    let smaller = instance < best_instance || (instance == best_instance && prim < best_prim);
+    if best_prim != NO_PRIM && smaller && best_t < bitcast<f32>(0x7f800000u) {
+        // The next f32 up: best_t is positive and finite.
+        return bitcast<f32>(bitcast<u32>(best_t) + 1u);
+    }
+    return best_t;
 }

@@ -1,11 +1,10 @@
-//#if PATH
 // The path-tracing integrator (`integrator = "path"`): the WGSL twin of
-// src/cpu/path.rs (path_radiance) and of its samplers, src/cpu/sample.rs, documented
-// in docs/path-tracing.md. It runs in the wavefront engine of shaders/trace.wgsl, one
+// src/cpu/path.rs (path_radiance) and of its samplers, src/sample.rs, documented
+// in docs/path-tracing.md. It runs in the wavefront engine of wavefront.wgsl, one
 // bounce per shading step, when frame.flags has FLAG_PATH:
 //
 // - a miss adds the background, or the environment map's radiance weighted by multiple
-//   importance sampling against its next-event estimation (shaders/environment.wgsl);
+//   importance sampling against its next-event estimation (environment.wgsl);
 // - at a hit (path_closest_hit) the path adds the emission it finds (weighted by
 //   multiple importance sampling against next-event estimation), picks one event of
 //   the material, and decides its continuation at once: the next ray (BRDF-sampled,
@@ -22,9 +21,26 @@
 // The path therefore draws the CPU's numbers for the CPU's decisions, in the CPU's
 // order of sums: the images agree per pixel within f32 rounding (tests/integration/path_gpu.rs).
 
-// The emitters of the AreaLights distribution (src/gpu/area_lights.rs), in the CPU's
-// order; one EMITTER_NONE record when the scene has none.
-@group(0) @binding(19) var<storage, read> emitters: array<Emitter>;
+#import types
+#import path_types
+#import bindings
+#import records
+#import math
+#import color
+#import sample
+#import medium
+#import intersect
+#import texture
+#import bxdf
+#import slot
+#import area_lights
+#import trace
+//#if ENVIRONMENT_MAP
+#import environment
+//#endif
+//#if TABULATED
+#import tabulated
+//#endif
 
 // Bounces after which Russian roulette may end a path. Twin of ROULETTE_DEPTH.
 const ROULETTE_DEPTH: u32 = 3u;
@@ -40,19 +56,6 @@ const DIMENSIONS_PER_BOUNCE: u32 = 8u;
 // perfectly specular event): its emission is not weighted.
 const NO_BRDF_PDF: f32 = -1.0;
 
-// Whether this trace uses the path integrator.
-fn path_mode() -> bool {
-    return (frame.flags & FLAG_PATH) != 0u;
-}
-
-// A uniform number in [0, 1) for dimension `dimension` of sample `sample` of image
-// pixel `pixel`: the three counters hashed in turn by PCG's RXS-M-XS permutation
-// (Jarzynski and Olano, JCGT 9(3), 2020; pcg_hash in shaders/sampling.wgsl), the top
-// 24 bits scaled by 2^-24, exact in f32. Twin of random_number (src/cpu/sample.rs).
-fn random_number(pixel: u32, sample: u32, dimension: u32) -> f32 {
-    return unit_from_hash(pcg_hash(pcg_hash(pcg_hash(pixel) ^ sample) ^ dimension));
-}
-
 // Random number `k` of the path's current bounce: dimension 2 + 8·depth + k of its
 // sample, for its image pixel (y·width + x).
 fn path_random(path: ptr<function, PathState>, k: u32) -> f32 {
@@ -61,256 +64,14 @@ fn path_random(path: ptr<function, PathState>, k: u32) -> f32 {
     return random_number(xy.y * frame.width + xy.x, (*path).sample, dimension);
 }
 
-// Relative luminance of a linear Rec. 709 colour (ITU-R BT.709 weights). Twin of
-// luminance (src/cpu/path.rs), in its order of sums.
-fn path_luminance(c: vec3<f32>) -> f32 {
-    return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
-}
-
-// `v / |v|`, or zero for a zero vector (glam's normalize_or_zero).
-fn normalize_or_zero(v: vec3<f32>) -> vec3<f32> {
-    let length_squared = dot(v, v);
-    if !(length_squared > 0.0) {
-        return vec3<f32>(0.0);
-    }
-    return v / sqrt(length_squared);
-}
-
-// An orthonormal basis around a unit normal (z = n), without branches on the normal's
-// direction except its sign (Duff et al., "Building an Orthonormal Basis, Revisited",
-// JCGT 6(1), 2017). Twin of ShadingFrame.
-struct ShadingFrame {
-    x: vec3<f32>,
-    y: vec3<f32>,
-    z: vec3<f32>,
-}
-
-fn shading_frame(n: vec3<f32>) -> ShadingFrame {
-    // copysign(1, n.z), read from the sign bit as Rust's copysign does (-0 gives -1).
-    let sign = select(1.0, -1.0, (bitcast<u32>(n.z) & 0x80000000u) != 0u);
-    let a = -1.0 / (sign + n.z);
-    let b = n.x * n.y * a;
-    return ShadingFrame(vec3<f32>(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
-                        vec3<f32>(b, sign + n.y * n.y * a, -n.y), n);
-}
-
-fn frame_to_local(f: ShadingFrame, v: vec3<f32>) -> vec3<f32> {
-    return vec3<f32>(dot(v, f.x), dot(v, f.y), dot(v, f.z));
-}
-
-fn frame_to_world(f: ShadingFrame, v: vec3<f32>) -> vec3<f32> {
-    return f.x * v.x + f.y * v.y + f.z * v.z;
-}
-
-// A point of the unit disk, uniform in area, by Shirley and Chiu's concentric map ("A
-// Low Distortion Map Between Disk and Square", JGT 2(3), 1997). Twin of
-// sample_concentric_disk.
-fn sample_concentric_disk(u: vec2<f32>) -> vec2<f32> {
-    let p = u * 2.0 - vec2<f32>(1.0);
-    if all(p == vec2<f32>(0.0)) {
-        return vec2<f32>(0.0);
-    }
-    let quarter = PI / 4.0;
-    var r = p.y;
-    var theta = 2.0 * quarter - quarter * (p.x / p.y);
-    if abs(p.x) > abs(p.y) {
-        r = p.x;
-        theta = quarter * (p.y / p.x);
-    }
-    return vec2<f32>(r * cos(theta), r * sin(theta));
-}
-
-// A direction of the upper hemisphere with density cos θ / π (Malley's method: a
-// uniform disk point lifted onto the hemisphere). Twin of sample_cosine_hemisphere.
-fn sample_cosine_hemisphere(u: vec2<f32>) -> vec3<f32> {
-    let d = sample_concentric_disk(u);
-    return vec3<f32>(d.x, d.y, sqrt(max(1.0 - dot(d, d), 0.0)));
-}
-
-// The density of sample_cosine_hemisphere per steradian. Twin of pdf_cosine_hemisphere.
-fn pdf_cosine_hemisphere(w: vec3<f32>) -> f32 {
-    return max(w.z, 0.0) * (1.0 / PI);
-}
-
-//#if COOK_TORRANCE || PBR
-// A microfacet normal of the isotropic GGX distribution visible from the local `wo`:
-// Heitz, "Sampling the GGX Distribution of Visible Normals", JCGT 7(4), 2018, listing
-// 1. Twin of sample_ggx_visible_normal.
-fn sample_ggx_visible_normal(wo: vec3<f32>, alpha: f32, u: vec2<f32>) -> vec3<f32> {
-    // The view direction stretched to alpha = 1, and a basis around it (T1 horizontal).
-    let vh = normalize(vec3<f32>(alpha * wo.x, alpha * wo.y, wo.z));
-    let length_squared = vh.x * vh.x + vh.y * vh.y;
-    var t1 = vec3<f32>(1.0, 0.0, 0.0);
-    if length_squared > 0.0 {
-        t1 = vec3<f32>(-vh.y, vh.x, 0.0) / sqrt(length_squared);
-    }
-    let t2 = cross(vh, t1);
-    // A point of the projected area: a disk, its far half squeezed by vh.z.
-    let r = sqrt(u.x);
-    let phi = 2.0 * PI * u.y;
-    let p1 = r * cos(phi);
-    let s = 0.5 * (1.0 + vh.z);
-    let p2 = (1.0 - s) * sqrt(max(1.0 - p1 * p1, 0.0)) + s * r * sin(phi);
-    // Onto the hemisphere, and back to the ellipsoid configuration.
-    let nh = t1 * p1 + t2 * p2 + vh * sqrt(max(1.0 - p1 * p1 - p2 * p2, 0.0));
-    return normalize(vec3<f32>(alpha * nh.x, alpha * nh.y, max(nh.z, 0.0)));
-}
-
-// Its density per steradian of normals, D_wo(h) = G1(wo)·max(0, wo·h)·D(h) / wo.z
-// (Heitz 2018, eq. 1). Twin of pdf_ggx_visible_normal.
-fn pdf_ggx_visible_normal(wo: vec3<f32>, h: vec3<f32>, alpha: f32) -> f32 {
-    if wo.z <= 0.0 || h.z <= 0.0 {
-        return 0.0;
-    }
-    let g1 = 1.0 / (1.0 + smith_lambda_ggx(wo.z, alpha));
-    return g1 * max(dot(wo, h), 0.0) * distribution_ggx(h.z, alpha) / wo.z;
-}
-//#endif
-
-//#if COOK_TORRANCE
-// A microfacet normal of the Beckmann distribution with density D(h)·cos θ_h:
-// tan² θ_h = -α² ln(1 - u₁), φ = 2π u₂ (Walter et al., "Microfacet Models for
-// Refraction through Rough Surfaces", EGSR 2007, eq. 28). Twin of
-// sample_beckmann_normal.
-fn sample_beckmann_normal(alpha: f32, u: vec2<f32>) -> vec3<f32> {
-    let tan_squared = -alpha * alpha * log(1.0 - u.x);
-    let cos_theta = 1.0 / sqrt(1.0 + tan_squared);
-    let sin_theta = sqrt(max(1.0 - cos_theta * cos_theta, 0.0));
-    let phi = 2.0 * PI * u.y;
-    return vec3<f32>(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
-}
-
-// Its density per steradian of normals. Twin of pdf_beckmann_normal.
-fn pdf_beckmann_normal(h: vec3<f32>, alpha: f32) -> f32 {
-    if h.z <= 0.0 {
-        return 0.0;
-    }
-    return distribution_beckmann(h.z, alpha) * h.z;
-}
-//#endif
-
-//#if BLINN_PHONG
-// A half vector of the normalized Blinn-Phong lobe of exponent n, density
-// (n + 2)/(2π)·cos^(n+1) θ_h: cos θ_h = (1 - u₁)^(1/(n+2)), φ = 2π u₂ (inverting its
-// CDF in cos θ_h). Twin of sample_blinn_phong_half.
-fn sample_blinn_phong_half(n: f32, u: vec2<f32>) -> vec3<f32> {
-    let cos_theta = pow(1.0 - u.x, 1.0 / (n + 2.0));
-    let sin_theta = sqrt(max(1.0 - cos_theta * cos_theta, 0.0));
-    let phi = 2.0 * PI * u.y;
-    return vec3<f32>(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
-}
-
-// Its density per steradian of half vectors. Twin of pdf_blinn_phong_half.
-fn pdf_blinn_phong_half(h: vec3<f32>, n: f32) -> f32 {
-    if h.z <= 0.0 {
-        return 0.0;
-    }
-    return (n + 2.0) / (2.0 * PI) * pow(h.z, n + 1.0);
-}
-//#endif
-
-// The direction `wo` reflects into about the half vector `h`. Twin of reflect_about.
-fn reflect_about(wo: vec3<f32>, h: vec3<f32>) -> vec3<f32> {
-    return h * (2.0 * dot(wo, h)) - wo;
-}
-
-// The density of a reflected direction from its half vector's, by the Jacobian
-// dω_h/dω_i = 1 / (4 |wo·h|) (Walter et al. 2007, eq. 14). Twin of reflected_pdf.
-fn reflected_pdf(pdf_h: f32, wo_dot_h: f32) -> f32 {
-    if wo_dot_h == 0.0 {
-        return 0.0;
-    }
-    return pdf_h / (4.0 * abs(wo_dot_h));
-}
-
-//#if SPHERES
-// A direction from `point` uniform over the cone a sphere subtends, with density
-// 1 / (2π (1 - cos θ_max)); not found inside the sphere (Shirley and Wang, "Direct
-// Lighting Calculation by Monte Carlo Integration", EGWR 1991; pbrt-v4 §6.2.4). Twin
-// of sample_sphere_cone; sin² θ is computed as a(2 - a) with a = 1 - cos θ, which
-// equals the CPU's 1 - cos² θ but keeps f32's precision for small cones.
-struct DirectionSample {
-    wi: vec3<f32>,
-    pdf: f32,
-    found: bool,
-}
-
-fn sample_sphere_cone(point: vec3<f32>, center: vec3<f32>, radius: f32, u: vec2<f32>) -> DirectionSample {
-    var sample = DirectionSample(vec3<f32>(0.0), 0.0, false);
-    let to_center = center - point;
-    let distance_squared = dot(to_center, to_center);
-    if distance_squared <= radius * radius {
-        return sample;
-    }
-    let sin_squared_max = radius * radius / distance_squared;
-    let cos_max = sqrt(max(1.0 - sin_squared_max, 0.0));
-    // 1 - cos θ_max, without cancellation for small, far spheres.
-    let one_minus_cos_max = sin_squared_max / (1.0 + cos_max);
-    let a = u.x * one_minus_cos_max;
-    let cos_theta = 1.0 - a;
-    let sin_theta = sqrt(max(a * (2.0 - a), 0.0));
-    let phi = 2.0 * PI * u.y;
-    let frame = shading_frame(to_center / sqrt(distance_squared));
-    let local = vec3<f32>(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
-    sample.wi = frame_to_world(frame, local);
-    sample.pdf = 1.0 / (2.0 * PI * one_minus_cos_max);
-    sample.found = true;
-    return sample;
-}
-
-// Its density for the unit direction `w`: 0 outside the cone or inside the sphere.
-// Twin of pdf_sphere_cone.
-fn pdf_sphere_cone(point: vec3<f32>, center: vec3<f32>, radius: f32, w: vec3<f32>) -> f32 {
-    let to_center = center - point;
-    let distance_squared = dot(to_center, to_center);
-    if distance_squared <= radius * radius {
-        return 0.0;
-    }
-    let sin_squared_max = radius * radius / distance_squared;
-    let cos_max = sqrt(max(1.0 - sin_squared_max, 0.0));
-    if dot(w, to_center) < cos_max * sqrt(distance_squared) {
-        return 0.0;
-    }
-    return 1.0 / (2.0 * PI * sin_squared_max / (1.0 + cos_max));
-}
-//#endif
-
-// Barycentric coordinates of a point uniform in area over a triangle: b₀ = 1 - √u₁,
-// b₁ = u₂ √u₁ (Turk, "Generating Random Points in Triangles", Graphics Gems, 1990).
-// Twin of sample_triangle_barycentrics.
-fn sample_triangle_barycentrics(u: vec2<f32>) -> vec3<f32> {
-    let root = sqrt(u.x);
-    let b0 = 1.0 - root;
-    let b1 = u.y * root;
-    return vec3<f32>(b0, b1, 1.0 - b0 - b1);
-}
-
-// The density per steradian, seen from `point`, of a point sampled with density
-// `pdf_area` per unit area: pdf_area · r² / |cos θ_light| (pbrt-v4 §4.2.3). Twin of
-// area_to_solid_angle_pdf.
-fn area_to_solid_angle_pdf(pdf_area: f32, point: vec3<f32>, on_light: vec3<f32>, light_normal: vec3<f32>) -> f32 {
-    let to_light = on_light - point;
-    let distance_squared = dot(to_light, to_light);
-    let cos_light = abs(dot(light_normal, to_light)) / sqrt(distance_squared);
-    if cos_light == 0.0 {
-        return 0.0;
-    }
-    return pdf_area * distance_squared / cos_light;
-}
-
-// The power heuristic with exponent 2, a² / (a² + b²) (Veach's thesis, 1997, §9.2.4).
-// Twin of power_heuristic, written with the ratio of the smaller density to the larger
-// so that f32 squares of large densities cannot overflow (equal in exact arithmetic).
-fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
-    if pdf_a == 0.0 && pdf_b == 0.0 {
-        return 0.0;
-    }
-    if pdf_a >= pdf_b {
-        let r = pdf_b / pdf_a;
-        return 1.0 / (1.0 + r * r);
-    }
-    let r = pdf_a / pdf_b;
-    return r * r / (1.0 + r * r);
+// The probability that next-event estimation picks the environment rather than an
+// area light: 0 without a map. Twin of environment_selection (src/cpu/path.rs).
+fn environment_selection() -> f32 {
+    //#if ENVIRONMENT_MAP
+    return environment.header.selection;
+    //#else
+    return 0.0;
+    //#endif
 }
 
 // The probability that the base BRDF's sampler picks its specular lobe (the lobes mixed
@@ -319,8 +80,8 @@ fn specular_lobe_probability(material: Material) -> f32 {
     var p = 0.0;
     //#if BLINN_PHONG
     if material.kind == MATERIAL_BLINN_PHONG {
-        let d = path_luminance(material.diffuse);
-        let s = path_luminance(material.specular);
+        let d = luminance(material.diffuse);
+        let s = luminance(material.specular);
         if d + s > 0.0 {
             p = s / (d + s);
         }
@@ -394,11 +155,11 @@ fn pdf_half_vector(material: Material, wo: vec3<f32>, h: vec3<f32>) -> f32 {
 // (world): a tabulated BRDF by its map's inverse CDF (shaders/tabulated.wgsl), else the
 // specular lobe with its probability, else the cosine sampler. Twin of sample_brdf.
 fn sample_brdf(material: Material, n: vec3<f32>, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> vec3<f32> {
-    let frame = shading_frame(n);
-    let wo_local = frame_to_local(frame, wo);
+    let basis = shading_frame(n);
+    let wo_local = shading_frame_to_local(basis, wo);
     //#if TABULATED
     if material.kind == MATERIAL_TABULATED && material.brdf_map_layer != NO_IMAGE {
-        return frame_to_world(frame, sample_tabulated(material.brdf_map_layer,
+        return shading_frame_to_world(basis, sample_tabulated(material.brdf_map_layer,
                                                       material.brdf_map_size, wo_local, u_lobe, u));
     }
     //#endif
@@ -406,15 +167,15 @@ fn sample_brdf(material: Material, n: vec3<f32>, wo: vec3<f32>, u_lobe: f32, u: 
     if u_lobe < specular_lobe_probability(material) {
         local = reflect_about(wo_local, sample_half_vector(material, wo_local, u));
     }
-    return frame_to_world(frame, local);
+    return shading_frame_to_world(basis, local);
 }
 
 // The density per steradian of sample_brdf producing `wi`: the mixture of its lobes'.
 // Twin of pdf_brdf.
 fn pdf_brdf(material: Material, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
-    let frame = shading_frame(n);
-    let wo_local = frame_to_local(frame, wo);
-    let wi_local = frame_to_local(frame, wi);
+    let basis = shading_frame(n);
+    let wo_local = shading_frame_to_local(basis, wo);
+    let wi_local = shading_frame_to_local(basis, wi);
     //#if TABULATED
     if material.kind == MATERIAL_TABULATED && material.brdf_map_layer != NO_IMAGE {
         return pdf_tabulated(material.brdf_map_layer, material.brdf_map_size, wo_local, wi_local);
@@ -431,66 +192,13 @@ fn pdf_brdf(material: Material, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f
     return pdf;
 }
 
-// How many emitters the scene has (the padding record of none is EMITTER_NONE).
-fn emitter_count() -> u32 {
-    if emitters[0].kind == EMITTER_NONE {
-        return 0u;
-    }
-    return arrayLength(&emitters);
-}
-
-// The emitter chosen by u ∈ [0, 1): the first whose cumulative probability exceeds u,
-// at most the last (CPU: AreaLights::choose, partition_point(c <= u·total)); binary
-// search, at most 32 steps.
-fn choose_emitter(u: f32, count: u32) -> u32 {
-    var low = 0u;
-    var high = count;
-    for (var step = 0u; step < 32u && low < high; step += 1u) {
-        let middle = (low + high) / 2u;
-        if emitters[middle].cdf <= u {
-            low = middle + 1u;
-        } else {
-            high = middle;
-        }
-    }
-    return min(low, count - 1u);
-}
-
-// Whether emitter record `index` comes before the surface (instance, prim) in the
-// records' order: ascending instance (NO_INSTANCE, the scene's own, last), then prim.
-fn emitter_before(index: u32, prim: u32, instance: u32) -> bool {
-    let e = emitters[index];
-    return e.instance < instance || (e.instance == instance && e.prim < prim);
-}
-
-// The first emitter record of primitive `prim` in instance `instance` (NO_INSTANCE for
-// the scene's own), or NO_PRIM when it is no sampled emitter (CPU:
-// AreaLights::first_of); binary search over the records' ascending (instance, prim).
-fn first_emitter_of(prim: u32, instance: u32) -> u32 {
-    let count = emitter_count();
-    var low = 0u;
-    var high = count;
-    for (var step = 0u; step < 32u && low < high; step += 1u) {
-        let middle = (low + high) / 2u;
-        if emitter_before(middle, prim, instance) {
-            low = middle + 1u;
-        } else {
-            high = middle;
-        }
-    }
-    if low < count && emitters[low].prim == prim && emitters[low].instance == instance {
-        return low;
-    }
-    return NO_PRIM;
-}
-
 // The density per steradian with which next-event estimation from `point` samples the
 // direction towards `hit`, made in instance `instance` (0 if `hit` is on no sampled
 // emitter): a sphere's cone
 // density times its selection probability, a flat emitter's selection / area per unit
 // area converted to solid angle. Twin of AreaLights::pdf.
 fn emitter_pdf(point: vec3<f32>, hit: Hit, instance: u32) -> f32 {
-    let index = first_emitter_of(hit.prim, instance);
+    let index = area_lights_first_piece(hit.prim, instance);
     if index == NO_PRIM {
         return 0.0;
     }
@@ -555,7 +263,7 @@ fn path_emitter_sample(path: ptr<function, PathState>) -> EmitterSample {
     if count == 0u {
         return sample;
     }
-    sample.emitter = choose_emitter((u_light - p_environment) / (1.0 - p_environment), count);
+    sample.emitter = area_lights_choose((u_light - p_environment) / (1.0 - p_environment), count);
     let emitter = emitters[sample.emitter];
     sample.radiance = emitter.radiance;
     if emitter.kind == EMITTER_SPHERE {
@@ -633,7 +341,7 @@ fn path_closest_hit(path: ptr<function, PathState>, trace: TraceRay) {
         (*path).phase = PHASE_POP;
         return;
     }
-    let hit = hit_record_in(trace.best_prim, trace.best_instance, ray, trace.best_t);
+    let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
     let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv);
     // Emission, weighted against next-event estimation where that could have found it;
     // shadow_origin still holds the previous hit's, where that estimation sampled from.
@@ -668,8 +376,8 @@ fn path_closest_hit(path: ptr<function, PathState>, trace: TraceRay) {
     if has_base_brdf(material.kind) {
         base = response.base;
     }
-    let reflect_weight = path_luminance(response.reflect);
-    let transmit_weight = path_luminance(response.transmit);
+    let reflect_weight = luminance(response.reflect);
+    let transmit_weight = luminance(response.transmit);
     let total = base + reflect_weight + transmit_weight;
     (*path).phase = PHASE_POP;
     if !(total > 0.0) {
@@ -789,7 +497,7 @@ fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
         // A textured emitter's radiance at the point the shadow ray reaches (the
         // sampled point), looked up at that hit's texture coordinates.
         if sample.emitter != ENVIRONMENT_EMITTER {
-            let light_hit = hit_record_in(trace.best_prim, trace.best_instance,
+            let light_hit = hit_record_keyed(trace.best_prim, trace.best_instance,
                                           Ray((*path).shadow_origin, sample.wi), trace.best_t);
             let light_material = materials[light_hit.material];
             if light_material.emission_layer != NO_IMAGE {
@@ -801,4 +509,3 @@ fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
     }
     (*path).phase = PHASE_POP;
 }
-//#endif

@@ -1,28 +1,17 @@
-//#if PATH
-//#if TABULATED
 // Importance sampling of tabulated BRDF maps by inverse CDF, for the path integrator.
 // CPU twin: src/cpu/tabulated.rs (same function names; the sampler and its density
 // are derived there), over the tables of src/accel/brdf_map_cdf.rs: texel (x, y) of
 // the inverse-CDF table of an N×N map is the cumulative probability of the bands
 // θi < θ_x for the outgoing angle θr = θ_y, in the alpha channel of the map's own
-// layer of `images` (shaders/texture.wgsl), the same f32 values the CPU reads.
+// layer of `images` (texture.wgsl), the same f32 values the CPU reads.
+
+#import math
+#import brdf_map_cdf
+#import sample
 
 // The probability of drawing from the cosine distribution instead of the map's. Twin
 // of TABULATED_COSINE_PROBABILITY.
 const TABULATED_COSINE_PROBABILITY: f32 = 0.1;
-
-// Texel (x, y) of the inverse-CDF table of the map in `layer`.
-fn brdf_map_cdf(layer: u32, x: u32, y: u32) -> f32 {
-    return textureLoad(images, vec2<u32>(x, y), layer, 0).a;
-}
-
-// sin² θ_{b+1} − sin² θ_b of band b of an n-texel axis, the band's projected solid angle
-// over π, as sin(θ_{b+1} + θ_b)·sin(θ_{b+1} − θ_b) (no cancellation). Twin of
-// band_projected_solid_angle (src/accel/brdf_map_cdf.rs).
-fn band_projected_solid_angle(b: u32, n: u32) -> f32 {
-    let step = (0.5 * PI) / f32(n - 1u);
-    return sin(f32(2u * b + 1u) * step) * sin(step);
-}
 
 // θ_b = b/(n−1)·π/2, the angle of texel b of an n-texel axis, and its cosine. Twin of
 // grid_angle.
@@ -79,14 +68,14 @@ fn sample_brdf_map_direction(layer: u32, n: u32, cos_o: f32, u_row: f32, u: vec2
     var hi = n - 1u;
     while hi - lo > 1u {
         let mid = (lo + hi) / 2u;
-        if brdf_map_cdf(layer, mid, row) <= u.x {
+        if brdf_map_cdf_value(layer, mid, row) <= u.x {
             lo = mid;
         } else {
             hi = mid;
         }
     }
-    let c0 = brdf_map_cdf(layer, lo, row);
-    let c1 = brdf_map_cdf(layer, lo + 1u, row);
+    let c0 = brdf_map_cdf_value(layer, lo, row);
+    let c1 = brdf_map_cdf_value(layer, lo + 1u, row);
     let t = (u.x - c0) / (c1 - c0);
     let edge = grid_angle(lo, n);
     let ds = band_projected_solid_angle(lo, n);
@@ -106,8 +95,8 @@ fn pdf_brdf_map_direction(layer: u32, n: u32, cos_o: f32, wi: vec3<f32>) -> f32 
     }
     let band = brdf_map_cell(n, min(wi.z, 1.0));
     let rows = brdf_map_rows(n, cos_o);
-    let p0 = brdf_map_cdf(layer, band + 1u, rows.y0) - brdf_map_cdf(layer, band, rows.y0);
-    let p1 = brdf_map_cdf(layer, band + 1u, rows.y0 + 1u) - brdf_map_cdf(layer, band, rows.y0 + 1u);
+    let p0 = brdf_map_cdf_value(layer, band + 1u, rows.y0) - brdf_map_cdf_value(layer, band, rows.y0);
+    let p1 = brdf_map_cdf_value(layer, band + 1u, rows.y0 + 1u) - brdf_map_cdf_value(layer, band, rows.y0 + 1u);
     let probability = (1.0 - rows.w) * p0 + rows.w * p1;
     return probability * wi.z / (PI * band_projected_solid_angle(band, n));
 }
@@ -129,5 +118,3 @@ fn pdf_tabulated(layer: u32, n: u32, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     return TABULATED_COSINE_PROBABILITY * pdf_cosine_hemisphere(wi)
         + (1.0 - TABULATED_COSINE_PROBABILITY) * pdf_brdf_map_direction(layer, n, wo.z, wi);
 }
-//#endif
-//#endif

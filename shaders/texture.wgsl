@@ -1,12 +1,13 @@
-// Texture coordinates and bilinear image lookups. CPU twin: src/cpu/texture.rs (same
+// Texture coordinates and bilinear image lookups. CPU twin: src/texture.rs (same
 // function names and conventions, documented there and in docs/materials.md).
 // Every image of the scene (albedo textures and BRDF maps) is one layer of `images`,
 // in the layer's top-left corner; texels are read with textureLoad (Rgba32Float is not
 // filterable without an optional feature) and filtered here.
 
-@group(0) @binding(11) var images: texture_2d_array<f32>;
+#import types
+#import math
 
-const TEXTURE_PI: f32 = 3.14159265358979323846;
+@group(0) @binding(11) var images: texture_2d_array<f32>;
 
 fn image_texel(layer: u32, x: u32, y: u32) -> vec3<f32> {
     return textureLoad(images, vec2<u32>(x, y), layer, 0).rgb;
@@ -41,10 +42,10 @@ fn texture_coordinates(material: Material, position: vec3<f32>, normal: vec3<f32
     }
     if material.texture_mapping == MAPPING_SPHERICAL {
         let y = clamp(normal.y, -1.0, 1.0);
-        return vec2<f32>(0.5 - atan2(normal.z, normal.x) / (2.0 * TEXTURE_PI), acos(y) / TEXTURE_PI);
+        return vec2<f32>(0.5 - atan2(normal.z, normal.x) / (2.0 * PI), acos(y) / PI);
     }
-    let frame = tangent_frame(normal);
-    return vec2<f32>(dot(position, frame.t), dot(position, frame.b)) / material.texture_scale;
+    let tangents = tangent_frame(normal);
+    return vec2<f32>(dot(position, tangents.t), dot(position, tangents.b)) / material.texture_scale;
 }
 //#endif
 
@@ -91,10 +92,10 @@ fn sample_texture(layer: u32, width: u32, height: u32, uv: vec2<f32>, wrap: vec2
 // θi = x/(N-1)·π/2, θr = y/(N-1)·π/2; bilinear, clamped.
 fn sample_brdf_map(layer: u32, size: u32, theta_i: f32, theta_r: f32) -> vec3<f32> {
     let last = f32(size - 1u);
-    let p = clamp(vec2<f32>(theta_i, theta_r) / (0.5 * TEXTURE_PI), vec2<f32>(0.0), vec2<f32>(1.0)) * last;
+    let p = clamp(vec2<f32>(theta_i, theta_r) / (0.5 * PI), vec2<f32>(0.0), vec2<f32>(1.0)) * last;
     let p0 = min(floor(p), vec2<f32>(last - 1.0));
     let i = vec2<u32>(p0);
-    return bilinear(layer, vec2<u32>(i.x, i.x + 1u), vec2<u32>(i.y, i.y + 1u), p - p0) / TEXTURE_PI;
+    return bilinear(layer, vec2<u32>(i.x, i.x + 1u), vec2<u32>(i.y, i.y + 1u), p - p0) / PI;
 }
 //#endif
 
@@ -102,7 +103,7 @@ fn sample_brdf_map(layer: u32, size: u32, theta_i: f32, theta_r: f32) -> vec3<f3
 // shading_emission, and its metalness and perceptual roughness times the blue and green
 // channels of the metallic/roughness texture where there is one (glTF 2.0 §3.9.2),
 // looked up at the albedo texture's coordinates. Twin of shading_material
-// (src/cpu/texture.rs).
+// (src/texture.rs).
 fn shading_material(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> Material {
     var shaded = material;
     shaded.diffuse = shading_albedo(material, position, normal, uv);
@@ -138,7 +139,7 @@ fn shading_albedo(material: Material, position: vec3<f32>, normal: vec3<f32>, uv
 // The emitted radiance at a point at `position` with geometric normal `normal` and mesh
 // texture coordinates `uv`: material.emission, times the emission texture where there
 // is one (glTF 2.0 §3.9.3: emissiveFactor times the texel), at the albedo texture's
-// coordinates. Twin of shading_emission (src/cpu/texture.rs).
+// coordinates. Twin of shading_emission (src/texture.rs).
 fn shading_emission(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> vec3<f32> {
     //#if TEXTURES
     if material.emission_layer != NO_IMAGE {

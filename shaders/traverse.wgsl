@@ -2,31 +2,37 @@
 // same rules: planes first, then the tree nearest child first; at equal distance the
 // smaller primitive reference wins, so the result does not depend on the visit order).
 //
-// MAX_BVH_DEPTH and MAX_POLYGON_VERTICES are prepended by the host from the Rust
-// constants (src/gpu/shaders.rs).
+// MAX_BVH_DEPTH and MAX_POLYGON_VERTICES come from the Rust constants (the module
+// `limits`, src/gpu/shaders.rs). Every step is charged to the invocation's budget
+// (budget.wgsl).
 //
-// Bounded work: every loop iteration of an invocation is charged to `iterations`
-// (a polygon test by its vertex count), and a traversal that would pass
-// frame.iteration_budget stops between two steps with its state (current node, leaf
-// cursor, best hit, stack depth) saved in its TraceRay and its stack in
-// `traversal_stack`; the next dispatch resumes it. llvmpipe ends every loop of an
-// invocation once the vector of invocations it runs together has made 65,535 loop
-// iterations in all (LP_MAX_TGSI_LOOP_ITERATIONS in Mesa's gallivm). A vector iterates
-// only while one of its lanes does, so its count is at most the sum of its lanes'
-// counts: the host gives each lane the limit divided by the lanes per vector. A loop
-// that ends without reaching one of its exits was cut by the driver all the same: that
-// sets ERROR_LOOP_CUT for the host, which then refuses the image.
+// The traversal runs in steps (`traverse`): a primitive test while a leaf is open,
+// else a node step (pop, or visit an inner node and descend into the child it enters
+// first), so that a lane never waits for the others to finish a phase of their own.
+// Its state between steps and between dispatches is its TraceRay.
 
 // Unrolled scenes: a scene of a few primitives (src/gpu/unrolled.rs says which) gets
-// no tree walk at all. The host writes unrolled_closest_hit, one call of the helpers
-// below per primitive with its record index (and a polygon's vertices) as literals, so
-// every record is read at a constant offset: llvmpipe loads such a record once for all
-// lanes, where a per-lane index costs a load per lane and component, and the
-// primitive's kind is known at compile time. The nearest hit, ties to the smaller
+// no tree walk at all. The host writes unrolled_closest_hit (the module
+// `unrolled_scene`), one call of the helpers of unrolled.wgsl per primitive with its
+// record index (and a polygon's vertices) as literals, so every record is read at a
+// constant offset: llvmpipe loads such a record once for all lanes, where a per-lane
+// index costs a load per lane and component, and the primitive's kind is known at
+// compile time. The nearest hit, ties to the smaller
 // reference, is the tree's (which only skips primitives whose boxes the ray misses),
 // so the image is the same; glass.toml traced 34% faster (BENCHMARKS.md, "Unrolled
 // scenes"). Its work is bounded by the scene: at most
 // MAX_UNROLLED_PRIMITIVES records, charged to `iterations` like the tree's tests.
+
+#import limits
+#import types
+#import records
+#import bindings
+#import budget
+#import intersect
+#import instance
+//#if UNROLLED
+#import unrolled_scene
+//#endif
 
 // Direction components smaller than this are replaced by it (with their sign; -0
 // counts as positive) before the slab test divides by them: a ray parallel to a slab
@@ -38,7 +44,7 @@ const MIN_DIRECTION_COMPONENT: f32 = 1e-20;
 // (Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013).
 const FAR_SLAB_SCALE: f32 = 1.0000003576;
 
-// What advance_traversal did: finished the traversal, stopped because the budget is
+// What `traverse` did: finished the traversal, stopped because the budget is
 // spent (or the loop was cut), or gave way to lanes whose rays have finished.
 const TRAVERSAL_FINISHED: u32 = 0u;
 const TRAVERSAL_SUSPENDED: u32 = 1u;
@@ -67,21 +73,32 @@ const MAX_STEP_COST: u32 = 1u + MAX_POLYGON_VERTICES;
 const MAX_STEP_COST: u32 = 1u;
 //#endif
 
-// Loop iterations this invocation has run (see above).
-var<private> iterations: u32;
-
+// `1 / d` per component, a component smaller than MIN_DIRECTION_COMPONENT in
+// magnitude replaced by it with its sign first. Twin of inverse_direction.
 fn inverse_direction(d: vec3<f32>) -> vec3<f32> {
     let tiny = select(vec3<f32>(MIN_DIRECTION_COMPONENT), vec3<f32>(-MIN_DIRECTION_COMPONENT),
                       d < vec3<f32>(0.0));
     return 1.0 / select(d, tiny, abs(d) < vec3<f32>(MIN_DIRECTION_COMPONENT));
 }
 
+// A ray prepared for the slab tests. Twin of SlabRay.
+struct SlabRay {
+    origin: vec3<f32>,
+    inverse_direction: vec3<f32>,
+}
+
+// Twin of SlabRay::new.
+fn slab_ray(ray: Ray) -> SlabRay {
+    return SlabRay(ray.origin, inverse_direction(ray.direction));
+}
+
 // The distance at which the ray enters node `index`'s box, if it does so in
 // [0, t_max], else NO_HIT (the slab test of Kay and Kajiya, with Ize's far distance).
-fn slab_enter(index: u32, origin: vec3<f32>, inverse: vec3<f32>, t_max: f32) -> f32 {
+// Twin of SlabRay::enter.
+fn slab_ray_enter(slab: SlabRay, index: u32, t_max: f32) -> f32 {
     let node = bvh_nodes[index];
-    let lo = (node.min - origin) * inverse;
-    let hi = (node.max - origin) * inverse;
+    let lo = (node.min - slab.origin) * slab.inverse_direction;
+    let hi = (node.max - slab.origin) * slab.inverse_direction;
     let near_axes = min(lo, hi);
     let far_axes = max(lo, hi);
     let near = max(max(max(near_axes.x, near_axes.y), near_axes.z), 0.0);
@@ -89,21 +106,16 @@ fn slab_enter(index: u32, origin: vec3<f32>, inverse: vec3<f32>, t_max: f32) -> 
     return select(NO_HIT, near, near <= far);
 }
 
-// The exclusive distance limit for testing `prim` against the best hit so far: the
-// best distance, or just beyond it for a smaller reference, which wins exact ties.
-fn tie_limit(prim: u32, best_t: f32, best_prim: u32) -> f32 {
-    return tie_limit_in(prim, NO_INSTANCE, best_t, best_prim, NO_INSTANCE);
+// The ray a traversal walks with, in the space of the tree it is in (the scene's, or
+// an instanced mesh's), prepared once for the slab and the triangle tests.
+struct TraversalRay {
+    ray: Ray,
+    slab: SlabRay,
+    sheared: ShearedRay,
 }
 
-// tie_limit for surfaces with instances: the key (instance, prim) decides ties, the
-// scene's own primitives (NO_INSTANCE) after every instance. CPU twin: HitKey's order.
-fn tie_limit_in(prim: u32, instance: u32, best_t: f32, best_prim: u32, best_instance: u32) -> f32 {
-    let smaller = instance < best_instance || (instance == best_instance && prim < best_prim);
-    if best_prim != NO_PRIM && smaller && best_t < bitcast<f32>(0x7f800000u) {
-        // The next f32 up: best_t is positive and finite.
-        return bitcast<f32>(bitcast<u32>(best_t) + 1u);
-    }
-    return best_t;
+fn traversal_ray(ray: Ray) -> TraversalRay {
+    return TraversalRay(ray, slab_ray(ray), shear_ray(ray));
 }
 
 //#if INSTANCES
@@ -118,16 +130,148 @@ fn object_ray(instance: Instance, ray: Ray) -> Ray {
 }
 //#endif
 
-// Opens node `*node` if it is a leaf: its primitives become the range [*cursor,
-// *leaf_end) and *node becomes NO_NODE (the traversal loop descends only through inner
-// nodes). Called on every node a traversal reaches, in the step that reaches it.
-fn open_if_leaf(node: ptr<function, u32>, cursor: ptr<function, u32>, leaf_end: ptr<function, u32>) {
-    let count = bvh_nodes[*node].count;
-    if count > 0u {
-        *cursor = bvh_nodes[*node].first;
-        *leaf_end = *cursor + count;
-        *node = NO_NODE;
+// The ray a call of `traverse` starts with: the scene's, or for a traversal suspended
+// inside an instance the object-space ray, recomputed from the instance's record.
+fn resumed_ray(trace: ptr<function, TraceRay>) -> TraversalRay {
+    let world_ray = Ray((*trace).origin, (*trace).direction);
+    //#if INSTANCES
+    if (*trace).status == TRACE_RUNNING && (*trace).instance != NO_INSTANCE {
+        return traversal_ray(object_ray(load_instance((*trace).instance), world_ray));
     }
+    //#endif
+    return traversal_ray(world_ray);
+}
+
+// Tests primitive `prim` of the tree being walked against the best hit so far with the
+// tie rule (limit_for), and keeps it if it is nearer. Twin of Query::consider.
+fn consider(trace: ptr<function, TraceRay>, prim: u32, ray: TraversalRay) {
+    let instance = (*trace).instance;
+    let limit = limit_for(prim, instance, (*trace).best_t, (*trace).best_prim, (*trace).best_instance);
+    let t = intersect_prim(prim, ray.ray, ray.sheared, limit);
+    if t != NO_HIT {
+        (*trace).best_t = t;
+        (*trace).best_prim = prim;
+        (*trace).best_instance = instance;
+    }
+}
+
+// Opens the current node if it is a leaf: its primitives become the range [cursor,
+// leaf_end) and the node becomes NO_NODE (the traversal descends only through inner
+// nodes). Called on every node a traversal reaches, in the step that reaches it, so
+// that the node on the saved state is never a leaf.
+fn open_if_leaf(trace: ptr<function, TraceRay>) {
+    let count = bvh_nodes[(*trace).node].count;
+    if count > 0u {
+        (*trace).cursor = bvh_nodes[(*trace).node].first;
+        (*trace).leaf_end = (*trace).cursor + count;
+        (*trace).node = NO_NODE;
+    }
+}
+
+//#if PLANES
+// Tests every plane: planes are unbounded, so every ray tests them all, before the
+// tree.
+fn test_planes(trace: ptr<function, TraceRay>, ray: TraversalRay) {
+    var i = 0u;
+    loop {
+        if i >= frame.plane_count {
+            break;
+        }
+        iterations += 1u;
+        consider(trace, (PRIM_PLANE << PRIM_KIND_SHIFT) | i, ray);
+        i += 1u;
+    }
+    if i < frame.plane_count {
+        atomicOr(&counters.errors, ERROR_LOOP_CUT);
+    }
+}
+//#endif
+
+// Starts a pending traversal: the planes, then the root of the tree; for an unrolled
+// scene, every primitive at once. Returns the steps it took.
+fn start_traversal(trace: ptr<function, TraceRay>, ray: TraversalRay) -> u32 {
+    (*trace).node = NO_NODE;
+    (*trace).cursor = 0u;
+    (*trace).leaf_end = 0u;
+    (*trace).stack_len = 0u;
+    (*trace).instance = NO_INSTANCE;
+    (*trace).stack_base = 0u;
+    (*trace).status = TRACE_RUNNING;
+    //#if UNROLLED
+    // A small scene's every primitive, planes included, in straight-line code with
+    // constant record indices (see "Unrolled scenes" above): the traversal finds
+    // nothing left to visit.
+    var best_t = (*trace).best_t;
+    var best_prim = (*trace).best_prim;
+    unrolled_closest_hit(ray.ray, ray.sheared, &best_t, &best_prim);
+    (*trace).best_t = best_t;
+    (*trace).best_prim = best_prim;
+    // The traversal's one step (so that a simulated loop cut still cuts it).
+    return 1u;
+    //#else
+    //#if PLANES
+    test_planes(trace, ray);
+    //#endif
+    if frame.node_count > 0u && slab_ray_enter(ray.slab, 0u, (*trace).best_t) != NO_HIT {
+        (*trace).node = 0u;
+        open_if_leaf(trace);
+    }
+    return 0u;
+    //#endif
+}
+
+// Whether the traversal is over: an any-hit trace (a shadow ray) has a hit, or nothing
+// is left to visit (no open leaf, current node, stacked node or instance). Twin of
+// Query::done and of the end of Query::walk.
+fn traversal_done(trace: TraceRay) -> bool {
+    return (trace.any_hit != 0u && trace.best_prim != NO_PRIM)
+        || (trace.cursor >= trace.leaf_end && trace.node == NO_NODE && trace.stack_len == 0u
+            && trace.instance == NO_INSTANCE);
+}
+
+//#if INSTANCES
+// Enters instance `record`, named by a leaf of the scene's tree: saves the leaf's
+// position, moves the ray to the mesh's space and continues in the mesh's tree, on the
+// same stack above the depth it entered at (stack_base). Twin of
+// Query::enter_instance.
+fn enter_instance(trace: ptr<function, TraceRay>, record: u32, world_ray: Ray) -> TraversalRay {
+    let placed = load_instance(record);
+    (*trace).world_cursor = (*trace).cursor;
+    (*trace).world_leaf_end = (*trace).leaf_end;
+    (*trace).cursor = 0u;
+    (*trace).leaf_end = 0u;
+    (*trace).instance = record;
+    (*trace).stack_base = (*trace).stack_len;
+    let ray = traversal_ray(object_ray(placed, world_ray));
+    (*trace).node = NO_NODE;
+    if slab_ray_enter(ray.slab, placed.root, (*trace).best_t) != NO_HIT {
+        (*trace).node = placed.root;
+        open_if_leaf(trace);
+    }
+    return ray;
+}
+
+// Leaves the instance whose tree is done: back to the scene's ray and leaf.
+fn leave_instance(trace: ptr<function, TraceRay>, world_ray: Ray) -> TraversalRay {
+    (*trace).instance = NO_INSTANCE;
+    (*trace).stack_base = 0u;
+    (*trace).cursor = (*trace).world_cursor;
+    (*trace).leaf_end = (*trace).world_leaf_end;
+    return traversal_ray(world_ray);
+}
+//#endif
+
+// Tests the open leaf's next primitive, or enters the instance it names.
+fn next_leaf_prim(trace: ptr<function, TraceRay>, ray: ptr<function, TraversalRay>, world_ray: Ray) {
+    let prim = prim_ref((*trace).cursor);
+    (*trace).cursor += 1u;
+    //#if INSTANCES
+    if prim_kind(prim) == PRIM_INSTANCE {
+        *ray = enter_instance(trace, prim_index(prim), world_ray);
+        return;
+    }
+    //#endif
+    consider(trace, prim, *ray);
 }
 
 // Where level `level` of slot `slot`'s traversal stack lives: levels are interleaved
@@ -136,19 +280,86 @@ fn traversal_stack_index(slot: u32, level: u32) -> u32 {
     return level * frame.slot_count + slot;
 }
 
+// The stack's top node is kept in `held` while it is not in traversal_stack (NO_NODE
+// when level stack_len - 1, if any, is in memory): a node pushed and popped with no push
+// between never goes through memory.
+
+// Pops the stack's top node and makes it current if the ray still enters its box: a
+// node pushed earlier may lie beyond a hit found since.
+fn pop_node(slot: u32, trace: ptr<function, TraceRay>, held: ptr<function, u32>, slab: SlabRay) {
+    (*trace).stack_len -= 1u;
+    var candidate = *held;
+    if *held == NO_NODE {
+        candidate = traversal_stack[traversal_stack_index(slot, (*trace).stack_len)];
+    }
+    *held = NO_NODE;
+    if slab_ray_enter(slab, candidate, (*trace).best_t) != NO_HIT {
+        (*trace).node = candidate;
+    }
+}
+
+// Visits the current inner node: descends into the child the ray enters nearer, the
+// other waiting on the stack, or into the only child it enters, or nowhere.
+fn visit_inner_node(slot: u32, trace: ptr<function, TraceRay>, held: ptr<function, u32>, slab: SlabRay) {
+    let a = bvh_nodes[(*trace).node].first;
+    let b = a + 1u;
+    let enter_a = slab_ray_enter(slab, a, (*trace).best_t);
+    let enter_b = slab_ray_enter(slab, b, (*trace).best_t);
+    if enter_a != NO_HIT && enter_b != NO_HIT {
+        var near = a;
+        var far = b;
+        if enter_b < enter_a {
+            near = b;
+            far = a;
+        }
+        if (*trace).stack_len < MAX_BVH_DEPTH {
+            if *held != NO_NODE {
+                traversal_stack[traversal_stack_index(slot, (*trace).stack_len - 1u)] = *held;
+            }
+            *held = far;
+            (*trace).stack_len += 1u;
+        } else {
+            atomicOr(&counters.errors, ERROR_TRAVERSAL_STACK);
+        }
+        (*trace).node = near;
+    } else if enter_a != NO_HIT {
+        (*trace).node = a;
+    } else if enter_b != NO_HIT {
+        (*trace).node = b;
+    } else {
+        (*trace).node = NO_NODE;
+    }
+}
+
+// One node step: a pop when no node is current, else a visit of the current inner
+// node; a leaf it reaches is opened in the same step.
+fn node_step(slot: u32, trace: ptr<function, TraceRay>, held: ptr<function, u32>, slab: SlabRay) {
+    if (*trace).node == NO_NODE {
+        pop_node(slot, trace, held, slab);
+    } else {
+        visit_inner_node(slot, trace, held, slab);
+    }
+    if (*trace).node != NO_NODE {
+        open_if_leaf(trace);
+    }
+}
+
 // Runs `trace`'s traversal until it finishes (TRAVERSAL_FINISHED), the iteration
 // budget is spent (TRAVERSAL_SUSPENDED) or, where `give_way` and the module has
 // REFILL_LANES, few lanes of its subgroup still traverse (TRAVERSAL_GAVE_WAY); in the
 // last two the state is saved in `trace` and the slot's traversal stack. For an any-hit
 // trace (a shadow ray) the first hit ends it; best_prim != NO_PRIM then means occluded.
+// Twin of traverse (without its budget: the CPU never suspends a traversal).
 //
 // Instances (a two-level BVH, src/accel/instance.rs): a leaf primitive of kind
-// PRIM_INSTANCE is entered as one step: the leaf's position is saved, the ray moves to
-// the mesh's space (object_ray) and the traversal continues in the mesh's tree, on the
-// same stack above the depth it entered at (stack_base); when that tree is done, one
-// more step moves the ray back and resumes the leaf. A suspended traversal inside an
-// instance recomputes the object-space ray from its record when it resumes.
-fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) -> u32 {
+// PRIM_INSTANCE is entered as one step (enter_instance); when the mesh's tree is done,
+// one more step moves the ray back and resumes the leaf (leave_instance).
+//
+// One loop whose every step is a primitive test or a node step measured 2-4% faster
+// on llvmpipe than "while-while" (Aila and Laine, "Understanding the Efficiency of Ray
+// Traversal on GPUs", HPG 2009: a descent loop, then a leaf loop), where lanes that
+// reached a leaf wait for the rest (BENCHMARKS.md, "Uniform records").
+fn traverse(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) -> u32 {
     //#if REFILL_LANES
     // The lanes of this subgroup that run this call together (counted only where they
     // may give way).
@@ -159,96 +370,23 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) 
     var gave_way = false;
     //#endif
     let world_ray = Ray((*trace).origin, (*trace).direction);
-    var ray = world_ray;
-    var inverse = inverse_direction(ray.direction);
-    var sheared = shear_ray(ray);
-    let any_hit = (*trace).any_hit != 0u;
-    var best_t = (*trace).best_t;
-    var best_prim = (*trace).best_prim;
-    var best_instance = (*trace).best_instance;
-    var node = (*trace).node;
-    var cursor = (*trace).cursor;
-    var leaf_end = (*trace).leaf_end;
-    var stack_len = (*trace).stack_len;
-    var instance = (*trace).instance;
-    var stack_base = (*trace).stack_base;
-    var world_cursor = (*trace).world_cursor;
-    var world_leaf_end = (*trace).world_leaf_end;
-    //#if INSTANCES
-    if (*trace).status == TRACE_RUNNING && instance != NO_INSTANCE {
-        ray = object_ray(load_instance(instance), world_ray);
-        inverse = inverse_direction(ray.direction);
-        sheared = shear_ray(ray);
-    }
-    //#endif
+    var ray = resumed_ray(trace);
     // At least one step per call, so that any budget makes progress.
     var steps = 0u;
     if (*trace).status == TRACE_PENDING {
-        node = NO_NODE;
-        cursor = 0u;
-        leaf_end = 0u;
-        stack_len = 0u;
-        instance = NO_INSTANCE;
-        stack_base = 0u;
-        //#if UNROLLED
-        // A small scene's every primitive, planes included, in straight-line code with
-        // constant record indices (unrolled_closest_hit, written by the host; see
-        // "Unrolled scenes" above): the loop below finds nothing left to visit.
-        unrolled_closest_hit(ray, sheared, &best_t, &best_prim);
-        // The traversal's one step (so that a simulated loop cut still cuts it).
-        steps = 1u;
-        //#else
-        //#if PLANES
-        // Planes are unbounded: every ray tests every plane, before the tree.
-        var i = 0u;
-        loop {
-            if i >= frame.plane_count {
-                break;
-            }
-            iterations += 1u;
-            let prim = (PRIM_PLANE << PRIM_KIND_SHIFT) | i;
-            let t = intersect_prim(prim, ray, sheared,
-                                   tie_limit_in(prim, NO_INSTANCE, best_t, best_prim, best_instance));
-            if t != NO_HIT {
-                best_t = t;
-                best_prim = prim;
-                best_instance = NO_INSTANCE;
-            }
-            i += 1u;
-        }
-        if i < frame.plane_count {
-            atomicOr(&counters.errors, ERROR_LOOP_CUT);
-        }
-        //#endif
-        if frame.node_count > 0u && slab_enter(0u, ray.origin, inverse, best_t) != NO_HIT {
-            node = 0u;
-            open_if_leaf(&node, &cursor, &leaf_end);
-        }
-        //#endif
-        (*trace).status = TRACE_RUNNING;
+        steps = start_traversal(trace, ray);
     }
     var finished = false;
     var exited = false;
-    // The top of the traversal stack while it is not in traversal_stack (NO_NODE when
-    // level stack_len - 1, if any, is in memory): a node pushed and popped with no push
-    // between never goes through memory. Written back before a suspended call returns.
+    // The stack's top (see pop_node), written back before a suspended call returns.
     var held = NO_NODE;
-    // One loop whose every step is either a primitive test (while the lane has a leaf
-    // open) or a node step (pop, or visit an inner node and open the child it descends
-    // into if that is a leaf), so that a lane never waits for the others to finish a
-    // phase: on llvmpipe this measured 2-4% faster than "while-while" (Aila and Laine,
-    // "Understanding the Efficiency of Ray Traversal on GPUs", HPG 2009: a descent loop,
-    // then a leaf loop), where lanes that reached a leaf wait for the rest
-    // (BENCHMARKS.md, "Uniform records"). Node records on the saved state are never
-    // leaves: a leaf is opened in the step that reaches it.
     loop {
         // The test switch: a driver that cuts the loop after its first step (even
         // one that would have ended it).
         if steps > 0u && (frame.flags & FLAG_SIMULATE_LOOP_CUT) != 0u {
             break;
         }
-        if (any_hit && best_prim != NO_PRIM)
-            || (cursor >= leaf_end && node == NO_NODE && stack_len == 0u && instance == NO_INSTANCE) {
+        if traversal_done(*trace) {
             finished = true;
             exited = true;
             break;
@@ -270,120 +408,24 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) 
         //#endif
         steps += 1u;
         iterations += 1u;
-        if cursor < leaf_end {
-            // Test the leaf's next primitive.
-            let prim = prim_ref(cursor);
-            cursor += 1u;
-            var entered = false;
-            //#if INSTANCES
-            if prim_kind(prim) == PRIM_INSTANCE {
-                // Enter the instance: its mesh's tree, with the ray in the mesh's space.
-                entered = true;
-                let record = prim_index(prim);
-                let placed = load_instance(record);
-                world_cursor = cursor;
-                world_leaf_end = leaf_end;
-                cursor = 0u;
-                leaf_end = 0u;
-                instance = record;
-                stack_base = stack_len;
-                ray = object_ray(placed, world_ray);
-                inverse = inverse_direction(ray.direction);
-                sheared = shear_ray(ray);
-                node = NO_NODE;
-                if slab_enter(placed.root, ray.origin, inverse, best_t) != NO_HIT {
-                    node = placed.root;
-                    open_if_leaf(&node, &cursor, &leaf_end);
-                }
-            }
-            //#endif
-            if !entered {
-                let t = intersect_prim(prim, ray, sheared,
-                                       tie_limit_in(prim, instance, best_t, best_prim, best_instance));
-                if t != NO_HIT {
-                    best_t = t;
-                    best_prim = prim;
-                    best_instance = instance;
-                }
-            }
+        if (*trace).cursor < (*trace).leaf_end {
+            next_leaf_prim(trace, &ray, world_ray);
             continue;
         }
         //#if INSTANCES
-        if node == NO_NODE && stack_len == stack_base {
-            // The instance's tree is done: back to the scene's ray and leaf.
-            instance = NO_INSTANCE;
-            stack_base = 0u;
-            ray = world_ray;
-            inverse = inverse_direction(ray.direction);
-            sheared = shear_ray(ray);
-            cursor = world_cursor;
-            leaf_end = world_leaf_end;
+        if (*trace).node == NO_NODE && (*trace).stack_len == (*trace).stack_base {
+            ray = leave_instance(trace, world_ray);
             continue;
         }
         //#endif
-        if node == NO_NODE {
-            // Pop; a node pushed earlier may lie beyond a hit found since.
-            stack_len -= 1u;
-            var candidate = held;
-            if held == NO_NODE {
-                candidate = traversal_stack[traversal_stack_index(slot, stack_len)];
-            }
-            held = NO_NODE;
-            if slab_enter(candidate, ray.origin, inverse, best_t) != NO_HIT {
-                node = candidate;
-            }
-        } else {
-            let a = bvh_nodes[node].first;
-            let b = a + 1u;
-            let enter_a = slab_enter(a, ray.origin, inverse, best_t);
-            let enter_b = slab_enter(b, ray.origin, inverse, best_t);
-            if enter_a != NO_HIT && enter_b != NO_HIT {
-                // Nearest child first; the other waits on the stack.
-                var near = a;
-                var far = b;
-                if enter_b < enter_a {
-                    near = b;
-                    far = a;
-                }
-                if stack_len < MAX_BVH_DEPTH {
-                    if held != NO_NODE {
-                        traversal_stack[traversal_stack_index(slot, stack_len - 1u)] = held;
-                    }
-                    held = far;
-                    stack_len += 1u;
-                } else {
-                    atomicOr(&counters.errors, ERROR_TRAVERSAL_STACK);
-                }
-                node = near;
-            } else if enter_a != NO_HIT {
-                node = a;
-            } else if enter_b != NO_HIT {
-                node = b;
-            } else {
-                node = NO_NODE;
-            }
-        }
-        if node != NO_NODE {
-            open_if_leaf(&node, &cursor, &leaf_end);
-        }
+        node_step(slot, trace, &held, ray.slab);
     }
     if !exited {
         atomicOr(&counters.errors, ERROR_LOOP_CUT);
     }
     if !finished && held != NO_NODE {
-        traversal_stack[traversal_stack_index(slot, stack_len - 1u)] = held;
+        traversal_stack[traversal_stack_index(slot, (*trace).stack_len - 1u)] = held;
     }
-    (*trace).best_t = best_t;
-    (*trace).best_prim = best_prim;
-    (*trace).best_instance = best_instance;
-    (*trace).node = node;
-    (*trace).cursor = cursor;
-    (*trace).leaf_end = leaf_end;
-    (*trace).stack_len = stack_len;
-    (*trace).instance = instance;
-    (*trace).stack_base = stack_base;
-    (*trace).world_cursor = world_cursor;
-    (*trace).world_leaf_end = world_leaf_end;
     if finished {
         return TRAVERSAL_FINISHED;
     }
@@ -394,72 +436,3 @@ fn advance_traversal(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) 
     //#endif
     return TRAVERSAL_SUSPENDED;
 }
-
-//#if UNROLLED
-//#if SPHERES
-// Unrolled test of sphere record `i` (a literal) against the best hit so far.
-fn unrolled_sphere(i: u32, ray: Ray, best_t: ptr<function, f32>, best_prim: ptr<function, u32>) {
-    let prim = (PRIM_SPHERE << PRIM_KIND_SHIFT) | i;
-    iterations += 1u;
-    let sphere = spheres[i];
-    let t = intersect_sphere(ray, sphere.anchor, sphere.normal, sphere.radius,
-                             tie_limit(prim, *best_t, *best_prim));
-    if t != NO_HIT {
-        *best_t = t;
-        *best_prim = prim;
-    }
-}
-//#endif
-
-//#if PLANES
-// Unrolled test of plane record `i` (a literal).
-fn unrolled_plane(i: u32, ray: Ray, best_t: ptr<function, f32>, best_prim: ptr<function, u32>) {
-    let prim = (PRIM_PLANE << PRIM_KIND_SHIFT) | i;
-    iterations += 1u;
-    let plane = planes[i];
-    let t = intersect_plane(ray, plane.normal, plane.offset, tie_limit(prim, *best_t, *best_prim));
-    if t != NO_HIT {
-        *best_t = t;
-        *best_prim = prim;
-    }
-}
-//#endif
-
-//#if POLYGONS
-// Unrolled test of polygon record `i` whose `count` vertices start at `first` in
-// polygon_points (literals, as upload wrote them): intersect_polygon with the
-// vertices read at constant offsets.
-fn unrolled_polygon(i: u32, first: u32, count: u32, ray: Ray, best_t: ptr<function, f32>,
-                    best_prim: ptr<function, u32>) {
-    let prim = (PRIM_POLYGON << PRIM_KIND_SHIFT) | i;
-    iterations += 1u;
-    let polygon = polygons[i];
-    let t = intersect_plane(ray, polygon.normal, polygon.offset, tie_limit(prim, *best_t, *best_prim));
-    if t == NO_HIT {
-        return;
-    }
-    // The same rule and charge as point_in_polygon (shaders/intersect.wgsl).
-    iterations += count;
-    if inside_polygon_points(project_to_plane(ray_at(ray, t), polygon.dropped_axis), first, count) {
-        *best_t = t;
-        *best_prim = prim;
-    }
-}
-//#endif
-
-//#if TRIANGLES
-// Unrolled test of triangle record `i` (a literal).
-fn unrolled_triangle(i: u32, sheared: ShearedRay, best_t: ptr<function, f32>,
-                     best_prim: ptr<function, u32>) {
-    let prim = (PRIM_TRIANGLE << PRIM_KIND_SHIFT) | i;
-    iterations += 1u;
-    let triangle = triangles[i];
-    let t = intersect_triangle(sheared, triangle.v0, triangle.v1, triangle.v2,
-                               tie_limit(prim, *best_t, *best_prim));
-    if t != NO_HIT {
-        *best_t = t;
-        *best_prim = prim;
-    }
-}
-//#endif
-//#endif

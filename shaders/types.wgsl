@@ -198,7 +198,7 @@ const PRIM_PLANE: u32 = 1u;
 const PRIM_POLYGON: u32 = 2u;
 const PRIM_TRIANGLE: u32 = 3u;
 // A placement of an instanced mesh; its index is the node index of its record in
-// bvh_nodes (see load_instance in shaders/traverse.wgsl).
+// bvh_nodes (see load_instance in shaders/instance.wgsl).
 const PRIM_INSTANCE: u32 = 4u;
 const NO_PRIM: u32 = 0xffffffffu;
 const NO_INSTANCE: u32 = 0xffffffffu;
@@ -234,7 +234,7 @@ struct TraceRay {
     world_leaf_end: u32,
 }
 
-// PathState.phase: what a path does next (see shaders/trace.wgsl).
+// PathState.phase: what a path does next (see shaders/wavefront.wgsl).
 // A zeroed slot, before its first pixel.
 const PHASE_FIRST_PIXEL: u32 = 0u;
 const PHASE_CLOSEST: u32 = 1u;

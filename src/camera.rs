@@ -1,8 +1,10 @@
 //! The pinhole camera and the pixel sample pattern, shared by both backends.
-//! The GPU twin is `shaders/sampling.wgsl` (`camera_ray`, `sample_offset`, `pcg_hash`).
+//! The GPU twin is `shaders/camera.wgsl` (`sample_offset`, `ray_direction` as
+//! `camera_ray_direction`); the hash is [`crate::sample::pcg_hash`].
 
 use glam::DVec3;
 
+use crate::sample::{pcg_hash, unit_from_hash};
 use crate::scene::{Camera, RenderSettings};
 
 /// An orthonormal camera basis with the projection constants, ready to generate rays.
@@ -48,19 +50,6 @@ impl CameraFrame {
             + self.up * (ndc_y * self.tan_half_fov_y))
             .normalize()
     }
-}
-
-/// PCG hash of one 32-bit word (Jarzynski and Olano, "Hash Functions for GPU
-/// Rendering", JCGT 2020): the same bits on CPU and GPU.
-pub fn pcg_hash(input: u32) -> u32 {
-    let state = input.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
-    let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277_803_737);
-    (word >> 22) ^ word
-}
-
-/// A uniform number in [0, 1) from the top 24 bits of a hash: exact in `f32`.
-pub fn unit_from_hash(hash: u32) -> f64 {
-    f64::from(hash >> 8) * (1.0 / 16_777_216.0)
 }
 
 /// The stratum grid of `samples_per_pixel` samples: `n` columns and `n` rows of
@@ -322,14 +311,5 @@ mod tests {
         }
         // The first round is the pattern as it always was.
         assert_eq!(jitter_seed(7, 16, 3), pcg_hash(7 * 16 + 3));
-    }
-
-    #[test]
-    fn pcg_hash_matches_reference_values() {
-        // Values computed by hand from the published algorithm.
-        let state = 747_796_405u32.wrapping_add(2_891_336_453);
-        let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277_803_737);
-        assert_eq!(pcg_hash(1), (word >> 22) ^ word);
-        assert_ne!(pcg_hash(0), pcg_hash(1));
     }
 }

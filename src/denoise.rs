@@ -8,7 +8,7 @@
 //! This is the CPU twin of the GPU filter: both work in `f32`, in the same order, so
 //! that their images agree per pixel.
 
-use crate::accel::area_lights::luminance;
+use crate::color::luminance;
 
 /// The auxiliary passes of a render that guide the filter, `width × height` each,
 /// row-major, top row first.

@@ -1,8 +1,11 @@
-//! What a render produces: a linear float image and honest statistics.
+//! What a render produces: a linear float image, its noise estimate and honest
+//! statistics; and the measure of an image's error against a reference.
 
 use std::time::Duration;
 
-use crate::color::{quantize_unorm8, srgb_encode};
+use glam::DVec3;
+
+use crate::color::{luminance, quantize_unorm8, srgb_encode};
 use crate::noise::NoiseEstimate;
 
 /// A linear-light RGBA image in 32-bit float, row-major, top row first.
@@ -135,4 +138,71 @@ pub struct Rendered {
     pub noise: Option<NoiseEstimate>,
     /// Ray count and times.
     pub stats: RenderStats,
+}
+
+// Here rather than in src/noise.rs: a film holds its noise estimate, so the estimate
+// stays below the film and knows no images.
+impl NoiseEstimate {
+    /// The standard errors as a grey linear image (R = G = B = the standard error,
+    /// alpha 1), for writing as EXR.
+    pub fn standard_error_image(&self) -> LinearImage {
+        LinearImage {
+            width: self.width,
+            height: self.height,
+            pixels: self
+                .standard_error
+                .iter()
+                .map(|&se| [se, se, se, 1.0])
+                .collect(),
+        }
+    }
+}
+
+/// Relative RMSE of `image`'s luminance against `reference`'s:
+/// `√(mean over pixels (Y − Y_ref)²) / mean over pixels Y_ref`, with `Y` the
+/// [`luminance`] of a pixel. The error measure of the tradeoff's time-to-1%
+/// figures (`docs/quality.md`), and the one [`NoiseEstimate::relative_error`]
+/// predicts. Infinite for a black reference.
+pub fn relative_rmse(reference: &LinearImage, image: &LinearImage) -> f64 {
+    let luminance = |p: &[f32; 4]| {
+        luminance(DVec3::new(
+            f64::from(p[0]),
+            f64::from(p[1]),
+            f64::from(p[2]),
+        ))
+    };
+    let mut squares = 0.0;
+    let mut total = 0.0;
+    for (r, x) in reference.pixels.iter().zip(&image.pixels) {
+        let (r, x) = (luminance(r), luminance(x));
+        squares += (x - r) * (x - r);
+        total += r;
+    }
+    let count = reference.pixels.len().max(1) as f64;
+    let mean = total / count;
+    if mean > 0.0 {
+        (squares / count).sqrt() / mean
+    } else {
+        f64::INFINITY
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn relative_rmse_of_a_uniform_offset() {
+        let mut reference = LinearImage::new(4, 2);
+        reference
+            .pixels
+            .iter_mut()
+            .for_each(|p| *p = [2.0, 2.0, 2.0, 1.0]);
+        let mut image = reference.clone();
+        image.pixels.iter_mut().for_each(|p| p[0] = 2.2);
+        // Red off by 0.2 in every pixel: luminance off by 0.2126 · 0.2, mean 2.
+        let expected = 0.2126 * 0.2 / 2.0;
+        assert!((relative_rmse(&reference, &image) - expected).abs() < 1e-6);
+        assert_eq!(relative_rmse(&reference, &reference), 0.0);
+    }
 }

@@ -4,15 +4,25 @@
 //! shaders through wgpu, with a plain CPU reference tracer that implements the same
 //! model and serves as the test oracle.
 //!
-//! - [`scene`]: the scene model and the TOML scene-file format.
-//! - [`accel`]: the primitives both tracers intersect and the BVH over them.
-//! - [`camera`], [`color`], [`film`]: the pinhole camera and sample pattern, the sRGB
-//!   curve, and the image a render produces.
-//! - [`cpu`]: the reference tracer (f64).
+//! The modules form layers, each using only those below it
+//! (`tests/integration/layering.rs` checks the arrows):
+//!
+//! 1. the model and the math both tracers share: [`scene`], the scene model and the
+//!    TOML scene-file format; [`color`], luminance and the sRGB curve; [`sample`], the
+//!    hash and the sample warps; [`texture`], texture coordinates and lookups;
+//!    [`camera`], the pinhole camera and the sample pattern; [`noise`], the per-pixel
+//!    noise estimate (standard error of each pixel's mean); [`film`], the image a
+//!    render produces;
+//! 2. [`accel`]: the primitives both tracers intersect, the BVH over them, and the
+//!    lights' distributions (emitters, the environment map, tabulated BRDF maps);
+//! 3. the two tracers, apart from each other: [`cpu`], the reference tracer (f64), and
+//!    [`gpu`], the wgpu backend, built from the caller's `Device` and `Queue`, whose
+//!    WGSL modules (`shaders/`) twin the files of the layers above of the same name.
+//!
+//! Beside the layers, using them:
+//!
 //! - [`denoise`]: the edge-avoiding à-trous denoiser guided by albedo, normal, depth
 //!   and variance (CPU twin of the GPU filter).
-//! - [`gpu`]: the wgpu backend, built from the caller's `Device` and `Queue`.
-//! - [`noise`]: the per-pixel noise estimate (standard error of each pixel's mean).
 //! - [`echo`]: text and numbers read from files, as messages quote them (control
 //!   characters escaped, long text cut, numbers short).
 //! - [`input`]: opening the files a render reads (regular files only, confined in a
@@ -43,7 +53,9 @@ pub mod output;
 pub mod plausibility;
 #[cfg(feature = "cli")]
 pub mod quality;
+pub mod sample;
 pub mod scene;
+pub mod texture;
 pub mod tiles;
 #[cfg(feature = "cli")]
 pub mod tradeoff;

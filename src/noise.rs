@@ -19,14 +19,7 @@
 
 use glam::DVec3;
 
-use crate::accel::luminance;
-use crate::film::LinearImage;
-
-/// Luminance weights of linear Rec. 709 / sRGB primaries (ITU-R BT.709-6, item 3.3;
-/// IEC 61966-2-1): `Y = 0.2126 R + 0.7152 G + 0.0722 B`, the weights of
-/// [`crate::accel::luminance`], which the estimate uses. Twin of `LUMINANCE_WEIGHTS` in
-/// `shaders/noise.wgsl`.
-pub const LUMINANCE_WEIGHTS: [f64; 3] = [0.2126, 0.7152, 0.0722];
+use crate::color::luminance;
 
 /// Welford's update of a pixel's `m2` for its sample number `index` (0-based) of
 /// luminance `luminance`: `sum_before` is the radiance sum of the samples before it,
@@ -42,9 +35,9 @@ pub fn luminance_m2_step(
     let mean_before = if index == 0 {
         0.0
     } else {
-        crate::accel::luminance(sum_before) / f64::from(index)
+        crate::color::luminance(sum_before) / f64::from(index)
     };
-    let mean_after = crate::accel::luminance(sum_after) / (f64::from(index) + 1.0);
+    let mean_after = crate::color::luminance(sum_after) / (f64::from(index) + 1.0);
     m2 + (luminance - mean_before) * (luminance - mean_after)
 }
 
@@ -110,20 +103,6 @@ impl NoiseEstimate {
         self.standard_error[y as usize * self.width as usize + x as usize]
     }
 
-    /// The standard errors as a grey linear image (R = G = B = the standard error,
-    /// alpha 1), for writing as EXR.
-    pub fn standard_error_image(&self) -> LinearImage {
-        LinearImage {
-            width: self.width,
-            height: self.height,
-            pixels: self
-                .standard_error
-                .iter()
-                .map(|&se| [se, se, se, 1.0])
-                .collect(),
-        }
-    }
-
     /// The estimated relative error of the image: `√(mean se²) / mean(mean
     /// luminance)`, the expected relative RMSE of its luminance against the converged
     /// image. `None` below two samples, for a black image, or where a pixel's
@@ -144,35 +123,6 @@ impl NoiseEstimate {
             / count;
         let relative = mean_square.sqrt() / mean;
         (relative.is_finite() && mean > 0.0).then_some(relative)
-    }
-}
-
-/// Relative RMSE of `image`'s luminance against `reference`'s:
-/// `√(mean over pixels (Y − Y_ref)²) / mean over pixels Y_ref`, with `Y` the
-/// [`luminance`] of a pixel. The error measure of the tradeoff's time-to-1%
-/// figures (`docs/quality.md`), and the one [`NoiseEstimate::relative_error`]
-/// predicts. Infinite for a black reference.
-pub fn relative_rmse(reference: &LinearImage, image: &LinearImage) -> f64 {
-    let luminance = |p: &[f32; 4]| {
-        luminance(DVec3::new(
-            f64::from(p[0]),
-            f64::from(p[1]),
-            f64::from(p[2]),
-        ))
-    };
-    let mut squares = 0.0;
-    let mut total = 0.0;
-    for (r, x) in reference.pixels.iter().zip(&image.pixels) {
-        let (r, x) = (luminance(r), luminance(x));
-        squares += (x - r) * (x - r);
-        total += r;
-    }
-    let count = reference.pixels.len().max(1) as f64;
-    let mean = total / count;
-    if mean > 0.0 {
-        (squares / count).sqrt() / mean
-    } else {
-        f64::INFINITY
     }
 }
 
@@ -203,34 +153,14 @@ mod tests {
         assert!((se - (two_pass / (n - 1.0) / n).sqrt()).abs() < 1e-12);
     }
 
+    // Grey's own luminance, once part of this test, is tested with `luminance` in
+    // src/color.rs.
     #[test]
-    fn grey_has_its_own_luminance_and_one_sample_is_unknown() {
-        assert!((luminance(DVec3::splat(0.25)) - 0.25).abs() < 1e-12);
-        // The weights the WGSL twin is checked against are the function's.
-        for (i, weight) in LUMINANCE_WEIGHTS.iter().enumerate() {
-            let mut primary = DVec3::ZERO;
-            primary[i] = 1.0;
-            assert_eq!(luminance(primary), *weight);
-        }
+    fn one_sample_and_a_non_finite_m2_are_unknown() {
         assert!(standard_error(1.0, 1).is_infinite());
         assert!(standard_error(f64::NAN, 8).is_infinite());
         assert_eq!(standard_error(-1e-20, 8), 0.0);
         let estimate = NoiseEstimate::from_sums(1, 1, 1, [(DVec3::ONE, 0.0)]);
         assert_eq!(estimate.relative_error(), None);
-    }
-
-    #[test]
-    fn relative_rmse_of_a_uniform_offset() {
-        let mut reference = LinearImage::new(4, 2);
-        reference
-            .pixels
-            .iter_mut()
-            .for_each(|p| *p = [2.0, 2.0, 2.0, 1.0]);
-        let mut image = reference.clone();
-        image.pixels.iter_mut().for_each(|p| p[0] = 2.2);
-        // Red off by 0.2 in every pixel: luminance off by 0.2126 · 0.2, mean 2.
-        let expected = 0.2126 * 0.2 / 2.0;
-        assert!((relative_rmse(&reference, &image) - expected).abs() < 1e-6);
-        assert_eq!(relative_rmse(&reference, &reference), 0.0);
     }
 }

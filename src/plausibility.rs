@@ -5,13 +5,13 @@
 //! - energy conservation: `∫ f(ωi, ωr) cos θr dωr ≤ 1` for every `ωi`;
 //! - Helmholtz reciprocity: `f(ωi, ωr) = f(ωr, ωi)`.
 //!
-//! The map is read as the renderer reads it ([`crate::cpu::texture::sample_brdf_map`]):
+//! The map is read as the renderer reads it ([`crate::texture::sample_brdf_map`]):
 //! isotropic, so `∫ f cos θr dωr = 2π ∫₀^{π/2} f(θi, θr) cos θr sin θr dθr`.
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use crate::cpu::texture::sample_brdf_map;
 use crate::scene::Image;
+use crate::texture::sample_brdf_map;
 
 /// Steps of the midpoint rule over `θr` in the energy integral. With a bilinear map
 /// the integrand is smooth between grid lines; 4096 steps integrate a constant map

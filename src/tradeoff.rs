@@ -1,7 +1,7 @@
 //! Measuring the speed/accuracy trade: render a converged reference, sweep the knobs
 //! that trade one for the other (samples per pixel, maximum depth, ray-weight cutoff),
 //! and measure each setting's time and its error against the reference, in linear
-//! RMSE, in relative luminance RMSE ([`crate::noise::relative_rmse`]) and in FLIP
+//! RMSE, in relative luminance RMSE ([`crate::film::relative_rmse`]) and in FLIP
 //! (Andersson et al., "FLIP: A Difference Evaluator for Alternating Images", HPG
 //! 2020), then find the Pareto front of time versus error. Each integrator (Whitted,
 //! path) is a series of its own, measured against its own converged reference, and
@@ -44,7 +44,7 @@ pub struct Measurement {
     /// Root-mean-square error of the linear RGB channels against the reference.
     pub rmse: f64,
     /// Relative RMSE of the luminance against the reference's
-    /// ([`crate::noise::relative_rmse`]).
+    /// ([`crate::film::relative_rmse`]).
     pub relative_error: f64,
     /// The same error as the render's own noise estimate predicts it
     /// ([`crate::noise::NoiseEstimate::relative_error`]), where it has one.

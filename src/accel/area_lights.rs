@@ -7,13 +7,9 @@
 use glam::DVec3;
 
 use super::{HitKey, PrimKind, PrimRef, SceneGeometry};
-use crate::cpu::texture::mean_texel;
+use crate::color::luminance;
 use crate::scene::{Image, Material, project_to_plane};
-
-/// Relative luminance of a linear Rec. 709 colour (ITU-R BT.709 weights).
-pub fn luminance(c: DVec3) -> f64 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
-}
+use crate::texture::mean_texel;
 
 /// An emissive shape that next-event estimation samples.
 #[derive(Debug, Clone, Copy, PartialEq)]

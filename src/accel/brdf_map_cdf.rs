@@ -26,7 +26,7 @@ use std::f64::consts::FRAC_PI_2;
 
 use glam::DVec3;
 
-use super::luminance;
+use crate::color::luminance;
 use crate::scene::{Image, Material, MaterialKind};
 
 /// The inverse-CDF table of one `N × N` BRDF map (see the module's documentation).

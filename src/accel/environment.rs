@@ -20,7 +20,7 @@ use std::sync::Arc;
 
 use glam::{DVec2, DVec3};
 
-use super::luminance;
+use crate::color::luminance;
 use crate::scene::{EnvironmentMap, direction_to_uv, texel_at, uv_to_direction};
 
 /// The probability with which next-event estimation picks the environment when the

@@ -30,7 +30,7 @@ pub mod environment;
 pub mod geometry;
 pub mod instance;
 
-pub use area_lights::{AreaLights, EmitterEntry, EmitterEntryShape, luminance};
+pub use area_lights::{AreaLights, EmitterEntry, EmitterEntryShape};
 pub use brdf_map_cdf::{BrdfMapCdf, BrdfMapCdfs};
 pub use bvh::{BuildMethod, Bvh, BvhNode, BvhStats, MAX_BVH_DEPTH, MAX_LEAF_PRIMITIVES};
 pub use environment::{Distribution1D, ENVIRONMENT_SELECTION, EnvironmentLight, EnvironmentSample};

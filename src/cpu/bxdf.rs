@@ -3,10 +3,10 @@
 
 use std::f64::consts::PI;
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
-use super::texture::sample_brdf_map;
 use crate::scene::{FresnelModel, Image, Material, MaterialKind, MicrofacetDistribution};
+use crate::texture::sample_brdf_map;
 
 /// Smallest microfacet `alpha`: roughness 0 is clamped here so that the distribution's
 /// peak `1/(π α²)` stays finite (≈ 3.2e5, far inside `f32`) instead of becoming a
@@ -202,16 +202,19 @@ pub fn fresnel_schlick(cos: f64, f0: DVec3) -> DVec3 {
 /// The Fresnel reflectance a Cook-Torrance material uses at `cos` (conductor or
 /// dielectric, exact or Schlick with the exact `F0`).
 pub fn microfacet_fresnel(material: &Material, cos: f64) -> DVec3 {
-    let exact = |c: f64| {
-        if material.conductor {
-            fresnel_conductor(c, material.eta, material.k)
-        } else {
-            DVec3::splat(fresnel_dielectric(c, 1.0, material.ior))
-        }
-    };
     match material.fresnel {
-        FresnelModel::Exact => exact(cos),
-        FresnelModel::Schlick => fresnel_schlick(cos, exact(1.0)),
+        FresnelModel::Exact => microfacet_fresnel_exact(material, cos),
+        FresnelModel::Schlick => fresnel_schlick(cos, microfacet_fresnel_exact(material, 1.0)),
+    }
+}
+
+/// The exact Fresnel reflectance of a Cook-Torrance material at `cos`: the
+/// conductor's, or the dielectric's from air.
+pub fn microfacet_fresnel_exact(material: &Material, cos: f64) -> DVec3 {
+    if material.conductor {
+        fresnel_conductor(cos, material.eta, material.k)
+    } else {
+        DVec3::splat(fresnel_dielectric(cos, 1.0, material.ior))
     }
 }
 
@@ -341,7 +344,7 @@ pub fn brdf_pbr(material: &Material, n: DVec3, wi: DVec3, wo: DVec3) -> DVec3 {
 /// The BRDF of `material`'s base layer for light arriving from `wi` and leaving
 /// towards `wo`, both unit and on the side of the unit normal `n`. `images` are the
 /// scene's (for tabulated maps); `material.diffuse` is the albedo at the hit (see
-/// [`super::texture::shading_albedo`]).
+/// [`crate::texture::shading_albedo`]).
 pub fn eval_brdf(material: &Material, images: &[Image], n: DVec3, wi: DVec3, wo: DVec3) -> DVec3 {
     match material.kind {
         MaterialKind::Lambert => brdf_lambert(material.diffuse),
@@ -489,6 +492,86 @@ pub fn surface_response(
         MaterialKind::Emissive => {}
     }
     response
+}
+
+// The importance samplers of the lobes' distributions and their densities, for the
+// path integrator (`tests/integration/sampler_chi2.rs` checks each against its
+// density); the general warps are in `crate::sample`.
+
+/// A microfacet normal of the GGX distribution of roughness `alpha` (isotropic)
+/// visible from the local direction `wo` (`wo.z > 0`), with density
+/// [`pdf_ggx_visible_normal`]: Heitz, "Sampling the GGX Distribution of Visible
+/// Normals", JCGT 7(4), 2018, listing 1.
+pub fn sample_ggx_visible_normal(wo: DVec3, alpha: f64, u: DVec2) -> DVec3 {
+    // The view direction in the hemisphere configuration (stretched to alpha = 1).
+    let vh = DVec3::new(alpha * wo.x, alpha * wo.y, wo.z).normalize();
+    // An orthonormal basis around it (T1 is horizontal).
+    let length_squared = vh.x * vh.x + vh.y * vh.y;
+    let t1 = if length_squared > 0.0 {
+        DVec3::new(-vh.y, vh.x, 0.0) / length_squared.sqrt()
+    } else {
+        DVec3::X
+    };
+    let t2 = vh.cross(t1);
+    // A point of the projected area: a disk, its far half squeezed by vh.z.
+    let r = u.x.sqrt();
+    let phi = 2.0 * std::f64::consts::PI * u.y;
+    let p1 = r * phi.cos();
+    let s = 0.5 * (1.0 + vh.z);
+    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
+    // Onto the hemisphere, and back to the ellipsoid configuration.
+    let nh = t1 * p1 + t2 * p2 + vh * (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
+    DVec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(0.0)).normalize()
+}
+
+/// The density of [`sample_ggx_visible_normal`] at the microfacet normal `h`, per
+/// steradian of normals: `D_wo(h) = G1(wo) · max(0, wo·h) · D(h) / wo.z` (Heitz 2018,
+/// eq. 1).
+pub fn pdf_ggx_visible_normal(wo: DVec3, h: DVec3, alpha: f64) -> f64 {
+    if wo.z <= 0.0 || h.z <= 0.0 {
+        return 0.0;
+    }
+    let g1 = 1.0 / (1.0 + smith_lambda_ggx(wo.z, alpha));
+    g1 * wo.dot(h).max(0.0) * distribution_ggx(h.z, alpha) / wo.z
+}
+
+/// A microfacet normal of the Beckmann distribution of roughness `alpha`, with density
+/// `D(h) · cos θ_h` ([`pdf_beckmann_normal`]): `tan² θ_h = -α² ln(1 - u₁)`, `φ = 2π u₂`
+/// (Walter et al., "Microfacet Models for Refraction through Rough Surfaces", EGSR
+/// 2007, eq. 28).
+pub fn sample_beckmann_normal(alpha: f64, u: DVec2) -> DVec3 {
+    let tan_squared = -alpha * alpha * (1.0 - u.x).ln();
+    let cos_theta = 1.0 / (1.0 + tan_squared).sqrt();
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let phi = 2.0 * std::f64::consts::PI * u.y;
+    DVec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+}
+
+/// The density of [`sample_beckmann_normal`] at `h`, per steradian of normals.
+pub fn pdf_beckmann_normal(h: DVec3, alpha: f64) -> f64 {
+    if h.z <= 0.0 {
+        return 0.0;
+    }
+    distribution_beckmann(h.z, alpha) * h.z
+}
+
+/// A half vector of the normalized Blinn-Phong lobe of exponent `n`, with density
+/// `(n + 2)/(2π) · cos^(n+1) θ_h` ([`pdf_blinn_phong_half`]), the lobe's
+/// distribution `(n + 2)/(2π) cos^n θ_h` times `cos θ_h`: `cos θ_h = u₁^(1/(n+2))`,
+/// `φ = 2π u₂` (inverting its CDF in `cos θ_h`).
+pub fn sample_blinn_phong_half(n: f64, u: DVec2) -> DVec3 {
+    let cos_theta = (1.0 - u.x).powf(1.0 / (n + 2.0));
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let phi = 2.0 * std::f64::consts::PI * u.y;
+    DVec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+}
+
+/// The density of [`sample_blinn_phong_half`] at `h`, per steradian of half vectors.
+pub fn pdf_blinn_phong_half(h: DVec3, n: f64) -> f64 {
+    if h.z <= 0.0 {
+        return 0.0;
+    }
+    (n + 2.0) / (2.0 * std::f64::consts::PI) * h.z.powf(n + 1.0)
 }
 
 #[cfg(test)]

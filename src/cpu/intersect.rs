@@ -92,6 +92,17 @@ pub fn world_triangle(
     }
 }
 
+/// The exclusive distance limit for testing the surface `key` against the best hit so
+/// far: the best distance, or just beyond it for a smaller key, which wins exact ties
+/// (so that the nearest hit does not depend on the order of the tests). Without a hit
+/// yet, the query's own exclusive `t_max`.
+pub fn limit_for(key: HitKey, best_t: f64, best: Option<HitKey>) -> f64 {
+    match best {
+        Some(b) if key < b && best_t.is_finite() => best_t.next_up(),
+        _ => best_t,
+    }
+}
+
 /// The ray parameter of `prim`'s nearest hit along `ray` in (0, `t_max`); `sheared`
 /// is [`shear_ray`] of `ray`, for triangles.
 pub fn intersect_prim(
@@ -176,10 +187,16 @@ pub fn hit_record_keyed(geometry: &SceneGeometry, key: HitKey, ray: &Ray, t: f64
         // Triangles are handled above; an instance is never a hit.
         PrimKind::Triangle | PrimKind::Instance => (DVec3::Z, point),
     };
+    flat_hit(prim, t, normal, geometry.material(prim), position)
+}
+
+/// A hit without vertex attributes: its shading normal is its geometric normal, its
+/// texture coordinates `(0, 0)`, its barycentric coordinates `(1, 0, 0)`.
+pub fn flat_hit(prim: PrimRef, t: f64, normal: DVec3, material: u32, position: DVec3) -> Hit {
     Hit {
         t,
         normal,
-        material: geometry.material(prim),
+        material,
         position,
         prim,
         shading_normal: normal,
@@ -203,33 +220,31 @@ fn triangle_hit(
     let vertices = &triangle.vertices;
     let normal = triangle_normal(vertices);
     let position = project_onto_plane(point, normal, normal.dot(vertices[0]));
-    let mut hit = Hit {
-        t,
-        normal,
-        material: triangle.material,
-        position,
-        prim: key.prim,
-        shading_normal: normal,
-        uv: DVec2::ZERO,
-        barycentrics: triangle_barycentrics(position, vertices),
-        instance: key.instance,
-    };
+    let mut hit = flat_hit(key.prim, t, normal, triangle.material, position);
+    hit.instance = key.instance;
+    hit.barycentrics = triangle_barycentrics(position, vertices);
     if let Some(attributes) = attributes {
-        let b = hit.barycentrics;
-        if let Some(n) = attributes.normals {
-            let interpolated = n[0] * b.x + n[1] * b.y + n[2] * b.z;
-            // Degenerate interpolations and normals facing away from the surface
-            // fall back to the geometric normal.
-            let shading = interpolated.normalize_or(normal);
-            if shading.dot(normal) > 0.0 {
-                hit.shading_normal = shading;
-            }
-        }
-        if let Some(uv) = attributes.uvs {
-            hit.uv = uv[0] * b.x + uv[1] * b.y + uv[2] * b.z;
-        }
+        apply_triangle_attributes(&mut hit, attributes);
     }
     hit
+}
+
+/// Fills a triangle hit's shading normal (its vertex normals interpolated at its
+/// barycentric coordinates) and texture coordinates from its world-space `attributes`.
+pub fn apply_triangle_attributes(hit: &mut Hit, attributes: &TriangleAttributes) {
+    let b = hit.barycentrics;
+    if let Some(n) = attributes.normals {
+        let interpolated = n[0] * b.x + n[1] * b.y + n[2] * b.z;
+        // Degenerate interpolations and normals facing away from the surface
+        // fall back to the geometric normal.
+        let shading = interpolated.normalize_or(hit.normal);
+        if shading.dot(hit.normal) > 0.0 {
+            hit.shading_normal = shading;
+        }
+    }
+    if let Some(uv) = attributes.uvs {
+        hit.uv = uv[0] * b.x + uv[1] * b.y + uv[2] * b.z;
+    }
 }
 
 /// The barycentric coordinates of `point` (on the triangle's plane) in the triangle
@@ -361,12 +376,15 @@ pub fn intersect_sphere(
     // sign(b) with sign(0) = +1, as the WGSL twin computes it.
     let sign_b = if b >= 0.0 { 1.0 } else { -1.0 };
     let q = b + sign_b * discriminant.sqrt();
-    let (t0, t1) = if q == 0.0 {
-        (0.0, 0.0)
-    } else {
-        let (a, b) = (c / q * radius, q * radius);
-        (a.min(b), a.max(b))
-    };
+    if q == 0.0 {
+        return None;
+    }
+    let (r0, r1) = (c / q * radius, q * radius);
+    nearest_root(r0.min(r1), r0.max(r1), t_max)
+}
+
+/// The nearer of two sorted roots `t0 <= t1` that lies in (0, `t_max`).
+pub fn nearest_root(t0: f64, t1: f64, t_max: f64) -> Option<f64> {
     if t0 > 0.0 && t0 < t_max {
         Some(t0)
     } else if t1 > 0.0 && t1 < t_max {
@@ -411,16 +429,25 @@ pub fn point_in_polygon(point: DVec3, vertices: &[DVec3], dropped_axis: u32) -> 
     let mut previous = project_to_plane(vertices[vertices.len() - 1], dropped_axis);
     for vertex in vertices {
         let current = project_to_plane(*vertex, dropped_axis);
-        if (current.1 > pv) != (previous.1 > pv) {
-            let crossing_u =
-                current.0 + (pv - current.1) * (previous.0 - current.0) / (previous.1 - current.1);
-            if pu < crossing_u {
-                inside = !inside;
-            }
+        if edge_crosses((pu, pv), previous, current) {
+            inside = !inside;
         }
         previous = current;
     }
     inside
+}
+
+/// Whether the edge from `previous` to `current` (projected, `(u, v)`) crosses the ray
+/// from `point` along +u: one step of [`point_in_polygon`]'s even-odd rule. An edge
+/// that does not straddle the point's `v` never crosses.
+pub fn edge_crosses(point: (f64, f64), previous: (f64, f64), current: (f64, f64)) -> bool {
+    let (pu, pv) = point;
+    if (current.1 > pv) == (previous.1 > pv) {
+        return false;
+    }
+    let crossing_u =
+        current.0 + (pv - current.1) * (previous.0 - current.0) / (previous.1 - current.1);
+    pu < crossing_u
 }
 
 /// The per-ray part of the watertight ray/triangle test (Woop, Benthin and Wald,
@@ -454,11 +481,18 @@ pub fn shear_ray(ray: &Ray) -> ShearedRay {
     if d[kz] < 0.0 {
         std::mem::swap(&mut kx, &mut ky);
     }
+    let axes = [kx, ky, kz];
+    let p = permute(d, axes);
     ShearedRay {
         origin: ray.origin,
-        axes: [kx, ky, kz],
-        shear: DVec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]),
+        axes,
+        shear: DVec3::new(p.x / p.z, p.y / p.z, 1.0 / p.z),
     }
+}
+
+/// `v` with its components reordered to (`kx`, `ky`, `kz`).
+pub fn permute(v: DVec3, axes: [usize; 3]) -> DVec3 {
+    DVec3::new(v[axes[0]], v[axes[1]], v[axes[2]])
 }
 
 /// Watertight ray/triangle intersection of Woop, Benthin and Wald, "Watertight
@@ -478,14 +512,13 @@ pub fn shear_ray(ray: &Ray) -> ShearedRay {
 ///
 /// Returns the ray parameter in (0, `t_max`); a non-finite `t` is a miss.
 pub fn intersect_triangle(ray: &ShearedRay, vertices: &[DVec3; 3], t_max: f64) -> Option<f64> {
-    let [kx, ky, kz] = ray.axes;
     let (shear_x, shear_y, shear_z) = (ray.shear.x, ray.shear.y, ray.shear.z);
-    let a = vertices[0] - ray.origin;
-    let b = vertices[1] - ray.origin;
-    let c = vertices[2] - ray.origin;
-    let (ax, ay) = (a[kx] - shear_x * a[kz], a[ky] - shear_y * a[kz]);
-    let (bx, by) = (b[kx] - shear_x * b[kz], b[ky] - shear_y * b[kz]);
-    let (cx, cy) = (c[kx] - shear_x * c[kz], c[ky] - shear_y * c[kz]);
+    let a = permute(vertices[0] - ray.origin, ray.axes);
+    let b = permute(vertices[1] - ray.origin, ray.axes);
+    let c = permute(vertices[2] - ray.origin, ray.axes);
+    let (ax, ay) = (a.x - shear_x * a.z, a.y - shear_y * a.z);
+    let (bx, by) = (b.x - shear_x * b.z, b.y - shear_y * b.z);
+    let (cx, cy) = (c.x - shear_x * c.z, c.y - shear_y * c.z);
     // Scaled barycentric coordinates (2D edge functions).
     let u = cx * by - cy * bx;
     let v = ax * cy - ay * cx;
@@ -497,7 +530,7 @@ pub fn intersect_triangle(ray: &ShearedRay, vertices: &[DVec3; 3], t_max: f64) -
     if determinant == 0.0 {
         return None;
     }
-    let t_scaled = shear_z * (u * a[kz] + v * b[kz] + w * c[kz]);
+    let t_scaled = shear_z * (u * a.z + v * b.z + w * c.z);
     let t = t_scaled / determinant;
     (t > 0.0 && t < t_max).then_some(t)
 }

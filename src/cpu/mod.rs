@@ -8,9 +8,7 @@
 pub mod bxdf;
 pub mod intersect;
 pub mod path;
-pub mod sample;
 pub mod tabulated;
-pub mod texture;
 pub mod trace;
 pub mod traverse;
 
@@ -208,7 +206,7 @@ fn trace_window(
                             1.0,
                         ];
                         if let Some((mean, error)) = &mut row_noise {
-                            mean[i] = crate::accel::luminance(result.radiance) as f32;
+                            mean[i] = crate::color::luminance(result.radiance) as f32;
                             error[i] = standard_error(result.luminance_m2, samples) as f32;
                         }
                         row_rays += result.rays;

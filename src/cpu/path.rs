@@ -10,8 +10,8 @@
 //! or the environment map by its luminance (`crate::accel::EnvironmentLight`),
 //! combined with the BRDF-sampled hits of emitters and escapes to the map by multiple
 //! importance sampling (the power heuristic; Veach's thesis, 1997, ch. 9). Then it
-//! continues in a
-//! direction drawn from the BRDF's importance sampler (`sample.rs`), and Russian
+//! continues in a direction drawn from the BRDF's importance sampler (`sample_brdf`,
+//! over `crate::sample` and the lobe samplers of `super::bxdf`), and Russian
 //! roulette ends it in proportion to its throughput after [`ROULETTE_DEPTH`] bounces.
 //! Random numbers come from the counter-based generator [`random_number`] of the
 //! pixel, the sample and the dimension, so the GPU twin can draw the same ones.
@@ -19,25 +19,27 @@
 use glam::{DVec2, DVec3};
 
 use super::bxdf::{
-    eval_brdf, has_base_brdf, microfacet_alpha, reflect_direction, surface_response,
+    eval_brdf, has_base_brdf, microfacet_alpha, pdf_beckmann_normal, pdf_blinn_phong_half,
+    pdf_ggx_visible_normal, reflect_direction, sample_beckmann_normal, sample_blinn_phong_half,
+    sample_ggx_visible_normal, surface_response,
 };
 use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
-use super::sample::{
-    ShadingFrame, area_to_solid_angle_pdf, pdf_beckmann_normal, pdf_blinn_phong_half,
-    pdf_cosine_hemisphere, pdf_ggx_visible_normal, pdf_sphere_cone, power_heuristic, random_number,
-    reflect_about, reflected_pdf, sample_beckmann_normal, sample_blinn_phong_half,
-    sample_cosine_hemisphere, sample_ggx_visible_normal, sample_sphere_cone,
-    sample_triangle_barycentrics,
-};
 use super::tabulated::{pdf_tabulated, sample_tabulated};
-use super::texture::{shading_emission, shading_material};
 use super::trace::{
-    PreparedScene, direct_light, finite_radiance, keep_on_side, shading_frame_normal,
+    PreparedScene, add_contribution, direct_light, finite_radiance, keep_on_side,
+    shading_frame_normal,
 };
 use super::traverse::{intersect_scene, occluded};
 use crate::accel::area_lights::{Emitter, EmitterShape};
-use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight, PrimKind, luminance};
+use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight, PrimKind};
+use crate::color::luminance;
+use crate::sample::{
+    ShadingFrame, area_to_solid_angle_pdf, pdf_cosine_hemisphere, pdf_sphere_cone, power_heuristic,
+    random_number, reflect_about, reflected_pdf, sample_cosine_hemisphere, sample_sphere_cone,
+    sample_triangle_barycentrics,
+};
 use crate::scene::{Material, MaterialKind, MediumStack, MicrofacetDistribution};
+use crate::texture::{shading_emission, shading_material};
 
 /// Bounces after which Russian roulette may end a path.
 pub const ROULETTE_DEPTH: u32 = 3;
@@ -211,7 +213,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
                 }
                 None => scene.background,
             };
-            add(&mut radiance, throughput * background);
+            add_contribution(&mut radiance, throughput * background);
             break;
         };
         let material = shading_material(
@@ -234,7 +236,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
                 ),
                 None => 1.0,
             };
-            add(&mut radiance, throughput * material.emission * weight);
+            add_contribution(&mut radiance, throughput * material.emission * weight);
         }
         let entering = ray.direction.dot(hit.normal) < 0.0;
         let ng = if entering { hit.normal } else { -hit.normal };
@@ -274,7 +276,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
             for light in &scene.lights {
                 let (lit, traced) = direct_light(scene, light, &material, shadow_origin, n, wo);
                 rays += traced;
-                add(&mut radiance, event_weight * lit);
+                add_contribution(&mut radiance, event_weight * lit);
             }
             // One light: the environment with its selection probability, else an
             // emitter chosen by power with the rest of the numbers' range.
@@ -294,7 +296,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
                     continues,
                 );
                 rays += traced;
-                add(&mut radiance, event_weight * lit);
+                add_contribution(&mut radiance, event_weight * lit);
             } else if let Some((emitter, selection)) = scene
                 .area_lights
                 .choose((u_light - p_environment) / (1.0 - p_environment))
@@ -311,7 +313,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
                     continues,
                 );
                 rays += traced;
-                add(&mut radiance, event_weight * lit);
+                add_contribution(&mut radiance, event_weight * lit);
             }
             if !continues {
                 break;
@@ -382,13 +384,6 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
         }
     }
     (radiance, rays)
-}
-
-/// Adds a contribution to `radiance` when it is finite (as the Whitted tracer does).
-fn add(radiance: &mut DVec3, contribution: DVec3) {
-    if finite_radiance(contribution) {
-        *radiance += contribution;
-    }
 }
 
 /// Next-event estimation of one emitter (chosen with probability `selection`) from

@@ -32,9 +32,9 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use glam::{DVec2, DVec3};
 
-use super::sample::{pdf_cosine_hemisphere, sample_cosine_hemisphere};
 use crate::accel::BrdfMapCdf;
 use crate::accel::brdf_map_cdf::band_projected_solid_angle;
+use crate::sample::{pdf_cosine_hemisphere, sample_cosine_hemisphere};
 
 /// The probability with which the sampler of a tabulated BRDF draws from the cosine
 /// distribution instead of the map's (a defensive mixture; see the module's

@@ -1,13 +1,13 @@
 //! The Whitted tracer with an explicit bounce stack: the CPU twin of
-//! `shaders/trace.wgsl` (same function names and the same stack discipline, so the two
-//! agree even when a small stack drops branches).
+//! `shaders/trace.wgsl` (same function names) and of the slots of
+//! `shaders/wavefront.wgsl` (the same stack discipline, so the two agree even when a
+//! small stack drops branches).
 
 use glam::DVec3;
 
 use super::bxdf::{eval_brdf, has_base_brdf, reflect_direction, surface_response};
 use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
 use super::path::path_radiance;
-use super::texture::shading_material;
 use super::traverse::{intersect_scene, occluded};
 use crate::accel::SceneGeometry;
 use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight};
@@ -15,6 +15,7 @@ use crate::camera::{CameraFrame, SamplePattern};
 use crate::noise::luminance_m2_step;
 pub use crate::scene::MediumStack;
 use crate::scene::{Image, Integrator, Light, Material, RenderSettings, Scene};
+use crate::texture::shading_material;
 
 /// The scene in the form the tracer reads: colours in the lighting space, the geometry
 /// with its BVH, the camera basis.
@@ -114,6 +115,13 @@ pub fn finite_radiance(c: DVec3) -> bool {
     c.x.abs() <= limit && c.y.abs() <= limit && c.z.abs() <= limit
 }
 
+/// Adds a contribution to `radiance` when it is [`finite_radiance`].
+pub fn add_contribution(radiance: &mut DVec3, contribution: DVec3) {
+    if finite_radiance(contribution) {
+        *radiance += contribution;
+    }
+}
+
 /// The radiance a ray escaping along the unit `direction` sees: the environment map's
 /// texel times its scale, or the constant background.
 pub fn background_radiance(scene: &PreparedScene, direction: DVec3) -> DVec3 {
@@ -175,7 +183,7 @@ pub fn trace_pixel(scene: &PreparedScene, x: u32, y: u32) -> PixelResult {
             luminance_m2,
             before,
             sum,
-            crate::accel::luminance(radiance),
+            crate::color::luminance(radiance),
             index,
         );
         rays += sample_rays;
@@ -214,17 +222,14 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
     while let Some(entry) = stack.pop() {
         rays += 1;
         let Some(hit) = intersect_scene(&scene.geometry, &entry.ray, f64::INFINITY) else {
-            let contribution = entry.weight * background_radiance(scene, entry.ray.direction);
-            if finite_radiance(contribution) {
-                radiance += contribution;
-            }
+            add_contribution(
+                &mut radiance,
+                entry.weight * background_radiance(scene, entry.ray.direction),
+            );
             continue;
         };
         let shaded = shade_hit(scene, &entry.ray, &hit, &entry.medium);
-        let contribution = entry.weight * shaded.radiance;
-        if finite_radiance(contribution) {
-            radiance += contribution;
-        }
+        add_contribution(&mut radiance, entry.weight * shaded.radiance);
         rays += shaded.shadow_rays;
         if entry.depth >= scene.settings.max_depth {
             continue;
@@ -389,6 +394,41 @@ pub fn direct_light(
     n: DVec3,
     wo: DVec3,
 ) -> (DVec3, u64) {
+    let Some(sample) = sample_light(light, origin, n) else {
+        return (DVec3::ZERO, 0);
+    };
+    let shadow = Ray {
+        origin,
+        direction: sample.wi,
+    };
+    if occluded(&scene.geometry, &shadow, sample.distance) {
+        return (DVec3::ZERO, 1);
+    }
+    (
+        eval_brdf(material, &scene.images, n, sample.wi, wo) * sample.irradiance * sample.cos_i,
+        1,
+    )
+}
+
+/// What a light does at a shading point: the direction to it, its distance, the
+/// irradiance it delivers on a surface facing it, and `cos θi` about the shading
+/// normal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightSample {
+    /// Unit direction from the point towards the light.
+    pub wi: DVec3,
+    /// Distance to the light (infinite for a directional light).
+    pub distance: f64,
+    /// Irradiance on a surface facing the light.
+    pub irradiance: DVec3,
+    /// `n · wi`, in (0, 1].
+    pub cos_i: f64,
+}
+
+/// The geometry of `light` seen from `origin` with shading normal `n`, or `None` when
+/// it contributes nothing and casts no shadow ray: a light below `n`, or a point
+/// light at a zero, denormal or NaN distance.
+pub fn sample_light(light: &Light, origin: DVec3, n: DVec3) -> Option<LightSample> {
     let (wi, distance, irradiance) = match *light {
         Light::Point {
             position,
@@ -398,7 +438,7 @@ pub fn direct_light(
             let distance_squared = to_light.length_squared();
             // Zero, denormal or NaN distance: no contribution (see the constant).
             if distance_squared.is_nan() || distance_squared < MIN_LIGHT_DISTANCE_SQUARED {
-                return (DVec3::ZERO, 0);
+                return None;
             }
             let distance = distance_squared.sqrt();
             // Inverse-square law: E = I / r² on a surface facing the light.
@@ -410,18 +450,10 @@ pub fn direct_light(
         } => (-direction, f64::INFINITY, irradiance),
     };
     let cos_i = n.dot(wi).clamp(-1.0, 1.0);
-    if cos_i <= 0.0 {
-        return (DVec3::ZERO, 0);
-    }
-    let shadow = Ray {
-        origin,
-        direction: wi,
-    };
-    if occluded(&scene.geometry, &shadow, distance) {
-        return (DVec3::ZERO, 1);
-    }
-    (
-        eval_brdf(material, &scene.images, n, wi, wo) * irradiance * cos_i,
-        1,
-    )
+    (cos_i > 0.0).then_some(LightSample {
+        wi,
+        distance,
+        irradiance,
+        cos_i,
+    })
 }

@@ -9,7 +9,8 @@
 use glam::DVec3;
 
 use super::intersect::{
-    Hit, Ray, ShearedRay, hit_record_keyed, intersect_prim, intersect_triangle, shear_ray,
+    Hit, Ray, ShearedRay, hit_record_keyed, intersect_prim, intersect_triangle, limit_for,
+    shear_ray,
 };
 use crate::accel::{
     Bvh, BvhNode, HitKey, Instance, MAX_BVH_DEPTH, PrimKind, PrimRef, SceneGeometry,
@@ -41,22 +42,27 @@ struct SlabRay {
     inverse_direction: DVec3,
 }
 
+/// `1 / d` per component, a component smaller than [`MIN_DIRECTION_COMPONENT`] in
+/// magnitude replaced by it with its sign first.
+fn inverse_direction(d: DVec3) -> DVec3 {
+    // -0 counts as positive, as in the WGSL twin's `select`.
+    let safe = |d: f64| {
+        if d.abs() >= MIN_DIRECTION_COMPONENT {
+            d
+        } else if d < 0.0 {
+            -MIN_DIRECTION_COMPONENT
+        } else {
+            MIN_DIRECTION_COMPONENT
+        }
+    };
+    DVec3::new(1.0 / safe(d.x), 1.0 / safe(d.y), 1.0 / safe(d.z))
+}
+
 impl SlabRay {
     fn new(ray: &Ray) -> Self {
-        // -0 counts as positive, as in the WGSL twin's `select`.
-        let safe = |d: f64| {
-            if d.abs() >= MIN_DIRECTION_COMPONENT {
-                d
-            } else if d < 0.0 {
-                -MIN_DIRECTION_COMPONENT
-            } else {
-                MIN_DIRECTION_COMPONENT
-            }
-        };
-        let d = ray.direction;
         Self {
             origin: ray.origin,
-            inverse_direction: DVec3::new(1.0 / safe(d.x), 1.0 / safe(d.y), 1.0 / safe(d.z)),
+            inverse_direction: inverse_direction(ray.direction),
         }
     }
 
@@ -70,16 +76,6 @@ impl SlabRay {
         let near = lo.min(hi).max_element().max(0.0);
         let far = lo.max(hi).min_element().min(t_max) * FAR_SLAB_SCALE;
         (near <= far).then_some(near)
-    }
-}
-
-/// The exclusive distance limit for testing the surface `key` against the best hit so
-/// far: the best distance, or just beyond it for a smaller key, which wins exact ties.
-/// Without a hit yet, the query's own exclusive `t_max`.
-fn limit_for(key: HitKey, best_t: f64, best: Option<HitKey>) -> f64 {
-    match best {
-        Some(b) if key < b && best_t.is_finite() => best_t.next_up(),
-        _ => best_t,
     }
 }
 
@@ -203,7 +199,7 @@ pub fn object_ray(instance: &Instance, ray: &Ray) -> Ray {
     }
 }
 
-/// The traversal both queries share, twin of `advance_traversal` in
+/// The traversal both queries share, twin of `traverse` in
 /// `shaders/traverse.wgsl` (without its budget: the CPU never suspends a traversal):
 /// the planes, then the tree nearest child first, each leaf's primitives in order
 /// (an instance's mesh traversed in its own space where the leaf names it), each

@@ -187,43 +187,93 @@ const FEATURE_NAMES: [(&str, FeatureFlag); 17] = [
     ("UNROLLED", |f| f.unrolled.is_some()),
 ];
 
+/// A malformed feature directive in a WGSL source: a bug in our own shaders, which the
+/// tests catch. Lines count from 1.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum DirectiveError {
+    /// `//#if` names a feature that [`ShaderFeatures`] does not have.
+    #[error("line {line}: unknown shader feature `{name}`")]
+    UnknownFeature {
+        /// The directive's line.
+        line: usize,
+        /// The unknown name.
+        name: String,
+    },
+    /// `//#else` outside any `//#if` block.
+    #[error("line {line}: //#else without //#if")]
+    ElseWithoutIf {
+        /// The directive's line.
+        line: usize,
+    },
+    /// `//#endif` outside any `//#if` block.
+    #[error("line {line}: //#endif without //#if")]
+    EndifWithoutIf {
+        /// The directive's line.
+        line: usize,
+    },
+    /// The source ends inside `//#if` blocks.
+    #[error("{count} //#if without //#endif")]
+    UnclosedIf {
+        /// The blocks left open.
+        count: usize,
+    },
+}
+
 /// Keeps the lines of `source` whose enclosing `//#if` directives hold for `features`
 /// and removes the directive lines. An unknown feature name or unbalanced directives
 /// are errors (they are bugs in our own shaders, caught by the tests).
-pub fn specialise(source: &str, features: &ShaderFeatures) -> Result<String, String> {
-    // One entry per open `//#if`: whether its branch currently being read is kept.
-    let mut open: Vec<(bool, bool)> = Vec::new(); // (condition, in_else)
+pub fn specialise(source: &str, features: &ShaderFeatures) -> Result<String, DirectiveError> {
     let mut output = String::with_capacity(source.len());
+    for (_, line) in kept_lines(source, features)? {
+        output.push_str(line);
+        output.push('\n');
+    }
+    Ok(output)
+}
+
+/// The lines [`specialise`] keeps, each with its line number in `source` (from 1), so
+/// that what is read from them (the composer's `#import` lines) can be reported where
+/// it was written.
+pub(crate) fn kept_lines<'a>(
+    source: &'a str,
+    features: &ShaderFeatures,
+) -> Result<Vec<(usize, &'a str)>, DirectiveError> {
+    // One entry per open `//#if`: its condition and whether its `//#else` was reached.
+    let mut open: Vec<(bool, bool)> = Vec::new();
+    let mut kept = Vec::new();
     for (index, line) in source.lines().enumerate() {
+        let number = index + 1;
         let directive = line.trim_start();
         if let Some(condition) = directive.strip_prefix("//#if ") {
             let mut value = false;
             for name in condition.split("||").map(str::trim) {
-                value |= features.named(name).ok_or_else(|| {
-                    format!("line {}: unknown shader feature `{name}`", index + 1)
-                })?;
+                value |= features
+                    .named(name)
+                    .ok_or_else(|| DirectiveError::UnknownFeature {
+                        line: number,
+                        name: name.to_string(),
+                    })?;
             }
             open.push((value, false));
         } else if directive.starts_with("//#else") {
             let top = open
                 .last_mut()
-                .ok_or_else(|| format!("line {}: //#else without //#if", index + 1))?;
+                .ok_or(DirectiveError::ElseWithoutIf { line: number })?;
             top.1 = true;
         } else if directive.starts_with("//#endif") {
             open.pop()
-                .ok_or_else(|| format!("line {}: //#endif without //#if", index + 1))?;
+                .ok_or(DirectiveError::EndifWithoutIf { line: number })?;
         } else if open
             .iter()
             .all(|&(condition, in_else)| condition != in_else)
         {
-            output.push_str(line);
-            output.push('\n');
+            kept.push((number, line));
         }
     }
     if open.is_empty() {
-        Ok(output)
+        Ok(kept)
     } else {
-        Err(format!("{} //#if without //#endif", open.len()))
+        Err(DirectiveError::UnclosedIf { count: open.len() })
     }
 }
 
@@ -268,5 +318,20 @@ mod tests {
         assert!(specialise("//#if GLITTER\n//#endif\n", &ShaderFeatures::ALL).is_err());
         assert!(specialise("//#if PBR\n", &ShaderFeatures::ALL).is_err());
         assert!(specialise("//#endif\n", &ShaderFeatures::ALL).is_err());
+        assert_eq!(
+            specialise("a\n//#if GLITTER\n//#endif\n", &ShaderFeatures::ALL),
+            Err(DirectiveError::UnknownFeature {
+                line: 2,
+                name: "GLITTER".into()
+            })
+        );
+        assert_eq!(
+            specialise("//#else\n", &ShaderFeatures::ALL),
+            Err(DirectiveError::ElseWithoutIf { line: 1 })
+        );
+        assert_eq!(
+            specialise("//#if PBR\n//#if PBR\n//#endif\n", &ShaderFeatures::ALL),
+            Err(DirectiveError::UnclosedIf { count: 1 })
+        );
     }
 }

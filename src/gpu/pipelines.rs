@@ -288,11 +288,10 @@ impl Pipelines {
         }
         let layout = self.trace_layout(device, features)?;
         let label = format!("trace ({})", features.label());
-        let source =
-            trace_shader_source(features).map_err(|message| RenderError::ShaderSource {
-                module: label.clone(),
-                message,
-            })?;
+        let source = trace_shader_source(features).map_err(|error| RenderError::ShaderSource {
+            module: label.clone(),
+            message: error.to_string(),
+        })?;
         let entry_points: &[&str] = match schedule {
             Schedule::Fused => &[FUSED_ENTRY_POINT],
             Schedule::Wavefront => &[SHADE_ENTRY_POINT, TRACE_ENTRY_POINT],

@@ -1,50 +1,156 @@
-//! Composition of the WGSL sources. WGSL has no `#include`, so the modules are
-//! concatenated in dependency order; every source file is embedded at compile time.
-//! Optional code is kept or dropped by [`specialise`] (see [`super::features`]).
+//! The WGSL sources and their composition. Each file of `shaders/` is one module that
+//! names the modules it uses in `#import NAME` lines (vello's convention); the
+//! composer (`src/gpu/shaders/composer.rs`) joins a module with everything it
+//! imports, each module once and after its imports, and refuses an import cycle. Each
+//! module is specialised to the scene's features first ([`super::features`]), so an
+//! import inside an `//#if` block is followed only where the block is kept.
+//!
+//! Besides the files, three modules are written by the host: `limits` (the Rust
+//! constants `MAX_BVH_DEPTH` and `MAX_POLYGON_VERTICES`), `records` (the bindings of
+//! the scene records, storage or uniform arrays: [`super::uniform_records`]) and, for
+//! an unrolled scene, `unrolled_scene` (its `unrolled_closest_hit`: [`super::unrolled`]).
+//!
+//! Each module twins the Rust file of the same name (`shaders/intersect.wgsl` and
+//! `src/cpu/intersect.rs`, `shaders/color.wgsl` and `src/color.rs`): the same
+//! functions under the same names, which `tests/integration/shader_modules.rs` holds
+//! them to.
 
-use super::features::{ShaderFeatures, specialise};
+mod composer;
 
-/// The shared records (`FrameUniforms`, `Sphere`, ...), twins of [`super::layout`].
-pub const TYPES_WGSL: &str = include_str!("../../shaders/types.wgsl");
-/// The exact sRGB curve, twin of [`crate::color::srgb_encode`].
-pub const COLOR_WGSL: &str = include_str!("../../shaders/color.wgsl");
-/// The display pass (`encode_display`).
-pub const DISPLAY_WGSL: &str = include_str!("../../shaders/display.wgsl");
-/// `shaders/draw.wgsl`: the fullscreen-triangle draw of a film into a colour attachment.
-pub const DRAW_WGSL: &str = include_str!("../../shaders/draw.wgsl");
-/// Camera rays and the sample pattern, twin of [`crate::camera`].
-pub const SAMPLING_WGSL: &str = include_str!("../../shaders/sampling.wgsl");
-/// Ray/shape intersection.
-pub const INTERSECT_WGSL: &str = include_str!("../../shaders/intersect.wgsl");
-/// Texture coordinates and bilinear lookups (the `images` binding), twin of
-/// [`crate::cpu::texture`].
-pub const TEXTURE_WGSL: &str = include_str!("../../shaders/texture.wgsl");
-/// Materials.
-pub const BXDF_WGSL: &str = include_str!("../../shaders/bxdf.wgsl");
-/// The BRDF test kernel (`eval_brdfs`), composed by [`bxdf_eval_shader_source`].
-pub const BXDF_EVAL_WGSL: &str = include_str!("../../shaders/bxdf_eval.wgsl");
+use std::borrow::Cow;
+
+pub use composer::ComposeError;
+
+use super::features::ShaderFeatures;
+
+/// One WGSL source file of `shaders/`, embedded at compile time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ShaderModule {
+    /// Its name, the file's stem (`shaders/{name}.wgsl`), by which others import it.
+    pub name: &'static str,
+    /// Its text.
+    pub source: &'static str,
+}
+
+macro_rules! shader_modules {
+    ($($name:literal),* $(,)?) => {
+        [$(ShaderModule {
+            name: $name,
+            source: include_str!(concat!("../../shaders/", $name, ".wgsl")),
+        }),*]
+    };
+}
+
+/// Every module of `shaders/`, the lower ones first.
+pub const SHADER_MODULES: [ShaderModule; 27] = shader_modules![
+    "types",
+    "path_types",
+    "math",
+    "bindings",
+    "budget",
+    "color",
+    "sample",
+    "medium",
+    "camera",
+    "noise",
+    "texture",
+    "bxdf",
+    "instance",
+    "intersect",
+    "unrolled",
+    "traverse",
+    "environment",
+    "brdf_map_cdf",
+    "tabulated",
+    "area_lights",
+    "slot",
+    "trace",
+    "path",
+    "wavefront",
+    "display",
+    "draw",
+    "bxdf_eval",
+];
+
+/// The modules the host writes (see the module's documentation).
+pub const HOST_MODULES: [&str; 3] = ["limits", "records", "unrolled_scene"];
+
+/// The text of the module of `shaders/` called `name`.
+pub fn shader_module(name: &str) -> Option<&'static str> {
+    SHADER_MODULES
+        .iter()
+        .find(|module| module.name == name)
+        .map(|module| module.source)
+}
+
+/// The text of the host's module `name` for a trace module with `features` (`None`
+/// for other names, and for `unrolled_scene` without an unrolled scene).
+pub fn host_module(name: &str, features: &ShaderFeatures) -> Option<String> {
+    match name {
+        "limits" => Some(format!(
+            "const MAX_BVH_DEPTH: u32 = {}u;\nconst MAX_POLYGON_VERTICES: u32 = {}u;\n",
+            crate::accel::MAX_BVH_DEPTH,
+            crate::accel::MAX_POLYGON_VERTICES
+        )),
+        "records" => Some(format!(
+            "#import types\n{}",
+            super::uniform_records::declarations(features.uniform_records)
+        )),
+        "unrolled_scene" => features.unrolled.as_ref().map(|unrolled| unrolled.wgsl()),
+        _ => None,
+    }
+}
+
+/// The module `name`, a file's or the host's, composed with everything it imports and
+/// specialised to `features`.
+///
+/// Errors: [`ComposeError`] for a missing module, an import cycle or malformed
+/// directives.
+pub fn compose(name: &str, features: &ShaderFeatures) -> Result<String, ComposeError> {
+    let lookup = |module: &str| lookup(module, features);
+    let source = lookup(name).ok_or_else(|| ComposeError::MissingModule {
+        module: name.to_string(),
+        importer: None,
+    })?;
+    composer::compose(name, &source, &lookup, features)
+}
+
+/// A WGSL source of the caller's (a test's kernel) composed with the modules its
+/// `#import` lines name, specialised to `features`.
+///
+/// Errors: [`ComposeError`] for a missing module, an import cycle or malformed
+/// directives.
+pub fn compose_source(source: &str, features: &ShaderFeatures) -> Result<String, ComposeError> {
+    let lookup = |module: &str| lookup(module, features);
+    composer::compose("<source>", source, &lookup, features)
+}
+
+/// The modules a WGSL source imports, in the order of its `#import` lines, with
+/// `features` deciding its `//#if` blocks.
+///
+/// Errors: [`ComposeError`] for malformed directives or imports.
+pub fn imports(source: &str, features: &ShaderFeatures) -> Result<Vec<String>, ComposeError> {
+    composer::imports_of("<source>", source, features)
+}
+
+/// A module of `shaders/` or of the host by its name.
+fn lookup(name: &str, features: &ShaderFeatures) -> Option<Cow<'static, str>> {
+    shader_module(name)
+        .map(Cow::Borrowed)
+        .or_else(|| host_module(name, features).map(Cow::Owned))
+}
+
+/// The shipped module `name` composed with every feature on: the display, draw and
+/// BRDF test kernels, whose modules have no feature directives but those of the
+/// modules they share with the trace kernels.
+fn compose_shipped(name: &str) -> String {
+    compose(name, &ShaderFeatures::ALL).unwrap_or_else(|error| {
+        panic!("the shipped modules compose (tests/integration/shader_modules.rs): {error}")
+    })
+}
+
 /// Entry point of the BRDF test kernel.
 pub const BXDF_EVAL_ENTRY_POINT: &str = "eval_brdfs";
-/// The resumable BVH traversal, twin of [`crate::cpu::traverse`].
-pub const TRAVERSE_WGSL: &str = include_str!("../../shaders/traverse.wgsl");
-/// The wavefront kernels (`shade_paths`, `trace_rays`) and their bindings.
-pub const TRACE_WGSL: &str = include_str!("../../shaders/trace.wgsl");
-/// `shaders/noise.wgsl`: the per-pixel noise estimate's running sums (twin of
-/// [`crate::noise`]).
-pub const NOISE_WGSL: &str = include_str!("../../shaders/noise.wgsl");
-/// The path integrator's records and constants (`Emitter`, `FLAG_PATH`), twins of
-/// [`super::area_lights`].
-pub const PATH_TYPES_WGSL: &str = include_str!("../../shaders/path_types.wgsl");
-/// The environment map (`ENVIRONMENT_MAP` feature): its radiance by direction and its
-/// sampler, twins of [`crate::scene::EnvironmentMap`] and
-/// [`crate::accel::EnvironmentLight`].
-pub const ENVIRONMENT_WGSL: &str = include_str!("../../shaders/environment.wgsl");
-/// The path integrator (`PATH` feature), twin of [`crate::cpu::path`] and its samplers.
-pub const PATH_WGSL: &str = include_str!("../../shaders/path.wgsl");
-/// The inverse-CDF sampler of tabulated BRDF maps (`PATH` and `TABULATED` features),
-/// twin of [`crate::cpu::tabulated`].
-pub const TABULATED_WGSL: &str = include_str!("../../shaders/tabulated.wgsl");
-
 /// Entry point of the shading kernel of the trace module.
 pub const SHADE_ENTRY_POINT: &str = "shade_paths";
 /// Entry point of the traversal kernel of the trace module.
@@ -59,97 +165,93 @@ pub const DISPLAY_ENTRY_POINT: &str = "encode_display";
 /// Workgroup size (x and y) of the display pass, `@workgroup_size(8, 8, 1)`.
 pub const WORKGROUP_SIZE: u32 = 8;
 
-/// The complete trace module specialised to `features` (see [`super::features`]): the
-/// constants shared with the Rust side (`MAX_BVH_DEPTH`, `MAX_POLYGON_VERTICES`), the
-/// record bindings (storage or uniform arrays, as `features.uniform_records` says), then
-/// types, path types, sampling, intersect, texture, bxdf, environment, traverse, noise,
-/// trace, path and the tabulated BRDF sampler, then for an unrolled scene its
-/// `unrolled_closest_hit` ([`super::unrolled`]).
+/// The complete trace module specialised to `features` (see [`super::features`]):
+/// `shaders/wavefront.wgsl`, the trace kernels, with everything it imports, the
+/// record bindings storage or uniform arrays as `features.uniform_records` says, and
+/// for an unrolled scene its `unrolled_closest_hit` ([`super::unrolled`]).
 ///
-/// Errors: a message if the sources' feature directives are malformed.
+/// Errors: [`ComposeError`] if the sources' feature directives or imports are
+/// malformed (bugs in our own sources, which the tests catch).
 ///
 /// ```
 /// use gpu_render::gpu::ShaderFeatures;
 /// let src = gpu_render::gpu::shaders::trace_shader_source(&ShaderFeatures::ALL).unwrap();
-/// assert!(src.starts_with("const MAX_BVH_DEPTH: u32 = 64u;\n"));
+/// assert!(src.contains("const MAX_BVH_DEPTH: u32 = 64u;\n"));
 /// assert!(src.contains("fn refract_direction"));
 /// assert!(src.contains("fn shade_paths") && src.contains("fn trace_rays"));
 /// ```
-pub fn trace_shader_source(features: &ShaderFeatures) -> Result<String, String> {
-    let parts = [
-        TYPES_WGSL,
-        PATH_TYPES_WGSL,
-        SAMPLING_WGSL,
-        INTERSECT_WGSL,
-        TEXTURE_WGSL,
-        BXDF_WGSL,
-        ENVIRONMENT_WGSL,
-        TRAVERSE_WGSL,
-        NOISE_WGSL,
-        TRACE_WGSL,
-        PATH_WGSL,
-        TABULATED_WGSL,
-    ];
-    let mut source = format!(
-        "const MAX_BVH_DEPTH: u32 = {}u;\nconst MAX_POLYGON_VERTICES: u32 = {}u;\n",
-        crate::accel::MAX_BVH_DEPTH,
-        crate::accel::MAX_POLYGON_VERTICES
-    );
-    source.push_str(&super::uniform_records::declarations(
-        features.uniform_records,
-    ));
-    for part in parts {
-        source.push_str(&specialise(part, features)?);
-    }
-    if let Some(unrolled) = &features.unrolled {
-        source.push_str(&unrolled.wgsl());
-    }
-    Ok(source)
+pub fn trace_shader_source(features: &ShaderFeatures) -> Result<String, ComposeError> {
+    compose("wavefront", features)
 }
 
-/// The BRDF test kernel: types, texture, bxdf and `shaders/bxdf_eval.wgsl`, which
-/// evaluates [`crate::cpu::bxdf::eval_brdf`]'s twin on a list of (material, n, wi, wo)
-/// cases so that tests can compare it with the CPU.
+/// The BRDF test kernel, `shaders/bxdf_eval.wgsl`, which evaluates
+/// [`crate::cpu::bxdf::eval_brdf`]'s twin on a list of (material, n, wi, wo) cases so
+/// that tests can compare it with the CPU.
 ///
 /// ```
 /// let src = gpu_render::gpu::shaders::bxdf_eval_shader_source();
 /// assert!(src.contains("fn eval_brdfs"));
 /// ```
 pub fn bxdf_eval_shader_source() -> String {
-    let mut source = String::new();
-    for part in [TYPES_WGSL, TEXTURE_WGSL, BXDF_WGSL, BXDF_EVAL_WGSL] {
-        // Every feature is on: the directives are only stripped, which cannot fail
-        // for our own sources (the layout tests check that it does not).
-        source.push_str(&specialise(part, &ShaderFeatures::ALL).unwrap_or_default());
-    }
-    source
+    compose_shipped("bxdf_eval")
 }
 
-/// The complete display module: types, colour and display.
+/// The complete display module, `shaders/display.wgsl` and its imports.
 ///
 /// ```
 /// let src = gpu_render::gpu::shaders::display_shader_source();
 /// assert!(src.contains("fn encode_display"));
 /// ```
 pub fn display_shader_source() -> String {
-    let mut source = String::new();
-    for part in [TYPES_WGSL, COLOR_WGSL, DISPLAY_WGSL] {
-        source.push_str(part);
-        if !part.ends_with('\n') {
-            source.push('\n');
-        }
-    }
-    source
+    compose_shipped("display")
 }
 
-/// The draw shader (`shaders/draw.wgsl` after `shaders/color.wgsl`).
+/// The draw shader, `shaders/draw.wgsl` and its imports.
 pub fn draw_shader_source() -> String {
-    let mut source = String::new();
-    for part in [COLOR_WGSL, DRAW_WGSL] {
-        source.push_str(part);
-        if !part.ends_with('\n') {
-            source.push('\n');
+    compose_shipped("draw")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Parses and validates `source` with every capability the trace kernels may use.
+    fn validate(name: &str, source: &str) -> naga::Module {
+        let module = naga::front::wgsl::parse_str(source)
+            .unwrap_or_else(|e| panic!("{name} does not parse:\n{}", e.emit_to_string(source)));
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::default(),
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{name} does not validate:\n{}", e.emit_to_string(source)));
+        module
+    }
+
+    /// Each module, composed alone with every feature, is valid WGSL: it imports every
+    /// module whose names it uses (naga refuses an unknown identifier).
+    #[test]
+    fn every_module_composed_alone_validates() {
+        for module in SHADER_MODULES {
+            let source = compose(module.name, &ShaderFeatures::ALL)
+                .unwrap_or_else(|e| panic!("{}: {e}", module.name));
+            validate(module.name, &source);
+        }
+        for name in ["limits", "records"] {
+            validate(name, &compose(name, &ShaderFeatures::ALL).expect(name));
         }
     }
-    source
+
+    #[test]
+    fn every_module_is_emitted_once_after_its_imports() {
+        let source = trace_shader_source(&ShaderFeatures::ALL).expect("composes");
+        let types = source.find("struct FrameUniforms {").expect("types");
+        let bindings = source
+            .find("var<uniform> frame: FrameUniforms")
+            .expect("bindings");
+        let kernels = source.find("fn trace_paths(").expect("wavefront");
+        assert!(types < bindings && bindings < kernels);
+        assert_eq!(source.matches("struct FrameUniforms {").count(), 1);
+        assert!(!source.contains("#import"));
+    }
 }

@@ -15,8 +15,9 @@
 //! addresses, so those keep storage buffers.
 //!
 //! The WGSL declarations of these bindings are composed here ([`declarations`]) rather
-//! than written in `shaders/trace.wgsl`, since their address space and array type are
-//! what differs; the code that reads them is the same.
+//! than written in `shaders/bindings.wgsl`, as the module `records` of the composer
+//! (`super::shaders`), since their address space and array type are what differs; the
+//! code that reads them is the same.
 
 use std::mem::size_of;
 

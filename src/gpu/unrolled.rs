@@ -113,8 +113,10 @@ impl UnrolledPrimitives {
         &self.tests[..self.len]
     }
 
-    /// The WGSL function `unrolled_closest_hit(ray, sheared, best_t, best_prim)` that
-    /// runs the tests (the helpers it calls are in `shaders/traverse.wgsl`).
+    /// The WGSL module `unrolled_scene` (see [`super::shaders`]): the function
+    /// `unrolled_closest_hit(ray, sheared, best_t, best_prim)` that runs the tests, with
+    /// the imports of the helpers it calls (`shaders/unrolled.wgsl`) and of the types of
+    /// its arguments.
     pub fn wgsl(&self) -> String {
         let mut body = String::new();
         for test in self.tests() {
@@ -143,7 +145,8 @@ impl UnrolledPrimitives {
             };
         }
         format!(
-            "// The scene's every primitive, unrolled (src/gpu/unrolled.rs).\n\
+            "#import intersect\n#import unrolled\n\
+             // The scene's every primitive, unrolled (src/gpu/unrolled.rs).\n\
              fn unrolled_closest_hit(ray: Ray, sheared: ShearedRay, best_t: ptr<function, f32>,\n\
              \x20                       best_prim: ptr<function, u32>) {{\n{body}}}\n"
         )

@@ -1,5 +1,5 @@
 //! The per-path medium stack: which dielectrics a ray travels inside, shared by both
-//! tracers (the GPU twin is `MediumStack` in `shaders/trace.wgsl`).
+//! tracers (the GPU twin is `MediumStack` in `shaders/medium.wgsl`).
 
 /// How many nested dielectrics a [`MediumStack`] remembers.
 pub const MEDIUM_STACK_SIZE: usize = 4;

@@ -12,9 +12,8 @@ use gpu_render::accel::{BuildMethod, SceneGeometry};
 use gpu_render::cpu::intersect::Ray;
 use gpu_render::cpu::traverse::closest_hit_brute_force;
 use gpu_render::gpu::ShaderFeatures;
-use gpu_render::gpu::features::specialise;
 use gpu_render::gpu::layout::{FrameUniforms, GpuCounters};
-use gpu_render::gpu::shaders::{INTERSECT_WGSL, TRAVERSE_WGSL, TYPES_WGSL};
+use gpu_render::gpu::shaders::compose_source;
 use gpu_render::gpu::upload::{SceneRecords, frame_uniforms};
 use gpu_render::scene::{Camera, Environment, Material, RenderSettings, Scene, Shape};
 use wgpu::util::DeviceExt;
@@ -23,22 +22,15 @@ use wgpu::util::DeviceExt;
 /// traversal, resumed until it finishes, and the brute force with the same tie rule.
 /// Each writes `(bits of best_t, best_prim)`.
 const KERNELS: &str = r"
-@group(0) @binding(0) var<uniform> frame: FrameUniforms;
-@group(0) @binding(1) var<storage, read> spheres: array<Sphere>;
-@group(0) @binding(2) var<storage, read> planes: array<Plane>;
-@group(0) @binding(3) var<storage, read> polygons: array<Polygon>;
-@group(0) @binding(4) var<storage, read> polygon_points: array<vec2<f32>>;
-@group(0) @binding(5) var<storage, read> triangles: array<Triangle>;
-@group(0) @binding(9) var<storage, read_write> counters: Counters;
-@group(0) @binding(12) var<storage, read> bvh_nodes: array<BvhNode>;
-@group(0) @binding(13) var<storage, read> bvh_prims: array<u32>;
-fn prim_ref(i: u32) -> u32 { return bvh_prims[i]; }
-fn polygon_point(i: u32) -> vec2<f32> { return polygon_points[i]; }
-@group(0) @binding(17) var<storage, read_write> traversal_stack: array<u32>;
-@group(0) @binding(18) var<storage, read> test_rays: array<vec4<f32>>;
-@group(0) @binding(19) var<storage, read_write> results: array<vec2<u32>>;
-// Declared for the shared intersection code; neither entry point reads it.
-@group(0) @binding(20) var<storage, read> triangle_attributes: array<TriangleAttributes>;
+#import types
+#import bindings
+#import records
+#import budget
+#import intersect
+#import traverse
+
+@group(0) @binding(21) var<storage, read> test_rays: array<vec4<f32>>;
+@group(0) @binding(22) var<storage, read_write> results: array<vec2<u32>>;
 
 fn test_trace(slot: u32) -> TraceRay {
     let a = test_rays[2u * slot];
@@ -56,16 +48,16 @@ fn traverse_rays(@builtin(global_invocation_id) id: vec3<u32>) {
     var trace = test_trace(slot);
     loop {
         iterations = 0u;
-        if advance_traversal(slot, &trace, false) == TRAVERSAL_FINISHED {
+        if traverse(slot, &trace, false) == TRAVERSAL_FINISHED {
             break;
         }
     }
     results[slot] = vec2<u32>(bitcast<u32>(trace.best_t), trace.best_prim);
 }
 
-fn consider(prim: u32, ray: Ray, best: ptr<function, vec2<u32>>) {
+fn brute_force_consider(prim: u32, ray: Ray, best: ptr<function, vec2<u32>>) {
     let t = intersect_prim(prim, ray, shear_ray(ray),
-                           tie_limit(prim, bitcast<f32>((*best).x), (*best).y));
+                           limit_for(prim, NO_INSTANCE, bitcast<f32>((*best).x), (*best).y, NO_INSTANCE));
     if t != NO_HIT {
         *best = vec2<u32>(bitcast<u32>(t), prim);
     }
@@ -81,16 +73,16 @@ fn brute_force_rays(@builtin(global_invocation_id) id: vec3<u32>) {
     let ray = Ray(trace.origin, trace.direction);
     var best = vec2<u32>(bitcast<u32>(trace.t_max), NO_PRIM);
     for (var i = 0u; i < arrayLength(&spheres); i += 1u) {
-        consider((PRIM_SPHERE << PRIM_KIND_SHIFT) | i, ray, &best);
+        brute_force_consider((PRIM_SPHERE << PRIM_KIND_SHIFT) | i, ray, &best);
     }
     for (var i = 0u; i < frame.plane_count; i += 1u) {
-        consider((PRIM_PLANE << PRIM_KIND_SHIFT) | i, ray, &best);
+        brute_force_consider((PRIM_PLANE << PRIM_KIND_SHIFT) | i, ray, &best);
     }
     for (var i = 0u; i < arrayLength(&polygons); i += 1u) {
-        consider((PRIM_POLYGON << PRIM_KIND_SHIFT) | i, ray, &best);
+        brute_force_consider((PRIM_POLYGON << PRIM_KIND_SHIFT) | i, ray, &best);
     }
     for (var i = 0u; i < arrayLength(&triangles); i += 1u) {
-        consider((PRIM_TRIANGLE << PRIM_KIND_SHIFT) | i, ray, &best);
+        brute_force_consider((PRIM_TRIANGLE << PRIM_KIND_SHIFT) | i, ray, &best);
     }
     results[slot] = best;
 }
@@ -128,14 +120,7 @@ fn run_kernel(
     budget: u32,
 ) -> Vec<GpuHit> {
     let (device, queue) = (&gpu.device, &gpu.queue);
-    let source = format!(
-        "const MAX_BVH_DEPTH: u32 = {}u;\nconst MAX_POLYGON_VERTICES: u32 = {}u;\n{}{}{}{KERNELS}",
-        gpu_render::accel::MAX_BVH_DEPTH,
-        gpu_render::accel::MAX_POLYGON_VERTICES,
-        TYPES_WGSL,
-        specialise(INTERSECT_WGSL, &ShaderFeatures::ALL).expect("directives"),
-        specialise(TRAVERSE_WGSL, &ShaderFeatures::ALL).expect("directives"),
-    );
+    let source = compose_source(KERNELS, &ShaderFeatures::ALL).expect("the kernels compose");
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("traversal test"),
         source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -203,17 +188,17 @@ fn run_kernel(
                 none,
             ),
         ),
-        (18, storage(bytemuck::cast_slice(&ray_words), none)),
+        (21, storage(bytemuck::cast_slice(&ray_words), none)),
         (
-            19,
+            22,
             storage(&vec![0u8; rays.len() * 8], wgpu::BufferUsages::COPY_SRC),
         ),
     ];
     // The automatic layout keeps only what the entry point uses.
     let layout = pipeline.get_bind_group_layout(0);
     let used: Vec<u32> = match entry {
-        "traverse_rays" => vec![0, 1, 2, 3, 4, 5, 9, 12, 13, 17, 18, 19],
-        _ => vec![0, 1, 2, 3, 4, 5, 18, 19],
+        "traverse_rays" => vec![0, 1, 2, 3, 4, 5, 9, 12, 13, 17, 21, 22],
+        _ => vec![0, 1, 2, 3, 4, 5, 21, 22],
     };
     let mut entries = vec![wgpu::BindGroupEntry {
         binding: 0,

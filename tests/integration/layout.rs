@@ -14,13 +14,13 @@ use gpu_render::gpu::area_lights::{
 use gpu_render::gpu::environment::GpuEnvironmentHeader;
 use gpu_render::gpu::layout::*;
 use gpu_render::gpu::shaders::{
-    PATH_TYPES_WGSL, TYPES_WGSL, bxdf_eval_shader_source, display_shader_source,
-    trace_shader_source,
+    bxdf_eval_shader_source, display_shader_source, shader_module, trace_shader_source,
 };
 
 /// The shared records: types.wgsl and the path integrator's path_types.wgsl.
 fn shared_types_wgsl() -> String {
-    format!("{TYPES_WGSL}\n{PATH_TYPES_WGSL}")
+    let module = |name| shader_module(name).unwrap_or_else(|| panic!("shaders/{name}.wgsl"));
+    format!("{}\n{}", module("types"), module("path_types"))
 }
 
 /// Rust twin of one WGSL struct: size and (member name, offset) pairs.
@@ -489,7 +489,8 @@ fn wgsl_f32_const(source: &str, name: &str) -> f32 {
 /// Numeric constants written in the WGSL by hand equal their Rust twins in f32.
 #[test]
 fn wgsl_constants_equal_their_rust_twins() {
-    let trace = gpu_render::gpu::shaders::TRACE_WGSL;
+    let module = |name| shader_module(name).unwrap_or_else(|| panic!("shaders/{name}.wgsl"));
+    let trace = module("trace");
     for (name, rust) in [
         (
             "MIN_LIGHT_DISTANCE_SQUARED",
@@ -502,16 +503,13 @@ fn wgsl_constants_equal_their_rust_twins() {
     ] {
         assert_eq!(wgsl_f32_const(trace, name), rust as f32, "{name}");
     }
-    let path = gpu_render::gpu::shaders::PATH_WGSL;
+    let path = module("path");
     assert_eq!(
         wgsl_f32_const(path, "MIN_SURVIVAL"),
         gpu_render::cpu::path::MIN_SURVIVAL as f32
     );
     assert_eq!(
-        wgsl_f32_const(
-            gpu_render::gpu::shaders::TABULATED_WGSL,
-            "TABULATED_COSINE_PROBABILITY"
-        ),
+        wgsl_f32_const(module("tabulated"), "TABULATED_COSINE_PROBABILITY"),
         gpu_render::cpu::tabulated::TABULATED_COSINE_PROBABILITY as f32
     );
     let roulette = format!(
@@ -519,14 +517,9 @@ fn wgsl_constants_equal_their_rust_twins() {
         gpu_render::cpu::path::ROULETTE_DEPTH
     );
     assert!(path.lines().any(|l| l == roulette), "{roulette}");
-    let [r, g, b] = gpu_render::noise::LUMINANCE_WEIGHTS.map(|w| w as f32);
+    let [r, g, b] = gpu_render::color::LUMINANCE_WEIGHTS.map(|w| w as f32);
     let weights = format!("const LUMINANCE_WEIGHTS: vec3<f32> = vec3<f32>({r:?}, {g:?}, {b:?});");
-    assert!(
-        gpu_render::gpu::shaders::NOISE_WGSL
-            .lines()
-            .any(|l| l == weights),
-        "{weights}"
-    );
+    assert!(module("color").lines().any(|l| l == weights), "{weights}");
 }
 
 #[test]

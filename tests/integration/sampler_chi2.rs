@@ -1,5 +1,5 @@
-//! Chi-square tests of every importance sampler against its density (src/cpu/sample.rs,
-//! and the tabulated BRDF maps' inverse-CDF sampler of src/cpu/tabulated.rs),
+//! Chi-square tests of every importance sampler against its density (src/sample.rs, the
+//! lobe samplers of src/cpu/bxdf.rs, and the tabulated BRDF maps' inverse-CDF sampler of src/cpu/tabulated.rs),
 //! as pbrt-v4 and Mitsuba 3 test theirs: the sphere of directions is cut into a grid
 //! of cells in (θ, φ), a cell's expected count is the sample count times the density
 //! integrated over the cell (the midpoint rule on a 32 × 32 grid in θ and φ, with the
@@ -14,10 +14,14 @@ use std::cell::Cell;
 
 use glam::{DVec2, DVec3};
 use gpu_render::accel::BrdfMapCdf;
-use gpu_render::cpu::sample::*;
+use gpu_render::cpu::bxdf::{
+    pdf_beckmann_normal, pdf_blinn_phong_half, pdf_ggx_visible_normal, sample_beckmann_normal,
+    sample_blinn_phong_half, sample_ggx_visible_normal,
+};
 use gpu_render::cpu::tabulated::{
     TABULATED_COSINE_PROBABILITY, pdf_brdf_map_direction, pdf_tabulated, sample_tabulated,
 };
+use gpu_render::sample::*;
 use gpu_render::scene::Image;
 
 /// Tests in this file that compute a p-value (for Šidák's correction).

@@ -1,4 +1,4 @@
-//! The WGSL sample pattern (`shaders/sampling.wgsl`) against its CPU twin
+//! The WGSL sample pattern (`shaders/camera.wgsl`) against its CPU twin
 //! (`src/camera.rs`): a test kernel calls `sample_offset` for two rounds of every sample
 //! (the pattern and the progressive samples past it) of a few
 //! pixels at every sample count 1..=300 and at the largest counts (where the u32
@@ -7,14 +7,17 @@
 //! in every column and every row of the strata) is tested in `src/camera.rs`.
 
 use gpu_render::camera::sample_offset;
+use gpu_render::gpu::ShaderFeatures;
 use gpu_render::gpu::layout::FrameUniforms;
-use gpu_render::gpu::shaders::{SAMPLING_WGSL, TYPES_WGSL};
+use gpu_render::gpu::shaders::compose_source;
 use gpu_render::scene::RenderSettings;
 use wgpu::util::DeviceExt;
 
 /// The kernel: one invocation per (pixel, sample index).
 const KERNEL: &str = r"
-@group(0) @binding(0) var<uniform> frame: FrameUniforms;
+#import bindings
+#import camera
+
 @group(0) @binding(1) var<storage, read> pixels: array<vec2<u32>>;
 @group(0) @binding(2) var<storage, read_write> offsets: array<vec2<f32>>;
 
@@ -51,7 +54,7 @@ fn gpu_sample_offsets_match_the_cpu() {
         return;
     };
     let (device, queue) = (&gpu.device, &gpu.queue);
-    let source = format!("{TYPES_WGSL}\n{SAMPLING_WGSL}\n{KERNEL}");
+    let source = compose_source(KERNEL, &ShaderFeatures::ALL).expect("the kernel composes");
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("sample offsets"),
         source: wgpu::ShaderSource::Wgsl(source.into()),

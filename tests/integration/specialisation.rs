@@ -86,7 +86,7 @@ fn only_a_scene_with_an_environment_map_gets_its_code() {
         "environment_sample",
         "environment_pdf",
         "environment_radiance",
-        "environment_sample_1d",
+        "distribution_1d_sample",
     ];
     let cornell = ShaderFeatures::for_scene(&scene("cornell-box.toml"));
     assert!(cornell.path && !cornell.environment_map);

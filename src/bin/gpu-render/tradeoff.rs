@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use anyhow::{Context, Result};
 use gpu_render::film::TimingSource;
-use gpu_render::noise::relative_rmse;
+use gpu_render::film::relative_rmse;
 use gpu_render::scene::{Integrator, RenderOverrides, RenderSettings, Scene};
 use gpu_render::tradeoff::{
     ErrorAxis, Knobs, Measurement, default_sweep, integrator_name, mean_flip, pareto_front,

@@ -13,7 +13,7 @@
 use std::time::Instant;
 
 use glam::DVec3;
-use gpu_render::accel::luminance;
+use gpu_render::color::luminance;
 use gpu_render::cpu::intersect::Ray;
 use gpu_render::cpu::path::path_radiance;
 use gpu_render::cpu::trace::PreparedScene;

@@ -1,6 +1,7 @@
-//! Texture coordinates and bilinear image lookups: the CPU twin of
-//! `shaders/texture.wgsl` (same function names, `f64` arithmetic on the same `f32`
-//! texels).
+//! Texture coordinates and bilinear image lookups, below both tracers: the CPU
+//! reference shades with them, and the light distributions of [`crate::accel`] weigh
+//! textured emitters by [`mean_texel`]. The GPU twin is `shaders/texture.wgsl` (same
+//! function names, `f64` arithmetic on the same `f32` texels).
 //!
 //! Conventions (also in `docs/materials.md`): texture coordinates `(u, v)` run from
 //! the image's left edge to its right (`u`) and from its top row to its bottom (`v`);
@@ -109,11 +110,14 @@ pub fn sample_brdf_map(image: &Image, theta_i: f64, theta_r: f64) -> DVec3 {
     bilinear(image, [xa, xa + 1], [ya, ya + 1], fx, fy) / PI
 }
 
+/// The colour of texel (`x`, `y`) of `image`.
+pub fn image_texel(image: &Image, x: u32, y: u32) -> DVec3 {
+    let t = image.texel(x, y);
+    DVec3::new(f64::from(t[0]), f64::from(t[1]), f64::from(t[2]))
+}
+
 fn bilinear(image: &Image, xs: [u32; 2], ys: [u32; 2], fx: f64, fy: f64) -> DVec3 {
-    let texel = |x: u32, y: u32| {
-        let t = image.texel(x, y);
-        DVec3::new(f64::from(t[0]), f64::from(t[1]), f64::from(t[2]))
-    };
+    let texel = |x: u32, y: u32| image_texel(image, x, y);
     let top = texel(xs[0], ys[0]) * (1.0 - fx) + texel(xs[1], ys[0]) * fx;
     let bottom = texel(xs[0], ys[1]) * (1.0 - fx) + texel(xs[1], ys[1]) * fx;
     top * (1.0 - fy) + bottom * fy

@@ -1,21 +1,11 @@
-// The pinhole camera and the pixel sample pattern.
-// CPU twin: src/camera.rs (pcg_hash, unit_from_hash, strata_grid, sample_offset,
-// CameraFrame::ray_direction -> camera_ray_direction). The lattice generator of the
+// The pinhole camera and the pixel sample pattern. CPU twin: src/camera.rs
+// (strata_grid, jitter_seed, sample_offset, CameraFrame::ray_direction ->
+// camera_ray_direction); the hash is sample.wgsl's. The lattice generator of the
 // sample count is computed once on the host (camera::lattice_generator) and arrives in
 // frame.lattice_generator.
 
-// PCG hash of one 32-bit word (Jarzynski and Olano, "Hash Functions for GPU Rendering",
-// JCGT 2020). u32 arithmetic wraps, as Rust's wrapping_mul/wrapping_add do.
-fn pcg_hash(input: u32) -> u32 {
-    let state = input * 747796405u + 2891336453u;
-    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
-}
-
-// A uniform number in [0, 1) from the top 24 bits of a hash: exact in f32.
-fn unit_from_hash(hash: u32) -> f32 {
-    return f32(hash >> 8u) * (1.0 / 16777216.0);
-}
+#import bindings
+#import sample
 
 // n columns and n rows of elementary strata for n samples; sample_offset puts exactly
 // one sample in every column and every row.

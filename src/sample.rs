@@ -1,6 +1,9 @@
-//! Importance samplers and their densities, the building blocks of a path-tracing
-//! integrator (issue 11): directions over the hemisphere for each BRDF lobe, points on
-//! area lights, and a counter-based random number per pixel, sample and dimension.
+//! Hashing and sample warps, below both tracers: the one PCG hash that the camera's
+//! sample pattern ([`crate::camera`]) and the path integrator's counter-based random
+//! numbers both draw from, and the warps from uniform numbers to directions and points
+//! (the cosine hemisphere, the cone of a sphere, a triangle's area) with their
+//! densities. The samplers of the BRDF lobes' own distributions are with the BRDFs
+//! (`crate::cpu::bxdf`). The GPU twin is `shaders/sample.wgsl` (same names).
 //!
 //! Every sampler maps uniform numbers `u ∈ [0, 1)²` to a sample and has a density
 //! function for the same measure (solid angle for directions, area for points) that
@@ -9,8 +12,6 @@
 //! surface normal ([`ShadingFrame`]).
 
 use glam::{DVec2, DVec3};
-
-use super::bxdf::{distribution_beckmann, distribution_ggx, smith_lambda_ggx};
 
 /// An orthonormal basis around a unit normal `n` (`z` = `n`), without branches on
 /// the normal's direction except its sign (Duff et al., "Building an Orthonormal Basis,
@@ -79,82 +80,6 @@ pub fn sample_cosine_hemisphere(u: DVec2) -> DVec3 {
 /// steradian.
 pub fn pdf_cosine_hemisphere(w: DVec3) -> f64 {
     w.z.max(0.0) * std::f64::consts::FRAC_1_PI
-}
-
-/// A microfacet normal of the GGX distribution of roughness `alpha` (isotropic)
-/// visible from the local direction `wo` (`wo.z > 0`), with density
-/// [`pdf_ggx_visible_normal`]: Heitz, "Sampling the GGX Distribution of Visible
-/// Normals", JCGT 7(4), 2018, listing 1.
-pub fn sample_ggx_visible_normal(wo: DVec3, alpha: f64, u: DVec2) -> DVec3 {
-    // The view direction in the hemisphere configuration (stretched to alpha = 1).
-    let vh = DVec3::new(alpha * wo.x, alpha * wo.y, wo.z).normalize();
-    // An orthonormal basis around it (T1 is horizontal).
-    let length_squared = vh.x * vh.x + vh.y * vh.y;
-    let t1 = if length_squared > 0.0 {
-        DVec3::new(-vh.y, vh.x, 0.0) / length_squared.sqrt()
-    } else {
-        DVec3::X
-    };
-    let t2 = vh.cross(t1);
-    // A point of the projected area: a disk, its far half squeezed by vh.z.
-    let r = u.x.sqrt();
-    let phi = 2.0 * std::f64::consts::PI * u.y;
-    let p1 = r * phi.cos();
-    let s = 0.5 * (1.0 + vh.z);
-    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
-    // Onto the hemisphere, and back to the ellipsoid configuration.
-    let nh = t1 * p1 + t2 * p2 + vh * (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
-    DVec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(0.0)).normalize()
-}
-
-/// The density of [`sample_ggx_visible_normal`] at the microfacet normal `h`, per
-/// steradian of normals: `D_wo(h) = G1(wo) · max(0, wo·h) · D(h) / wo.z` (Heitz 2018,
-/// eq. 1).
-pub fn pdf_ggx_visible_normal(wo: DVec3, h: DVec3, alpha: f64) -> f64 {
-    if wo.z <= 0.0 || h.z <= 0.0 {
-        return 0.0;
-    }
-    let g1 = 1.0 / (1.0 + smith_lambda_ggx(wo.z, alpha));
-    g1 * wo.dot(h).max(0.0) * distribution_ggx(h.z, alpha) / wo.z
-}
-
-/// A microfacet normal of the Beckmann distribution of roughness `alpha`, with density
-/// `D(h) · cos θ_h` ([`pdf_beckmann_normal`]): `tan² θ_h = -α² ln(1 - u₁)`, `φ = 2π u₂`
-/// (Walter et al., "Microfacet Models for Refraction through Rough Surfaces", EGSR
-/// 2007, eq. 28).
-pub fn sample_beckmann_normal(alpha: f64, u: DVec2) -> DVec3 {
-    let tan_squared = -alpha * alpha * (1.0 - u.x).ln();
-    let cos_theta = 1.0 / (1.0 + tan_squared).sqrt();
-    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-    let phi = 2.0 * std::f64::consts::PI * u.y;
-    DVec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
-}
-
-/// The density of [`sample_beckmann_normal`] at `h`, per steradian of normals.
-pub fn pdf_beckmann_normal(h: DVec3, alpha: f64) -> f64 {
-    if h.z <= 0.0 {
-        return 0.0;
-    }
-    distribution_beckmann(h.z, alpha) * h.z
-}
-
-/// A half vector of the normalized Blinn-Phong lobe of exponent `n`, with density
-/// `(n + 2)/(2π) · cos^(n+1) θ_h` ([`pdf_blinn_phong_half`]), the lobe's
-/// distribution `(n + 2)/(2π) cos^n θ_h` times `cos θ_h`: `cos θ_h = u₁^(1/(n+2))`,
-/// `φ = 2π u₂` (inverting its CDF in `cos θ_h`).
-pub fn sample_blinn_phong_half(n: f64, u: DVec2) -> DVec3 {
-    let cos_theta = (1.0 - u.x).powf(1.0 / (n + 2.0));
-    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-    let phi = 2.0 * std::f64::consts::PI * u.y;
-    DVec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
-}
-
-/// The density of [`sample_blinn_phong_half`] at `h`, per steradian of half vectors.
-pub fn pdf_blinn_phong_half(h: DVec3, n: f64) -> f64 {
-    if h.z <= 0.0 {
-        return 0.0;
-    }
-    (n + 2.0) / (2.0 * std::f64::consts::PI) * h.z.powf(n + 1.0)
 }
 
 /// The direction `wo` reflects into about the half vector `h`.
@@ -263,14 +188,18 @@ pub fn pcg_hash(input: u32) -> u32 {
     (word >> 22) ^ word
 }
 
+/// A uniform number in [0, 1) from the top 24 bits of a hash: exact in `f32`.
+pub fn unit_from_hash(hash: u32) -> f64 {
+    f64::from(hash >> 8) * (1.0 / 16_777_216.0)
+}
+
 /// A uniform number in `[0, 1)` for dimension `dimension` of sample `sample` of the
 /// pixel `pixel` (its index in the image): the three counters hashed in turn, the top
 /// 24 bits of the result scaled by 2⁻²⁴, so that f32 represents it exactly.
 /// Counter-based: no state, so any pixel's samples can be drawn in any order, on
 /// either backend.
 pub fn random_number(pixel: u32, sample: u32, dimension: u32) -> f64 {
-    let hashed = pcg_hash(pcg_hash(pcg_hash(pixel) ^ sample) ^ dimension);
-    f64::from(hashed >> 8) * (1.0 / 16_777_216.0)
+    unit_from_hash(pcg_hash(pcg_hash(pcg_hash(pixel) ^ sample) ^ dimension))
 }
 
 #[cfg(test)]
@@ -296,6 +225,15 @@ mod tests {
             let w = DVec3::new(0.2, -0.7, 0.5);
             assert!(f.to_world(f.to_local(w)).distance(w) < 1e-12);
         }
+    }
+
+    #[test]
+    fn pcg_hash_matches_reference_values() {
+        // Values computed by hand from the published algorithm.
+        let state = 747_796_405u32.wrapping_add(2_891_336_453);
+        let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277_803_737);
+        assert_eq!(pcg_hash(1), (word >> 22) ^ word);
+        assert_ne!(pcg_hash(0), pcg_hash(1));
     }
 
     #[test]
