@@ -87,26 +87,38 @@ fn microfacet_alpha(roughness: f32) -> f32 {
 //#endif
 
 //#if COOK_TORRANCE || PBR
-// GGX: D = α² / (π ((n·h)²(α² - 1) + 1)²) (Walter et al. 2007, eq. 33).
-fn distribution_ggx(cos_h: f32, alpha: f32) -> f32 {
+// sin² of the angle between unit n and h as |n × h|², exact where 1 - (n·h)² cancels:
+// at α = 1e-3 an f32 cosine leaves 1 - cos² about 10% wrong, a bias of the near-mirror
+// lobes against the f64 twin.
+fn sin2_between(n: vec3<f32>, h: vec3<f32>) -> f32 {
+    let c = cross(n, h);
+    return dot(c, c);
+}
+//#endif
+
+//#if COOK_TORRANCE || PBR
+// GGX: D = α² / (π ((n·h)²(α² - 1) + 1)²) (Walter et al. 2007, eq. 33), the
+// denominator written sin²θh + α² cos²θh, which does not cancel near the peak.
+fn distribution_ggx(cos_h: f32, sin2_h: f32, alpha: f32) -> f32 {
     if cos_h <= 0.0 {
         return 0.0;
     }
     let a2 = alpha * alpha;
-    let d = cos_h * cos_h * (a2 - 1.0) + 1.0;
+    let d = sin2_h + cos_h * cos_h * a2;
     return a2 / (PI * d * d);
 }
 //#endif
 
 //#if COOK_TORRANCE || PBR
-// Beckmann: D = exp(-tan²θh/α²) / (π α² cos⁴θh) (Walter et al. 2007, eq. 25).
-fn distribution_beckmann(cos_h: f32, alpha: f32) -> f32 {
+// Beckmann: D = exp(-tan²θh/α²) / (π α² cos⁴θh) (Walter et al. 2007, eq. 25),
+// tan²θh = sin²θh / cos²θh.
+fn distribution_beckmann(cos_h: f32, sin2_h: f32, alpha: f32) -> f32 {
     if cos_h <= 0.0 {
         return 0.0;
     }
     let c2 = cos_h * cos_h;
     let a2 = alpha * alpha;
-    let tan2 = (1.0 - c2) / c2;
+    let tan2 = sin2_h / c2;
     return exp(-tan2 / a2) / (PI * a2 * c2 * c2);
 }
 //#endif
@@ -147,11 +159,11 @@ fn smith_g2_height_correlated(cos_i: f32, cos_o: f32, alpha: f32, distribution: 
 //#endif
 
 //#if COOK_TORRANCE || PBR
-fn microfacet_distribution(cos_h: f32, alpha: f32, distribution: u32) -> f32 {
+fn microfacet_distribution(cos_h: f32, sin2_h: f32, alpha: f32, distribution: u32) -> f32 {
     if distribution == DISTRIBUTION_BECKMANN {
-        return distribution_beckmann(cos_h, alpha);
+        return distribution_beckmann(cos_h, sin2_h, alpha);
     }
-    return distribution_ggx(cos_h, alpha);
+    return distribution_ggx(cos_h, sin2_h, alpha);
 }
 //#endif
 
@@ -248,25 +260,38 @@ fn microfacet_fresnel(material: Material, cos: f32) -> vec3<f32> {
 
 //#if COOK_TORRANCE || PBR
 // F·D·G2 / (4 cos θi cos θo) (Cook and Torrance 1982; Walter et al. 2007, eq. 20).
-fn microfacet_specular(fresnel: vec3<f32>, alpha: f32, distribution: u32, cos_i: f32, cos_o: f32, cos_h: f32) -> vec3<f32> {
-    let d = microfacet_distribution(cos_h, alpha, distribution);
-    let g = smith_g2_height_correlated(cos_i, cos_o, alpha, distribution);
-    return fresnel * (d * g / (4.0 * cos_i * cos_o));
+fn microfacet_specular(fresnel: vec3<f32>, alpha: f32, distribution: u32, angles: MicrofacetAngles) -> vec3<f32> {
+    let d = microfacet_distribution(angles.cos_h, angles.sin2_h, alpha, distribution);
+    let g = smith_g2_height_correlated(angles.cos_i, angles.cos_o, alpha, distribution);
+    return fresnel * (d * g / (4.0 * angles.cos_i * angles.cos_o));
 }
 //#endif
 
 //#if COOK_TORRANCE || PBR
-// (n·wi, n·wo, n·h, wi·h); x = 0 when the pair gives no reflection.
-fn microfacet_cosines(n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec4<f32> {
+// The angles the microfacet models need, for directions wi, wo and their half vector
+// h. Twin of the Rust struct of the same name.
+struct MicrofacetAngles {
+    cos_i: f32,  // n·wi; 0 when the pair gives no reflection
+    cos_o: f32,  // n·wo
+    cos_h: f32,  // n·h
+    sin2_h: f32, // |n × h|²
+    cos_d: f32,  // wi·h, clamped to [0, 1]
+}
+//#endif
+
+//#if COOK_TORRANCE || PBR
+// The MicrofacetAngles of wi and wo about n; cos_i = 0 when the pair gives no
+// reflection.
+fn microfacet_cosines(n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> MicrofacetAngles {
     let cos_i = dot(n, wi);
     let cos_o = dot(n, wo);
     let half_sum = wi + wo;
     let length_squared = dot(half_sum, half_sum);
     if cos_i <= 0.0 || cos_o <= 0.0 || length_squared == 0.0 {
-        return vec4<f32>(0.0);
+        return MicrofacetAngles(0.0, 0.0, 0.0, 0.0, 0.0);
     }
     let h = half_sum * inverseSqrt(length_squared);
-    return vec4<f32>(cos_i, cos_o, dot(n, h), clamp(dot(wi, h), 0.0, 1.0));
+    return MicrofacetAngles(cos_i, cos_o, dot(n, h), sin2_between(n, h), clamp(dot(wi, h), 0.0, 1.0));
 }
 //#endif
 
@@ -274,16 +299,16 @@ fn microfacet_cosines(n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec4<f32> {
 // Cook-Torrance: specular lobe, plus for a dielectric kd/π·(1 - F(θi))(1 - F(θo))
 // (Shirley et al. 1997, §4).
 fn brdf_cook_torrance(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
-    let c = microfacet_cosines(n, wi, wo);
-    if c.x == 0.0 {
+    let angles = microfacet_cosines(n, wi, wo);
+    if angles.cos_i == 0.0 {
         return vec3<f32>(0.0);
     }
     let alpha = microfacet_alpha(material.roughness);
-    let specular = microfacet_specular(microfacet_fresnel(material, c.w), alpha, material.distribution, c.x, c.y, c.z);
+    let specular = microfacet_specular(microfacet_fresnel(material, angles.cos_d), alpha, material.distribution, angles);
     if material.conductor != 0u {
         return specular;
     }
-    let through = (vec3<f32>(1.0) - microfacet_fresnel(material, c.x)) * (vec3<f32>(1.0) - microfacet_fresnel(material, c.y));
+    let through = (vec3<f32>(1.0) - microfacet_fresnel(material, angles.cos_i)) * (vec3<f32>(1.0) - microfacet_fresnel(material, angles.cos_o));
     return specular + material.diffuse / PI * through;
 }
 //#endif
@@ -341,15 +366,15 @@ fn brdf_tabulated(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>
 // glTF 2.0 Appendix B: F0 = mix(0.04, base, metallic), Schlick F at h·wi, GGX D with
 // α = roughness², height-correlated Smith G2, diffuse (1 - F)(1 - metallic)·base/π.
 fn brdf_pbr(material: Material, n: vec3<f32>, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
-    let c = microfacet_cosines(n, wi, wo);
-    if c.x == 0.0 {
+    let angles = microfacet_cosines(n, wi, wo);
+    if angles.cos_i == 0.0 {
         return vec3<f32>(0.0);
     }
     let base = material.diffuse;
     let f0 = mix(vec3<f32>(0.04), base, material.metallic);
-    let fresnel = fresnel_schlick(c.w, f0);
+    let fresnel = fresnel_schlick(angles.cos_d, f0);
     let alpha = microfacet_alpha(material.roughness);
-    let specular = microfacet_specular(fresnel, alpha, DISTRIBUTION_GGX, c.x, c.y, c.z);
+    let specular = microfacet_specular(fresnel, alpha, DISTRIBUTION_GGX, angles);
     return specular + (vec3<f32>(1.0) - fresnel) * (1.0 - material.metallic) * base / PI;
 }
 //#endif
@@ -470,7 +495,7 @@ fn pdf_ggx_visible_normal(wo: vec3<f32>, h: vec3<f32>, alpha: f32) -> f32 {
         return 0.0;
     }
     let g1 = 1.0 / (1.0 + smith_lambda_ggx(wo.z, alpha));
-    return g1 * max(dot(wo, h), 0.0) * distribution_ggx(h.z, alpha) / wo.z;
+    return g1 * max(dot(wo, h), 0.0) * distribution_ggx(h.z, h.x * h.x + h.y * h.y, alpha) / wo.z;
 }
 //#endif
 
@@ -482,7 +507,8 @@ fn pdf_ggx_visible_normal(wo: vec3<f32>, h: vec3<f32>, alpha: f32) -> f32 {
 fn sample_beckmann_normal(alpha: f32, u: vec2<f32>) -> vec3<f32> {
     let tan_squared = -alpha * alpha * log(1.0 - u.x);
     let cos_theta = 1.0 / sqrt(1.0 + tan_squared);
-    let sin_theta = sqrt(max(1.0 - cos_theta * cos_theta, 0.0));
+    // tan θ·cos θ, not sqrt(1 - cos²θ), which cancels near the normal.
+    let sin_theta = sqrt(tan_squared) * cos_theta;
     let phi = 2.0 * PI * u.y;
     return vec3<f32>(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
 }
@@ -492,7 +518,7 @@ fn pdf_beckmann_normal(h: vec3<f32>, alpha: f32) -> f32 {
     if h.z <= 0.0 {
         return 0.0;
     }
-    return distribution_beckmann(h.z, alpha) * h.z;
+    return distribution_beckmann(h.z, h.x * h.x + h.y * h.y, alpha) * h.z;
 }
 //#endif
 

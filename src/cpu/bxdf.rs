@@ -91,27 +91,36 @@ pub fn microfacet_alpha(roughness: f64) -> f64 {
     (roughness * roughness).max(MIN_ALPHA)
 }
 
-/// Trowbridge-Reitz (GGX) normal distribution for `cos_h = n·h`:
-/// `D = α² / (π ((n·h)²(α² - 1) + 1)²)` (Walter et al. 2007, "Microfacet Models for
-/// Refraction through Rough Surfaces", eq. 33). Zero for `cos_h ≤ 0`.
-pub fn distribution_ggx(cos_h: f64, alpha: f64) -> f64 {
+/// `sin²` of the angle between the unit vectors `n` and `h`, as `|n × h|²`: exact to
+/// the rounding of the components even where the angle is tiny, where `1 - (n·h)²`
+/// cancels (at `α = 10⁻³` the GPU's `f32` cosine leaves `1 - cos²` about 10% wrong).
+pub fn sin2_between(n: DVec3, h: DVec3) -> f64 {
+    n.cross(h).length_squared()
+}
+
+/// Trowbridge-Reitz (GGX) normal distribution for a microfacet normal at `cos_h = n·h`,
+/// `sin2_h = 1 - (n·h)²` from the normal: `D = α² / (π ((n·h)²(α² - 1) + 1)²)` (Walter
+/// et al. 2007, "Microfacet Models for Refraction through Rough Surfaces", eq. 33),
+/// its denominator written `sin²θh + α² cos²θh`, which has no cancellation near the
+/// peak. Zero for `cos_h ≤ 0`.
+pub fn distribution_ggx(cos_h: f64, sin2_h: f64, alpha: f64) -> f64 {
     if cos_h <= 0.0 {
         return 0.0;
     }
     let a2 = alpha * alpha;
-    let d = cos_h * cos_h * (a2 - 1.0) + 1.0;
+    let d = sin2_h + cos_h * cos_h * a2;
     a2 / (PI * d * d)
 }
 
 /// Beckmann normal distribution: `D = exp(-tan²θh/α²) / (π α² cos⁴θh)` (Walter et al.
-/// 2007, eq. 25). Zero for `cos_h ≤ 0`.
-pub fn distribution_beckmann(cos_h: f64, alpha: f64) -> f64 {
+/// 2007, eq. 25), `tan²θh = sin2_h / cos²θh`. Zero for `cos_h ≤ 0`.
+pub fn distribution_beckmann(cos_h: f64, sin2_h: f64, alpha: f64) -> f64 {
     if cos_h <= 0.0 {
         return 0.0;
     }
     let c2 = cos_h * cos_h;
     let a2 = alpha * alpha;
-    let tan2 = (1.0 - c2) / c2;
+    let tan2 = sin2_h / c2;
     (-tan2 / a2).exp() / (PI * a2 * c2 * c2)
 }
 
@@ -158,12 +167,13 @@ pub fn smith_g2_height_correlated(
 /// The normal distribution `D(h)` of `distribution`.
 pub fn microfacet_distribution(
     cos_h: f64,
+    sin2_h: f64,
     alpha: f64,
     distribution: MicrofacetDistribution,
 ) -> f64 {
     match distribution {
-        MicrofacetDistribution::Ggx => distribution_ggx(cos_h, alpha),
-        MicrofacetDistribution::Beckmann => distribution_beckmann(cos_h, alpha),
+        MicrofacetDistribution::Ggx => distribution_ggx(cos_h, sin2_h, alpha),
+        MicrofacetDistribution::Beckmann => distribution_beckmann(cos_h, sin2_h, alpha),
     }
 }
 
@@ -224,25 +234,44 @@ fn microfacet_specular(
     fresnel: DVec3,
     alpha: f64,
     distribution: MicrofacetDistribution,
-    cos_i: f64,
-    cos_o: f64,
-    cos_h: f64,
+    angles: &MicrofacetAngles,
 ) -> DVec3 {
-    let d = microfacet_distribution(cos_h, alpha, distribution);
-    let g = smith_g2_height_correlated(cos_i, cos_o, alpha, distribution);
-    fresnel * (d * g / (4.0 * cos_i * cos_o))
+    let d = microfacet_distribution(angles.cos_h, angles.sin2_h, alpha, distribution);
+    let g = smith_g2_height_correlated(angles.cos_i, angles.cos_o, alpha, distribution);
+    fresnel * (d * g / (4.0 * angles.cos_i * angles.cos_o))
 }
 
-/// The cosines the microfacet models need: `(n·wi, n·wo, n·h, wi·h)`, or `None` when
-/// either direction is below the surface or they cancel out.
-fn microfacet_cosines(n: DVec3, wi: DVec3, wo: DVec3) -> Option<(f64, f64, f64, f64)> {
+/// The angles the microfacet models need, for a pair of directions and the half
+/// vector `h` between them.
+struct MicrofacetAngles {
+    /// `n·wi`.
+    cos_i: f64,
+    /// `n·wo`.
+    cos_o: f64,
+    /// `n·h`.
+    cos_h: f64,
+    /// `|n × h|²`, see [`sin2_between`].
+    sin2_h: f64,
+    /// `wi·h`, clamped to [0, 1].
+    cos_d: f64,
+}
+
+/// The [`MicrofacetAngles`] of `wi` and `wo` about `n`, or `None` when either direction
+/// is below the surface or they cancel out.
+fn microfacet_cosines(n: DVec3, wi: DVec3, wo: DVec3) -> Option<MicrofacetAngles> {
     let cos_i = n.dot(wi);
     let cos_o = n.dot(wo);
     let h = (wi + wo).normalize_or_zero();
     if cos_i <= 0.0 || cos_o <= 0.0 || h == DVec3::ZERO {
         return None;
     }
-    Some((cos_i, cos_o, n.dot(h), wi.dot(h).clamp(0.0, 1.0)))
+    Some(MicrofacetAngles {
+        cos_i,
+        cos_o,
+        cos_h: n.dot(h),
+        sin2_h: sin2_between(n, h),
+        cos_d: wi.dot(h).clamp(0.0, 1.0),
+    })
 }
 
 /// Cook-Torrance BRDF: the specular lobe [`microfacet_fresnel`]·D·G2/(4 cos θi cos θo),
@@ -252,23 +281,21 @@ fn microfacet_cosines(n: DVec3, wi: DVec3, wo: DVec3) -> Option<(f64, f64, f64, 
 /// sum reciprocal and near energy conserving. `material.diffuse` is the (textured)
 /// albedo.
 pub fn brdf_cook_torrance(material: &Material, n: DVec3, wi: DVec3, wo: DVec3) -> DVec3 {
-    let Some((cos_i, cos_o, cos_h, cos_d)) = microfacet_cosines(n, wi, wo) else {
+    let Some(angles) = microfacet_cosines(n, wi, wo) else {
         return DVec3::ZERO;
     };
     let alpha = microfacet_alpha(material.roughness);
     let specular = microfacet_specular(
-        microfacet_fresnel(material, cos_d),
+        microfacet_fresnel(material, angles.cos_d),
         alpha,
         material.distribution,
-        cos_i,
-        cos_o,
-        cos_h,
+        &angles,
     );
     if material.conductor {
         return specular;
     }
-    let through = (DVec3::ONE - microfacet_fresnel(material, cos_i))
-        * (DVec3::ONE - microfacet_fresnel(material, cos_o));
+    let through = (DVec3::ONE - microfacet_fresnel(material, angles.cos_i))
+        * (DVec3::ONE - microfacet_fresnel(material, angles.cos_o));
     specular + material.diffuse / PI * through
 }
 
@@ -323,21 +350,14 @@ pub fn brdf_tabulated(map: &Image, n: DVec3, wi: DVec3, wo: DVec3) -> DVec3 {
 /// the specification's text writes the separable form). `material.diffuse` is the
 /// (textured) base colour.
 pub fn brdf_pbr(material: &Material, n: DVec3, wi: DVec3, wo: DVec3) -> DVec3 {
-    let Some((cos_i, cos_o, cos_h, cos_d)) = microfacet_cosines(n, wi, wo) else {
+    let Some(angles) = microfacet_cosines(n, wi, wo) else {
         return DVec3::ZERO;
     };
     let base = material.diffuse;
     let f0 = DVec3::splat(0.04).lerp(base, material.metallic);
-    let fresnel = fresnel_schlick(cos_d, f0);
+    let fresnel = fresnel_schlick(angles.cos_d, f0);
     let alpha = microfacet_alpha(material.roughness);
-    let specular = microfacet_specular(
-        fresnel,
-        alpha,
-        MicrofacetDistribution::Ggx,
-        cos_i,
-        cos_o,
-        cos_h,
-    );
+    let specular = microfacet_specular(fresnel, alpha, MicrofacetDistribution::Ggx, &angles);
     specular + (DVec3::ONE - fresnel) * (1.0 - material.metallic) * base / PI
 }
 
@@ -532,7 +552,8 @@ pub fn pdf_ggx_visible_normal(wo: DVec3, h: DVec3, alpha: f64) -> f64 {
         return 0.0;
     }
     let g1 = 1.0 / (1.0 + smith_lambda_ggx(wo.z, alpha));
-    g1 * wo.dot(h).max(0.0) * distribution_ggx(h.z, alpha) / wo.z
+    let sin2_h = h.x * h.x + h.y * h.y;
+    g1 * wo.dot(h).max(0.0) * distribution_ggx(h.z, sin2_h, alpha) / wo.z
 }
 
 /// A microfacet normal of the Beckmann distribution of roughness `alpha`, with density
@@ -542,7 +563,8 @@ pub fn pdf_ggx_visible_normal(wo: DVec3, h: DVec3, alpha: f64) -> f64 {
 pub fn sample_beckmann_normal(alpha: f64, u: DVec2) -> DVec3 {
     let tan_squared = -alpha * alpha * (1.0 - u.x).ln();
     let cos_theta = 1.0 / (1.0 + tan_squared).sqrt();
-    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    // tan θ·cos θ, not sqrt(1 - cos²θ), which cancels near the normal.
+    let sin_theta = tan_squared.sqrt() * cos_theta;
     let phi = 2.0 * std::f64::consts::PI * u.y;
     DVec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
 }
@@ -552,7 +574,7 @@ pub fn pdf_beckmann_normal(h: DVec3, alpha: f64) -> f64 {
     if h.z <= 0.0 {
         return 0.0;
     }
-    distribution_beckmann(h.z, alpha) * h.z
+    distribution_beckmann(h.z, h.x * h.x + h.y * h.y, alpha) * h.z
 }
 
 /// A half vector of the normalized Blinn-Phong lobe of exponent `n`, with density

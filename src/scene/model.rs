@@ -447,6 +447,13 @@ pub const MAX_SAMPLES_PER_PIXEL: u32 = 65_536;
 pub const MAX_DEPTH_LIMIT: u32 = 64;
 /// Largest accepted bounce-stack capacity.
 pub const MAX_STACK_SIZE: u32 = 128;
+/// Largest accepted radiance (emission, background, ambient, environment texels times
+/// their scale) and light strength (point intensity, directional irradiance, colour
+/// included), per channel. The GPU sums samples and bounces in `f32`: at this value
+/// [`MAX_SAMPLES_PER_PIXEL`] samples sum to 6.6e34, which leaves a factor of 5,000 for
+/// bounces and path weights below the largest `f32` (3.4e38), where a 1e38 environment
+/// at 4 samples per pixel overflowed.
+pub const MAX_RADIANCE: f64 = 1e30;
 
 /// Settings a user may override on the command line, on top of the scene file.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -642,3 +642,39 @@ fn self_crossing_polygons_are_refused_where_they_would_not_fill_by_the_even_odd_
         .collect();
     parse_scene(&scene(&polygon("grey", &comb)), Path::new(FILE)).expect("accepted");
 }
+
+/// Radiance and light strengths above 1e30 are refused where they are written: the GPU
+/// sums samples in f32, and a 1e38 environment at 4 samples per pixel overflowed (issue
+/// 26). 1e30 itself is accepted.
+#[test]
+fn radiance_that_the_gpu_cannot_sum_is_refused() {
+    for (text, needles) in [
+        (
+            scene("[materials.lamp]\ntype = \"emissive\"\nradiance = 2e30\n"),
+            &["materials.lamp", "at most 1e30"][..],
+        ),
+        (
+            format!("{CAMERA}[environment]\nbackground = [1, 3e38, 1]\n"),
+            &["environment", "at most 1e30"][..],
+        ),
+        (
+            format!(
+                "{CAMERA}[[lights]]\ntype = \"point\"\nposition = [0, 4, 0]\nintensity = 1e20\ncolor = [1e15, 1, 1]\n"
+            ),
+            &["lights[0]", "intensity times color", "1e35"][..],
+        ),
+        (
+            format!(
+                "{CAMERA}[[lights]]\ntype = \"directional\"\ndirection = [0, -1, 0]\nirradiance = 3e38\n"
+            ),
+            &["irradiance times color", "above the 1e30"][..],
+        ),
+    ] {
+        error(&text, needles);
+    }
+    let accepted = format!(
+        "{CAMERA}[environment]\nbackground = 1e30\n[materials.lamp]\ntype = \"emissive\"\nradiance = 1e30\n\
+         [[lights]]\ntype = \"point\"\nposition = [0, 4, 0]\nintensity = 1e30\n"
+    );
+    parse_scene(&accepted, Path::new(FILE)).expect("1e30 is accepted");
+}

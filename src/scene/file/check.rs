@@ -13,7 +13,7 @@ use glam::DVec3;
 
 use super::raw::{RawColor, RawVec3};
 use crate::echo::short;
-use crate::scene::{SceneError, SceneWarning};
+use crate::scene::{MAX_RADIANCE, SceneError, SceneWarning};
 
 /// The scene text and its path, for building located errors.
 pub struct Source<'a> {
@@ -198,11 +198,14 @@ impl Item<'_> {
         let value = self.number(field, value)?;
         let ok = match range {
             ColourRange::Fraction => (0.0..=1.0).contains(&value),
-            ColourRange::Radiance => value >= 0.0,
+            ColourRange::Radiance => (0.0..=MAX_RADIANCE).contains(&value),
         };
         if !ok {
             let accepted = match range {
                 ColourRange::Fraction => "in [0, 1]",
+                ColourRange::Radiance if value >= 0.0 => {
+                    "at most 1e30 (the GPU sums radiance in 32-bit floats)"
+                }
                 ColourRange::Radiance => ">= 0",
             };
             return Err(self.fail(format_args!(

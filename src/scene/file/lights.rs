@@ -5,8 +5,8 @@ use toml::Spanned;
 
 use super::check::{ColourRange, Item, Source};
 use super::raw::RawLight;
-use crate::echo::echo;
-use crate::scene::{Light, SceneError};
+use crate::echo::{echo, short};
+use crate::scene::{Light, MAX_RADIANCE, SceneError};
 
 const POINT_FIELDS: &[&str] = &["position", "intensity", "color"];
 const DIRECTIONAL_FIELDS: &[&str] = &["direction", "irradiance", "color"];
@@ -44,7 +44,7 @@ fn point(item: &Item<'_>, raw: &RawLight) -> Result<Light, SceneError> {
     let intensity = item.non_negative("intensity", item.require("intensity", raw.intensity)?)?;
     Ok(Light::Point {
         position,
-        intensity: intensity * color(item, raw)?,
+        intensity: strength(item, "intensity", intensity * color(item, raw)?)?,
     })
 }
 
@@ -57,8 +57,22 @@ fn directional(item: &Item<'_>, raw: &RawLight) -> Result<Light, SceneError> {
         item.non_negative("irradiance", item.require("irradiance", raw.irradiance)?)?;
     Ok(Light::Directional {
         direction,
-        irradiance: irradiance * color(item, raw)?,
+        irradiance: strength(item, "irradiance", irradiance * color(item, raw)?)?,
     })
+}
+
+/// A light's strength times its colour, refused above [`MAX_RADIANCE`] per channel.
+fn strength(item: &Item<'_>, field: &str, value: DVec3) -> Result<DVec3, SceneError> {
+    let largest = value.max_element();
+    if largest > MAX_RADIANCE {
+        return Err(item.fail(format_args!(
+            "{field} times color reaches {}, above the {} accepted (the GPU sums light \
+             in 32-bit floats)",
+            short(largest),
+            short(MAX_RADIANCE)
+        )));
+    }
+    Ok(value)
 }
 
 fn color(item: &Item<'_>, raw: &RawLight) -> Result<DVec3, SceneError> {

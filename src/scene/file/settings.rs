@@ -12,8 +12,8 @@ use super::paths::confined_path;
 use super::raw::{RawCamera, RawEnvironment, RawIntegrator, RawLighting, RawRender};
 use crate::echo::{echo_path, short};
 use crate::scene::{
-    Camera, Environment, EnvironmentMap, Image, Integrator, LightingSpace, RenderSettings,
-    SceneError, load_confined_image, load_image,
+    Camera, Environment, EnvironmentMap, Image, Integrator, LightingSpace, MAX_RADIANCE,
+    RenderSettings, SceneError, load_confined_image, load_image,
 };
 
 /// Default image width in pixels.
@@ -138,12 +138,11 @@ pub fn environment(
                         .max_element()
                 })
                 .fold(0.0, f64::max);
-            if brightest > f64::from(f32::MAX) {
+            if brightest > MAX_RADIANCE {
                 return Err(item.fail(format_args!(
-                    "map `{}` times scale reaches {brightest:e}, beyond the largest f32 \
-                     ({:e}); lower scale",
+                    "map `{}` times scale reaches {brightest:e}, above the {MAX_RADIANCE:e} \
+                     accepted (the GPU sums radiance in 32-bit floats); lower scale",
                     echo_path(Path::new(file)),
-                    f32::MAX
                 )));
             }
             Some(Arc::new(EnvironmentMap {

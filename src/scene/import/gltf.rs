@@ -23,7 +23,8 @@ use super::{
     ImportOptions, ImportedCamera, ImportedMaterial, ImportedMesh, ImportedModel,
     MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES, TextureRef, WrapMode, error, read_file,
 };
-use crate::scene::{Camera, Light, Material, MaterialKind, SceneError};
+use crate::echo::short;
+use crate::scene::{Camera, Light, MAX_RADIANCE, Material, MaterialKind, SceneError};
 
 /// Luminous efficacy used to turn `KHR_lights_punctual`'s photometric intensities into
 /// our radiometric ones, in lm/W: 683, the peak of the photopic curve at 555 nm (the
@@ -1028,7 +1029,15 @@ impl Importer<'_> {
         // occlusionTexture is left out without a warning: baked ambient occlusion is a
         // rasteriser's stand-in for the shadowing of indirect light (glTF 2.0 §3.9.3),
         // which a path tracer computes; applying it too would darken creases twice.
-        let emission = emissive * strength;
+        let mut emission = emissive * strength;
+        if emission.max_element() > MAX_RADIANCE {
+            self.warn(format!(
+                "{name}: emission {} is above the {} the GPU can sum in 32-bit floats; clamped",
+                short(emission.max_element()),
+                short(MAX_RADIANCE)
+            ));
+            emission = emission.min(DVec3::splat(MAX_RADIANCE));
+        }
         let transmission = material
             .transmission()
             .map_or(0.0, |t| f64::from(t.transmission_factor()));
@@ -1302,6 +1311,15 @@ impl Importer<'_> {
             ));
         }
         let strength = color * intensity / LUMENS_PER_WATT;
+        if strength.max_element() > MAX_RADIANCE {
+            return Err(self.fail(format!(
+                "{name}: intensity {} is {} W after conversion, above the {} accepted (the GPU \
+                 sums light in 32-bit floats)",
+                short(intensity),
+                short(strength.max_element()),
+                short(MAX_RADIANCE)
+            )));
+        }
         let position = world.transform_point3(DVec3::ZERO);
         let point = Light::Point {
             position,

@@ -14,7 +14,7 @@ use crate::input::{InputError, read_input};
 use crate::scene::import::mesh::Budget;
 use crate::scene::import::texture::{Encoding, Textures};
 use crate::scene::import::{ImportedMaterial, MAX_MODEL_FILE_BYTES, TextureRef, WrapMode, error};
-use crate::scene::{Material, MaterialKind, SceneError};
+use crate::scene::{MAX_RADIANCE, Material, MaterialKind, SceneError};
 
 /// Index of refraction assumed for glass (`illum` 4, 6, 7, 9) and coats (`illum` 3, 5, 8)
 /// whose material gives no usable `Ni`.
@@ -486,9 +486,12 @@ pub(super) fn map_material(
         }
         clamped
     };
-    let emission = ke.max(DVec3::ZERO);
+    let emission = ke.clamp(DVec3::ZERO, DVec3::splat(MAX_RADIANCE));
     if emission != ke {
-        warn(format!("Ke {} is negative; clamped to 0", short3(ke)));
+        warn(format!(
+            "Ke {} is negative or above the 1e30 the GPU can sum in 32-bit floats; clamped",
+            short3(ke)
+        ));
     }
     let ior_or_default = |warn: &mut dyn FnMut(String), what: &str| match ni {
         Some(ni) if ni > 0.0 => ni,
