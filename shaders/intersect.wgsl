@@ -85,10 +85,14 @@ fn world_attributes(index: u32, instance: u32, facing: vec3<f32>) -> TriangleAtt
 // The barycentric coordinates of `p` (on the triangle's plane) in the triangle
 // (v0, v1, v2), clamped to it and summing to 1 (Ericson, "Real-Time Collision
 // Detection", §3.4). CPU twin: triangle_barycentrics.
+// The vectors are first scaled by the power of two of scale_to_unit (exact), so that
+// the products of four coordinates neither overflow (edges beyond about 4e9) nor
+// underflow (edges below about 1e-10).
 fn triangle_barycentrics(p: vec3<f32>, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> vec3<f32> {
-    let e1 = v1 - v0;
-    let e2 = v2 - v0;
-    let q = p - v0;
+    let exponent = scale_to_unit(max(max_component(abs(v1 - v0)), max_component(abs(v2 - v0))));
+    let e1 = ldexp(v1 - v0, vec3<i32>(exponent));
+    let e2 = ldexp(v2 - v0, vec3<i32>(exponent));
+    let q = ldexp(p - v0, vec3<i32>(exponent));
     let d00 = dot(e1, e1);
     let d01 = dot(e1, e2);
     let d11 = dot(e2, e2);
@@ -163,9 +167,23 @@ fn ray_at(ray: Ray, t: f32) -> vec3<f32> {
 }
 
 //#if TRIANGLES
-// The unit normal (v1 - v0) × (v2 - v0), normalized.
+// The power of two 2^k (returned as k) that brings `largest` (finite, >= 0) into
+// [0.5, 1): scaling by it is exact, and keeps squares and products of a few such
+// values inside f32's range. 0 for 0.
+fn scale_to_unit(largest: f32) -> i32 {
+    return -frexp(largest).exp;
+}
+
+// The unit normal (v1 - v0) × (v2 - v0), normalized, with the edges and then the cross
+// product scaled by powers of two (scale_to_unit) before their squares are taken: a
+// ground triangle of corners ±2.2e9 (|cross|² beyond f32's 3.4e38) and one of size
+// 1e-15 (|cross|² below its smallest number) had no normal.
 fn triangle_normal(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> vec3<f32> {
-    return normalize(cross(v1 - v0, v2 - v0));
+    let e1 = v1 - v0;
+    let e2 = v2 - v0;
+    let edges = scale_to_unit(max(max_component(abs(e1)), max_component(abs(e2))));
+    let c = cross(ldexp(e1, vec3<i32>(edges)), ldexp(e2, vec3<i32>(edges)));
+    return normalize(ldexp(c, vec3<i32>(scale_to_unit(max_component(abs(c))))));
 }
 //#endif
 
@@ -406,7 +424,10 @@ fn intersect_triangle(ray: ShearedRay, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f3
     if determinant == 0.0 {
         return NO_HIT;
     }
-    let t = ray.shear.z * (u * a.z + v * b.z + w * c.z) / determinant;
+    // Normalised weights first: u·a.z is a product of three coordinates, which
+    // overflowed f32 for triangles beyond about 7e12 from the ray origin.
+    let inverse = 1.0 / determinant;
+    let t = ray.shear.z * ((u * inverse) * a.z + (v * inverse) * b.z + (w * inverse) * c.z);
     if t > 0.0 && t < t_max {
         return t;
     }

@@ -251,9 +251,17 @@ pub fn apply_triangle_attributes(hit: &mut Hit, attributes: &TriangleAttributes)
 /// `vertices`, clamped to the triangle and summing to 1 (Ericson, "Real-Time Collision
 /// Detection", §3.4): the weights of the corners for interpolating their attributes.
 pub fn triangle_barycentrics(point: DVec3, vertices: &[DVec3; 3]) -> DVec3 {
-    let e1 = vertices[1] - vertices[0];
-    let e2 = vertices[2] - vertices[0];
-    let p = point - vertices[0];
+    // Scaled by a power of two as the GPU twin, whose f32 products of four coordinates
+    // overflow for edges beyond about 4e9.
+    let scale = scale_to_unit(
+        (vertices[1] - vertices[0])
+            .abs()
+            .max_element()
+            .max((vertices[2] - vertices[0]).abs().max_element()),
+    );
+    let e1 = (vertices[1] - vertices[0]) * scale;
+    let e2 = (vertices[2] - vertices[0]) * scale;
+    let p = (point - vertices[0]) * scale;
     let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
     let (d20, d21) = (p.dot(e1), p.dot(e2));
     let denominator = d00 * d11 - d01 * d01;
@@ -302,9 +310,32 @@ pub fn shadow_terminator_point(geometry: &SceneGeometry, hit: &Hit, facing: DVec
 
 /// The unit normal `(v1 - v0) × (v2 - v0)` of a triangle, normalized.
 pub fn triangle_normal(vertices: &[DVec3; 3]) -> DVec3 {
-    (vertices[1] - vertices[0])
-        .cross(vertices[2] - vertices[0])
-        .normalize()
+    let e1 = vertices[1] - vertices[0];
+    let e2 = vertices[2] - vertices[0];
+    let edges = scale_to_unit(e1.abs().max_element().max(e2.abs().max_element()));
+    let c = (e1 * edges).cross(e2 * edges);
+    (c * scale_to_unit(c.abs().max_element())).normalize()
+}
+
+/// The power of two that brings `largest` (finite, at least 0) into [0.5, 1), 1 for 0:
+/// scaling by it is exact and keeps squares and products of a few such values inside
+/// the floating-point range. The GPU twin returns the exponent, for `ldexp` (in `f32` a
+/// triangle of corners ±2.2e9 had a squared cross product beyond the largest float).
+pub fn scale_to_unit(largest: f64) -> f64 {
+    if largest == 0.0 || !largest.is_finite() {
+        return 1.0;
+    }
+    // frexp: largest = m·2^e with m in [0.5, 1).
+    let exponent = largest.log2().floor() as i32 + 1;
+    let scale = 2f64.powi(-exponent);
+    // log2 may round across a power of two: correct by one step either way.
+    if largest * scale >= 1.0 {
+        scale * 0.5
+    } else if largest * scale < 0.5 {
+        scale * 2.0
+    } else {
+        scale
+    }
 }
 
 /// The unit outward normal at `point` of the sphere of radius `radius` through
@@ -530,8 +561,10 @@ pub fn intersect_triangle(ray: &ShearedRay, vertices: &[DVec3; 3], t_max: f64) -
     if determinant == 0.0 {
         return None;
     }
-    let t_scaled = shear_z * (u * a.z + v * b.z + w * c.z);
-    let t = t_scaled / determinant;
+    // Normalised weights first, as the GPU twin (where `u·a.z`, a product of three
+    // coordinates, overflowed f32 for triangles beyond about 7e12 from the origin).
+    let inverse = 1.0 / determinant;
+    let t = shear_z * ((u * inverse) * a.z + (v * inverse) * b.z + (w * inverse) * c.z);
     (t > 0.0 && t < t_max).then_some(t)
 }
 

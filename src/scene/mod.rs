@@ -10,6 +10,7 @@ pub mod import;
 mod medium;
 mod model;
 pub mod outline;
+mod precision;
 mod sphere;
 
 pub use animation::{CameraKey, CameraPath, Interpolation, MAX_FRAMES};
@@ -26,7 +27,12 @@ pub use image::{
 };
 pub use medium::{MEDIUM_STACK_SIZE, MediumStack};
 pub use model::*;
+pub use precision::{
+    CAMERA_PRECISION_LIMIT, FlatShapeBeyondTheGpu, camera_pixel_precision, flat_precision,
+    flat_shape_beyond_the_gpu, mesh_triangle_beyond_the_gpu,
+};
 pub use sphere::{
-    FAR_WALL_PRECISION_LIMIT, FarWallPrecision, SPHERE_PRECISION_LIMIT, SphereGap, SpherePrecision,
-    coincident_spheres, far_wall_precision, sphere_anchor, sphere_level, sphere_precision,
+    FAR_WALL_PRECISION_LIMIT, FarWallPrecision, SPHERE_PRECISION_LIMIT, SphereGap,
+    SurfacePrecision, coincident_spheres, far_wall_precision, sphere_anchor, sphere_level,
+    sphere_precision,
 };

@@ -425,6 +425,17 @@ pub enum Shape {
 }
 
 impl Shape {
+    /// The shape's kind as the scene format writes it: `sphere`, `plane`, `polygon` or
+    /// `triangle`.
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Shape::Sphere { .. } => "sphere",
+            Shape::Plane { .. } => "plane",
+            Shape::Polygon { .. } => "polygon",
+            Shape::Triangle { .. } => "triangle",
+        }
+    }
+
     /// The material index of this shape.
     pub fn material(&self) -> u32 {
         match self {

@@ -40,9 +40,10 @@ pub fn sphere_level(point: DVec3, anchor: DVec3, normal: DVec3, radius: f64) -> 
 /// 1000-pixel-high image with a 45° field of view is 8e-4 of the distance.
 pub const SPHERE_PRECISION_LIMIT: f64 = 1e-4;
 
-/// How precisely each backend places a sphere's surface, as seen from a camera.
+/// How precisely each backend places a surface (a sphere's, [`sphere_precision`], or a
+/// flat shape's, [`crate::scene::flat_precision`]), as seen from a camera.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SpherePrecision {
+pub struct SurfacePrecision {
     /// Distance from the camera to the sphere's surface (scene units).
     pub distance: f64,
     /// About how far the CPU reference (`f64`) may misplace the surface near its
@@ -53,7 +54,7 @@ pub struct SpherePrecision {
     pub gpu: f64,
 }
 
-impl SpherePrecision {
+impl SurfacePrecision {
     /// The CPU's error as a fraction of the distance (infinite for a camera on the
     /// surface).
     pub fn cpu_relative(&self) -> f64 {
@@ -83,7 +84,7 @@ fn beyond_the_limit(relative: f64) -> bool {
 
 /// How precisely the CPU reference and the GPU place the surface of the sphere
 /// (`center`, `radius`) seen from `eye`; see the module documentation.
-pub fn sphere_precision(center: DVec3, radius: f64, eye: DVec3) -> SpherePrecision {
+pub fn sphere_precision(center: DVec3, radius: f64, eye: DVec3) -> SurfacePrecision {
     let (anchor, normal) = sphere_anchor(center, radius);
     // | |e - c| - r | = |level|·r / (|y + n| + 1), without cancellation.
     let y = (eye - anchor) / radius;
@@ -91,7 +92,7 @@ pub fn sphere_precision(center: DVec3, radius: f64, eye: DVec3) -> SpherePrecisi
         sphere_level(eye, anchor, normal, radius).abs() * radius / ((y + normal).length() + 1.0);
     let cpu = f64::EPSILON * center.abs().max_element().max(radius);
     let gpu = cpu + f64::from(f32::EPSILON) * anchor.abs().max_element();
-    SpherePrecision { distance, cpu, gpu }
+    SurfacePrecision { distance, cpu, gpu }
 }
 
 /// Fraction of the scene's extent above which the loader warns that the GPU places the
@@ -159,7 +160,7 @@ pub struct SphereGap {
     /// sphere's surface.
     pub gap: f64,
     /// About how far the GPU (`f32`) may misplace either surface there: both spheres'
-    /// [`SpherePrecision::gpu`] and the `f32` rounding of a hit at that distance.
+    /// [`SurfacePrecision::gpu`] and the `f32` rounding of a hit at that distance.
     pub gpu: f64,
     /// The same for the CPU reference (`f64`).
     pub cpu: f64,
@@ -182,7 +183,7 @@ pub fn coincident_spheres(
     let (a2, n2) = sphere_anchor(second.0, second.1);
     let p1 = sphere_precision(first.0, first.1, eye);
     let p2 = sphere_precision(second.0, second.1, eye);
-    let large = |p: &SpherePrecision, radius: f64| p.distance * 100.0 <= radius;
+    let large = |p: &SurfacePrecision, radius: f64| p.distance * 100.0 <= radius;
     if !(large(&p1, first.1) && large(&p2, second.1)) {
         return None;
     }

@@ -1217,6 +1217,54 @@ fn a_sphere_beyond_the_gpus_precision_is_warned_about_and_auto_renders_on_the_cp
     assert!(!run.stderr.contains("warning"), "{}", run.stderr);
 }
 
+/// A ground triangle of corners ±2.2e9 seen from 3 units and a field of view of 1e-6°
+/// (issue 26: black on the GPU, grey on the CPU; every GPU ray the same): each gets a
+/// load warning that names it and the GPU's precision, and `--backend auto` renders on
+/// the CPU reference and says why.
+#[test]
+fn triangles_and_views_beyond_the_gpus_precision_are_warned_about_and_auto_renders_on_the_cpu() {
+    let triangle = TINY_SCENE.replace(
+        "type = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0",
+        "type = \"triangle\"\nvertices = [[-2.2e9, -1.0, 2.2e9], [2.2e9, -1.0, 2.2e9], [0.0, -1.0, -2.2e9]]",
+    );
+    let narrow = TINY_SCENE.replace(
+        "look_at = [0.0, 0.0, 0.0]",
+        "look_at = [0.0, 0.0, 0.0]\nfov_y_degrees = 1e-6",
+    );
+    for (text, warning, why) in [
+        (
+            &triangle,
+            "objects[0] (triangle): its corners at",
+            "CPU reference (auto: objects[0] (triangle) is beyond the GPU's f32",
+        ),
+        (
+            &narrow,
+            "camera: fov_y_degrees = 1e-6 over 24 pixels",
+            "CPU reference (auto: the field of view of 1e-6° over 24 pixels",
+        ),
+    ] {
+        let ws = Workspace::new(text);
+        let run = gpu_render(&[
+            &ws.arg("scene.toml"),
+            "-o",
+            &ws.arg("out.png"),
+            "--backend",
+            "auto",
+        ]);
+        assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
+        assert!(
+            run.stderr.contains("warning: ") && run.stderr.contains(warning),
+            "{warning:?} not in {}",
+            run.stderr
+        );
+        assert!(
+            run.stderr.contains(why) || run.stderr.contains("CPU reference (auto: no GPU adapter"),
+            "{why:?} not in {}",
+            run.stderr
+        );
+    }
+}
+
 #[test]
 fn standard_error_is_written_beside_the_image_and_summarised() {
     let ws = Workspace::new(TINY_SCENE);

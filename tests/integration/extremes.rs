@@ -1065,3 +1065,131 @@ fn a_device_with_few_uniform_buffers_keeps_storage_records() {
         .expect("render with storage records");
     assert!(rendered.stats.rays_traced > 0);
 }
+
+/// A triangle floor with corners at ±`half` around the origin under a point light,
+/// seen from 3 units above it (issue 26: at ±2.2e9 the GPU's f32 squared cross product
+/// overflowed and the floor came out black).
+fn triangle_floor(half: f64) -> Scene {
+    Scene {
+        render: settings(32, 24, 2),
+        camera: Camera {
+            eye: DVec3::new(0.0, 3.0, 3.0),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y_degrees: 60.0,
+        },
+        environment: Environment {
+            background: DVec3::new(0.2, 0.3, 0.5),
+            ambient: DVec3::ZERO,
+            map: None,
+        },
+        materials: vec![Material::lambert(DVec3::splat(0.6))],
+        meshes: vec![],
+        images: Vec::new(),
+        material_names: vec!["floor".into()],
+        lights: vec![Light::Point {
+            position: DVec3::new(1.0, 4.0, 1.0),
+            intensity: DVec3::splat(40.0),
+        }],
+        shapes: vec![
+            Shape::Triangle {
+                vertices: [
+                    DVec3::new(-half, 0.0, half),
+                    DVec3::new(half, 0.0, half),
+                    DVec3::new(half, 0.0, -half),
+                ],
+                material: 0,
+            },
+            Shape::Triangle {
+                vertices: [
+                    DVec3::new(-half, 0.0, half),
+                    DVec3::new(half, 0.0, -half),
+                    DVec3::new(-half, 0.0, -half),
+                ],
+                material: 0,
+            },
+        ],
+    }
+}
+
+/// Scenes of triangles at scales from 1e-15 to 1e15 render alike on both backends
+/// (issue 26: triangles at scale 1e10, 1e15 and 1e-15 differed): the GPU scales edges
+/// by powers of two before squaring them and normalises the edge weights before the
+/// depth, so that no f32 product of three or four coordinates leaves its range. A
+/// triangle whose corners are far beyond its distance from the camera (a ground
+/// triangle of corners ±2.2e9 seen from 3 units, black on the GPU) is beyond f32's
+/// precision there: the loader warns at the object and `--backend auto` takes the CPU.
+#[test]
+fn triangles_at_extreme_coordinates_render_alike_or_are_warned_about() {
+    let gpu = gpu();
+    for half in [1e4, 2.2e9] {
+        let scene = triangle_floor(half);
+        let beyond = gpu_render::scene::flat_shape_beyond_the_gpu(&scene)
+            .unwrap_or_else(|| panic!("a floor of ±{half:e} seen from 3 units is not flagged"));
+        assert_eq!(beyond.what, "objects[0] (triangle)");
+        assert!(beyond.precision.gpu_relative() > 1e-4, "{beyond:?}");
+    }
+    // At ±1e15 not even f64 places it to 1e-4 of 3 units: warned, no backend preferred.
+    let floor = triangle_floor(1e15);
+    let Shape::Triangle { vertices, .. } = &floor.shapes[0] else {
+        unreachable!()
+    };
+    let precision = gpu_render::scene::flat_precision(vertices, floor.camera.eye);
+    assert!(
+        precision.cpu_hopeless() && precision.gpu_hopeless(),
+        "{precision:?}"
+    );
+    assert_eq!(gpu_render::scene::flat_shape_beyond_the_gpu(&floor), None);
+    for half in [10.0, 100.0] {
+        let scene = triangle_floor(half);
+        assert_eq!(gpu_render::scene::flat_shape_beyond_the_gpu(&scene), None);
+        let label = format!("triangle floor ±{half:e}");
+        let cpu = cpu_render(&label, &scene);
+        assert!(
+            cpu.pixels.iter().any(|p| p[0] > 0.21),
+            "{label}: the CPU sees no lit floor"
+        );
+        if let Some(g) = &gpu {
+            let image = gpu_render_image(&label, g, &scene);
+            let c = assert_images_match(
+                &format!("triangle-floor-{half:e}"),
+                &cpu,
+                &image,
+                common_tolerance(),
+            );
+            report(&format!("{label}: GPU vs CPU"), &c);
+        }
+    }
+    let mesh = icosphere_mesh();
+    for s in [1e-15, 1e-10, 1e10, 1e15] {
+        let scaled: Vec<[DVec3; 3]> = mesh
+            .iter()
+            .map(|t| [t[0] * s, t[1] * s, t[2] * s])
+            .collect();
+        let mut scene = mesh_scene(&scaled, DVec3::new(0.4, 0.9, 3.0) * s, DVec3::ZERO, 40.0);
+        scene.render = settings(33, 25, 2);
+        scene.materials = vec![Material::lambert(DVec3::new(0.7, 0.5, 0.3))];
+        scene.environment.background = DVec3::splat(0.1);
+        scene.lights = vec![Light::Point {
+            position: DVec3::new(2.0, 3.0, 4.0) * s,
+            intensity: DVec3::splat(20.0 * s * s),
+        }];
+        let label = format!("icosphere × {s:e}");
+        assert_eq!(
+            gpu_render::scene::flat_shape_beyond_the_gpu(&scene),
+            None,
+            "{label}"
+        );
+        let cpu = cpu_render(&label, &scene);
+        if let Some(g) = &gpu {
+            let image = gpu_render_image(&label, g, &scene);
+            let c = assert_images_match(
+                &format!("icosphere-{s:e}"),
+                &cpu,
+                &image,
+                common_tolerance(),
+            );
+            report(&format!("{label}: GPU vs CPU"), &c);
+        }
+    }
+}

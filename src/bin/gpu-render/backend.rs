@@ -299,6 +299,23 @@ pub fn auto_rule(adapter: &wgpu::AdapterInfo, scene: &Scene) -> Option<String> {
              the CPU reference's f64 (see the load warning); --backend gpu uses the GPU anyway"
         ));
     }
+    let aim = gpu_render::scene::camera_pixel_precision(&scene.camera, scene.render.height);
+    if aim > gpu_render::scene::CAMERA_PRECISION_LIMIT {
+        return Some(format!(
+            "the field of view of {:e}° over {} pixels is beyond the GPU's f32 ray \
+             directions ({aim:.1e} of a pixel) but not the CPU reference's f64; --backend gpu \
+             uses the GPU anyway",
+            scene.camera.fov_y_degrees, scene.render.height
+        ));
+    }
+    if let Some(beyond) = gpu_render::scene::flat_shape_beyond_the_gpu(scene) {
+        return Some(format!(
+            "{} is beyond the GPU's f32 precision or range here (placed to {:.1e} units at \
+             {:.1e} from the camera) but not the CPU reference's f64; --backend gpu uses the \
+             GPU anyway",
+            beyond.what, beyond.precision.gpu, beyond.precision.distance
+        ));
+    }
     if adapter.device_type != wgpu::DeviceType::Cpu {
         return None;
     }

@@ -25,7 +25,7 @@ pub use self::paths::confined_path;
 use self::raw::RawScene;
 pub(crate) use self::settings::view_problem;
 use super::{CameraPath, Scene, SceneError, SceneWarning};
-use crate::echo::echo;
+use crate::echo::{echo, short};
 
 /// Largest scene file accepted, in bytes (64 MiB).
 pub const MAX_SCENE_FILE_BYTES: u64 = 64 * 1024 * 1024;
@@ -328,6 +328,19 @@ fn build_scene(
     let render = settings::render(source, raw.render)?;
     let camera = settings::camera(source, raw.camera)?;
     let camera_path = animation::animation(source, raw.animation, &camera)?;
+    let aim = crate::scene::camera_pixel_precision(&camera, render.height);
+    if let Some(warn) = options.warning
+        && aim > crate::scene::CAMERA_PRECISION_LIMIT
+    {
+        warn(&source.item("camera".into(), None).warning(format_args!(
+            "fov_y_degrees = {} over {} pixels: the GPU aims its rays (f32) to {aim:.1e} of a \
+             pixel, more than {:e}; --backend auto renders this scene on the CPU reference, \
+             or widen the view",
+            short(camera.fov_y_degrees),
+            render.height,
+            crate::scene::CAMERA_PRECISION_LIMIT
+        )));
+    }
     let environment = settings::environment(
         source,
         raw.environment,
@@ -383,11 +396,14 @@ fn build_scene(
             let span = object.span();
             let shape = objects::object(source, &table, i, object)?;
             if let Some(warn) = options.warning
-                && let Some(message) = objects::sphere_precision_warning(&shape, camera.eye)
+                && let Some(message) = objects::precision_warning(&shape, camera.eye)
             {
                 warn(
                     &source
-                        .item(format!("objects[{i}] (sphere)"), Some(span.clone()))
+                        .item(
+                            format!("objects[{i}] ({})", shape.kind_name()),
+                            Some(span.clone()),
+                        )
                         .warning(message),
                 );
             }
@@ -437,6 +453,18 @@ fn build_scene(
             .map(|k| models[k].placement)
             .collect();
         model.add_placements_to_scene(&mut scene, &placements);
+    }
+    if let Some(warn) = options.warning
+        && !scene.meshes.is_empty()
+        && let Some(beyond) =
+            crate::scene::mesh_triangle_beyond_the_gpu(&scene.meshes, scene.camera.eye)
+        && let Some(message) = objects::precision_message(
+            "a triangle",
+            &beyond.precision,
+            "split it into smaller triangles",
+        )
+    {
+        warn(&source.item(beyond.what, None).warning(message));
     }
     Ok(SceneFile { scene, camera_path })
 }

@@ -12,8 +12,8 @@ use crate::echo::{echo, echo_path, short, short3};
 use crate::scene::import::{ImportOptions, ImportedModel, ModelPlacement, import_model_with};
 use crate::scene::outline::MAX_POLYGON_VERTICES;
 use crate::scene::{
-    FAR_WALL_PRECISION_LIMIT, Light, SPHERE_PRECISION_LIMIT, SceneError, Shape, coincident_spheres,
-    far_wall_precision, sphere_precision,
+    FAR_WALL_PRECISION_LIMIT, Light, SPHERE_PRECISION_LIMIT, SceneError, Shape, SurfacePrecision,
+    coincident_spheres, far_wall_precision, flat_precision, sphere_precision,
 };
 
 const SPHERE_FIELDS: &[&str] = &["center", "radius", "material"];
@@ -235,26 +235,46 @@ fn sphere(item: &Item<'_>, raw: &RawObject, material: u32) -> Result<Shape, Scen
     })
 }
 
-/// The warning for a sphere that a backend cannot place precisely enough, relative to
-/// its distance from the camera at `eye` (see [`crate::scene::sphere_precision`]), or
-/// `None` for any other shape and for a sphere both backends place well.
-pub fn sphere_precision_warning(shape: &Shape, eye: DVec3) -> Option<String> {
-    let Shape::Sphere { center, radius, .. } = shape else {
-        return None;
+/// The warning for a sphere, triangle or polygon that a backend cannot place precisely
+/// enough, relative to its distance from the camera at `eye` (see
+/// [`crate::scene::sphere_precision`] and [`crate::scene::flat_precision`]), or `None`
+/// for a plane and for a shape both backends place well.
+pub fn precision_warning(shape: &Shape, eye: DVec3) -> Option<String> {
+    let (what, precision, remedy) = match shape {
+        Shape::Sphere { center, radius, .. } => (
+            format!("radius {radius:e}"),
+            sphere_precision(*center, *radius, eye),
+            "use a plane for a floor",
+        ),
+        Shape::Triangle { vertices, .. } => (
+            "its corners".to_string(),
+            flat_precision(vertices, eye),
+            "split it into smaller triangles or use a plane for a floor",
+        ),
+        Shape::Polygon { vertices, .. } => (
+            "its vertices".to_string(),
+            flat_precision(vertices, eye),
+            "split it into smaller polygons or use a plane for a floor",
+        ),
+        Shape::Plane { .. } => return None,
     };
-    let precision = sphere_precision(*center, *radius, eye);
+    precision_message(&what, &precision, remedy)
+}
+
+/// The warning for a surface placed with `precision` (see [`precision_warning`]):
+/// `None` where both backends place it well; `what` names the shape's size.
+pub fn precision_message(what: &str, precision: &SurfacePrecision, remedy: &str) -> Option<String> {
     let consequence = match (precision.cpu_hopeless(), precision.gpu_hopeless()) {
         (false, false) => return None,
-        (true, _) => "neither backend can place it precisely: use a plane for a floor",
-        (false, true) => {
-            "the GPU cannot place it precisely (the CPU reference can: --backend auto \
-             renders this scene on the CPU); move the scene nearer the origin"
-        }
+        (true, _) => format!("neither backend can place it precisely: {remedy}"),
+        (false, true) => "the GPU cannot place it precisely (the CPU reference can: --backend \
+             auto renders this scene on the CPU); move the scene nearer the origin or scale it"
+            .to_string(),
     };
     Some(format!(
-        "radius {radius:e} at {:.3e} from the camera: its surface is placed to about {:.1e} \
-         units on the CPU reference (f64, {:.1e} of that distance) and {:.1e} on the GPU \
-         (f32, {:.1e}), more than {SPHERE_PRECISION_LIMIT:e}; {consequence}",
+        "{what} at {:.3e} from the camera: its surface is placed to about {:.1e} units on \
+         the CPU reference (f64, {:.1e} of that distance) and {:.1e} on the GPU (f32, \
+         {:.1e}), more than {SPHERE_PRECISION_LIMIT:e}; {consequence}",
         precision.distance,
         precision.cpu,
         precision.cpu_relative(),
