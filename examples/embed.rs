@@ -10,8 +10,8 @@
 //! ```
 
 use anyhow::{Context, Result};
-use gpu_render::gpu::{Renderer, RendererOptions, read_texture};
-use gpu_render::scene::load_scene;
+use gpu_render::gpu::read_texture;
+use gpu_render::{Renderer, RendererOptions, load_scene};
 
 /// The application's swapchain format.
 const SURFACE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Bgra8UnormSrgb;

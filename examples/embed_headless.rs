@@ -12,7 +12,7 @@
 //! ```
 
 use anyhow::{Context, Result};
-use gpu_render::gpu::{Renderer, RendererOptions};
+use gpu_render::{Renderer, RendererOptions};
 
 fn main() -> Result<()> {
     let mut args = std::env::args().skip(1);
@@ -33,7 +33,7 @@ fn main() -> Result<()> {
     }))?;
 
     // gpu-render: from here
-    let scene = gpu_render::scene::load_scene(scene_path.as_ref())?;
+    let scene = gpu_render::load_scene(scene_path.as_ref())?;
     let renderer = Renderer::new(&device, RendererOptions::default())?;
     let gpu_scene = renderer.upload(&device, &queue, &scene)?;
     let (width, height) = (gpu_scene.width(), gpu_scene.height());

@@ -35,8 +35,19 @@
 //!   them into the whole image.
 //! - `tradeoff` (with the default `cli` feature): measuring time against error for the
 //!   speed/accuracy knobs.
+//!
+//! What an embedding application needs is re-exported here, at the top
+//! (`docs/embedding.md`): [`Renderer`] and [`RendererOptions`] with the caller's
+//! `Device` and `Queue`, the [`Film`] it accumulates into, scene loading
+//! ([`load_scene`], [`Scene`]), the images it reads back ([`LinearImage`]) and one
+//! error type per layer ([`SceneError`], [`RenderError`], [`OutputError`]).
 
 #![warn(missing_docs)]
+
+pub use film::{LinearImage, RenderStats};
+pub use gpu::{Film, HeadlessGpu, RenderError, Renderer, RendererOptions};
+pub use output::OutputError;
+pub use scene::{LoadOptions, Scene, SceneError, SceneWarning, load_scene, load_scene_with};
 
 pub mod accel;
 pub mod camera;
