@@ -11,7 +11,7 @@
 // first), so that a lane never waits for the others to finish a phase of their own.
 // Its state between steps and between dispatches is its TraceRay.
 
-// Unrolled scenes: a scene of a few primitives (src/gpu/unrolled.rs says which) gets
+// Unrolled scenes: a scene of a few primitives (src/gpu/cpu_device/unrolled.rs says which) gets
 // no tree walk at all. The host writes unrolled_closest_hit (the module
 // `unrolled_scene`), one call of the helpers of unrolled.wgsl per primitive with its
 // record index (and a polygon's vertices) as literals, so every record is read at a

@@ -1,4 +1,4 @@
-// The primitive tests of an unrolled scene (src/gpu/unrolled.rs, which writes one call
+// The primitive tests of an unrolled scene (src/gpu/cpu_device/unrolled.rs, which writes one call
 // per primitive into unrolled_closest_hit; see traverse.wgsl, "Unrolled scenes"): the
 // tree's tests with the record index a literal, charged to the budget as the tree's.
 

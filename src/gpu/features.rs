@@ -9,7 +9,7 @@
 //! to remove it. Dropping the text means a module for a scene without glass really
 //! has no refraction code, which `tests/integration/specialisation.rs` checks on the naga module.
 
-use super::unrolled::UnrolledPrimitives;
+use super::cpu_device::unrolled::UnrolledPrimitives;
 use crate::accel::MAX_POLYGON_VERTICES;
 use crate::scene::{MaterialKind, Scene, Shape};
 
@@ -54,7 +54,7 @@ pub struct ShaderFeatures {
     /// spheres, polygons and their points, triangles, materials, lights) are uniform
     /// arrays of a fixed length rather than storage buffers: chosen at upload for
     /// small scenes on CPU devices (see
-    /// `src/gpu/uniform_records.rs`), never by [`ShaderFeatures::for_scene`]. Not a
+    /// `src/gpu/cpu_device/uniform_records.rs`), never by [`ShaderFeatures::for_scene`]. Not a
     /// directive: the bindings' declarations differ, not the code.
     pub uniform_records: bool,
     /// The fused kernel's Whitted traversals give way once few lanes of their subgroup

@@ -31,6 +31,7 @@
 
 pub mod area_lights;
 pub mod context;
+pub mod cpu_device;
 mod display;
 mod draw;
 pub mod environment;
@@ -45,8 +46,6 @@ mod readback;
 pub mod renderer;
 mod scene_buffers;
 pub mod shaders;
-mod uniform_records;
-pub mod unrolled;
 pub mod upload;
 mod wavefront;
 

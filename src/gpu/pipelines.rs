@@ -5,13 +5,13 @@ use std::collections::HashMap;
 use std::sync::{Mutex, PoisonError};
 
 use super::RenderError;
+use super::cpu_device::uniform_records::{UNIFORM_BUFFERS, device_allows, is_uniform_record};
 use super::features::ShaderFeatures;
 use super::readback::{Caught, capture};
 use super::shaders::{
     DISPLAY_ENTRY_POINT, FUSED_ENTRY_POINT, SHADE_ENTRY_POINT, TRACE_ENTRY_POINT,
     display_shader_source, trace_shader_source,
 };
-use super::uniform_records::{UNIFORM_BUFFERS, device_allows, is_uniform_record};
 use super::wavefront::Schedule;
 
 /// Format of the linear radiance texture the trace writes.

@@ -1,16 +1,16 @@
 //! A scene uploaded to one device: its buffers (primitives, BVH, materials, lights; the
-//! records every traversal step reads in uniform buffers where `super::uniform_records`
+//! records every traversal step reads in uniform buffers where `super::cpu_device::uniform_records`
 //! says), its image array and its trace constants.
 
 use super::RenderError;
 use super::area_lights::{EMITTER_NONE, FLAG_PATH, GpuEmitter, emitter_records};
+use super::cpu_device::uniform_records;
+use super::cpu_device::unrolled::{self, UnrolledPrimitives};
 use super::environment::environment_buffer;
 use super::features::ShaderFeatures;
 use super::layout::FrameUniforms;
 use super::pipelines::binding;
 use super::readback::{Caught, capture};
-use super::uniform_records;
-use super::unrolled::{self, UnrolledPrimitives};
 use super::upload::{SceneRecords, frame_uniforms, image_layers};
 use crate::accel::{BrdfMapCdfs, BvhStats, EnvironmentLight, MAX_PLANES, SceneGeometry};
 use crate::scene::{Integrator, Scene};
@@ -123,7 +123,7 @@ pub(crate) struct UploadOptions {
 /// Uploads `scene` (as loaded: it is converted to its lighting space here) with its
 /// `geometry` (built from the lighting-space-independent shapes). With
 /// `allow_uniform_records`, a scene whose records fit is bound with uniform records
-/// where the device prefers them (see `super::uniform_records`). With
+/// where the device prefers them (see `super::cpu_device::uniform_records`). With
 /// `allow_refill_lanes`, the trace module gives way to finished lanes
 /// ([`ShaderFeatures::refill_lanes`]) where the device has subgroup operations. With
 /// `allow_unrolled`, a small scene's closest-hit test is unrolled

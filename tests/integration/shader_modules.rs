@@ -9,8 +9,8 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use gpu_render::gpu::ShaderFeatures;
+use gpu_render::gpu::cpu_device::unrolled::UnrolledPrimitives;
 use gpu_render::gpu::shaders::{HOST_MODULES, SHADER_MODULES, host_module, imports, shader_module};
-use gpu_render::gpu::unrolled::UnrolledPrimitives;
 
 /// `source` without its `//` comments (the feature directives among them).
 fn code_of(source: &str) -> String {
@@ -312,7 +312,7 @@ const WITHOUT_RUST_TWIN: &[(&str, &[&str], &str)] = &[
         "unrolled",
         &["*"],
         "the unrolled primitive tests of small scenes on lavapipe, a GPU-only strategy \
-         (src/gpu/unrolled.rs writes the calls)",
+         (src/gpu/cpu_device/unrolled.rs writes the calls)",
     ),
     (
         "draw",

@@ -1,6 +1,6 @@
 //! On CPU devices, a scene whose records fit is bound with its BVH nodes, spheres,
 //! polygons, triangles, materials and lights in uniform buffers
-//! (`src/gpu/uniform_records.rs`): the same pixels and the same rays as with storage
+//! (`src/gpu/cpu_device/uniform_records.rs`): the same pixels and the same rays as with storage
 //! buffers, and scenes too large for them keep storage buffers.
 
 use glam::DVec3;

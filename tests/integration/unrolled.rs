@@ -1,5 +1,5 @@
 //! On CPU devices, a scene of at most `MAX_UNROLLED_PRIMITIVES` primitives tests them
-//! in straight-line code instead of walking its BVH (`src/gpu/unrolled.rs`): the same
+//! in straight-line code instead of walking its BVH (`src/gpu/cpu_device/unrolled.rs`): the same
 //! pixels and the same rays as the tree's walk, on shipped scenes and on one with
 //! every kind of primitive (a polygon of more than four vertices among them); larger
 //! scenes keep the tree.
@@ -8,7 +8,7 @@ use std::path::Path;
 
 use gpu_render::gpu::Renderer;
 use gpu_render::gpu::RendererOptions;
-use gpu_render::gpu::unrolled::MAX_UNROLLED_PRIMITIVES;
+use gpu_render::gpu::cpu_device::unrolled::MAX_UNROLLED_PRIMITIVES;
 use gpu_render::scene::{RenderOverrides, Scene, parse_scene};
 
 /// Spheres, planes, a triangle, a quad and a hexagon, in glass, a mirror and Lambert

@@ -5,7 +5,7 @@ use std::io::Write;
 use anyhow::{Context, Result, bail};
 use gpu_render::cpu;
 use gpu_render::film::{LinearImage, ProgressFn, RenderStats, Rendered};
-use gpu_render::gpu::unrolled::MAX_UNROLLED_PRIMITIVES;
+use gpu_render::gpu::cpu_device::unrolled::MAX_UNROLLED_PRIMITIVES;
 use gpu_render::gpu::{self, AdapterChoice, HeadlessGpu, Renderer, RendererOptions, TraceRegion};
 use gpu_render::noise::NoiseEstimate;
 use gpu_render::scene::{Integrator, Scene};
@@ -282,8 +282,8 @@ impl Backend {
 /// meshes, that is without models loaded from files (loose triangles are fine): the
 /// 1920x1080 showcase 1.10x, the direct-light scene 2.5x, the Whitted caustic and
 /// Cornell box 1.4x-1.6x, with lanes refilled (`gpu::ShaderFeatures::refill_lanes`),
-/// and `glass.toml` 1.6x with its primitives unrolled (`gpu::unrolled`); and on
-/// path-traced scenes of at most `gpu::unrolled::MAX_UNROLLED_PRIMITIVES` primitives
+/// and `glass.toml` 1.6x with its primitives unrolled (`gpu::cpu_device::unrolled`); and on
+/// path-traced scenes of at most `gpu::cpu_device::unrolled::MAX_UNROLLED_PRIMITIVES` primitives
 /// without meshes, unrolled (the Cornell box 1.8x, the caustic and the environment-lit
 /// materials 1.1x). Meshes make it slower (`models.toml`, OBJ and glTF tori and vases,
 /// 0.55x), and so does every scene on older Mesa, and larger path-traced scenes (the
@@ -340,7 +340,7 @@ pub fn auto_rule(adapter: &wgpu::AdapterInfo, scene: &Scene) -> Option<String> {
 }
 
 /// The primitives a scene without meshes has for an unrolled closest-hit test
-/// (`gpu::unrolled`): one per shape, a polygon of more vertices than the GPU tests
+/// (`gpu::cpu_device::unrolled`): one per shape, a polygon of more vertices than the GPU tests
 /// directly counted as its triangles.
 fn unrolled_primitives(scene: &Scene) -> usize {
     scene

@@ -16,15 +16,15 @@
 //!
 //! The WGSL declarations of these bindings are composed here ([`declarations`]) rather
 //! than written in `shaders/bindings.wgsl`, as the module `records` of the composer
-//! (`super::shaders`), since their address space and array type are what differs; the
+//! (`crate::gpu::shaders`), since their address space and array type are what differs; the
 //! code that reads them is the same.
 
 use std::mem::size_of;
 
-use super::layout::{GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle};
-use super::pipelines::binding;
-use super::upload::SceneRecords;
 use crate::accel::BvhNode;
+use crate::gpu::layout::{GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle};
+use crate::gpu::pipelines::binding;
+use crate::gpu::upload::SceneRecords;
 
 /// The bytes of each uniform record binding: the least `maxUniformBufferRange` Vulkan
 /// guarantees is 16 KiB, lavapipe's is 64 KiB; [`fits`] checks the device's.
@@ -255,7 +255,7 @@ mod tests {
         assert!(padded_bytes(binding::PATHS).is_none());
         assert!(!is_uniform_record(binding::PATHS));
         // Every plane a scene may have fits.
-        assert!(capacity(size_of::<super::super::layout::GpuPlane>()) >= crate::accel::MAX_PLANES);
+        assert!(capacity(size_of::<crate::gpu::layout::GpuPlane>()) >= crate::accel::MAX_PLANES);
         assert_eq!(padded_bytes(binding::BVH_PRIMS), Some(UNIFORM_RECORD_BYTES));
     }
 

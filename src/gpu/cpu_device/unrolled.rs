@@ -16,7 +16,7 @@ use std::fmt::Write as _;
 
 use crate::accel::{MAX_POLYGON_VERTICES, PrimKind, PrimRef};
 
-use super::layout::GpuPolygon;
+use crate::gpu::layout::GpuPolygon;
 
 /// The most primitives (bounded ones and planes) a scene may have for its trace module
 /// to test them unrolled. Past it the tree is used: the module's code grows with the
@@ -28,7 +28,7 @@ pub const MAX_UNROLLED_PRIMITIVES: usize = 48;
 
 /// The most loop iterations an unrolled closest-hit test charges: every primitive,
 /// each a polygon of the most vertices. It must fit in the slack the iteration budget
-/// leaves past its limit (`super::iteration_budget_for`, 2048).
+/// leaves past its limit (`crate::gpu::iteration_budget_for`, 2048).
 pub const MAX_UNROLLED_ITERATIONS: usize = MAX_UNROLLED_PRIMITIVES * (1 + MAX_POLYGON_VERTICES);
 
 const _: () = assert!(MAX_UNROLLED_ITERATIONS <= 2048);
@@ -55,7 +55,7 @@ pub enum UnrolledTest {
 }
 
 /// The primitive tests of an unrolled scene, in the order the module runs them (any
-/// order gives the same hit). Part of [`super::ShaderFeatures`], so that a trace module
+/// order gives the same hit). Part of [`crate::gpu::ShaderFeatures`], so that a trace module
 /// is built once per such list.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct UnrolledPrimitives {
@@ -113,7 +113,7 @@ impl UnrolledPrimitives {
         &self.tests[..self.len]
     }
 
-    /// The WGSL module `unrolled_scene` (see [`super::shaders`]): the function
+    /// The WGSL module `unrolled_scene` (see [`crate::gpu::shaders`]): the function
     /// `unrolled_closest_hit(ray, sheared, best_t, best_prim)` that runs the tests, with
     /// the imports of the helpers it calls (`shaders/unrolled.wgsl`) and of the types of
     /// its arguments.
@@ -146,7 +146,7 @@ impl UnrolledPrimitives {
         }
         format!(
             "#import intersect\n#import unrolled\n\
-             // The scene's every primitive, unrolled (src/gpu/unrolled.rs).\n\
+             // The scene's every primitive, unrolled (src/gpu/cpu_device/unrolled.rs).\n\
              fn unrolled_closest_hit(ray: Ray, sheared: ShearedRay, best_t: ptr<function, f32>,\n\
              \x20                       best_prim: ptr<function, u32>) {{\n{body}}}\n"
         )
