@@ -67,7 +67,7 @@ const MIN_ALBEDO: f32 = 1e-3;
 /// is 0 (converged) keep their value unless their neighbours agree with them.
 ///
 /// ```
-/// use gpu_render::denoise::{GuidePasses, DenoiseSettings, denoise};
+/// use gpu_render::low_level::denoise::{GuidePasses, DenoiseSettings, denoise};
 /// let guides = GuidePasses {
 ///     width: 2, height: 1,
 ///     albedo: vec![[0.5; 3]; 2], normal: vec![[0.0, 0.0, 1.0]; 2], depth: vec![1.0; 2],

@@ -10,7 +10,7 @@
 //! [`escape_controls`] escapes without cutting, for whole messages.
 //!
 //! ```
-//! use gpu_render::echo::{echo, short};
+//! use gpu_render::low_level::echo::{echo, short};
 //! assert_eq!(echo("a\0b\nc").to_string(), r"a\0b\nc");
 //! assert_eq!(short(1e300).to_string(), "1e300");
 //! assert_eq!(short(0.25).to_string(), "0.25");

@@ -66,7 +66,7 @@ pub struct ShaderFeatures {
     /// image does not depend on it.
     pub refill_lanes: bool,
     /// The closest-hit test of a small scene as straight-line code over its primitives
-    /// (`UNROLLED`; see [`super::unrolled`]), instead of the BVH's walk: chosen at
+    /// (`UNROLLED`; see [`super::cpu_device::unrolled`]), instead of the BVH's walk: chosen at
     /// upload for small scenes on CPU devices, never by [`ShaderFeatures::for_scene`],
     /// and [`ShaderFeatures::ALL`] leaves it out. The image does not depend on it.
     pub unrolled: Option<UnrolledPrimitives>,

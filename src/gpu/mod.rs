@@ -13,10 +13,9 @@
 //! - [`shaders`]: composition of the WGSL sources, specialised by [`features`];
 //!   [`upload`]: pure conversion of a [`crate::scene::Scene`] into the GPU records,
 //!   [`layout`] their `#[repr(C)]` twins of `shaders/types.wgsl`.
-//! - For CPU devices (lavapipe), strategies that only pay there: `uniform_records`
-//!   (the scene records in uniform buffers), [`unrolled`] (small scenes' closest-hit
-//!   test without the tree), and lanes that give way to finished ones
-//!   ([`ShaderFeatures::refill_lanes`]).
+//! - [`cpu_device`]: for CPU devices (lavapipe), the strategies that only pay there:
+//!   the scene records in uniform buffers, small scenes' closest-hit test without the
+//!   tree, and lanes that give way to finished ones ([`ShaderFeatures::refill_lanes`]).
 //!
 //! ```no_run
 //! use gpu_render::gpu::{AdapterChoice, HeadlessGpu, Renderer, RendererOptions};

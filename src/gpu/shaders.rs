@@ -7,8 +7,8 @@
 //!
 //! Besides the files, three modules are written by the host: `limits` (the Rust
 //! constants `MAX_BVH_DEPTH` and `MAX_POLYGON_VERTICES`), `records` (the bindings of
-//! the scene records, storage or uniform arrays: [`super::uniform_records`]) and, for
-//! an unrolled scene, `unrolled_scene` (its `unrolled_closest_hit`: [`super::unrolled`]).
+//! the scene records, storage or uniform arrays: `super::cpu_device::uniform_records`) and, for
+//! an unrolled scene, `unrolled_scene` (its `unrolled_closest_hit`: [`super::cpu_device::unrolled`]).
 //!
 //! Each module twins the Rust file of the same name (`shaders/intersect.wgsl` and
 //! `src/cpu/intersect.rs`, `shaders/color.wgsl` and `src/color.rs`): the same
@@ -168,7 +168,7 @@ pub const WORKGROUP_SIZE: u32 = 8;
 /// The complete trace module specialised to `features` (see [`super::features`]):
 /// `shaders/wavefront.wgsl`, the trace kernels, with everything it imports, the
 /// record bindings storage or uniform arrays as `features.uniform_records` says, and
-/// for an unrolled scene its `unrolled_closest_hit` ([`super::unrolled`]).
+/// for an unrolled scene its `unrolled_closest_hit` ([`super::cpu_device::unrolled`]).
 ///
 /// Errors: [`ComposeError`] if the sources' feature directives or imports are
 /// malformed (bugs in our own sources, which the tests catch).

@@ -8,13 +8,13 @@ use crate::support::geometry::{
     blob, mixed_shapes, random_rays, rays_through_mesh_edges, small_polygons,
 };
 use glam::{DMat4, DQuat, DVec3};
-use gpu_render::accel::{BuildMethod, SceneGeometry};
 use gpu_render::cpu::intersect::Ray;
 use gpu_render::cpu::traverse::closest_hit_brute_force;
 use gpu_render::gpu::ShaderFeatures;
 use gpu_render::gpu::layout::{FrameUniforms, GpuCounters};
 use gpu_render::gpu::shaders::compose_source;
 use gpu_render::gpu::upload::{SceneRecords, frame_uniforms};
+use gpu_render::low_level::accel::{BuildMethod, SceneGeometry};
 use gpu_render::scene::{Camera, Environment, Material, RenderSettings, Scene, Shape};
 use wgpu::util::DeviceExt;
 
@@ -184,7 +184,7 @@ fn run_kernel(
         (
             17,
             storage(
-                &vec![0u8; rays.len() * gpu_render::accel::MAX_BVH_DEPTH as usize * 4],
+                &vec![0u8; rays.len() * gpu_render::low_level::accel::MAX_BVH_DEPTH as usize * 4],
                 none,
             ),
         ),

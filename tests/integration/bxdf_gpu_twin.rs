@@ -10,10 +10,10 @@ use std::path::Path;
 
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
-use gpu_render::accel::BrdfMapCdfs;
 use gpu_render::cpu::bxdf::eval_brdf;
 use gpu_render::gpu::shaders::{BXDF_EVAL_ENTRY_POINT, bxdf_eval_shader_source};
 use gpu_render::gpu::upload::{image_layers, material_record};
+use gpu_render::low_level::accel::BrdfMapCdfs;
 use gpu_render::scene::{
     CONDUCTOR_PRESETS, FresnelModel, Image, Material, MaterialKind, MicrofacetDistribution,
     load_image,

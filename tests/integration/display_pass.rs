@@ -10,9 +10,9 @@
 
 use std::time::Duration;
 
-use gpu_render::color::srgb_encode;
 use gpu_render::film::LinearImage;
 use gpu_render::gpu::read_texture;
+use gpu_render::low_level::color::srgb_encode;
 
 const WIDTH: u32 = 37; // 37 * 4 bytes is not a multiple of 256: exercises row padding
 
@@ -44,7 +44,7 @@ fn ramp() -> Vec<f32> {
     values.extend((0..=4096).map(|i| i as f32 / 4096.0));
     values.extend((0..255).map(|k| {
         let encoded = (f64::from(k) + 0.5) / 255.0;
-        gpu_render::color::srgb_decode(encoded) as f32
+        gpu_render::low_level::color::srgb_decode(encoded) as f32
     }));
     values
 }

@@ -8,8 +8,8 @@
 
 use base64::Engine;
 use glam::DVec3;
-use gpu_render::accel::{AreaLights, SceneGeometry};
-use gpu_render::camera::CameraFrame;
+use gpu_render::low_level::accel::{AreaLights, SceneGeometry};
+use gpu_render::low_level::camera::CameraFrame;
 use gpu_render::scene::import::{ModelPlacement, import_gltf};
 use gpu_render::scene::{
     Camera, Environment, Image, Integrator, Light, Material, MaterialKind, RenderSettings, Scene,

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use base64::Engine;
 use glam::{DMat4, DQuat, DVec3};
-use gpu_render::camera::CameraFrame;
-use gpu_render::color::srgb_decode;
+use gpu_render::low_level::camera::CameraFrame;
+use gpu_render::low_level::color::srgb_decode;
 use gpu_render::scene::import::{
     ImportedModel, LUMENS_PER_WATT, WrapMode, import_gltf, import_model, parse_gltf,
 };

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::{DVec2, DVec3};
-use gpu_render::color::srgb_decode;
+use gpu_render::low_level::color::srgb_decode;
 use gpu_render::scene::import::{ImportedModel, WrapMode, import_model, import_obj, parse_obj};
 use gpu_render::scene::{MaterialKind, SceneError};
 
@@ -1093,7 +1093,7 @@ fn fastest_load(text: &str, groups: usize, runs: usize) -> std::time::Duration {
             let started = std::time::Instant::now();
             let model = parse_obj(text.as_bytes(), Path::new("groups.obj")).expect("imports");
             let scene = model.into_scene(Default::default());
-            let geometry = gpu_render::accel::SceneGeometry::new(&scene);
+            let geometry = gpu_render::low_level::accel::SceneGeometry::new(&scene);
             let elapsed = started.elapsed();
             assert_eq!(model.meshes.len(), groups);
             drop(geometry);

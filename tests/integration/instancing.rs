@@ -18,12 +18,12 @@
 use crate::support::compare::{Tolerance, assert_images_match};
 use crate::support::geometry::{SplitMix, blob};
 use glam::{DMat3, DMat4, DVec3};
-use gpu_render::accel::SceneGeometry;
 use gpu_render::cpu::intersect::Ray;
 use gpu_render::cpu::traverse::{
     TraversalCounts, closest_hit_brute_force, closest_hit_counted, occluded,
 };
 use gpu_render::gpu::upload::SceneRecords;
+use gpu_render::low_level::accel::SceneGeometry;
 use gpu_render::scene::import::ModelPlacement;
 use gpu_render::scene::{
     Camera, Environment, Integrator, Light, Material, MaterialKind, Mesh, RenderSettings, Scene,
@@ -378,8 +378,11 @@ fn path_tracing_samples_emissive_instances() {
     let parts = SceneGeometry::new(&instanced);
     assert_eq!(parts.instances.len(), 2);
     assert!(parts.triangles.is_empty(), "nothing flattened");
-    let lights =
-        gpu_render::accel::AreaLights::new(&parts, &instanced.materials, &instanced.images);
+    let lights = gpu_render::low_level::accel::AreaLights::new(
+        &parts,
+        &instanced.materials,
+        &instanced.images,
+    );
     assert_eq!(lights.entries().len(), 2 * mesh.triangles.len());
     let flat = make(
         transforms

@@ -5,7 +5,6 @@
 use std::collections::BTreeMap;
 use std::mem::{offset_of, size_of};
 
-use gpu_render::accel::{BvhNode, PrimKind, PrimRef};
 use gpu_render::gpu::ShaderFeatures;
 use gpu_render::gpu::area_lights::{
     EMITTER_NONE, EMITTER_SPHERE, EMITTER_TRIANGLE, EMITTER_TWO_SIDED_TRIANGLE, FLAG_PATH,
@@ -16,6 +15,7 @@ use gpu_render::gpu::layout::*;
 use gpu_render::gpu::shaders::{
     bxdf_eval_shader_source, display_shader_source, shader_module, trace_shader_source,
 };
+use gpu_render::low_level::accel::{BvhNode, PrimKind, PrimRef};
 
 /// The shared records: types.wgsl and the path integrator's path_types.wgsl.
 fn shared_types_wgsl() -> String {
@@ -517,7 +517,7 @@ fn wgsl_constants_equal_their_rust_twins() {
         gpu_render::cpu::path::ROULETTE_DEPTH
     );
     assert!(path.lines().any(|l| l == roulette), "{roulette}");
-    let [r, g, b] = gpu_render::color::LUMINANCE_WEIGHTS.map(|w| w as f32);
+    let [r, g, b] = gpu_render::low_level::color::LUMINANCE_WEIGHTS.map(|w| w as f32);
     let weights = format!("const LUMINANCE_WEIGHTS: vec3<f32> = vec3<f32>({r:?}, {g:?}, {b:?});");
     assert!(module("color").lines().any(|l| l == weights), "{weights}");
 }

@@ -15,7 +15,7 @@
 //!   `tests/integration/path_gpu.rs` for paths that branch differently in f32.
 
 use gpu_render::gpu::{Renderer, RendererOptions};
-use gpu_render::noise::NoiseEstimate;
+use gpu_render::low_level::noise::NoiseEstimate;
 use gpu_render::scene::{Integrator, RenderOverrides, Scene};
 
 /// The largest fraction of pixels allowed outside the tolerance (as `tests/integration/path_gpu.rs`).

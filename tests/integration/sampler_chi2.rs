@@ -13,7 +13,6 @@
 use std::cell::Cell;
 
 use glam::{DVec2, DVec3};
-use gpu_render::accel::BrdfMapCdf;
 use gpu_render::cpu::bxdf::{
     pdf_beckmann_normal, pdf_blinn_phong_half, pdf_ggx_visible_normal, sample_beckmann_normal,
     sample_blinn_phong_half, sample_ggx_visible_normal,
@@ -21,7 +20,8 @@ use gpu_render::cpu::bxdf::{
 use gpu_render::cpu::tabulated::{
     TABULATED_COSINE_PROBABILITY, pdf_brdf_map_direction, pdf_tabulated, sample_tabulated,
 };
-use gpu_render::sample::*;
+use gpu_render::low_level::accel::BrdfMapCdf;
+use gpu_render::low_level::sample::*;
 use gpu_render::scene::Image;
 
 /// Tests in this file that compute a p-value (for Šidák's correction).
@@ -256,7 +256,7 @@ fn blinn_phong_half_vector_sampling_follows_its_density() {
     }
 }
 
-/// The environment map's sampler (`gpu_render::accel::EnvironmentLight`) on a
+/// The environment map's sampler (`gpu_render::low_level::accel::EnvironmentLight`) on a
 /// non-uniform 16 × 8 map with a black texel and a black row: the grid's pole is the
 /// map's +y (the directions are turned by a cyclic permutation of the axes, which
 /// keeps solid angle), so the map's texel edges fall on the grid's cell edges and the
@@ -264,7 +264,7 @@ fn blinn_phong_half_vector_sampling_follows_its_density() {
 /// the `sin θ` of its Jacobian, or a marginal/conditional mix-up, fails.
 #[test]
 fn environment_map_sampling_follows_its_density() {
-    use gpu_render::accel::EnvironmentLight;
+    use gpu_render::low_level::accel::EnvironmentLight;
     use gpu_render::scene::{EnvironmentMap, Image};
     let (width, height) = (16u32, 8u32);
     let texels = (0..width * height)

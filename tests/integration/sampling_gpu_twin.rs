@@ -6,10 +6,10 @@
 //! CPU's within f32 rounding. That the CPU pattern covers the pixel uniformly (one sample
 //! in every column and every row of the strata) is tested in `src/camera.rs`.
 
-use gpu_render::camera::sample_offset;
 use gpu_render::gpu::ShaderFeatures;
 use gpu_render::gpu::layout::FrameUniforms;
 use gpu_render::gpu::shaders::compose_source;
+use gpu_render::low_level::camera::sample_offset;
 use gpu_render::scene::RenderSettings;
 use wgpu::util::DeviceExt;
 
@@ -93,7 +93,7 @@ fn gpu_sample_offsets_match_the_cpu() {
             width: WIDTH,
             height: 1080,
             samples_per_pixel: n,
-            lattice_generator: gpu_render::camera::lattice_generator(n),
+            lattice_generator: gpu_render::low_level::camera::lattice_generator(n),
             ..bytemuck::Zeroable::zeroed()
         };
         let uniform_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

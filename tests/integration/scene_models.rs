@@ -202,7 +202,7 @@ fn a_model_placed_several_times_is_held_once_per_material() {
 /// meshes' triangles as they stand in world space), and how many of them face away from
 /// the vase's vertical axis.
 fn outward_side_triangles(scene: &Scene) -> (usize, usize) {
-    let geometry = gpu_render::accel::SceneGeometry::new(scene);
+    let geometry = gpu_render::low_level::accel::SceneGeometry::new(scene);
     let mut world: Vec<[DVec3; 3]> = geometry.triangles.iter().map(|t| t.vertices).collect();
     for instance in &geometry.instances {
         let mesh = &geometry.instanced_meshes[instance.mesh as usize];

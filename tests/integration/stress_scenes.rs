@@ -399,9 +399,9 @@ fn identical_triangles_build_a_bounded_tree_and_render() {
             })
             .collect()
     };
-    let million = gpu_render::accel::SceneGeometry::from_shapes(
+    let million = gpu_render::low_level::accel::SceneGeometry::from_shapes(
         &many(1_000_000),
-        gpu_render::accel::BuildMethod::Sah,
+        gpu_render::low_level::accel::BuildMethod::Sah,
     );
     let stats = million.bvh.stats;
     assert!(

@@ -172,7 +172,7 @@ fn scenes_past_the_limit_walk_the_tree() {
     let renderer = crate::support::gpu::renderer(&gpu);
     let mut scene = every_kind();
     let count = |scene: &Scene| {
-        gpu_render::accel::SceneGeometry::new(scene).bounded_count() + 2 // two planes
+        gpu_render::low_level::accel::SceneGeometry::new(scene).bounded_count() + 2 // two planes
     };
     assert!(count(&scene) <= MAX_UNROLLED_PRIMITIVES);
     let sphere = scene.shapes[2].clone();

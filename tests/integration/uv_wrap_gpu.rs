@@ -7,11 +7,11 @@
 
 use crate::support::compare::{Tolerance, assert_images_match};
 use glam::{DMat4, DVec2, DVec3};
+use gpu_render::low_level::texture::wrap_index;
 use gpu_render::scene::{
     Camera, Environment, Image, Light, Material, Mesh, RenderSettings, Scene, TextureMapping,
     TextureWrap,
 };
-use gpu_render::texture::wrap_index;
 
 /// The shipped scenes' tolerance (tests/integration/gpu_vs_cpu.rs): f32 against f64, with 0.5% of
 /// the pixels (quad edges) allowed to land on either side.

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use gpu_render::quality::QualityPreset;
+use gpu_render::low_level::quality::QualityPreset;
 use gpu_render::scene::{
     Integrator, LightingSpace, MAX_DEPTH_LIMIT, MAX_IMAGE_DIMENSION, MAX_SAMPLES_PER_PIXEL,
     RenderOverrides,

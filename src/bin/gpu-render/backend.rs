@@ -7,7 +7,7 @@ use gpu_render::cpu;
 use gpu_render::film::{LinearImage, ProgressFn, RenderStats, Rendered};
 use gpu_render::gpu::cpu_device::unrolled::MAX_UNROLLED_PRIMITIVES;
 use gpu_render::gpu::{self, AdapterChoice, HeadlessGpu, Renderer, RendererOptions, TraceRegion};
-use gpu_render::noise::NoiseEstimate;
+use gpu_render::low_level::noise::NoiseEstimate;
 use gpu_render::scene::{Integrator, Scene};
 use gpu_render::tiles::PixelWindow;
 
@@ -348,7 +348,7 @@ fn unrolled_primitives(scene: &Scene) -> usize {
         .iter()
         .map(|shape| match shape {
             gpu_render::scene::Shape::Polygon { vertices, .. }
-                if vertices.len() > gpu_render::accel::MAX_POLYGON_VERTICES =>
+                if vertices.len() > gpu_render::low_level::accel::MAX_POLYGON_VERTICES =>
             {
                 vertices.len().saturating_sub(2)
             }

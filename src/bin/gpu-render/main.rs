@@ -86,7 +86,7 @@ fn run(cli: Cli) -> Result<()> {
 /// `gpu-render brdf-check FILE`: prints the worst case of each plausibility rule and
 /// fails when one is broken.
 fn brdf_check(file: &Path) -> Result<()> {
-    use gpu_render::plausibility::{
+    use gpu_render::low_level::plausibility::{
         ENERGY_TOLERANCE, RECIPROCITY_TOLERANCE, Worst, check_brdf_map,
     };
     let map = scene::load_image(file).map_err(|e| anyhow!("{}: {e}", file.display()))?;
@@ -389,7 +389,10 @@ pub fn load_model(
     let scene = model.into_scene(render);
     if !quiet {
         for warning in &model.warnings {
-            eprintln!("warning: {}", gpu_render::echo::escape_controls(warning));
+            eprintln!(
+                "warning: {}",
+                gpu_render::low_level::echo::escape_controls(warning)
+            );
         }
         if model.camera.is_none() {
             eprintln!(

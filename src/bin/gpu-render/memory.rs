@@ -148,7 +148,7 @@ impl fmt::Display for Estimate {
 /// Bytes of the scene the render holds: shapes, polygon vertices, image texels and
 /// mesh triangles (a mesh placed once in world space with its attributes, one placed
 /// more than once stored once plus a record per placement, as the geometry holds them;
-/// `gpu_render::accel::instance`), in the model and (for the GPU) once more in upload
+/// `gpu_render::low_level::accel::instance`), in the model and (for the GPU) once more in upload
 /// form.
 fn scene_bytes(scene: &Scene) -> u64 {
     use gpu_render::scene::Shape;
@@ -164,7 +164,7 @@ fn scene_bytes(scene: &Scene) -> u64 {
     // A world-space mesh triangle: 3 f64 corners plus a material and attribute index
     // (80 B), its attributes (3 normals and 3 UVs, 128 B) and its BVH share (~40 B).
     let (mut mesh_triangles, mut instances) = (0, 0);
-    for group in gpu_render::accel::instance::mesh_groups(&scene.meshes) {
+    for group in gpu_render::low_level::accel::instance::mesh_groups(&scene.meshes) {
         let placements: usize = group.iter().map(|&i| scene.meshes[i].instances.len()).sum();
         let triangles = scene.meshes[group[0]].triangles.len();
         if placements > 1 {

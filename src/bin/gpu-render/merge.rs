@@ -2,7 +2,7 @@
 //! assembled into the whole image, written as the whole render would have been.
 
 use anyhow::Result;
-use gpu_render::echo::echo;
+use gpu_render::low_level::echo::echo;
 use gpu_render::output;
 use gpu_render::tiles::merge_tiles;
 

@@ -31,7 +31,7 @@ impl PipelineCacheFile {
         }
         let key = wgpu::util::pipeline_cache_key(adapter)?;
         let path = cache_dir()?.join(format!("{key}.bin"));
-        let loaded = gpu_render::input::read_input(&path, MAX_CACHE_BYTES).ok();
+        let loaded = gpu_render::low_level::input::read_input(&path, MAX_CACHE_BYTES).ok();
         // SAFETY: the data is what `PipelineCache::get_data` returned in an earlier run
         // for this adapter key, written by `save` below into the user's own cache
         // folder, as `create_pipeline_cache` requires. wgpu validates its header

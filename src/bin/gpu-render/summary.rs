@@ -4,7 +4,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use gpu_render::film::RenderStats;
-use gpu_render::noise::NoiseEstimate;
+use gpu_render::low_level::noise::NoiseEstimate;
 use gpu_render::scene::RenderSettings;
 
 /// What the summary line reports.

@@ -5,11 +5,11 @@ use std::time::Duration;
 use anyhow::{Context, Result};
 use gpu_render::film::TimingSource;
 use gpu_render::film::relative_rmse;
-use gpu_render::scene::{Integrator, RenderOverrides, RenderSettings, Scene};
-use gpu_render::tradeoff::{
+use gpu_render::low_level::tradeoff::{
     ErrorAxis, Knobs, Measurement, default_sweep, integrator_name, mean_flip, pareto_front,
     plot_png, rmse, sweep, time_to_error, to_csv,
 };
+use gpu_render::scene::{Integrator, RenderOverrides, RenderSettings, Scene};
 
 use crate::args::TradeoffArgs;
 use crate::backend::{Backend, Frame, GpuOptions};

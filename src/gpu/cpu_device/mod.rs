@@ -2,7 +2,7 @@
 //! kept apart so that the path a real GPU takes reads without them. Each was measured
 //! on lavapipe (`BENCHMARKS.md`) and is chosen at upload from the adapter's device type:
 //!
-//! - [`uniform_records`]: the scene records every traversal step reads bound as
+//! - `uniform_records`: the scene records every traversal step reads bound as
 //!   uniform arrays instead of storage buffers (llvmpipe gathers uniform elements
 //!   without a branch per lane);
 //! - [`unrolled`]: the closest-hit test of a scene of a few primitives as straight-line

@@ -52,7 +52,7 @@ impl Renderer {
     /// split of N samples into calls equals a one-shot render of N samples). Records
     /// into `encoder` and returns at once: no wait, no poll, no error scope.
     ///
-    /// Each call records at most [`RendererOptions::max_rounds_per_call`] rounds of
+    /// Each call records at most [`RendererOptions::max_rounds_per_call`](crate::gpu::RendererOptions::max_rounds_per_call) rounds of
     /// the trace kernels and a copy of the pass's counters, which wgpu maps when the
     /// GPU has run them (inside the application's next `queue.submit` or
     /// `device.poll`). A pass covers every sample queued when it starts; until the
@@ -198,7 +198,7 @@ impl Renderer {
     }
 
     /// Draws `film` into the caller's render pass (whose colour attachment has the
-    /// [`RendererOptions::surface_format`]): one triangle over the pass's viewport,
+    /// [`RendererOptions::surface_format`](crate::gpu::RendererOptions::surface_format)): one triangle over the pass's viewport,
     /// which the film fills, each pixel showing the film texel under its centre (a
     /// viewport of the film's size shows film pixel (x, y) at viewport pixel (x, y);
     /// a larger one scales the film up by nearest texel). The sRGB curve is

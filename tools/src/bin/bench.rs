@@ -326,7 +326,7 @@ fn instanced_million_scene(
 /// Prints what instancing stores for `scene` and how long its geometry takes to build.
 fn instancing_figures(scene: &gpu_render::scene::Scene) {
     let started = Instant::now();
-    let geometry = gpu_render::accel::SceneGeometry::new(scene);
+    let geometry = gpu_render::low_level::accel::SceneGeometry::new(scene);
     let built = started.elapsed().as_secs_f64();
     if geometry.instances.is_empty() {
         return;
@@ -345,7 +345,7 @@ fn instancing_figures(scene: &gpu_render::scene::Scene) {
             m.triangles.len() * std::mem::size_of::<gpu_render::gpu::layout::GpuTriangle>()
                 + m.triangle_attributes.len()
                     * std::mem::size_of::<gpu_render::gpu::layout::GpuTriangleAttributes>()
-                + m.bvh.nodes.len() * std::mem::size_of::<gpu_render::accel::BvhNode>()
+                + m.bvh.nodes.len() * std::mem::size_of::<gpu_render::low_level::accel::BvhNode>()
                 + m.bvh.prims.len() * 4
         })
         .sum();
@@ -424,7 +424,7 @@ fn main() -> Result<()> {
     // Warm-up: the first dispatch compiles the pipeline (lavapipe runs LLVM then).
     renderer.render(&gpu.device, &gpu.queue, &scene, None)?;
     let prepared = renderer.upload(&gpu.device, &gpu.queue, &scene)?;
-    let primitives = gpu_render::accel::SceneGeometry::new(&scene).bounded_count();
+    let primitives = gpu_render::low_level::accel::SceneGeometry::new(&scene).bounded_count();
     println!(
         "GPU scene buffers: {} bytes for {primitives} bounded primitives ({:.1} bytes each, \
          BVH included); BVH built in {:.1} ms; records in {} buffers; closest hit {}",
@@ -623,14 +623,14 @@ fn compare_schedules(
 /// work of one camera ray per pixel (through the pixel centre) and of one shadow ray
 /// from each hit to the scene's first light.
 fn traversal_figures(scene: &gpu_render::scene::Scene) {
-    use gpu_render::accel::{BuildMethod, SceneGeometry};
     use gpu_render::cpu::intersect::{Ray, hit_record_keyed};
     use gpu_render::cpu::traverse::{TraversalCounts, closest_hit_counted, occluded_counted};
+    use gpu_render::low_level::accel::{BuildMethod, SceneGeometry};
     for method in [BuildMethod::Sah, BuildMethod::MedianSplit] {
         let geometry = SceneGeometry::with_method(scene, method);
         let stats = geometry.bvh.stats;
         let prims = geometry.bounded_count();
-        let camera = gpu_render::camera::CameraFrame::new(
+        let camera = gpu_render::low_level::camera::CameraFrame::new(
             &scene.camera,
             scene.render.width,
             scene.render.height,

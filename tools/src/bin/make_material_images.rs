@@ -11,7 +11,7 @@
 
 use std::f64::consts::FRAC_PI_2;
 
-use gpu_render::color::{quantize_unorm8, srgb_encode};
+use gpu_render::low_level::color::{quantize_unorm8, srgb_encode};
 use image::{ImageBuffer, Rgb, Rgb32FImage};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
