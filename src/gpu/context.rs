@@ -121,7 +121,7 @@ pub fn select_adapter(
 ///
 /// The device is created with the adapter's own limits (not [`wgpu::Limits::default`]),
 /// so large storage buffers and image sizes the hardware supports are usable, and with
-/// the features of [`super::limits::optional_features`] where the adapter offers them
+/// the features of `gpu::limits::optional_features` where the adapter offers them
 /// (timestamp queries, so that renders report GPU time, and subgroup operations).
 pub struct HeadlessGpu {
     /// The instance the adapter came from.

@@ -9,7 +9,7 @@
 //!   and tests that do not bring their own device.
 //! - The stages: `scene_buffers` (a scene uploaded to the device), `wavefront` (the
 //!   path slots and the schedule of the trace kernels), `pipelines`, `display`,
-//!   `draw`, and [`limits`] (what the renderer needs of a device).
+//!   `draw`, and `limits` (what the renderer needs of a device).
 //! - [`shaders`]: composition of the WGSL sources, specialised by [`features`];
 //!   [`upload`]: pure conversion of a [`crate::scene::Scene`] into the GPU records,
 //!   [`layout`] their `#[repr(C)]` twins of `shaders/types.wgsl`.
@@ -29,7 +29,7 @@
 //! ```
 
 pub mod area_lights;
-pub mod context;
+mod context;
 pub mod cpu_device;
 mod display;
 mod draw;
@@ -39,10 +39,10 @@ pub mod features;
 mod film;
 mod gpu_scene;
 pub mod layout;
-pub mod limits;
+mod limits;
 mod pipelines;
 mod readback;
-pub mod renderer;
+mod renderer;
 mod scene_buffers;
 pub mod shaders;
 pub mod upload;

@@ -198,13 +198,13 @@ impl Renderer {
     }
 
     /// The limits to request when creating a device for the renderer:
-    /// `adapter_limits` raised to the renderer's minimums ([`super::limits`]).
+    /// `adapter_limits` raised to the renderer's minimums (`gpu::limits`).
     pub fn required_limits(adapter_limits: &wgpu::Limits) -> wgpu::Limits {
         required_limits(adapter_limits)
     }
 
     /// The features to request when creating a device for the renderer, where the
-    /// adapter has them ([`super::limits::optional_features`]): the renderer runs
+    /// adapter has them (`gpu::limits::optional_features`): the renderer runs
     /// without them, only slower.
     pub fn optional_features(adapter_features: wgpu::Features) -> wgpu::Features {
         super::limits::optional_features(adapter_features)
