@@ -275,7 +275,7 @@ fn bad_maps_are_clear_errors_naming_the_file_and_the_problem() {
         );
     }
     write_exr(&dir.join("ok.exr"), 1.0);
-    // Finite texels and scale whose product is not finite in f32.
+    // Finite texels and a scale whose product is beyond what the GPU can sum (1e30).
     write_exr(&dir.join("big.exr"), 100.0);
     for (fields, problem) in [
         (
@@ -284,7 +284,11 @@ fn bad_maps_are_clear_errors_naming_the_file_and_the_problem() {
         ),
         ("map = \"ok.exr\"\nrotation = nan", "rotation is NaN"),
         ("map = \"ok.exr\"\nscale = -1", "scale must be >= 0"),
-        ("map = \"big.exr\"\nscale = 1e37", "beyond the largest f32"),
+        ("map = \"big.exr\"\nscale = 1e37", "at most 1e30"),
+        (
+            "map = \"big.exr\"\nscale = 1e29",
+            "reaches 1e31, above the 1e30 accepted",
+        ),
         ("rotation = 10", "there is no map"),
     ] {
         let message = load_error(&scene_with(&dir, fields));
