@@ -34,3 +34,37 @@ pub mod texture;
 #[cfg(feature = "cli")]
 #[path = "tradeoff.rs"]
 pub mod tradeoff;
+
+/// The GPU backend's internals: the `#[repr(C)]` records and their upload, the WGSL
+/// composition and specialisation, the emitter and environment records, and the
+/// strategies for CPU devices. The frame-loop API is [`crate::gpu`].
+pub mod gpu {
+    /// The GPU records, `#[repr(C)]` twins of `shaders/types.wgsl`.
+    pub mod layout {
+        pub use crate::gpu::layout::*;
+    }
+    /// Pure conversion of a scene into the GPU records.
+    pub mod upload {
+        pub use crate::gpu::upload::*;
+    }
+    /// Composition of the WGSL modules.
+    pub mod shaders {
+        pub use crate::gpu::shaders::*;
+    }
+    /// The shader features a scene needs, and specialising sources to them.
+    pub mod features {
+        pub use crate::gpu::features::*;
+    }
+    /// The emitter records of the path integrator's area lights.
+    pub mod area_lights {
+        pub use crate::gpu::area_lights::*;
+    }
+    /// The environment map's records.
+    pub mod environment {
+        pub use crate::gpu::environment::*;
+    }
+    /// The strategies the tracer takes on CPU devices only.
+    pub mod cpu_device {
+        pub use crate::gpu::cpu_device::unrolled;
+    }
+}

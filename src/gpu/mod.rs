@@ -10,10 +10,11 @@
 //! - The stages: `scene_buffers` (a scene uploaded to the device), `wavefront` (the
 //!   path slots and the schedule of the trace kernels), `pipelines`, `display`,
 //!   `draw`, and `limits` (what the renderer needs of a device).
-//! - [`shaders`]: composition of the WGSL sources, specialised by [`features`];
-//!   [`upload`]: pure conversion of a [`crate::scene::Scene`] into the GPU records,
-//!   [`layout`] their `#[repr(C)]` twins of `shaders/types.wgsl`.
-//! - [`cpu_device`]: for CPU devices (lavapipe), the strategies that only pay there:
+//! - `shaders`: composition of the WGSL sources, specialised by `features`;
+//!   `upload`: pure conversion of a [`crate::scene::Scene`] into the GPU records,
+//!   `layout` their `#[repr(C)]` twins of `shaders/types.wgsl` (these four public as
+//!   [`crate::low_level::gpu`]).
+//! - `cpu_device`: for CPU devices (lavapipe), the strategies that only pay there:
 //!   the scene records in uniform buffers, small scenes' closest-hit test without the
 //!   tree, and lanes that give way to finished ones ([`ShaderFeatures::refill_lanes`]).
 //!
@@ -28,24 +29,24 @@
 //! # }
 //! ```
 
-pub mod area_lights;
+pub(crate) mod area_lights;
 mod context;
-pub mod cpu_device;
+pub(crate) mod cpu_device;
 mod display;
 mod draw;
-pub mod environment;
+pub(crate) mod environment;
 mod error;
-pub mod features;
+pub(crate) mod features;
 mod film;
 mod gpu_scene;
-pub mod layout;
+pub(crate) mod layout;
 mod limits;
 mod pipelines;
 mod readback;
 mod renderer;
 mod scene_buffers;
-pub mod shaders;
-pub mod upload;
+pub(crate) mod shaders;
+pub(crate) mod upload;
 mod wavefront;
 
 pub use context::{

@@ -165,7 +165,7 @@ pub const DISPLAY_ENTRY_POINT: &str = "encode_display";
 /// Workgroup size (x and y) of the display pass, `@workgroup_size(8, 8, 1)`.
 pub const WORKGROUP_SIZE: u32 = 8;
 
-/// The complete trace module specialised to `features` (see [`super::features`]):
+/// The complete trace module specialised to `features` (see `gpu::features`):
 /// `shaders/wavefront.wgsl`, the trace kernels, with everything it imports, the
 /// record bindings storage or uniform arrays as `features.uniform_records` says, and
 /// for an unrolled scene its `unrolled_closest_hit` ([`super::cpu_device::unrolled`]).
@@ -175,7 +175,7 @@ pub const WORKGROUP_SIZE: u32 = 8;
 ///
 /// ```
 /// use gpu_render::gpu::ShaderFeatures;
-/// let src = gpu_render::gpu::shaders::trace_shader_source(&ShaderFeatures::ALL).unwrap();
+/// let src = gpu_render::low_level::gpu::shaders::trace_shader_source(&ShaderFeatures::ALL).unwrap();
 /// assert!(src.contains("const MAX_BVH_DEPTH: u32 = 64u;\n"));
 /// assert!(src.contains("fn refract_direction"));
 /// assert!(src.contains("fn shade_paths") && src.contains("fn trace_rays"));
@@ -189,7 +189,7 @@ pub fn trace_shader_source(features: &ShaderFeatures) -> Result<String, ComposeE
 /// that tests can compare it with the CPU.
 ///
 /// ```
-/// let src = gpu_render::gpu::shaders::bxdf_eval_shader_source();
+/// let src = gpu_render::low_level::gpu::shaders::bxdf_eval_shader_source();
 /// assert!(src.contains("fn eval_brdfs"));
 /// ```
 pub fn bxdf_eval_shader_source() -> String {
@@ -199,7 +199,7 @@ pub fn bxdf_eval_shader_source() -> String {
 /// The complete display module, `shaders/display.wgsl` and its imports.
 ///
 /// ```
-/// let src = gpu_render::gpu::shaders::display_shader_source();
+/// let src = gpu_render::low_level::gpu::shaders::display_shader_source();
 /// assert!(src.contains("fn encode_display"));
 /// ```
 pub fn display_shader_source() -> String {

@@ -11,10 +11,10 @@ use glam::{DMat4, DQuat, DVec3};
 use gpu_render::cpu::intersect::Ray;
 use gpu_render::cpu::traverse::closest_hit_brute_force;
 use gpu_render::gpu::ShaderFeatures;
-use gpu_render::gpu::layout::{FrameUniforms, GpuCounters};
-use gpu_render::gpu::shaders::compose_source;
-use gpu_render::gpu::upload::{SceneRecords, frame_uniforms};
 use gpu_render::low_level::accel::{BuildMethod, SceneGeometry};
+use gpu_render::low_level::gpu::layout::{FrameUniforms, GpuCounters};
+use gpu_render::low_level::gpu::shaders::compose_source;
+use gpu_render::low_level::gpu::upload::{SceneRecords, frame_uniforms};
 use gpu_render::scene::{Camera, Environment, Material, RenderSettings, Scene, Shape};
 use wgpu::util::DeviceExt;
 

@@ -11,9 +11,9 @@ use std::path::Path;
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
 use gpu_render::cpu::bxdf::eval_brdf;
-use gpu_render::gpu::shaders::{BXDF_EVAL_ENTRY_POINT, bxdf_eval_shader_source};
-use gpu_render::gpu::upload::{image_layers, material_record};
 use gpu_render::low_level::accel::BrdfMapCdfs;
+use gpu_render::low_level::gpu::shaders::{BXDF_EVAL_ENTRY_POINT, bxdf_eval_shader_source};
+use gpu_render::low_level::gpu::upload::{image_layers, material_record};
 use gpu_render::scene::{
     CONDUCTOR_PRESETS, FresnelModel, Image, Material, MaterialKind, MicrofacetDistribution,
     load_image,
@@ -187,7 +187,7 @@ fn wgsl_brdfs_match_the_cpu_reference() {
 fn evaluate(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
-    materials: &[gpu_render::gpu::layout::GpuMaterial],
+    materials: &[gpu_render::low_level::gpu::layout::GpuMaterial],
     cases: &[BrdfCase],
     images: &[Image],
 ) -> Vec<[f32; 4]> {

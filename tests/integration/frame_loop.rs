@@ -13,10 +13,10 @@ use std::sync::Mutex;
 
 use crate::support::compare::{Tolerance, assert_images_match};
 use gpu_render::film::LinearImage;
-use gpu_render::gpu::layout::FrameUniforms;
 use gpu_render::gpu::{
     BufferWrites, Film, GpuScene, HeadlessGpu, RenderError, Renderer, RendererOptions, Schedule,
 };
+use gpu_render::low_level::gpu::layout::FrameUniforms;
 use gpu_render::scene::{Camera, LightingSpace, RenderOverrides, Scene};
 
 const CPU_TOLERANCE: Tolerance = Tolerance {

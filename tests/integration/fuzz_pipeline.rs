@@ -111,7 +111,7 @@ fn fuzz(checker: &PipelineChecker, config: Config, seed: u64, name: &str, visit:
     }
 }
 
-/// Cases with their primitives unrolled (`gpu_render::gpu::cpu_device::unrolled`, on CPU devices):
+/// Cases with their primitives unrolled (`gpu_render::low_level::gpu::cpu_device::unrolled`, on CPU devices):
 /// fewer, as each compiles a module of its own. Most are unrolled (at most seven
 /// objects; the larger polygons' triangles may pass the limit).
 const UNROLLED_CASES: u32 = 8;

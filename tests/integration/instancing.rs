@@ -22,8 +22,8 @@ use gpu_render::cpu::intersect::Ray;
 use gpu_render::cpu::traverse::{
     TraversalCounts, closest_hit_brute_force, closest_hit_counted, occluded,
 };
-use gpu_render::gpu::upload::SceneRecords;
 use gpu_render::low_level::accel::SceneGeometry;
+use gpu_render::low_level::gpu::upload::SceneRecords;
 use gpu_render::scene::import::ModelPlacement;
 use gpu_render::scene::{
     Camera, Environment, Integrator, Light, Material, MaterialKind, Mesh, RenderSettings, Scene,
@@ -535,7 +535,7 @@ fn emissive_copies_are_instanced_with_an_emitter_record_per_triangle_and_copy() 
     };
     let (one, ten) = (record_bytes(&scene(1)), record_bytes(&scene(10)));
     let triangles = mesh.triangles.len();
-    let emitters = gpu_render::gpu::area_lights::emitter_records(
+    let emitters = gpu_render::low_level::gpu::area_lights::emitter_records(
         &SceneGeometry::new(&scene(10)),
         &scene(10).materials,
         &[],

@@ -6,16 +6,16 @@ use std::collections::BTreeMap;
 use std::mem::{offset_of, size_of};
 
 use gpu_render::gpu::ShaderFeatures;
-use gpu_render::gpu::area_lights::{
+use gpu_render::low_level::accel::{BvhNode, PrimKind, PrimRef};
+use gpu_render::low_level::gpu::area_lights::{
     EMITTER_NONE, EMITTER_SPHERE, EMITTER_TRIANGLE, EMITTER_TWO_SIDED_TRIANGLE, FLAG_PATH,
     GpuEmitter, PHASE_EMITTER,
 };
-use gpu_render::gpu::environment::GpuEnvironmentHeader;
-use gpu_render::gpu::layout::*;
-use gpu_render::gpu::shaders::{
+use gpu_render::low_level::gpu::environment::GpuEnvironmentHeader;
+use gpu_render::low_level::gpu::layout::*;
+use gpu_render::low_level::gpu::shaders::{
     bxdf_eval_shader_source, display_shader_source, shader_module, trace_shader_source,
 };
-use gpu_render::low_level::accel::{BvhNode, PrimKind, PrimRef};
 
 /// The shared records: types.wgsl and the path integrator's path_types.wgsl.
 fn shared_types_wgsl() -> String {
@@ -450,7 +450,11 @@ fn composed_trace_shader_validates() {
         assert_eq!(entry.stage, naga::ShaderStage::Compute);
         assert_eq!(
             entry.workgroup_size,
-            [gpu_render::gpu::shaders::SLOT_WORKGROUP_SIZE, 1, 1]
+            [
+                gpu_render::low_level::gpu::shaders::SLOT_WORKGROUP_SIZE,
+                1,
+                1
+            ]
         );
     }
 }
@@ -524,7 +528,7 @@ fn wgsl_constants_equal_their_rust_twins() {
 
 #[test]
 fn composed_draw_shader_validates() {
-    let source = gpu_render::gpu::shaders::draw_shader_source();
+    let source = gpu_render::low_level::gpu::shaders::draw_shader_source();
     validate("draw shader", &source);
     let module = naga::front::wgsl::parse_str(&source).expect("parsed above");
     for (name, stage) in [

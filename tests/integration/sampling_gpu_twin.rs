@@ -7,9 +7,9 @@
 //! in every column and every row of the strata) is tested in `src/camera.rs`.
 
 use gpu_render::gpu::ShaderFeatures;
-use gpu_render::gpu::layout::FrameUniforms;
-use gpu_render::gpu::shaders::compose_source;
 use gpu_render::low_level::camera::sample_offset;
+use gpu_render::low_level::gpu::layout::FrameUniforms;
+use gpu_render::low_level::gpu::shaders::compose_source;
 use gpu_render::scene::RenderSettings;
 use wgpu::util::DeviceExt;
 

@@ -9,8 +9,10 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use gpu_render::gpu::ShaderFeatures;
-use gpu_render::gpu::cpu_device::unrolled::UnrolledPrimitives;
-use gpu_render::gpu::shaders::{HOST_MODULES, SHADER_MODULES, host_module, imports, shader_module};
+use gpu_render::low_level::gpu::cpu_device::unrolled::UnrolledPrimitives;
+use gpu_render::low_level::gpu::shaders::{
+    HOST_MODULES, SHADER_MODULES, host_module, imports, shader_module,
+};
 
 /// `source` without its `//` comments (the feature directives among them).
 fn code_of(source: &str) -> String {
@@ -167,7 +169,7 @@ fn imports_and_uses(
     let texts: BTreeMap<String, String> = module_texts(features)
         .into_iter()
         .map(|(name, text)| {
-            let specialised = gpu_render::gpu::features::specialise(&text, features)
+            let specialised = gpu_render::low_level::gpu::features::specialise(&text, features)
                 .unwrap_or_else(|e| panic!("{name}: {e}"));
             (name, specialised)
         })

@@ -4,8 +4,8 @@
 use std::collections::BTreeSet;
 
 use gpu_render::gpu::RendererOptions;
-use gpu_render::gpu::shaders::trace_shader_source;
 use gpu_render::gpu::{Renderer, ShaderFeatures};
+use gpu_render::low_level::gpu::shaders::trace_shader_source;
 use gpu_render::scene::{RenderOverrides, Scene, load_scene};
 
 use crate::support::scenes::shipped as scene;

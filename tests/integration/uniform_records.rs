@@ -94,7 +94,7 @@ fn records_beyond_one_uniform_binding_stay_in_storage_buffers() {
         .lights
         .len();
     // 64 KiB of 32-byte light records hold 2,048 lights.
-    let capacity = 65536 / std::mem::size_of::<gpu_render::gpu::layout::GpuLight>();
+    let capacity = 65536 / std::mem::size_of::<gpu_render::low_level::gpu::layout::GpuLight>();
     let fits = renderer
         .upload(&gpu.device, &gpu.queue, &with_point_lights(capacity - base))
         .expect("prepare");

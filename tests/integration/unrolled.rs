@@ -8,7 +8,7 @@ use std::path::Path;
 
 use gpu_render::gpu::Renderer;
 use gpu_render::gpu::RendererOptions;
-use gpu_render::gpu::cpu_device::unrolled::MAX_UNROLLED_PRIMITIVES;
+use gpu_render::low_level::gpu::cpu_device::unrolled::MAX_UNROLLED_PRIMITIVES;
 use gpu_render::scene::{RenderOverrides, Scene, parse_scene};
 
 /// Spheres, planes, a triangle, a quad and a hexagon, in glass, a mirror and Lambert

@@ -113,7 +113,7 @@ impl UnrolledPrimitives {
         &self.tests[..self.len]
     }
 
-    /// The WGSL module `unrolled_scene` (see [`crate::gpu::shaders`]): the function
+    /// The WGSL module `unrolled_scene` (see `gpu::shaders`): the function
     /// `unrolled_closest_hit(ray, sheared, best_t, best_prim)` that runs the tests, with
     /// the imports of the helpers it calls (`shaders/unrolled.wgsl`) and of the types of
     /// its arguments.

@@ -686,7 +686,7 @@ impl PipelineChecker {
     }
 
     /// A checker on `gpu` whose cases, on CPU devices, test their primitives unrolled
-    /// (`gpu_render::gpu::cpu_device::unrolled`): a module of its own for every case, as each
+    /// (`gpu_render::low_level::gpu::cpu_device::unrolled`): a module of its own for every case, as each
     /// names its primitives, so a few seconds of compiling per case on lavapipe.
     pub fn unrolled(gpu: HeadlessGpu) -> Self {
         let options = RendererOptions {

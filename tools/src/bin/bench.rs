@@ -338,17 +338,22 @@ fn instancing_figures(scene: &gpu_render::scene::Scene) {
         .sum();
     // What the instanced meshes' triangles take on the GPU (records, attributes, their
     // trees' nodes and references), and what flattening every placement would take.
-    let mesh_bytes: usize = geometry
-        .instanced_meshes
-        .iter()
-        .map(|m| {
-            m.triangles.len() * std::mem::size_of::<gpu_render::gpu::layout::GpuTriangle>()
-                + m.triangle_attributes.len()
-                    * std::mem::size_of::<gpu_render::gpu::layout::GpuTriangleAttributes>()
-                + m.bvh.nodes.len() * std::mem::size_of::<gpu_render::low_level::accel::BvhNode>()
-                + m.bvh.prims.len() * 4
-        })
-        .sum();
+    let mesh_bytes: usize =
+        geometry
+            .instanced_meshes
+            .iter()
+            .map(|m| {
+                m.triangles.len()
+                    * std::mem::size_of::<gpu_render::low_level::gpu::layout::GpuTriangle>()
+                    + m.triangle_attributes.len()
+                        * std::mem::size_of::<
+                            gpu_render::low_level::gpu::layout::GpuTriangleAttributes,
+                        >()
+                    + m.bvh.nodes.len()
+                        * std::mem::size_of::<gpu_render::low_level::accel::BvhNode>()
+                    + m.bvh.prims.len() * 4
+            })
+            .sum();
     let flattened =
         mesh_bytes as f64 / stored.max(1) as f64 * geometry.instanced_triangle_count() as f64;
     println!(
@@ -545,8 +550,8 @@ fn compare_specialisation(
         let started = Instant::now();
         renderer.render(&gpu.device, &gpu.queue, &tiny, None)?;
         let first = started.elapsed().as_secs_f64();
-        let source =
-            gpu_render::gpu::shaders::trace_shader_source(&used).map_err(anyhow::Error::msg)?;
+        let source = gpu_render::low_level::gpu::shaders::trace_shader_source(&used)
+            .map_err(anyhow::Error::msg)?;
         println!(
             "{name}: {} lines of WGSL; create_compute_pipeline {:.1} ms; first 8x8 frame {:.1} ms",
             source.lines().count(),
