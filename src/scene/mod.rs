@@ -29,7 +29,7 @@ pub use medium::{MEDIUM_STACK_SIZE, MediumStack};
 pub use model::*;
 pub use precision::{
     CAMERA_PRECISION_LIMIT, FlatShapeBeyondTheGpu, camera_pixel_precision, flat_precision,
-    flat_shape_beyond_the_gpu, mesh_triangle_beyond_the_gpu,
+    flat_shape_beyond_the_gpu, light_beyond_the_gpu, mesh_triangle_beyond_the_gpu,
 };
 pub use sphere::{
     FAR_WALL_PRECISION_LIMIT, FarWallPrecision, SPHERE_PRECISION_LIMIT, SphereGap,

@@ -70,6 +70,51 @@ pub fn camera_pixel_precision(camera: &Camera, height: u32) -> f64 {
     f64::from(f32::EPSILON) / pixel
 }
 
+/// The fraction of the largest `f32` above which a point light's irradiance on a
+/// surface, `I/r²`, counts as beyond the GPU: the GPU forms it before the BRDF and the
+/// cosine scale it down, and an infinite irradiance makes the pixel 0 there (the CPU's
+/// `f64` gave 1.85e38 for a light of 1e30 7.2e-5 off a white sphere).
+const IRRADIANCE_LIMIT: f64 = f32::MAX as f64 / 16.0;
+
+/// A point light of `scene` so near one of its shapes (spheres, planes, polygons,
+/// triangles; not mesh triangles) that its irradiance there, `I/r²`, is beyond what
+/// the GPU's `f32` forms: `(light index, shape index, distance)` of the first such pair.
+pub fn light_beyond_the_gpu(scene: &Scene) -> Option<(usize, usize, f64)> {
+    scene.lights.iter().enumerate().find_map(|(i, light)| {
+        let super::Light::Point {
+            position,
+            intensity,
+        } = light
+        else {
+            return None;
+        };
+        // Nearer than this, I/r² exceeds the limit.
+        let nearest = (intensity.max_element() / IRRADIANCE_LIMIT).sqrt();
+        if nearest.is_nan() || nearest <= 0.0 {
+            return None;
+        }
+        scene.shapes.iter().enumerate().find_map(|(k, shape)| {
+            let distance = distance_to_shape(shape, *position);
+            (distance < nearest).then_some((i, k, distance))
+        })
+    })
+}
+
+/// The distance from `point` to the surface of `shape`.
+fn distance_to_shape(shape: &Shape, point: DVec3) -> f64 {
+    match shape {
+        Shape::Sphere { center, radius, .. } => {
+            let (anchor, normal) = super::sphere_anchor(*center, *radius);
+            let y = (point - anchor) / *radius;
+            super::sphere_level(point, anchor, normal, *radius).abs() * radius
+                / ((y + normal).length() + 1.0)
+        }
+        Shape::Plane { normal, offset, .. } => (normal.dot(point) - offset).abs(),
+        Shape::Polygon { vertices, .. } => distance_to_polygon(vertices, point),
+        Shape::Triangle { vertices, .. } => distance_to_polygon(vertices, point),
+    }
+}
+
 /// A flat shape of a scene that only the CPU reference places precisely enough.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlatShapeBeyondTheGpu {

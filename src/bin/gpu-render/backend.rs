@@ -308,6 +308,13 @@ pub fn auto_rule(adapter: &wgpu::AdapterInfo, scene: &Scene) -> Option<String> {
             scene.camera.fov_y_degrees, scene.render.height
         ));
     }
+    if let Some((light, shape, distance)) = gpu_render::scene::light_beyond_the_gpu(scene) {
+        return Some(format!(
+            "point light {light} is {distance:e} from shape {shape}, where its irradiance is \
+             beyond the GPU's f32 but not the CPU reference's f64; --backend gpu uses the GPU \
+             anyway"
+        ));
+    }
     if let Some(beyond) = gpu_render::scene::flat_shape_beyond_the_gpu(scene) {
         return Some(format!(
             "{} is beyond the GPU's f32 precision or range here (placed to {:.1e} units at \

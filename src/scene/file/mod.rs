@@ -364,6 +364,7 @@ fn build_scene(
         material_names.push(name);
         checked();
     }
+    let light_spans: Vec<_> = raw.lights.iter().map(|l| l.span()).collect();
     let lights = raw
         .lights
         .into_iter()
@@ -453,6 +454,24 @@ fn build_scene(
             .map(|k| models[k].placement)
             .collect();
         model.add_placements_to_scene(&mut scene, &placements);
+    }
+    if let Some(warn) = options.warning
+        && let Some((light, shape, distance)) = crate::scene::light_beyond_the_gpu(&scene)
+    {
+        warn(
+            &source
+                .item(
+                    format!("lights[{light}] (point)"),
+                    light_spans.get(light).cloned(),
+                )
+                .warning(format_args!(
+                    "{distance:.1e} from objects[{}], its irradiance there is beyond the \
+                     GPU's 32-bit floats (I/r² above 2e37), where the GPU shows 0; \
+                     --backend auto renders this scene on the CPU reference, or move the \
+                     light",
+                    shape_items.get(shape).map_or(shape, |(i, _)| *i)
+                )),
+        );
     }
     if let Some(warn) = options.warning
         && !scene.meshes.is_empty()

@@ -366,3 +366,32 @@ fn two_sided_emission_is_read_and_needs_emission() {
         "{error}"
     );
 }
+
+/// A point light so near a surface that `I/r²` is beyond f32 there (the GPU shows 0,
+/// the CPU 1.85e38) is warned about at the light; the same light a unit away is not.
+#[test]
+fn a_point_light_whose_irradiance_is_beyond_f32_is_warned_about() {
+    let scene = |z: &str| {
+        format!(
+            "[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\n\
+             [materials.m]\ntype = \"lambert\"\nalbedo = 1\n\
+             [[lights]]\ntype = \"point\"\nposition = [0, 0, {z}]\nintensity = 1e30\n\
+             [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n"
+        )
+    };
+    let found = warnings(&scene("1.000072"));
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!(found[0].location, Some((7, 1)), "{}", found[0]);
+    for part in [
+        "lights[0] (point)",
+        "7.2e-5 from objects[0]",
+        "--backend auto",
+    ] {
+        assert!(
+            found[0].message.contains(part),
+            "{part:?} missing from {}",
+            found[0]
+        );
+    }
+    assert!(warnings(&scene("2")).is_empty());
+}
