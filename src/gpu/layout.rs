@@ -114,6 +114,10 @@ pub const FLAG_STORE_SUM: u32 = 1;
 /// `FrameUniforms.flags`, for tests: traversals leave their loop without reaching an
 /// exit, as a driver that cuts loops makes them do.
 pub const FLAG_SIMULATE_LOOP_CUT: u32 = 2;
+/// `FrameUniforms::flags`: also sum each pixel's auxiliary passes (albedo and depth,
+/// normal: two `vec4<f32>` per pixel, `shaders/aov.wgsl`) in the accumulation buffer,
+/// after the sample sums; only modules with [`super::ShaderFeatures::aov`] do.
+pub const FLAG_AOV: u32 = 8;
 
 /// One traversal of one ray, resumable (`TraceRay` in WGSL). Only the shaders read and
 /// write it; the host zeroes it (`TRACE_IDLE`).

@@ -66,6 +66,13 @@ pub struct RendererOptions {
     /// pixel's sample sum and luminance m2 (16 bytes per pixel of the tile) and reads
     /// them back. Films always keep them.
     pub noise_estimate: bool,
+    /// With `true`, uploaded scenes' trace modules can record the auxiliary passes of
+    /// the camera rays' first hits (`shaders/aov.wgsl` and its CPU twin set out the
+    /// conventions: albedo, shading normal, depth); [`Renderer::render`] and
+    /// [`Renderer::render_region`] then return them ([`RenderedImage::aov`]; 32 more
+    /// bytes per pixel of the tile), and films keep them beside their sums
+    /// ([`Renderer::read_aov`], the denoiser's guides).
+    pub aov: bool,
     /// Trace shaders specialised to each scene's features (`true`, faster to run and
     /// to compile) or the general shader.
     pub specialise: bool,
@@ -103,6 +110,7 @@ impl Default for RendererOptions {
             max_rounds_per_call: 64,
             poll_timeout: None,
             noise_estimate: false,
+            aov: false,
             specialise: true,
             uniform_records: true,
             refill_lanes: true,
@@ -288,6 +296,7 @@ impl Renderer {
                 allow_uniform_records: self.options.uniform_records,
                 allow_refill_lanes: self.options.refill_lanes,
                 allow_unrolled: self.options.unrolled,
+                aov: self.options.aov,
             },
         )?;
         let cached = self.pipelines.has_trace(&prepared.features, self.schedule);
@@ -355,6 +364,7 @@ impl Renderer {
             self.draw_layout(),
             self.options.slot_count,
             scene.prepared.stack_size,
+            self.options.aov,
             width,
             height,
         )?;

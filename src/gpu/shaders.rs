@@ -42,7 +42,7 @@ macro_rules! shader_modules {
 }
 
 /// Every module of `shaders/`, the lower ones first.
-pub const SHADER_MODULES: [ShaderModule; 27] = shader_modules![
+pub const SHADER_MODULES: [ShaderModule; 28] = shader_modules![
     "types",
     "path_types",
     "math",
@@ -66,6 +66,7 @@ pub const SHADER_MODULES: [ShaderModule; 27] = shader_modules![
     "slot",
     "trace",
     "path",
+    "aov",
     "wavefront",
     "display",
     "draw",

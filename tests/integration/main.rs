@@ -4,6 +4,7 @@
 
 mod support;
 
+mod aov;
 mod bvh_cpu;
 mod bvh_gpu;
 mod bxdf_gpu_twin;
