@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use gpu_render::output::AuxPass;
 use gpu_render::quality::QualityPreset;
 use gpu_render::scene::{
     Integrator, LightingSpace, MAX_DEPTH_LIMIT, MAX_IMAGE_DIMENSION, MAX_SAMPLES_PER_PIXEL,
@@ -383,6 +384,37 @@ fn parse_tile(text: &str) -> Result<TileArg, String> {
     Ok(TileArg { index, count })
 }
 
+/// A comma-separated list of auxiliary pass names (`albedo,normal,depth`), each once,
+/// in the order given.
+fn parse_aov_list(text: &str) -> Result<AovList, String> {
+    let known = || {
+        AuxPass::ALL
+            .iter()
+            .map(|pass| pass.name())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut passes = Vec::new();
+    for name in text.split(',').map(str::trim) {
+        let Some(pass) = AuxPass::from_name(name) else {
+            return Err(format!(
+                "unknown pass `{}`: the passes are {} (comma-separated)",
+                gpu_render::echo::echo(name),
+                known()
+            ));
+        };
+        if passes.contains(&pass) {
+            return Err(format!("the pass `{name}` is named twice"));
+        }
+        passes.push(pass);
+    }
+    Ok(AovList(passes))
+}
+
+/// The passes `--aov` names, in its order.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct AovList(pub Vec<AuxPass>);
+
 /// `x0,y0,x1,y1` with `x0 < x1`, `y0 < y1` (checked against the image later).
 fn parse_crop(text: &str) -> Result<PixelWindow, String> {
     let usage = || format!("must be x0,y0,x1,y1 (whole pixels, x1 and y1 excluded), got `{text}`");
@@ -435,6 +467,19 @@ pub struct RenderArgs {
     /// left in the summary. `{frame}` and `{tile}` expand as in the output name.
     #[arg(long, value_name = "PATH.exr", conflicts_with = "compare_gamma")]
     pub standard_error: Option<PathBuf>,
+
+    /// Also write the auxiliary passes of the camera rays' first hits as layers of the
+    /// output EXR (give an .exr output): `albedo` (channels albedo.R/G/B, after
+    /// textures; mirrors and glass give their tint), `normal` (normal.X/Y/Z, world
+    /// space) and `depth` (depth.Z, distance along the camera ray, 0 where it
+    /// escapes), each averaged over the pixel's samples.
+    #[arg(
+        long,
+        value_name = "NAME,...",
+        value_parser = parse_aov_list,
+        conflicts_with = "compare_gamma"
+    )]
+    pub aov: Option<AovList>,
 
     /// Where and how to trace.
     #[command(flatten)]

@@ -35,7 +35,7 @@ use gpu_render::scene::{
 };
 use gpu_render::tiles::{Fingerprint, PixelWindow, Tile, TileInfo, tile_window};
 
-use crate::args::{AdapterArg, BackendArg, Cli, RenderArgs, SettingsArgs};
+use crate::args::{AdapterArg, AovList, BackendArg, Cli, RenderArgs, SettingsArgs};
 use crate::backend::{Backend, Frame, GpuOptions};
 use crate::memory::{BackendKind, Estimate};
 use crate::progress::Progress;
@@ -146,6 +146,17 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
             output_pattern.display()
         );
     }
+    if args.aov.is_some() && format != OutputFormat::Exr {
+        bail!(
+            "{}: --aov writes the passes as layers of an OpenEXR file, so the output must be an .exr (PNG and Radiance HDR hold no layers)",
+            output_pattern.display()
+        );
+    }
+    if args.aov.is_some() && piece {
+        bail!(
+            "--aov writes layers of a whole image's EXR; it cannot be used with --tile or --crop"
+        );
+    }
     if args.compare_gamma && piece {
         bail!("--compare-gamma renders two whole images side by side; it cannot be a tile");
     }
@@ -213,6 +224,7 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
         iteration_budget: args.device.iteration_budget,
         timeout: args.device.gpu_timeout,
         noise: standard_error_path.is_some(),
+        aov: args.aov.is_some(),
     };
     let backend = Backend::open(
         args.device.backend,
@@ -228,6 +240,7 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
         args.compare_gamma,
         window.as_ref(),
         standard_error_path.is_some(),
+        gpu_options.aov,
         args.max_memory,
     )?;
     let piece_name = window.as_ref().map(|window| match args.tile {
@@ -284,7 +297,16 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
             gpu_render::tiles::write_tile(&output_path, &tile)?;
             Written::default()
         }
-        None => output::write_image(&output_path, &rendered.image, &rendered.display_rgba8)?,
+        None => match (&args.aov, &rendered.aov) {
+            (Some(AovList(passes)), Some(aov)) => {
+                output::write_exr_with_passes(&output_path, &rendered.image, aov, passes)?;
+                Written::default()
+            }
+            (Some(_), None) => bail!("the backend returned no auxiliary passes"),
+            (None, _) => {
+                output::write_image(&output_path, &rendered.image, &rendered.display_rgba8)?
+            }
+        },
     };
     if let Some(path) = &standard_error_path {
         let noise = rendered
@@ -443,6 +465,7 @@ fn standard_error_path(
 }
 
 /// Refuses, before rendering, a render whose estimated peak memory is above the cap.
+#[allow(clippy::too_many_arguments)]
 fn check_memory(
     scene: &Scene,
     backend: &Backend,
@@ -450,6 +473,7 @@ fn check_memory(
     compare_gamma: bool,
     window: Option<&PixelWindow>,
     noise: bool,
+    aov: bool,
     max_memory_gib: f64,
 ) -> Result<()> {
     let kind = match backend {
@@ -462,6 +486,9 @@ fn check_memory(
     };
     if noise {
         estimate = estimate.with_noise_estimate(kind);
+    }
+    if aov {
+        estimate = estimate.with_aov();
     }
     let cap = max_memory_gib * f64::from(1u32 << 30);
     if estimate.total as f64 > cap {
