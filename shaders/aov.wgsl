@@ -2,7 +2,8 @@
 // tint of perfect specular surfaces), the shading normal facing the ray, and the
 // distance along the ray. Twin of src/cpu/aov.rs, where the conventions are set out.
 // The sums over a pixel's samples live in `accumulation` after the region's sample
-// sums, two vec4 per pixel: (albedo, depth) and (normal, 0).
+// sums, two vec4 per pixel: (albedo, depth) and (normal, samples counted), the count
+// telling a reader of a pass still in flight how many samples each pixel has.
 
 #import types
 #import bindings
@@ -70,11 +71,12 @@ fn clear_pixel_aov(pixel: u32) {
 // `trace`, to region pixel `pixel`'s sums (an escaped ray adds nothing):
 // trace_pixel_aov's sum, one sample at a time, in sample order.
 fn add_first_hit_aov(pixel: u32, origin: vec3<f32>, direction: vec3<f32>, trace: TraceRay) {
+    let at = aov_index(pixel);
     if trace.best_prim == NO_PRIM {
+        accumulation[at + 1u].w += 1.0;
         return;
     }
     let first = first_hit_aov(Ray(origin, direction), trace);
-    let at = aov_index(pixel);
     accumulation[at] += vec4<f32>(first.albedo, first.depth);
-    accumulation[at + 1u] += vec4<f32>(first.normal, 0.0);
+    accumulation[at + 1u] += vec4<f32>(first.normal, 1.0);
 }

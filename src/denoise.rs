@@ -61,6 +61,11 @@ const KERNEL: [f32; 5] = [1.0 / 16.0, 1.0 / 4.0, 3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.
 /// escaped ray, a black surface) and filtered as radiance.
 const MIN_ALBEDO: f32 = 1e-3;
 
+/// Variances above this (a pixel of fewer than two samples has an infinite one, see
+/// [`crate::noise::standard_error`]) are taken as this, which stops nothing: the
+/// filter then follows the geometry alone.
+pub const MAX_VARIANCE: f32 = 1e30;
+
 /// Denoises `radiance` (`width × height` linear RGB pixels) guided by `guides` and
 /// each pixel's `variance` (of its mean's luminance, the square of the noise
 /// estimate's standard error). Returns the filtered radiance; pixels whose variance
@@ -102,7 +107,7 @@ pub fn denoise(
     let mut var: Vec<f32> = variance
         .iter()
         .zip(&guides.albedo)
-        .map(|(&v, &a)| v / demodulation_scale(a).powi(2))
+        .map(|(&v, &a)| v.min(MAX_VARIANCE) / demodulation_scale(a).powi(2))
         .collect();
     for iteration in 0..settings.iterations {
         let step = 1i32 << iteration;
@@ -199,7 +204,9 @@ fn atrous_pass(
 }
 
 /// The edge-stopping weight of tap `q` for pixel `p` (SVGF eq. 3-6): normals, depth
-/// and luminance.
+/// and luminance; 1 for the pixel itself, so that every pixel keeps a weight however
+/// its guides stop the others. The normals' cosine is taken between their directions:
+/// a pixel's mean normal is shorter than 1 where its samples see several surfaces.
 #[allow(clippy::too_many_arguments)]
 fn edge_weight(
     p: usize,
@@ -211,7 +218,10 @@ fn edge_weight(
     settings: &DenoiseSettings,
     step: i32,
 ) -> f32 {
-    let (n_p, n_q) = (guides.normal[p], guides.normal[q]);
+    if p == q {
+        return 1.0;
+    }
+    let (n_p, n_q) = (unit_normal(guides.normal[p]), unit_normal(guides.normal[q]));
     let cosine = (n_p[0] * n_q[0] + n_p[1] * n_q[1] + n_p[2] * n_q[2]).max(0.0);
     // Escaped rays have no normal: they filter only with each other.
     let both_escaped = guides.depth[p] <= 0.0 && guides.depth[q] <= 0.0;
@@ -226,6 +236,16 @@ fn edge_weight(
     let l_q = luminance_f32(signal_q);
     let w_luminance = (-(l_p - l_q).abs() / (sigma_l + 1e-10)).exp();
     w_normal * w_depth * w_luminance
+}
+
+/// `n` scaled to unit length, or zero for a zero normal.
+fn unit_normal(n: [f32; 3]) -> [f32; 3] {
+    let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if length > 0.0 {
+        n.map(|c| c / length)
+    } else {
+        [0.0; 3]
+    }
 }
 
 /// The variance of pixel (x, y) blurred by a 3x3 Gaussian (SVGF section 4.4).

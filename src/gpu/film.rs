@@ -16,6 +16,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 
+use super::denoiser::DenoiseTargets;
 use super::gpu_scene::GpuScene;
 use super::layout::GpuCounters;
 use super::limits::{check_binding_bytes, check_film_size};
@@ -84,6 +85,8 @@ pub struct Film {
     requested_slots: Option<u32>,
     /// Whether the film keeps the auxiliary passes beside its sums.
     pub(crate) aov: bool,
+    /// The denoiser's buffers and image, made by its first use.
+    pub(crate) denoise: Option<DenoiseTargets>,
     /// The trace bind group and the scene it was built for.
     pub(crate) binding: Option<(u64, wgpu::BindGroup)>,
     /// `draw`'s bind group of the mean texture.
@@ -151,6 +154,7 @@ impl Film {
             stack_size,
             requested_slots,
             aov,
+            denoise: None,
             binding: None,
             draw_binding,
             generation: 0,
@@ -196,6 +200,13 @@ impl Film {
     /// recorded for scenes uploaded by one.
     pub fn keeps_aov(&self) -> bool {
         self.aov
+    }
+
+    /// The film's denoised image (`Rgba32Float`, `TEXTURE_BINDING | COPY_SRC`) as
+    /// [`super::Renderer::encode_denoise`] last wrote it; `None` before its first
+    /// call.
+    pub fn denoised_texture(&self) -> Option<&wgpu::Texture> {
+        self.denoise.as_ref().map(|targets| &targets.output)
     }
 
     /// Samples per pixel the host knows to be in the film (the GPU may be ahead).

@@ -476,6 +476,29 @@ pub struct GpuLight {
     pub _pad: u32,
 }
 
+/// Uniforms of one step of the denoiser (`DenoiseUniforms` in WGSL,
+/// `shaders/denoise.wgsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct DenoiseUniforms {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Tap spacing of an à-trous pass, `2^iteration` pixels.
+    pub step: u32,
+    /// Padding.
+    pub _pad: u32,
+    /// [`crate::denoise::DenoiseSettings::sigma_normal`].
+    pub sigma_normal: f32,
+    /// [`crate::denoise::DenoiseSettings::sigma_depth`].
+    pub sigma_depth: f32,
+    /// [`crate::denoise::DenoiseSettings::sigma_luminance`].
+    pub sigma_luminance: f32,
+    /// Padding.
+    pub _pad1: u32,
+}
+
 /// Uniforms of the display pass (`DisplayUniforms` in WGSL).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]

@@ -31,6 +31,7 @@
 
 pub mod area_lights;
 pub mod context;
+mod denoiser;
 mod display;
 mod draw;
 pub mod environment;
@@ -54,6 +55,7 @@ pub use context::{
     AdapterChoice, HeadlessGpu, adapter_listing, list_adapters, list_adapters_with_features,
     select_adapter,
 };
+pub use denoiser::MAX_DENOISE_ITERATIONS;
 pub use error::{RenderError, TraceFailure};
 pub use features::ShaderFeatures;
 pub use film::Film;

@@ -18,6 +18,7 @@
 
 use std::time::{Duration, Instant};
 
+use super::denoiser::DenoisePipelines;
 use super::draw::DrawPipelines;
 use super::film::Film;
 use super::gpu_scene::GpuScene;
@@ -30,6 +31,7 @@ use crate::accel::SceneGeometry;
 use crate::scene::{Camera, Scene, view_problem};
 
 mod blocking;
+mod denoising;
 mod frame_loop;
 
 pub use blocking::{RenderedImage, TraceRegion, image_tiles};
@@ -169,6 +171,8 @@ impl Default for RendererOptions {
 #[derive(Debug)]
 pub struct Renderer {
     pipelines: Pipelines,
+    /// The denoiser's kernels, with [`RendererOptions::aov`].
+    denoise: Option<DenoisePipelines>,
     draw: Option<DrawPipelines>,
     options: RendererOptions,
     schedule: Schedule,
@@ -190,9 +194,14 @@ impl Renderer {
             .surface_format
             .map(|format| DrawPipelines::new(device, format))
             .transpose()?;
+        let denoise = options
+            .aov
+            .then(|| DenoisePipelines::new(device, options.pipeline_cache.as_ref()))
+            .transpose()?;
         let adapter = device.adapter_info();
         Ok(Self {
             pipelines,
+            denoise,
             draw,
             schedule: options
                 .schedule

@@ -122,7 +122,7 @@ pub fn default_schedule(adapter: &wgpu::AdapterInfo) -> Schedule {
 /// Bytes of a pixel's sample sum and luminance m2 in the accumulation buffer.
 pub(crate) const SUM_BYTES_PER_PIXEL: u64 = 16;
 /// Bytes of a pixel's sums of the auxiliary passes after the sample sums (albedo and
-/// depth, normal: `shaders/aov.wgsl`).
+/// depth, normal and the samples counted: `shaders/aov.wgsl`).
 pub(crate) const AOV_BYTES_PER_PIXEL: u64 = 32;
 
 /// How long one submission of rounds should take.
@@ -143,7 +143,7 @@ pub(crate) struct SlotBuffers {
     ray_stack: wgpu::Buffer,
     traversal_stack: wgpu::Buffer,
     pub counters: wgpu::Buffer,
-    accumulation: wgpu::Buffer,
+    pub accumulation: wgpu::Buffer,
     readback: wgpu::Buffer,
     timestamps: Option<(wgpu::QuerySet, wgpu::Buffer)>,
 }

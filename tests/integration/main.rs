@@ -11,6 +11,7 @@ mod bxdf_gpu_twin;
 mod bxdf_plausibility;
 mod cli;
 mod corpus;
+mod denoise;
 mod display_pass;
 mod emissive_texture;
 mod environment;

@@ -383,6 +383,17 @@ const WITHOUT_RUST_TWIN: &[(&str, &[&str], &str)] = &[
          CPU sums them in the locals of trace_pixel_aov",
     ),
     (
+        "denoise",
+        &[
+            "tap_index",
+            "prepare_film_signal",
+            "demodulate_signal",
+            "remodulate_signal",
+        ],
+        "the kernels of the steps src/denoise.rs runs in one call over whole images \
+         (denoise's loops), and a film's sums read as its input",
+    ),
+    (
         "intersect",
         &["prim_kind", "prim_index"],
         "PrimRef::kind and PrimRef::index (src/accel/geometry.rs), on the bit layout \
