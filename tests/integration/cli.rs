@@ -389,6 +389,89 @@ fn aov_refuses_unknown_passes_outputs_without_layers_and_tiles() {
     ws.assert_old_output_kept();
 }
 
+/// The mean absolute difference between horizontal neighbours of the channel.
+fn roughness(channel: &[f32], width: usize) -> f64 {
+    let mut sum = 0.0;
+    let mut count = 0;
+    for (i, pair) in channel.windows(2).enumerate() {
+        if (i + 1) % width != 0 {
+            sum += f64::from((pair[1] - pair[0]).abs());
+            count += 1;
+        }
+    }
+    sum / f64::from(count)
+}
+
+#[test]
+fn denoise_smooths_a_path_traced_image_alike_on_both_backends() {
+    let ws = Workspace::new(TINY_SCENE);
+    let cornell = shipped_path("scenes/cornell-box.toml");
+    let mut images = Vec::new();
+    for (name, backend, denoise) in [
+        ("raw.exr", "cpu", false),
+        ("cpu.exr", "cpu", true),
+        ("gpu.exr", "gpu", true),
+    ] {
+        let mut args = vec![
+            cornell.clone(),
+            "-o".into(),
+            ws.arg(name),
+            "--backend".into(),
+            backend.into(),
+            "--width".into(),
+            "48".into(),
+            "--height".into(),
+            "48".into(),
+            "--spp".into(),
+            "4".into(),
+            "--quiet".into(),
+        ];
+        if denoise {
+            args.push("--denoise".into());
+        }
+        let run = gpu_render(&args);
+        assert_eq!(run.status, Some(0), "{name}: stderr:\n{}", run.stderr);
+        images.push(read_exr_channels(&ws.path(name)));
+    }
+    let (raw, cpu, gpu) = (&images[0]["G"], &images[1]["G"], &images[2]["G"]);
+    let (raw_roughness, denoised_roughness) = (roughness(raw, 48), roughness(cpu, 48));
+    assert!(
+        denoised_roughness < raw_roughness / 2.0,
+        "neighbour differences {raw_roughness:.4} raw, {denoised_roughness:.4} denoised"
+    );
+    // The backends' samples differ in a few paths (f32 against f64): their denoised
+    // images agree on average.
+    let mean = |v: &[f32]| v.iter().map(|&x| f64::from(x)).sum::<f64>() / v.len() as f64;
+    let difference = cpu
+        .iter()
+        .zip(gpu)
+        .map(|(a, b)| f64::from((a - b).abs()))
+        .sum::<f64>()
+        / cpu.len() as f64;
+    assert!(
+        difference < 0.02 * mean(cpu),
+        "mean |CPU - GPU| {difference:.4} against a mean of {:.4}",
+        mean(cpu)
+    );
+}
+
+#[test]
+fn denoise_refuses_the_whitted_integrator_and_tiles() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[&ws.arg("scene.toml"), "-o", &ws.arg("out.png"), "--denoise"]);
+    assert_fails_with(&run, &["scene.toml", "--denoise", "Whitted", "path"]);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("tile.exr"),
+        "--crop",
+        "0,0,4,4",
+        "--denoise",
+    ]);
+    assert_fails_with(&run, &["--denoise", "--tile or --crop"]);
+    ws.assert_old_output_kept();
+}
+
 #[test]
 fn compare_gamma_is_twice_as_wide() {
     let ws = Workspace::new(TINY_SCENE);

@@ -481,6 +481,13 @@ pub struct RenderArgs {
     )]
     pub aov: Option<AovList>,
 
+    /// Denoise the image with the built-in edge-avoiding à-trous filter, guided by the
+    /// first-hit albedo, normal and depth and by each pixel's noise estimate (on the
+    /// backend that renders). For the path integrator: Whitted images have no noise
+    /// to remove, and are refused.
+    #[arg(long, conflicts_with = "compare_gamma")]
+    pub denoise: bool,
+
     /// Where and how to trace.
     #[command(flatten)]
     pub device: DeviceArgs,

@@ -4,7 +4,7 @@ use std::io::Write;
 
 use anyhow::{Context, Result, bail};
 use gpu_render::cpu;
-use gpu_render::denoise::GuidePasses;
+use gpu_render::denoise::{self, DenoiseSettings, GuidePasses};
 use gpu_render::film::{LinearImage, ProgressFn, RenderStats, Rendered};
 use gpu_render::gpu::unrolled::MAX_UNROLLED_PRIMITIVES;
 use gpu_render::gpu::{self, AdapterChoice, HeadlessGpu, Renderer, RendererOptions, TraceRegion};
@@ -253,6 +253,42 @@ impl Backend {
                     Some(progress),
                 )?;
                 Ok(Frame::from_cpu(rendered, scene))
+            }
+        }
+    }
+
+    /// The image of `frame` (rendered with noise estimate and auxiliary passes)
+    /// denoised by the built-in filter, on the GPU where `frame` was rendered there.
+    pub fn denoise(&self, frame: &Frame) -> Result<LinearImage> {
+        let (Some(noise), Some(guides)) = (&frame.noise, &frame.aov) else {
+            bail!("the backend returned no noise estimate or auxiliary passes to denoise with");
+        };
+        let variance: Vec<f32> = noise.standard_error.iter().map(|se| se * se).collect();
+        let settings = DenoiseSettings::default();
+        match self {
+            Backend::Gpu { gpu, renderer, .. } => renderer
+                .denoise_image(
+                    &gpu.device,
+                    &gpu.queue,
+                    &frame.image,
+                    &variance,
+                    guides,
+                    &settings,
+                )
+                .context("GPU denoising failed"),
+            Backend::Cpu { .. } => {
+                let radiance: Vec<[f32; 3]> = frame
+                    .image
+                    .pixels
+                    .iter()
+                    .map(|p| [p[0], p[1], p[2]])
+                    .collect();
+                let denoised = denoise::denoise(&radiance, &variance, guides, &settings);
+                Ok(LinearImage {
+                    width: frame.image.width,
+                    height: frame.image.height,
+                    pixels: denoised.iter().map(|p| [p[0], p[1], p[2], 1.0]).collect(),
+                })
             }
         }
     }

@@ -31,7 +31,8 @@ use anyhow::{Context, Result, anyhow, bail};
 use clap::{CommandFactory, Parser, error::ErrorKind};
 use gpu_render::output::{self, HDR_MAX, OutputFormat, Written};
 use gpu_render::scene::{
-    self, LightingSpace, LoadOptions, LoadProgress, RenderSettings, Scene, SceneFile, SceneWarning,
+    self, Integrator, LightingSpace, LoadOptions, LoadProgress, RenderSettings, Scene, SceneFile,
+    SceneWarning,
 };
 use gpu_render::tiles::{Fingerprint, PixelWindow, Tile, TileInfo, tile_window};
 
@@ -152,6 +153,9 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
             output_pattern.display()
         );
     }
+    if args.denoise && piece {
+        bail!("--denoise filters a whole image; it cannot be used with --tile or --crop");
+    }
     if args.aov.is_some() && piece {
         bail!(
             "--aov writes layers of a whole image's EXR; it cannot be used with --tile or --crop"
@@ -218,13 +222,19 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
         .map(|pattern| standard_error_path(pattern, frame, tile, &output_path, scene_path, &scene))
         .transpose()?;
     check_inputs_survive(&output_path, scene_path, &scene)?;
+    if args.denoise && scene.render.integrator == Integrator::Whitted {
+        bail!(
+            "{}: --denoise removes the noise of path tracing, and the scene uses the Whitted integrator, whose images have none; render with integrator = \"path\" (or --integrator path), or without --denoise",
+            scene_path.display()
+        );
+    }
     let window = piece_window(args, &scene.render)?;
 
     let gpu_options = GpuOptions {
         iteration_budget: args.device.iteration_budget,
         timeout: args.device.gpu_timeout,
-        noise: standard_error_path.is_some(),
-        aov: args.aov.is_some(),
+        noise: standard_error_path.is_some() || args.denoise,
+        aov: args.aov.is_some() || args.denoise,
     };
     let backend = Backend::open(
         args.device.backend,
@@ -239,7 +249,7 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
         format,
         args.compare_gamma,
         window.as_ref(),
-        standard_error_path.is_some(),
+        gpu_options.noise,
         gpu_options.aov,
         args.max_memory,
     )?;
@@ -269,6 +279,12 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
     } else {
         render_pass(&backend, &scene, None, args.quiet)?
     };
+    let mut rendered = rendered;
+    if args.denoise {
+        let denoised = backend.denoise(&rendered)?;
+        rendered.display_rgba8 = denoised.to_display_rgba8(scene.display_encodes_srgb());
+        rendered.image = denoised;
+    }
     let wall = started.elapsed();
     backend.save_pipeline_cache(args.quiet);
 
@@ -328,7 +344,12 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
             compile: rendered.compile,
             stats: rendered.stats,
             output: &output_path,
-            noise: rendered.noise.as_ref(),
+            // The raw image's noise, shown only where asked for (--standard-error):
+            // --denoise takes it too, and its image has less.
+            noise: rendered
+                .noise
+                .as_ref()
+                .filter(|_| standard_error_path.is_some()),
         };
         eprintln!("{summary}");
     }
