@@ -89,7 +89,7 @@ fn unit_normal(n: vec3<f32>) -> vec3<f32> {
 }
 
 // The edge-stopping weight of tap q for pixel p (SVGF eq. 3-6): normals (their
-// directions), depth and luminance; 1 for the pixel itself. Twin of edge_weight.
+// directions), depth and luminance, and albedo; 1 for the pixel itself. Twin of edge_weight.
 fn edge_weight(p: u32, q: u32, l_p: f32, signal_q: vec3<f32>, sigma_l: f32, step: i32) -> f32 {
     if p == q {
         return 1.0;
@@ -108,7 +108,11 @@ fn edge_weight(p: u32, q: u32, l_p: f32, signal_q: vec3<f32>, sigma_l: f32, step
     let w_depth = exp(-abs(z_p - z_q) / scale);
     let l_q = luminance(signal_q);
     let w_luminance = exp(-abs(l_p - l_q) / (sigma_l + 1e-10));
-    return w_normal * w_depth * w_luminance;
+    let a_p = guides[2u * p].xyz;
+    let a_q = guides[2u * q].xyz;
+    let albedo_difference = (abs(a_p.x - a_q.x) + abs(a_p.y - a_q.y) + abs(a_p.z - a_q.z)) / 3.0;
+    let w_albedo = exp(-albedo_difference / params.sigma_albedo);
+    return w_normal * w_depth * w_luminance * w_albedo;
 }
 
 // A film's pixel as the filter's input: its mean radiance, the variance of its mean's

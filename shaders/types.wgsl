@@ -58,7 +58,7 @@ struct DenoiseUniforms {
     sigma_normal: f32,
     sigma_depth: f32,
     sigma_luminance: f32,
-    _pad1: u32,
+    sigma_albedo: f32,
 }
 
 // A sphere through its anchor (its point nearest the origin) with the outward normal

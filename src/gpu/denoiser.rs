@@ -209,7 +209,7 @@ pub(crate) fn encode_filter(
             sigma_normal: settings.sigma_normal,
             sigma_depth: settings.sigma_depth,
             sigma_luminance: settings.sigma_luminance,
-            _pad1: 0,
+            sigma_albedo: settings.sigma_albedo,
         };
         queue.write_buffer(
             &targets.uniforms,

@@ -495,8 +495,8 @@ pub struct DenoiseUniforms {
     pub sigma_depth: f32,
     /// [`crate::denoise::DenoiseSettings::sigma_luminance`].
     pub sigma_luminance: f32,
-    /// Padding.
-    pub _pad1: u32,
+    /// [`crate::denoise::DenoiseSettings::sigma_albedo`].
+    pub sigma_albedo: f32,
 }
 
 /// Uniforms of the display pass (`DisplayUniforms` in WGSL).

@@ -180,7 +180,7 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 sigma_normal,
                 sigma_depth,
                 sigma_luminance,
-                _pad1,
+                sigma_albedo,
             }),
         ),
         (
