@@ -132,10 +132,17 @@ pub(crate) struct DenoiseTargets {
     pub signals: [wgpu::Buffer; 2],
     pub output: wgpu::Texture,
     pub output_view: wgpu::TextureView,
+    /// `draw`'s bind group of the denoised image, with a draw layout.
+    pub draw_binding: Option<wgpu::BindGroup>,
 }
 
 impl DenoiseTargets {
-    pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Result<Self, RenderError> {
+    pub fn new(
+        device: &wgpu::Device,
+        width: u32,
+        height: u32,
+        draw_layout: Option<&wgpu::BindGroupLayout>,
+    ) -> Result<Self, RenderError> {
         let pixels = u64::from(width) * u64::from(height);
         let output = create_texture(
             device,
@@ -155,6 +162,17 @@ impl DenoiseTargets {
                 mapped_at_creation: false,
             })
         };
+        let output_view = output.create_view(&wgpu::TextureViewDescriptor::default());
+        let draw_binding = draw_layout.map(|layout| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("gpu-render denoised draw bind group"),
+                layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&output_view),
+                }],
+            })
+        });
         capture(device, "denoise buffers", Caught::Resource, || Self {
             width,
             height,
@@ -169,8 +187,9 @@ impl DenoiseTargets {
                 storage("gpu-render denoise signal A", pixels * 16),
                 storage("gpu-render denoise signal B", pixels * 16),
             ],
-            output_view: output.create_view(&wgpu::TextureViewDescriptor::default()),
+            output_view,
             output,
+            draw_binding,
         })
     }
 }

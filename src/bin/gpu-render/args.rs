@@ -319,6 +319,13 @@ pub struct ViewArgs {
     )]
     pub scale: f64,
 
+    /// Show the film denoised by the built-in à-trous filter (guided by the first-hit
+    /// albedo, normal and depth the trace then records, and the noise estimate); the
+    /// D key switches between the denoised and the raw film. The samples accumulate
+    /// the same either way.
+    #[arg(long)]
+    pub denoise: bool,
+
     /// The GPU adapter to show the window with: an index from the list the viewer
     /// prints when this does not match, or part of an adapter's name.
     #[arg(long, value_name = "INDEX|NAME", value_parser = parse_view_adapter)]

@@ -43,7 +43,12 @@ impl Renderer {
             return Err(RenderError::NoAov);
         }
         if film.denoise.is_none() {
-            film.denoise = Some(DenoiseTargets::new(device, film.width(), film.height())?);
+            film.denoise = Some(DenoiseTargets::new(
+                device,
+                film.width(),
+                film.height(),
+                self.draw_layout(),
+            )?);
         }
         let Some(targets) = &film.denoise else {
             return Ok(());
@@ -90,6 +95,31 @@ impl Renderer {
             target,
             scene.display_encodes_srgb(),
         )
+    }
+
+    /// [`Renderer::draw`] of the film's denoised image as [`Renderer::encode_denoise`]
+    /// last recorded it (the film itself before the first call): what a viewer draws
+    /// with its denoiser on. Records only.
+    ///
+    /// Errors: [`RenderError::NoSurfaceFormat`] for a renderer built without one.
+    pub fn draw_denoised(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        scene: &GpuScene,
+        film: &Film,
+    ) -> Result<(), RenderError> {
+        let (Some(draw), Some(bind_group)) = (
+            &self.draw,
+            film.denoise
+                .as_ref()
+                .and_then(|targets| targets.draw_binding.as_ref()),
+        ) else {
+            return self.draw(pass, scene, film);
+        };
+        pass.set_pipeline(draw.pipeline(scene.display_encodes_srgb()));
+        pass.set_bind_group(0, bind_group, &[]);
+        pass.draw(0..3, 0..1);
+        Ok(())
     }
 
     /// Waits for every sample asked of `film` ([`Renderer::finish`]), denoises it
@@ -150,7 +180,7 @@ impl Renderer {
                 && guides.depth.len() == pixels,
             "the image, its variance and its guides differ in size"
         );
-        let targets = DenoiseTargets::new(device, image.width, image.height)?;
+        let targets = DenoiseTargets::new(device, image.width, image.height, None)?;
         let signal: Vec<[f32; 4]> = image
             .pixels
             .iter()
