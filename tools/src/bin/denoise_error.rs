@@ -13,7 +13,9 @@
 //! own relative MSE against the exact image (from its estimated variance) is printed
 //! beside. Relative MSE: the mean over pixels and channels of `(x - r)² / (r² + 0.01)`
 //! (Rousselle, Knaus and Zwicker 2012, as SVGF's evaluation uses it), which keeps dark
-//! pixels from dominating.
+//! pixels from dominating. With `DENOISE_ERROR_WORST` set it also prints, for each spp,
+//! the eight pixels of largest denoised error with their guides (how the albedo edge
+//! stop's need was found).
 
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::Instant;
