@@ -44,6 +44,22 @@ const FLAG_STORE_SUM: u32 = 1u;
 // FrameUniforms.flags, for tests: traversals leave their loop early without reaching
 // an exit, as a driver that cuts loops makes them do.
 const FLAG_SIMULATE_LOOP_CUT: u32 = 2u;
+// FrameUniforms.flags: also sum each pixel's auxiliary passes (aov.wgsl) in
+// `accumulation`, after the sample sums (bit 4 is path_types.wgsl's FLAG_PATH).
+const FLAG_AOV: u32 = 8u;
+
+// Uniforms of one step of the denoiser (denoise.wgsl): the image size, the tap
+// spacing of an à-trous pass, and the edge-stopping settings (DenoiseSettings).
+struct DenoiseUniforms {
+    width: u32,
+    height: u32,
+    step: u32,
+    _pad: u32,
+    sigma_normal: f32,
+    sigma_depth: f32,
+    sigma_luminance: f32,
+    sigma_albedo: f32,
+}
 
 // A sphere through its anchor (its point nearest the origin) with the outward normal
 // there: see src/scene/sphere.rs.

@@ -36,6 +36,9 @@
 //#if PATH
 #import path
 //#endif
+//#if AOV
+#import aov
+//#endif
 
 //#if PATH
 // Whether this trace uses the path integrator.
@@ -47,6 +50,12 @@ fn path_mode() -> bool {
 // Shades the finished closest-hit trace of the path's current ray with the trace's
 // integrator.
 fn consume_closest_trace(slot: u32, path: ptr<function, PathState>, trace: TraceRay) {
+    //#if AOV
+    // Depth 0 is the camera ray: every branch and bounce is one deeper.
+    if aov_mode() && (*path).depth == 0u {
+        add_first_hit_aov((*path).pixel, (*path).origin, (*path).direction, trace);
+    }
+    //#endif
     //#if PATH
     if path_mode() {
         path_closest_hit(path, trace);
@@ -201,6 +210,11 @@ fn fetch_pixel(slot: u32, path: ptr<function, PathState>) {
         (*path).pixel_sum = sums.xyz;
         (*path).luminance_m2 = sums.w;
     }
+    //#if AOV
+    if aov_mode() && frame.first_sample == 0u {
+        clear_pixel_aov(pixel);
+    }
+    //#endif
     (*path).phase = PHASE_START_SAMPLE;
 }
 

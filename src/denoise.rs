@@ -41,6 +41,11 @@ pub struct DenoiseSettings {
     /// Luminance difference, in standard deviations of the pixel's noise, that weighs
     /// `e^-1` (SVGF: 4).
     pub sigma_luminance: f32,
+    /// Albedo difference (the mean of the channels' absolute differences) that weighs
+    /// `e^-1`. SVGF has no albedo stop, only demodulation; without it an emitter
+    /// (albedo 0, no noise) and the wall around it (same normal and depth) blurred
+    /// into each other on the Cornell box (`BENCHMARKS.md`, "Denoiser").
+    pub sigma_albedo: f32,
 }
 
 impl Default for DenoiseSettings {
@@ -50,6 +55,7 @@ impl Default for DenoiseSettings {
             sigma_normal: 128.0,
             sigma_depth: 0.1,
             sigma_luminance: 4.0,
+            sigma_albedo: 0.1,
         }
     }
 }
@@ -60,6 +66,11 @@ const KERNEL: [f32; 5] = [1.0 / 16.0, 1.0 / 4.0, 3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.
 /// Smallest albedo a pixel is demodulated by; darker albedos are kept as they are (an
 /// escaped ray, a black surface) and filtered as radiance.
 const MIN_ALBEDO: f32 = 1e-3;
+
+/// Variances above this (a pixel of fewer than two samples has an infinite one, see
+/// [`crate::noise::standard_error`]) are taken as this, which stops nothing: the
+/// filter then follows the geometry alone.
+pub const MAX_VARIANCE: f32 = 1e30;
 
 /// Denoises `radiance` (`width × height` linear RGB pixels) guided by `guides` and
 /// each pixel's `variance` (of its mean's luminance, the square of the noise
@@ -102,7 +113,7 @@ pub fn denoise(
     let mut var: Vec<f32> = variance
         .iter()
         .zip(&guides.albedo)
-        .map(|(&v, &a)| v / demodulation_scale(a).powi(2))
+        .map(|(&v, &a)| v.min(MAX_VARIANCE) / demodulation_scale(a).powi(2))
         .collect();
     for iteration in 0..settings.iterations {
         let step = 1i32 << iteration;
@@ -199,7 +210,9 @@ fn atrous_pass(
 }
 
 /// The edge-stopping weight of tap `q` for pixel `p` (SVGF eq. 3-6): normals, depth
-/// and luminance.
+/// and luminance, and albedo; 1 for the pixel itself, so that every pixel keeps a weight however
+/// its guides stop the others. The normals' cosine is taken between their directions:
+/// a pixel's mean normal is shorter than 1 where its samples see several surfaces.
 #[allow(clippy::too_many_arguments)]
 fn edge_weight(
     p: usize,
@@ -211,7 +224,10 @@ fn edge_weight(
     settings: &DenoiseSettings,
     step: i32,
 ) -> f32 {
-    let (n_p, n_q) = (guides.normal[p], guides.normal[q]);
+    if p == q {
+        return 1.0;
+    }
+    let (n_p, n_q) = (unit_normal(guides.normal[p]), unit_normal(guides.normal[q]));
     let cosine = (n_p[0] * n_q[0] + n_p[1] * n_q[1] + n_p[2] * n_q[2]).max(0.0);
     // Escaped rays have no normal: they filter only with each other.
     let both_escaped = guides.depth[p] <= 0.0 && guides.depth[q] <= 0.0;
@@ -225,7 +241,21 @@ fn edge_weight(
     let w_depth = (-(z_p - z_q).abs() / scale).exp();
     let l_q = luminance_f32(signal_q);
     let w_luminance = (-(l_p - l_q).abs() / (sigma_l + 1e-10)).exp();
-    w_normal * w_depth * w_luminance
+    let (a_p, a_q) = (guides.albedo[p], guides.albedo[q]);
+    let albedo_difference =
+        ((a_p[0] - a_q[0]).abs() + (a_p[1] - a_q[1]).abs() + (a_p[2] - a_q[2]).abs()) / 3.0;
+    let w_albedo = (-albedo_difference / settings.sigma_albedo).exp();
+    w_normal * w_depth * w_luminance * w_albedo
+}
+
+/// `n` scaled to unit length, or zero for a zero normal.
+fn unit_normal(n: [f32; 3]) -> [f32; 3] {
+    let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if length > 0.0 {
+        n.map(|c| c / length)
+    } else {
+        [0.0; 3]
+    }
 }
 
 /// The variance of pixel (x, y) blurred by a 3x3 Gaussian (SVGF section 4.4).
@@ -360,6 +390,48 @@ mod tests {
                 "pixel {i}: {} for {light}",
                 pixel[0]
             );
+        }
+    }
+
+    #[test]
+    fn an_emitter_does_not_bleed_into_the_wall_around_it() {
+        // The Cornell box's light in its ceiling: the same normal and depth, the light
+        // of albedo 0 and radiance 17 without noise, the ceiling of albedo 0.73 and
+        // radiance 0.1 with noise, its edge pixels' variance large.
+        let (w, h) = (24u32, 8u32);
+        let n = (w * h) as usize;
+        let mut guides = flat_guides(w, h);
+        let mut image = Vec::with_capacity(n);
+        let mut variance = Vec::with_capacity(n);
+        for i in 0..n {
+            let x = i as u32 % w;
+            let light = x < w / 2;
+            guides.albedo[i] = if light { [0.0; 3] } else { [0.73; 3] };
+            image.push(if light {
+                [17.0; 3]
+            } else {
+                [0.1 * (1.0 + (noise(i) - 0.5)); 3]
+            });
+            variance.push(if light {
+                0.0
+            } else if x == w / 2 {
+                10.0
+            } else {
+                1e-3
+            });
+        }
+        let out = denoise(&image, &variance, &guides, &DenoiseSettings::default());
+        for (i, pixel) in out.iter().enumerate() {
+            let light = (i as u32 % w) < w / 2;
+            if light {
+                assert!(
+                    (pixel[0] - 17.0).abs() < 0.2,
+                    "light pixel {i}: {}",
+                    pixel[0]
+                );
+            } else {
+                assert!(pixel[0] < 0.2, "wall pixel {i}: {}", pixel[0]);
+            }
         }
     }
 }

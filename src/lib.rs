@@ -22,7 +22,8 @@
 //! Beside the layers, using them:
 //!
 //! - [`denoise`]: the edge-avoiding à-trous denoiser guided by albedo, normal, depth
-//!   and variance (CPU twin of the GPU filter).
+//!   and variance (CPU twin of the GPU filter, `shaders/denoise.wgsl`); the guides are
+//!   the auxiliary passes of `cpu::aov` and of the GPU's `shaders/aov.wgsl`.
 //! - [`echo`]: text and numbers read from files, as messages quote them (control
 //!   characters escaped, long text cut, numbers short).
 //! - [`input`]: opening the files a render reads (regular files only, confined in a

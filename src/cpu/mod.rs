@@ -5,6 +5,7 @@
 //! computes in `f64` so that its own rounding error is negligible next to the GPU's
 //! `f32`: the difference between the two images is then the GPU's error budget.
 
+pub mod aov;
 pub mod bxdf;
 pub mod intersect;
 pub mod path;

@@ -113,6 +113,13 @@ pub enum RenderError {
     /// [`super::Renderer::draw`] on a renderer built without a `surface_format`.
     #[error("draw needs RendererOptions::surface_format")]
     NoSurfaceFormat,
+    /// The auxiliary passes (or the denoiser they guide) asked of a film or scene made
+    /// by a renderer without [`super::RendererOptions::aov`].
+    #[error(
+        "the auxiliary passes need RendererOptions::aov for the renderer that made the film \
+         and uploaded the scene"
+    )]
+    NoAov,
     /// A film whose bounce stacks are smaller than the scene's `stack_size` (create a
     /// film for that scene).
     #[error("the film's bounce stacks hold {film} entries, the scene needs {scene}")]

@@ -50,6 +50,11 @@ pub struct ShaderFeatures {
     /// An environment map as the background and, for the path integrator, a light
     /// (`ENVIRONMENT_MAP`, `shaders/environment.wgsl`).
     pub environment_map: bool,
+    /// The auxiliary passes of the camera rays' first hits (`AOV`,
+    /// `shaders/aov.wgsl`): chosen at upload ([`super::RendererOptions::aov`]), never
+    /// by [`ShaderFeatures::for_scene`]; a module with it records them only when the
+    /// trace's flags ask for it. The image does not depend on it.
+    pub aov: bool,
     /// The records every traversal step reads (BVH nodes and primitive references,
     /// spheres, polygons and their points, triangles, materials, lights) are uniform
     /// arrays of a fixed length rather than storage buffers: chosen at upload for
@@ -91,6 +96,7 @@ impl ShaderFeatures {
         instances: true,
         path: true,
         environment_map: true,
+        aov: true,
         uniform_records: false,
         refill_lanes: false,
         unrolled: None,
@@ -131,6 +137,7 @@ impl ShaderFeatures {
             instances: crate::accel::instance::has_instances(&scene.meshes),
             path: scene.render.integrator == crate::scene::Integrator::Path,
             environment_map: scene.environment.map.is_some(),
+            aov: false,
             uniform_records: false,
             refill_lanes: false,
             unrolled: None,
@@ -167,7 +174,7 @@ impl ShaderFeatures {
 type FeatureFlag = fn(&ShaderFeatures) -> bool;
 
 /// The name of each feature in the WGSL directives, with the flag it reads.
-const FEATURE_NAMES: [(&str, FeatureFlag); 17] = [
+const FEATURE_NAMES: [(&str, FeatureFlag); 18] = [
     ("SPHERES", |f| f.spheres),
     ("PLANES", |f| f.planes),
     ("POLYGONS", |f| f.polygons),
@@ -183,6 +190,7 @@ const FEATURE_NAMES: [(&str, FeatureFlag); 17] = [
     ("INSTANCES", |f| f.instances),
     ("PATH", |f| f.path),
     ("ENVIRONMENT_MAP", |f| f.environment_map),
+    ("AOV", |f| f.aov),
     ("REFILL_LANES", |f| f.refill_lanes),
     ("UNROLLED", |f| f.unrolled.is_some()),
 ];

@@ -16,12 +16,13 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 
+use super::denoiser::DenoiseTargets;
 use super::gpu_scene::GpuScene;
 use super::layout::GpuCounters;
 use super::limits::{check_binding_bytes, check_film_size};
 use super::pipelines::LINEAR_FORMAT;
 use super::readback::{Caught, capture, create_texture};
-use super::wavefront::{SlotBuffers, check_errors};
+use super::wavefront::{AOV_BYTES_PER_PIXEL, SUM_BYTES_PER_PIXEL, SlotBuffers, check_errors};
 use super::{RenderError, Renderer};
 
 /// Readback buffers a film keeps (made with it); with all of them in flight, a call
@@ -82,6 +83,10 @@ pub struct Film {
     pub(crate) slot_count: u32,
     pub(crate) stack_size: u32,
     requested_slots: Option<u32>,
+    /// Whether the film keeps the auxiliary passes beside its sums.
+    pub(crate) aov: bool,
+    /// The denoiser's buffers and image, made by its first use.
+    pub(crate) denoise: Option<DenoiseTargets>,
     /// The trace bind group and the scene it was built for.
     pub(crate) binding: Option<(u64, wgpu::BindGroup)>,
     /// `draw`'s bind group of the mean texture.
@@ -107,15 +112,17 @@ impl Film {
         draw_layout: Option<&wgpu::BindGroupLayout>,
         requested_slots: Option<u32>,
         stack_size: u32,
+        aov: bool,
         width: u32,
         height: u32,
     ) -> Result<Self, RenderError> {
         let limits = device.limits();
         check_film_size(&limits, width.max(1), height.max(1))?;
         let pixels = u64::from(width.max(1)) * u64::from(height.max(1));
-        check_binding_bytes(&limits, pixels * 16)?;
+        let per_pixel = SUM_BYTES_PER_PIXEL + u64::from(aov) * AOV_BYTES_PER_PIXEL;
+        check_binding_bytes(&limits, pixels * per_pixel)?;
         let slot_count = SlotBuffers::slot_count(device, requested_slots, pixels, stack_size);
-        let slots = SlotBuffers::new(device, slot_count, stack_size, pixels)?;
+        let slots = SlotBuffers::new(device, slot_count, stack_size, pixels, aov)?;
         let texture = create_texture(
             device,
             "gpu-render film",
@@ -146,6 +153,8 @@ impl Film {
             slot_count,
             stack_size,
             requested_slots,
+            aov,
+            denoise: None,
             binding: None,
             draw_binding,
             generation: 0,
@@ -184,6 +193,20 @@ impl Film {
     /// A view of [`Film::texture`].
     pub fn view(&self) -> &wgpu::TextureView {
         &self.view
+    }
+
+    /// Whether the film keeps the auxiliary passes (albedo, normal, depth) beside its
+    /// sums: made by a renderer with [`super::RendererOptions::aov`]; they are
+    /// recorded for scenes uploaded by one.
+    pub fn keeps_aov(&self) -> bool {
+        self.aov
+    }
+
+    /// The film's denoised image (`Rgba32Float`, `TEXTURE_BINDING | COPY_SRC`) as
+    /// [`super::Renderer::encode_denoise`] last wrote it; `None` before its first
+    /// call.
+    pub fn denoised_texture(&self) -> Option<&wgpu::Texture> {
+        self.denoise.as_ref().map(|targets| &targets.output)
     }
 
     /// Samples per pixel the host knows to be in the film (the GPU may be ahead).
@@ -244,6 +267,7 @@ impl Film {
             renderer.draw_layout(),
             self.requested_slots,
             self.stack_size,
+            self.aov,
             width,
             height,
         )?;

@@ -114,6 +114,10 @@ pub const FLAG_STORE_SUM: u32 = 1;
 /// `FrameUniforms.flags`, for tests: traversals leave their loop without reaching an
 /// exit, as a driver that cuts loops makes them do.
 pub const FLAG_SIMULATE_LOOP_CUT: u32 = 2;
+/// `FrameUniforms::flags`: also sum each pixel's auxiliary passes (albedo and depth,
+/// normal: two `vec4<f32>` per pixel, `shaders/aov.wgsl`) in the accumulation buffer,
+/// after the sample sums; only modules with [`super::ShaderFeatures::aov`] do.
+pub const FLAG_AOV: u32 = 8;
 
 /// One traversal of one ray, resumable (`TraceRay` in WGSL). Only the shaders read and
 /// write it; the host zeroes it (`TRACE_IDLE`).
@@ -470,6 +474,29 @@ pub struct GpuLight {
     pub power: [f32; 3],
     /// Padding.
     pub _pad: u32,
+}
+
+/// Uniforms of one step of the denoiser (`DenoiseUniforms` in WGSL,
+/// `shaders/denoise.wgsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct DenoiseUniforms {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Tap spacing of an à-trous pass, `2^iteration` pixels.
+    pub step: u32,
+    /// Padding.
+    pub _pad: u32,
+    /// [`crate::denoise::DenoiseSettings::sigma_normal`].
+    pub sigma_normal: f32,
+    /// [`crate::denoise::DenoiseSettings::sigma_depth`].
+    pub sigma_depth: f32,
+    /// [`crate::denoise::DenoiseSettings::sigma_luminance`].
+    pub sigma_luminance: f32,
+    /// [`crate::denoise::DenoiseSettings::sigma_albedo`].
+    pub sigma_albedo: f32,
 }
 
 /// Uniforms of the display pass (`DisplayUniforms` in WGSL).

@@ -32,6 +32,7 @@
 pub(crate) mod area_lights;
 mod context;
 pub(crate) mod cpu_device;
+mod denoiser;
 mod display;
 mod draw;
 pub(crate) mod environment;
@@ -49,10 +50,14 @@ pub(crate) mod shaders;
 pub(crate) mod upload;
 mod wavefront;
 
+/// The denoiser's settings and the auxiliary passes that guide it, which the frame
+/// loop's denoising calls take and return (the filter itself: `low_level::denoise`).
+pub use crate::denoise::{DenoiseSettings, GuidePasses};
 pub use context::{
     AdapterChoice, HeadlessGpu, adapter_listing, list_adapters, list_adapters_with_features,
     select_adapter,
 };
+pub use denoiser::MAX_DENOISE_ITERATIONS;
 pub use error::{RenderError, TraceFailure};
 pub use features::ShaderFeatures;
 pub use film::Film;

@@ -367,7 +367,7 @@ impl Pipelines {
 /// Creates one shader module and a compute pipeline per entry point inside error
 /// scopes, so that WGSL or pipeline errors come back as [`RenderError::Shader`] instead of
 /// panicking.
-fn build_pipelines(
+pub(crate) fn build_pipelines(
     device: &wgpu::Device,
     name: &str,
     source: String,

@@ -18,6 +18,7 @@
 
 use std::time::{Duration, Instant};
 
+use super::denoiser::DenoisePipelines;
 use super::draw::DrawPipelines;
 use super::film::Film;
 use super::gpu_scene::GpuScene;
@@ -30,6 +31,7 @@ use crate::accel::SceneGeometry;
 use crate::scene::{Camera, Scene, view_problem};
 
 mod blocking;
+mod denoising;
 mod frame_loop;
 
 pub use blocking::{RenderedImage, TraceRegion, image_tiles};
@@ -66,6 +68,13 @@ pub struct RendererOptions {
     /// pixel's sample sum and luminance m2 (16 bytes per pixel of the tile) and reads
     /// them back. Films always keep them.
     pub noise_estimate: bool,
+    /// With `true`, uploaded scenes' trace modules can record the auxiliary passes of
+    /// the camera rays' first hits (`shaders/aov.wgsl` and its CPU twin set out the
+    /// conventions: albedo, shading normal, depth); [`Renderer::render`] and
+    /// [`Renderer::render_region`] then return them ([`RenderedImage::aov`]; 32 more
+    /// bytes per pixel of the tile), and films keep them beside their sums
+    /// ([`Renderer::read_aov`], the denoiser's guides).
+    pub aov: bool,
     /// Trace shaders specialised to each scene's features (`true`, faster to run and
     /// to compile) or the general shader.
     pub specialise: bool,
@@ -103,6 +112,7 @@ impl Default for RendererOptions {
             max_rounds_per_call: 64,
             poll_timeout: None,
             noise_estimate: false,
+            aov: false,
             specialise: true,
             uniform_records: true,
             refill_lanes: true,
@@ -161,6 +171,8 @@ impl Default for RendererOptions {
 #[derive(Debug)]
 pub struct Renderer {
     pipelines: Pipelines,
+    /// The denoiser's kernels, with [`RendererOptions::aov`].
+    denoise: Option<DenoisePipelines>,
     draw: Option<DrawPipelines>,
     options: RendererOptions,
     schedule: Schedule,
@@ -182,9 +194,14 @@ impl Renderer {
             .surface_format
             .map(|format| DrawPipelines::new(device, format))
             .transpose()?;
+        let denoise = options
+            .aov
+            .then(|| DenoisePipelines::new(device, options.pipeline_cache.as_ref()))
+            .transpose()?;
         let adapter = device.adapter_info();
         Ok(Self {
             pipelines,
+            denoise,
             draw,
             schedule: options
                 .schedule
@@ -288,6 +305,7 @@ impl Renderer {
                 allow_uniform_records: self.options.uniform_records,
                 allow_refill_lanes: self.options.refill_lanes,
                 allow_unrolled: self.options.unrolled,
+                aov: self.options.aov,
             },
         )?;
         let cached = self.pipelines.has_trace(&prepared.features, self.schedule);
@@ -355,6 +373,7 @@ impl Renderer {
             self.draw_layout(),
             self.options.slot_count,
             scene.prepared.stack_size,
+            self.options.aov,
             width,
             height,
         )?;

@@ -118,6 +118,9 @@ pub(crate) struct UploadOptions {
     /// A small scene's closest-hit test unrolled, where the device prefers it
     /// ([`super::unrolled`]).
     pub allow_unrolled: bool,
+    /// The module records the auxiliary passes ([`ShaderFeatures::aov`]; the general
+    /// module always can).
+    pub aov: bool,
 }
 
 /// Uploads `scene` (as loaded: it is converted to its lighting space here) with its
@@ -140,6 +143,7 @@ pub(crate) fn upload_scene(
         allow_uniform_records,
         allow_refill_lanes,
         allow_unrolled,
+        aov,
     } = options;
     scene.render.check().map_err(RenderError::InvalidSettings)?;
     if geometry.planes.len() > MAX_PLANES {
@@ -296,6 +300,7 @@ pub(crate) fn upload_scene(
             refill_lanes: allow_refill_lanes
                 && device.features().contains(wgpu::Features::SUBGROUP),
             unrolled,
+            aov: aov || !specialise,
             ..if specialise {
                 ShaderFeatures::for_scene(scene)
             } else {

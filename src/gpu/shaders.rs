@@ -42,7 +42,7 @@ macro_rules! shader_modules {
 }
 
 /// Every module of `shaders/`, the lower ones first.
-pub const SHADER_MODULES: [ShaderModule; 27] = shader_modules![
+pub const SHADER_MODULES: [ShaderModule; 29] = shader_modules![
     "types",
     "path_types",
     "math",
@@ -66,10 +66,12 @@ pub const SHADER_MODULES: [ShaderModule; 27] = shader_modules![
     "slot",
     "trace",
     "path",
+    "aov",
     "wavefront",
     "display",
     "draw",
     "bxdf_eval",
+    "denoise",
 ];
 
 /// The modules the host writes (see the module's documentation).
@@ -204,6 +206,16 @@ pub fn bxdf_eval_shader_source() -> String {
 /// ```
 pub fn display_shader_source() -> String {
     compose_shipped("display")
+}
+
+/// The denoiser, `shaders/denoise.wgsl` and its imports.
+///
+/// ```
+/// let src = gpu_render::low_level::gpu::shaders::denoise_shader_source();
+/// assert!(src.contains("fn atrous_pass"));
+/// ```
+pub fn denoise_shader_source() -> String {
+    compose_shipped("denoise")
 }
 
 /// The draw shader, `shaders/draw.wgsl` and its imports.

@@ -23,6 +23,7 @@ use super::readback::{Caught, capture, create_texture, map_read, read_buffer, su
 use super::scene_buffers::DeviceScene;
 use super::shaders::SLOT_WORKGROUP_SIZE;
 use crate::accel::MAX_BVH_DEPTH;
+use crate::denoise::GuidePasses;
 use crate::noise::NoiseEstimate;
 
 /// llvmpipe's (and so lavapipe's) limit on the loop iterations of one shader
@@ -118,6 +119,12 @@ pub fn default_schedule(adapter: &wgpu::AdapterInfo) -> Schedule {
     }
 }
 
+/// Bytes of a pixel's sample sum and luminance m2 in the accumulation buffer.
+pub(crate) const SUM_BYTES_PER_PIXEL: u64 = 16;
+/// Bytes of a pixel's sums of the auxiliary passes after the sample sums (albedo and
+/// depth, normal and the samples counted: `shaders/aov.wgsl`).
+pub(crate) const AOV_BYTES_PER_PIXEL: u64 = 32;
+
 /// How long one submission of rounds should take.
 pub const TARGET_SUBMISSION: Duration = Duration::from_millis(100);
 
@@ -136,7 +143,7 @@ pub(crate) struct SlotBuffers {
     ray_stack: wgpu::Buffer,
     traversal_stack: wgpu::Buffer,
     pub counters: wgpu::Buffer,
-    accumulation: wgpu::Buffer,
+    pub accumulation: wgpu::Buffer,
     readback: wgpu::Buffer,
     timestamps: Option<(wgpu::QuerySet, wgpu::Buffer)>,
 }
@@ -168,13 +175,17 @@ impl SlotBuffers {
 
     /// Creates the buffers for `slot_count` slots with bounce stacks of `stack_size`,
     /// and an accumulation buffer of one sum per pixel for `accumulation_pixels`
-    /// pixels (0 for whole renders, which keep no sums).
+    /// pixels (0 for whole renders, which keep no sums), with `aov` followed by each
+    /// pixel's sums of the auxiliary passes ([`AOV_BYTES_PER_PIXEL`]).
     pub fn new(
         device: &wgpu::Device,
         slot_count: u32,
         stack_size: u32,
         accumulation_pixels: u64,
+        aov: bool,
     ) -> Result<Self, RenderError> {
+        let accumulation_bytes =
+            accumulation_pixels * (SUM_BYTES_PER_PIXEL + u64::from(aov) * AOV_BYTES_PER_PIXEL);
         let storage = |label: &str, bytes: u64, extra: wgpu::BufferUsages| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -217,11 +228,11 @@ impl SlotBuffers {
                 size_of::<GpuCounters>() as u64,
                 wgpu::BufferUsages::COPY_SRC,
             ),
-            // One vec4 sum per pixel (progressive rendering); whole renders keep none
-            // and get the 16-byte minimum.
+            // One vec4 sum per pixel (progressive rendering), and the passes' sums;
+            // whole renders keep none and get the 16-byte minimum.
             accumulation: storage(
                 "gpu-render accumulation",
-                accumulation_pixels * 16,
+                accumulation_bytes,
                 wgpu::BufferUsages::COPY_SRC,
             ),
             readback: device.create_buffer(&wgpu::BufferDescriptor {
@@ -272,6 +283,43 @@ impl SlotBuffers {
                 )
             }),
         ))
+    }
+
+    /// Reads the auxiliary passes of `width × height` region pixels after `samples`
+    /// samples back (blocking): their sums, kept after the sample sums by a trace with
+    /// [`super::layout::FLAG_AOV`], divided by the sample count.
+    pub fn read_aov(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        (width, height): (u32, u32),
+        samples: u32,
+        timeout: Option<Duration>,
+    ) -> Result<GuidePasses, RenderError> {
+        let pixels = u64::from(width) * u64::from(height);
+        let bytes = read_buffer(
+            device,
+            queue,
+            &self.accumulation,
+            pixels * (SUM_BYTES_PER_PIXEL + AOV_BYTES_PER_PIXEL),
+            timeout,
+        )?;
+        let sums: Vec<[f32; 8]> =
+            bytemuck::pod_collect_to_vec(&bytes[(pixels * SUM_BYTES_PER_PIXEL) as usize..]);
+        let scale = 1.0 / samples.max(1) as f32;
+        Ok(GuidePasses {
+            width,
+            height,
+            albedo: sums
+                .iter()
+                .map(|s| [s[0] * scale, s[1] * scale, s[2] * scale])
+                .collect(),
+            normal: sums
+                .iter()
+                .map(|s| [s[4] * scale, s[5] * scale, s[6] * scale])
+                .collect(),
+            depth: sums.iter().map(|s| s[3] * scale).collect(),
+        })
     }
 
     /// The bind group of the trace kernels for `scene`, writing into `target`, built
@@ -487,7 +535,7 @@ pub(crate) fn warm_up(
     scene: &DeviceScene,
     timeout: Option<Duration>,
 ) -> Result<(), RenderError> {
-    let slots = SlotBuffers::new(device, 1, scene.stack_size, 0)?;
+    let slots = SlotBuffers::new(device, 1, scene.stack_size, 0, false)?;
     let target = create_texture(
         device,
         "gpu-render warm-up target",

@@ -275,6 +275,207 @@ fn cpu_render_writes_exr_and_hdr_quietly() {
     }
 }
 
+/// The channels of the first layer of the EXR file `path`, by name.
+fn read_exr_channels(path: &Path) -> std::collections::BTreeMap<String, Vec<f32>> {
+    let image = exr::prelude::read_all_flat_layers_from_file(path).expect("reads as EXR");
+    image.layer_data[0]
+        .channel_data
+        .list
+        .iter()
+        .map(|channel| {
+            let samples = match &channel.sample_data {
+                exr::prelude::FlatSamples::F32(v) => v.clone(),
+                other => panic!("{}: {other:?}", channel.name),
+            };
+            (channel.name.to_string(), samples)
+        })
+        .collect()
+}
+
+#[test]
+fn aov_writes_named_exr_layers_that_read_back_alike_from_both_backends() {
+    let ws = Workspace::new(TINY_SCENE);
+    let mut files = Vec::new();
+    for backend in ["cpu", "gpu"] {
+        let name = format!("{backend}.exr");
+        let run = gpu_render(&[
+            &ws.arg("scene.toml"),
+            "-o",
+            &ws.arg(&name),
+            "--backend",
+            backend,
+            "--spp",
+            "4",
+            "--aov",
+            "albedo,normal,depth",
+            "--quiet",
+        ]);
+        assert_eq!(run.status, Some(0), "{backend}: stderr:\n{}", run.stderr);
+        files.push(read_exr_channels(&ws.path(&name)));
+    }
+    let cpu = &files[0];
+    let names: Vec<&str> = cpu.keys().map(String::as_str).collect();
+    assert_eq!(
+        names,
+        [
+            "A", "B", "G", "R", "albedo.B", "albedo.G", "albedo.R", "depth.Z", "normal.X",
+            "normal.Y", "normal.Z"
+        ]
+    );
+    // The pixel by the image centre sees the sphere's front: albedo 0.7, normal +z,
+    // depth 3 - 1 = 2 (the camera at z = 3, the sphere of radius 1 at the origin).
+    let centre = 12 * 32 + 16;
+    assert!((cpu["albedo.G"][centre] - 0.7).abs() < 1e-6);
+    assert!((cpu["normal.Z"][centre] - 1.0).abs() < 0.01);
+    assert!((cpu["depth.Z"][centre] - 2.0).abs() < 0.01);
+    // A corner sees nothing: zero in every pass.
+    assert_eq!(
+        (cpu["albedo.R"][0], cpu["normal.Z"][0], cpu["depth.Z"][0]),
+        (0.0, 0.0, 0.0)
+    );
+    for (name, values) in cpu {
+        for (i, (c, g)) in values.iter().zip(&files[1][name]).enumerate() {
+            assert!(
+                (c - g).abs() <= 1e-3 + 5e-3 * c.abs(),
+                "{name} pixel {i}: CPU {c}, GPU {g}"
+            );
+        }
+    }
+}
+
+#[test]
+fn aov_refuses_unknown_passes_outputs_without_layers_and_tiles() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.exr"),
+        "--aov",
+        "albedo,speed",
+    ]);
+    assert_eq!(run.status, Some(2), "stderr:\n{}", run.stderr);
+    for needle in ["--aov", "unknown pass `speed`", "albedo, normal, depth"] {
+        assert!(run.stderr.contains(needle), "{needle}: {}", run.stderr);
+    }
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("out.exr"),
+        "--aov",
+        "depth,depth",
+    ]);
+    assert_eq!(run.status, Some(2), "stderr:\n{}", run.stderr);
+    assert!(run.stderr.contains("named twice"), "{}", run.stderr);
+    for output in ["out.png", "out.hdr"] {
+        let run = gpu_render(&[
+            &ws.arg("scene.toml"),
+            "-o",
+            &ws.arg(output),
+            "--aov",
+            "albedo",
+        ]);
+        assert_fails_with(&run, &[output, "--aov", "layers", ".exr"]);
+    }
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("tile.exr"),
+        "--tile",
+        "0/2",
+        "--aov",
+        "normal",
+    ]);
+    assert_fails_with(&run, &["--aov", "--tile"]);
+    ws.assert_old_output_kept();
+}
+
+/// The relative MSE of `image` against `reference`, `(x - r)² / (r² + 0.01)`.
+fn relative_mse(image: &[f32], reference: &[f32]) -> f64 {
+    image
+        .iter()
+        .zip(reference)
+        .map(|(&x, &r)| {
+            let (x, r) = (f64::from(x), f64::from(r));
+            (x - r) * (x - r) / (r * r + 0.01)
+        })
+        .sum::<f64>()
+        / image.len() as f64
+}
+
+#[test]
+fn denoise_smooths_a_path_traced_image_alike_on_both_backends() {
+    let ws = Workspace::new(TINY_SCENE);
+    let cornell = shipped_path("scenes/cornell-box.toml");
+    let mut images = Vec::new();
+    for (name, backend, denoise, spp) in [
+        ("raw.exr", "cpu", false, "4"),
+        ("cpu.exr", "cpu", true, "4"),
+        ("gpu.exr", "gpu", true, "4"),
+        ("more.exr", "cpu", false, "256"),
+    ] {
+        let mut args = vec![
+            cornell.clone(),
+            "-o".into(),
+            ws.arg(name),
+            "--backend".into(),
+            backend.into(),
+            "--width".into(),
+            "48".into(),
+            "--height".into(),
+            "48".into(),
+            "--spp".into(),
+            spp.into(),
+            "--quiet".into(),
+        ];
+        if denoise {
+            args.push("--denoise".into());
+        }
+        let run = gpu_render(&args);
+        assert_eq!(run.status, Some(0), "{name}: stderr:\n{}", run.stderr);
+        images.push(read_exr_channels(&ws.path(name)));
+    }
+    let (raw, cpu, gpu) = (&images[0]["G"], &images[1]["G"], &images[2]["G"]);
+    // Closer to the 256-sample image than the raw 4-sample one, by half at least.
+    let more = &images[3]["G"];
+    let (raw_error, denoised_error) = (relative_mse(raw, more), relative_mse(cpu, more));
+    eprintln!("relative MSE against 256 spp: raw {raw_error:.4e}, denoised {denoised_error:.4e}");
+    assert!(
+        denoised_error < raw_error / 2.0,
+        "relative MSE against 256 spp: raw {raw_error:.4e}, denoised {denoised_error:.4e}"
+    );
+    // The backends' samples differ in a few paths (f32 against f64): their denoised
+    // images agree on average.
+    let mean = |v: &[f32]| v.iter().map(|&x| f64::from(x)).sum::<f64>() / v.len() as f64;
+    let difference = cpu
+        .iter()
+        .zip(gpu)
+        .map(|(a, b)| f64::from((a - b).abs()))
+        .sum::<f64>()
+        / cpu.len() as f64;
+    assert!(
+        difference < 0.02 * mean(cpu),
+        "mean |CPU - GPU| {difference:.4} against a mean of {:.4}",
+        mean(cpu)
+    );
+}
+
+#[test]
+fn denoise_refuses_the_whitted_integrator_and_tiles() {
+    let ws = Workspace::new(TINY_SCENE);
+    let run = gpu_render(&[&ws.arg("scene.toml"), "-o", &ws.arg("out.png"), "--denoise"]);
+    assert_fails_with(&run, &["scene.toml", "--denoise", "Whitted", "path"]);
+    let run = gpu_render(&[
+        &ws.arg("scene.toml"),
+        "-o",
+        &ws.arg("tile.exr"),
+        "--crop",
+        "0,0,4,4",
+        "--denoise",
+    ]);
+    assert_fails_with(&run, &["--denoise", "--tile or --crop"]);
+    ws.assert_old_output_kept();
+}
+
 #[test]
 fn compare_gamma_is_twice_as_wide() {
     let ws = Workspace::new(TINY_SCENE);

@@ -171,6 +171,19 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
             twin!(DisplayUniforms { encode_srgb, _pad }),
         ),
         (
+            "DenoiseUniforms",
+            twin!(DenoiseUniforms {
+                width,
+                height,
+                step,
+                _pad,
+                sigma_normal,
+                sigma_depth,
+                sigma_luminance,
+                sigma_albedo,
+            }),
+        ),
+        (
             "BvhNode",
             twin!(BvhNode {
                 min,

@@ -4,12 +4,14 @@
 
 mod support;
 
+mod aov;
 mod bvh_cpu;
 mod bvh_gpu;
 mod bxdf_gpu_twin;
 mod bxdf_plausibility;
 mod cli;
 mod corpus;
+mod denoise;
 mod display_pass;
 mod emissive_texture;
 mod environment;

@@ -117,12 +117,13 @@ fn feature_sets() -> Vec<ShaderFeatures> {
         instances: false,
         path: false,
         environment_map: false,
+        aov: false,
         uniform_records: false,
         refill_lanes: false,
         unrolled: None,
     };
     type Toggle = fn(&mut ShaderFeatures, bool);
-    let toggles: [Toggle; 15] = [
+    let toggles: [Toggle; 16] = [
         |f, v| f.spheres = v,
         |f, v| f.planes = v,
         |f, v| f.polygons = v,
@@ -138,6 +139,7 @@ fn feature_sets() -> Vec<ShaderFeatures> {
         |f, v| f.instances = v,
         |f, v| f.path = v,
         |f, v| f.environment_map = v,
+        |f, v| f.aov = v,
     ];
     let unrolled = UnrolledPrimitives::for_scene(&[0], 1, &[]);
     assert!(unrolled.is_some(), "a sphere and a plane are unrolled");
@@ -370,6 +372,28 @@ const WITHOUT_RUST_TWIN: &[(&str, &[&str], &str)] = &[
         ],
         "path_radiance's loop body cut at each shadow ray into the wavefront's steps, \
          with the path's random numbers and state in its slot",
+    ),
+    (
+        "aov",
+        &[
+            "aov_mode",
+            "aov_index",
+            "clear_pixel_aov",
+            "add_first_hit_aov",
+        ],
+        "the passes' sums kept in the accumulation buffer between a slot's samples: the \
+         CPU sums them in the locals of trace_pixel_aov",
+    ),
+    (
+        "denoise",
+        &[
+            "tap_index",
+            "prepare_film_signal",
+            "demodulate_signal",
+            "remodulate_signal",
+        ],
+        "the kernels of the steps src/denoise.rs runs in one call over whole images \
+         (denoise's loops), and a film's sums read as its input",
     ),
     (
         "intersect",

@@ -163,12 +163,13 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         instances: false,
         path: false,
         environment_map: false,
+        aov: false,
         uniform_records: false,
         refill_lanes: false,
         unrolled: None,
     };
     type Toggle = fn(&mut ShaderFeatures, bool);
-    let toggles: [Toggle; 15] = [
+    let toggles: [Toggle; 16] = [
         |f, v| f.spheres = v,
         |f, v| f.planes = v,
         |f, v| f.polygons = v,
@@ -184,6 +185,7 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         |f, v| f.instances = v,
         |f, v| f.path = v,
         |f, v| f.environment_map = v,
+        |f, v| f.aov = v,
     ];
     let all = function_names(&ShaderFeatures::ALL).len();
     let bare = function_names(&none).len();

@@ -212,6 +212,67 @@ fn the_screenshot_matches_the_headless_render_of_the_same_samples() {
     assert!(distinct.len() > 100, "{} distinct colours", distinct.len());
 }
 
+/// With `--denoise` the window shows the film denoised in the frame loop: after N
+/// frames of one sample, the headless `--denoise` render of N samples per pixel (the
+/// same filter on the same samples), within one 8-bit level except
+/// [`OUTLIER_FRACTION`] of pixels.
+#[test]
+fn a_denoised_window_shows_the_headless_denoised_render() {
+    let Some(xvfb) = window_environment() else {
+        return;
+    };
+    let dir = output_dir("denoised");
+    let screenshot = dir.join("window.png");
+    let reference = dir.join("headless.png");
+    let _ = std::fs::remove_file(&screenshot);
+    let size = ["--width", "64", "--height", "64", "--spp", "4"];
+    let mut view = gpu_render(Some(&xvfb.display));
+    view.args([
+        "view",
+        "scenes/cornell-box.toml",
+        "--denoise",
+        "--frames",
+        "4",
+        "--screenshot",
+    ])
+    .arg(&screenshot)
+    .args(size);
+    let (status, stderr) = run(view);
+    assert_eq!(status, Some(0), "gpu-render view failed:\n{stderr}");
+    let mut render = gpu_render(None);
+    render
+        .args([
+            "scenes/cornell-box.toml",
+            "--backend",
+            "gpu",
+            "--denoise",
+            "-o",
+        ])
+        .arg(&reference)
+        .args(size);
+    let (status, headless_stderr) = run(render);
+    assert_eq!(
+        status,
+        Some(0),
+        "the headless render failed:\n{headless_stderr}"
+    );
+    let shown = load_rgba(&screenshot);
+    let expected = load_rgba(&reference);
+    assert_eq!(shown.dimensions(), expected.dimensions());
+    let outliers = shown
+        .pixels()
+        .zip(expected.pixels())
+        .filter(|(a, b)| (0..3).any(|c| a[c].abs_diff(b[c]) > 1))
+        .count();
+    let pixels = (shown.width() * shown.height()) as usize;
+    let allowed = (pixels as f64 * OUTLIER_FRACTION).floor() as usize;
+    assert!(
+        outliers <= allowed,
+        "{outliers} of {pixels} pixels differ by more than one level; {allowed} allowed. See {}",
+        dir.display()
+    );
+}
+
 /// `--scale 0.5` traces a film of half the window's size and draws it scaled up: each
 /// 2 x 2 block of the screenshot is one pixel of the headless render at half size,
 /// within one 8-bit level except [`OUTLIER_FRACTION`] of pixels. `--adapter` with a

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use gpu_render::low_level::quality::QualityPreset;
+use gpu_render::output::AuxPass;
 use gpu_render::scene::{
     Integrator, LightingSpace, MAX_DEPTH_LIMIT, MAX_IMAGE_DIMENSION, MAX_SAMPLES_PER_PIXEL,
     RenderOverrides,
@@ -318,6 +319,13 @@ pub struct ViewArgs {
     )]
     pub scale: f64,
 
+    /// Show the film denoised by the built-in à-trous filter (guided by the first-hit
+    /// albedo, normal and depth the trace then records, and the noise estimate); the
+    /// D key switches between the denoised and the raw film. The samples accumulate
+    /// the same either way.
+    #[arg(long)]
+    pub denoise: bool,
+
     /// The GPU adapter to show the window with: an index from the list the viewer
     /// prints when this does not match, or part of an adapter's name.
     #[arg(long, value_name = "INDEX|NAME", value_parser = parse_view_adapter)]
@@ -383,6 +391,37 @@ fn parse_tile(text: &str) -> Result<TileArg, String> {
     Ok(TileArg { index, count })
 }
 
+/// A comma-separated list of auxiliary pass names (`albedo,normal,depth`), each once,
+/// in the order given.
+fn parse_aov_list(text: &str) -> Result<AovList, String> {
+    let known = || {
+        AuxPass::ALL
+            .iter()
+            .map(|pass| pass.name())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut passes = Vec::new();
+    for name in text.split(',').map(str::trim) {
+        let Some(pass) = AuxPass::from_name(name) else {
+            return Err(format!(
+                "unknown pass `{}`: the passes are {} (comma-separated)",
+                gpu_render::low_level::echo::echo(name),
+                known()
+            ));
+        };
+        if passes.contains(&pass) {
+            return Err(format!("the pass `{name}` is named twice"));
+        }
+        passes.push(pass);
+    }
+    Ok(AovList(passes))
+}
+
+/// The passes `--aov` names, in its order.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct AovList(pub Vec<AuxPass>);
+
 /// `x0,y0,x1,y1` with `x0 < x1`, `y0 < y1` (checked against the image later).
 fn parse_crop(text: &str) -> Result<PixelWindow, String> {
     let usage = || format!("must be x0,y0,x1,y1 (whole pixels, x1 and y1 excluded), got `{text}`");
@@ -435,6 +474,26 @@ pub struct RenderArgs {
     /// left in the summary. `{frame}` and `{tile}` expand as in the output name.
     #[arg(long, value_name = "PATH.exr", conflicts_with = "compare_gamma")]
     pub standard_error: Option<PathBuf>,
+
+    /// Also write the auxiliary passes of the camera rays' first hits as layers of the
+    /// output EXR (give an .exr output): `albedo` (channels albedo.R/G/B, after
+    /// textures; mirrors and glass give their tint), `normal` (normal.X/Y/Z, world
+    /// space) and `depth` (depth.Z, distance along the camera ray, 0 where it
+    /// escapes), each averaged over the pixel's samples.
+    #[arg(
+        long,
+        value_name = "NAME,...",
+        value_parser = parse_aov_list,
+        conflicts_with = "compare_gamma"
+    )]
+    pub aov: Option<AovList>,
+
+    /// Denoise the image with the built-in edge-avoiding à-trous filter, guided by the
+    /// first-hit albedo, normal and depth and by each pixel's noise estimate (on the
+    /// backend that renders). For the path integrator: Whitted images have no noise
+    /// to remove, and are refused.
+    #[arg(long, conflicts_with = "compare_gamma")]
+    pub denoise: bool,
 
     /// Where and how to trace.
     #[command(flatten)]

@@ -6,6 +6,7 @@ use anyhow::{Context, Result, bail};
 use gpu_render::cpu;
 use gpu_render::film::{LinearImage, ProgressFn, RenderStats, Rendered};
 use gpu_render::gpu::{self, AdapterChoice, HeadlessGpu, Renderer, RendererOptions, TraceRegion};
+use gpu_render::low_level::denoise::{self, DenoiseSettings, GuidePasses};
 use gpu_render::low_level::gpu::cpu_device::unrolled::MAX_UNROLLED_PRIMITIVES;
 use gpu_render::low_level::noise::NoiseEstimate;
 use gpu_render::scene::{Integrator, Scene};
@@ -25,6 +26,9 @@ pub struct Frame {
     /// Each pixel's noise estimate, where the backend was opened with
     /// [`GpuOptions::noise`].
     pub noise: Option<NoiseEstimate>,
+    /// The auxiliary passes, where the backend was opened with [`GpuOptions::aov`]
+    /// (whole renders only).
+    pub aov: Option<GuidePasses>,
     /// How long the GPU spent compiling the scene's kernels (zero when they were
     /// cached); `None` on the CPU reference.
     pub compile: Option<std::time::Duration>,
@@ -41,6 +45,7 @@ impl Frame {
             display_rgba8,
             stats: rendered.stats,
             noise: rendered.noise,
+            aov: None,
             compile: None,
         }
     }
@@ -55,6 +60,8 @@ pub struct GpuOptions {
     pub timeout: Option<std::time::Duration>,
     /// Estimate each pixel's noise (`--standard-error`); on either backend.
     pub noise: bool,
+    /// Record the auxiliary passes (`--aov`, `--denoise`); on either backend.
+    pub aov: bool,
 }
 
 /// An opened backend, ready to render any number of scenes.
@@ -76,6 +83,8 @@ pub enum Backend {
         reason: Option<String>,
         /// Whether renders estimate each pixel's noise.
         noise: bool,
+        /// Whether whole renders record the auxiliary passes.
+        aov: bool,
     },
 }
 
@@ -100,6 +109,7 @@ impl Backend {
             BackendArg::Cpu => Ok(Backend::Cpu {
                 reason: None,
                 noise: options.noise,
+                aov: options.aov,
             }),
             BackendArg::Gpu => Self::open_gpu(&adapter_choice, options),
             BackendArg::Auto if adapter.is_some() => Self::open_gpu(&adapter_choice, options),
@@ -108,6 +118,7 @@ impl Backend {
                     Some(reason) => Ok(Backend::Cpu {
                         reason: Some(reason),
                         noise: options.noise,
+                        aov: options.aov,
                     }),
                     None => Self::with_device(gpu, options),
                 },
@@ -118,6 +129,7 @@ impl Backend {
                     Ok(Backend::Cpu {
                         reason: Some("no GPU adapter".into()),
                         noise: options.noise,
+                        aov: options.aov,
                     })
                 }
             },
@@ -144,6 +156,7 @@ impl Backend {
             iteration_budget: options.iteration_budget,
             poll_timeout: options.timeout,
             noise_estimate: options.noise,
+            aov: options.aov,
             pipeline_cache: pipeline_cache.as_ref().map(PipelineCacheFile::cache),
             ..RendererOptions::default()
         };
@@ -223,6 +236,7 @@ impl Backend {
                     display_rgba8: rendered.display_rgba8,
                     stats: rendered.stats,
                     noise: rendered.noise,
+                    aov: None,
                     compile: Some(uploaded.compile_time()),
                 })
             }
@@ -243,6 +257,42 @@ impl Backend {
         }
     }
 
+    /// The image of `frame` (rendered with noise estimate and auxiliary passes)
+    /// denoised by the built-in filter, on the GPU where `frame` was rendered there.
+    pub fn denoise(&self, frame: &Frame) -> Result<LinearImage> {
+        let (Some(noise), Some(guides)) = (&frame.noise, &frame.aov) else {
+            bail!("the backend returned no noise estimate or auxiliary passes to denoise with");
+        };
+        let variance: Vec<f32> = noise.standard_error.iter().map(|se| se * se).collect();
+        let settings = DenoiseSettings::default();
+        match self {
+            Backend::Gpu { gpu, renderer, .. } => renderer
+                .denoise_image(
+                    &gpu.device,
+                    &gpu.queue,
+                    &frame.image,
+                    &variance,
+                    guides,
+                    &settings,
+                )
+                .context("GPU denoising failed"),
+            Backend::Cpu { .. } => {
+                let radiance: Vec<[f32; 3]> = frame
+                    .image
+                    .pixels
+                    .iter()
+                    .map(|p| [p[0], p[1], p[2]])
+                    .collect();
+                let denoised = denoise::denoise(&radiance, &variance, guides, &settings);
+                Ok(LinearImage {
+                    width: frame.image.width,
+                    height: frame.image.height,
+                    pixels: denoised.iter().map(|p| [p[0], p[1], p[2], 1.0]).collect(),
+                })
+            }
+        }
+    }
+
     /// Renders `scene`, reporting rows done to `progress`.
     pub fn render(&self, scene: &Scene, progress: ProgressFn<'_>) -> Result<Frame> {
         match self {
@@ -259,16 +309,19 @@ impl Backend {
                     display_rgba8: rendered.display_rgba8,
                     stats: rendered.stats,
                     noise: rendered.noise,
+                    aov: rendered.aov,
                     compile: Some(uploaded.compile_time()),
                 })
             }
-            Backend::Cpu { noise, .. } => {
+            Backend::Cpu { noise, aov, .. } => {
                 let rendered = if *noise {
                     cpu::render_with_noise(scene, Some(progress))
                 } else {
                     cpu::render(scene, Some(progress))
                 };
-                Ok(Frame::from_cpu(rendered, scene))
+                let mut frame = Frame::from_cpu(rendered, scene);
+                frame.aov = aov.then(|| cpu::aov::render_aovs(scene));
+                Ok(frame)
             }
         }
     }

@@ -37,6 +37,7 @@ pub fn side_by_side(left: &Frame, right: &Frame) -> Result<Frame> {
         stats: crate::summary::add_stats(left.stats, right.stats),
         // --compare-gamma and --standard-error exclude each other.
         noise: None,
+        aov: None,
         compile: left.compile.zip(right.compile).map(|(a, b)| a + b),
     })
 }
@@ -56,6 +57,7 @@ mod tests {
             display_rgba8: vec![byte; 16],
             stats: RenderStats::default(),
             noise: None,
+            aov: None,
             compile: None,
         }
     }

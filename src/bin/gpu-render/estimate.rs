@@ -71,6 +71,7 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
         iteration_budget: args.device.iteration_budget,
         timeout: args.device.gpu_timeout,
         noise: false,
+        aov: false,
     };
     let backend = Backend::open(
         args.device.backend,

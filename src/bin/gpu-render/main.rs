@@ -31,11 +31,12 @@ use anyhow::{Context, Result, anyhow, bail};
 use clap::{CommandFactory, Parser, error::ErrorKind};
 use gpu_render::output::{self, HDR_MAX, OutputFormat, Written};
 use gpu_render::scene::{
-    self, LightingSpace, LoadOptions, LoadProgress, RenderSettings, Scene, SceneFile, SceneWarning,
+    self, Integrator, LightingSpace, LoadOptions, LoadProgress, RenderSettings, Scene, SceneFile,
+    SceneWarning,
 };
 use gpu_render::tiles::{Fingerprint, PixelWindow, Tile, TileInfo, tile_window};
 
-use crate::args::{AdapterArg, BackendArg, Cli, RenderArgs, SettingsArgs};
+use crate::args::{AdapterArg, AovList, BackendArg, Cli, RenderArgs, SettingsArgs};
 use crate::backend::{Backend, Frame, GpuOptions};
 use crate::memory::{BackendKind, Estimate};
 use crate::progress::Progress;
@@ -146,6 +147,20 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
             output_pattern.display()
         );
     }
+    if args.aov.is_some() && format != OutputFormat::Exr {
+        bail!(
+            "{}: --aov writes the passes as layers of an OpenEXR file, so the output must be an .exr (PNG and Radiance HDR hold no layers)",
+            output_pattern.display()
+        );
+    }
+    if args.denoise && piece {
+        bail!("--denoise filters a whole image; it cannot be used with --tile or --crop");
+    }
+    if args.aov.is_some() && piece {
+        bail!(
+            "--aov writes layers of a whole image's EXR; it cannot be used with --tile or --crop"
+        );
+    }
     if args.compare_gamma && piece {
         bail!("--compare-gamma renders two whole images side by side; it cannot be a tile");
     }
@@ -207,12 +222,19 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
         .map(|pattern| standard_error_path(pattern, frame, tile, &output_path, scene_path, &scene))
         .transpose()?;
     check_inputs_survive(&output_path, scene_path, &scene)?;
+    if args.denoise && scene.render.integrator == Integrator::Whitted {
+        bail!(
+            "{}: --denoise removes the noise of path tracing, and the scene uses the Whitted integrator, whose images have none; render with integrator = \"path\" (or --integrator path), or without --denoise",
+            scene_path.display()
+        );
+    }
     let window = piece_window(args, &scene.render)?;
 
     let gpu_options = GpuOptions {
         iteration_budget: args.device.iteration_budget,
         timeout: args.device.gpu_timeout,
-        noise: standard_error_path.is_some(),
+        noise: standard_error_path.is_some() || args.denoise,
+        aov: args.aov.is_some() || args.denoise,
     };
     let backend = Backend::open(
         args.device.backend,
@@ -227,7 +249,8 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
         format,
         args.compare_gamma,
         window.as_ref(),
-        standard_error_path.is_some(),
+        gpu_options.noise,
+        gpu_options.aov,
         args.max_memory,
     )?;
     let piece_name = window.as_ref().map(|window| match args.tile {
@@ -256,6 +279,12 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
     } else {
         render_pass(&backend, &scene, None, args.quiet)?
     };
+    let mut rendered = rendered;
+    if args.denoise {
+        let denoised = backend.denoise(&rendered)?;
+        rendered.display_rgba8 = denoised.to_display_rgba8(scene.display_encodes_srgb());
+        rendered.image = denoised;
+    }
     let wall = started.elapsed();
     backend.save_pipeline_cache(args.quiet);
 
@@ -284,7 +313,16 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
             gpu_render::tiles::write_tile(&output_path, &tile)?;
             Written::default()
         }
-        None => output::write_image(&output_path, &rendered.image, &rendered.display_rgba8)?,
+        None => match (&args.aov, &rendered.aov) {
+            (Some(AovList(passes)), Some(aov)) => {
+                output::write_exr_with_passes(&output_path, &rendered.image, aov, passes)?;
+                Written::default()
+            }
+            (Some(_), None) => bail!("the backend returned no auxiliary passes"),
+            (None, _) => {
+                output::write_image(&output_path, &rendered.image, &rendered.display_rgba8)?
+            }
+        },
     };
     if let Some(path) = &standard_error_path {
         let noise = rendered
@@ -306,7 +344,12 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
             compile: rendered.compile,
             stats: rendered.stats,
             output: &output_path,
-            noise: rendered.noise.as_ref(),
+            // The raw image's noise, shown only where asked for (--standard-error):
+            // --denoise takes it too, and its image has less.
+            noise: rendered
+                .noise
+                .as_ref()
+                .filter(|_| standard_error_path.is_some()),
         };
         eprintln!("{summary}");
     }
@@ -446,6 +489,7 @@ fn standard_error_path(
 }
 
 /// Refuses, before rendering, a render whose estimated peak memory is above the cap.
+#[allow(clippy::too_many_arguments)]
 fn check_memory(
     scene: &Scene,
     backend: &Backend,
@@ -453,6 +497,7 @@ fn check_memory(
     compare_gamma: bool,
     window: Option<&PixelWindow>,
     noise: bool,
+    aov: bool,
     max_memory_gib: f64,
 ) -> Result<()> {
     let kind = match backend {
@@ -465,6 +510,9 @@ fn check_memory(
     };
     if noise {
         estimate = estimate.with_noise_estimate(kind);
+    }
+    if aov {
+        estimate = estimate.with_aov();
     }
     let cap = max_memory_gib * f64::from(1u32 << 30);
     if estimate.total as f64 > cap {

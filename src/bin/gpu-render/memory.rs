@@ -64,6 +64,12 @@ fn noise_bytes_per_pixel(backend: BackendKind) -> u64 {
     }
 }
 
+/// Bytes per pixel an `--aov` (or `--denoise`) render adds, counted, not measured:
+/// the passes' seven `f32` (28) and on the CPU their `f64` means (56), on the GPU the
+/// accumulation buffer's two `vec4<f32>` (32) and their readback (32), and the EXR
+/// encoder's copy of the channels with its compressed blocks (56).
+const AOV_BYTES_PER_PIXEL: u64 = 148;
+
 /// An estimate of a render's peak memory, with its parts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Estimate {
@@ -109,6 +115,15 @@ impl Estimate {
         Self {
             per_pixel: self.per_pixel + extra,
             total: self.total + self.pixels * extra,
+            ..self
+        }
+    }
+
+    /// The estimate with the auxiliary passes' bytes per pixel added (`--aov`).
+    pub fn with_aov(self) -> Self {
+        Self {
+            per_pixel: self.per_pixel + AOV_BYTES_PER_PIXEL,
+            total: self.total + self.pixels * AOV_BYTES_PER_PIXEL,
             ..self
         }
     }

@@ -10,6 +10,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
 
 use super::Renderer;
+use crate::denoise::GuidePasses;
 use crate::film::{LinearImage, ProgressFn, RenderStats};
 use crate::gpu::RenderError;
 use crate::gpu::display::{TextureSize, check_texture, encode_display};
@@ -76,6 +77,9 @@ pub struct RenderedImage {
     pub stats: RenderStats,
     /// Each pixel's noise estimate, with [`super::RendererOptions::noise_estimate`].
     pub noise: Option<NoiseEstimate>,
+    /// The auxiliary passes (first-hit albedo, shading normal, depth; averaged over
+    /// each pixel's samples), with [`super::RendererOptions::aov`].
+    pub aov: Option<GuidePasses>,
 }
 
 /// The tiles [`Renderer::render`] traces an image of `width × height` in: one tile
@@ -178,12 +182,15 @@ impl Renderer {
                 .saturating_mul(WORKGROUP_SIZE),
         );
         let noise_estimate = self.options().noise_estimate;
-        if noise_estimate {
-            // And the noise estimate's sums, 16 bytes per pixel, one storage binding.
+        let aov = self.options().aov && scene.prepared.features.aov;
+        if noise_estimate || aov {
+            // And the noise estimate's sums, 16 bytes per pixel, and the auxiliary
+            // passes', 32 more: one storage binding.
             let binding = limits
                 .max_storage_buffer_binding_size
                 .min(limits.max_buffer_size);
-            let side = ((binding / 16) as f64).sqrt() as u32;
+            let per_pixel = 16 + if aov { 32 } else { 0 };
+            let side = ((binding / per_pixel) as f64).sqrt() as u32;
             tile_limit = tile_limit.min(side.max(1));
         }
         let (x0, y0) = (region.columns.start, region.rows.start);
@@ -212,6 +219,13 @@ impl Renderer {
             mean_luminance: vec![0.0; width as usize * height as usize],
             standard_error: vec![0.0; width as usize * height as usize],
         });
+        let mut passes = aov.then(|| GuidePasses {
+            width,
+            height,
+            albedo: vec![[0.0; 3]; width as usize * height as usize],
+            normal: vec![[0.0; 3]; width as usize * height as usize],
+            depth: vec![0.0; width as usize * height as usize],
+        });
         for tile in tiles {
             let traced = self.render_tile(device, queue, scene, &tile, &report)?;
             stats.rays_traced += traced.stats.rays_traced;
@@ -235,6 +249,15 @@ impl Renderer {
                         .copy_from_slice(&part.mean_luminance[from.clone()]);
                     whole.standard_error[to].copy_from_slice(&part.standard_error[from]);
                 }
+                if let (Some(whole), Some(part)) = (&mut passes, &traced.aov) {
+                    let (to, from) = (
+                        start..start + tile_width,
+                        row * tile_width..(row + 1) * tile_width,
+                    );
+                    whole.albedo[to.clone()].copy_from_slice(&part.albedo[from.clone()]);
+                    whole.normal[to.clone()].copy_from_slice(&part.normal[from.clone()]);
+                    whole.depth[to].copy_from_slice(&part.depth[from]);
+                }
             }
         }
         stats.gpu_time = gpu_time;
@@ -247,6 +270,7 @@ impl Renderer {
             display_rgba8,
             stats,
             noise,
+            aov: passes,
         })
     }
 
@@ -287,7 +311,7 @@ impl Renderer {
             let before = last.swap(done, Ordering::Relaxed);
             report(done - before);
         };
-        let (stats, noise) = self.trace_region_into(
+        let (stats, noise, aov) = self.trace_region_into(
             device,
             queue,
             scene,
@@ -295,6 +319,7 @@ impl Renderer {
             tile,
             Some(&tile_progress),
             self.options().noise_estimate,
+            self.options().aov,
         )?;
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("gpu-render display pass"),
@@ -321,6 +346,7 @@ impl Renderer {
             display_rgba8,
             stats,
             noise,
+            aov,
         })
     }
 
@@ -389,11 +415,12 @@ impl Renderer {
         region: &TraceRegion,
         progress: Option<&dyn Fn(u64, u64)>,
     ) -> Result<RenderStats, RenderError> {
-        self.trace_region_into(device, queue, scene, target, region, progress, false)
-            .map(|(stats, _)| stats)
+        self.trace_region_into(device, queue, scene, target, region, progress, false, false)
+            .map(|(stats, _, _)| stats)
     }
 
-    /// [`Renderer::trace_into`], and with `noise` the region's noise estimate.
+    /// [`Renderer::trace_into`], and with `noise` the region's noise estimate, with
+    /// `aov` its auxiliary passes (where the scene's module records them).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn trace_region_into(
         &self,
@@ -404,7 +431,9 @@ impl Renderer {
         region: &TraceRegion,
         progress: Option<&dyn Fn(u64, u64)>,
         noise: bool,
-    ) -> Result<(RenderStats, Option<NoiseEstimate>), RenderError> {
+        aov: bool,
+    ) -> Result<(RenderStats, Option<NoiseEstimate>, Option<GuidePasses>), RenderError> {
+        let aov = aov && scene.prepared.features.aov;
         let (width, height) = region.size();
         let (origin_x, origin_y) = region.target_origin;
         if region.columns.end > scene.width()
@@ -416,7 +445,7 @@ impl Renderer {
         }
         let pixels = u64::from(width) * u64::from(height);
         if pixels == 0 {
-            return Ok((RenderStats::default(), None));
+            return Ok((RenderStats::default(), None, None));
         }
         check_texture(
             target,
@@ -433,9 +462,10 @@ impl Renderer {
             pixels,
             prepared.stack_size,
         );
-        // The sums are kept only for the noise estimate (16 bytes per region pixel).
-        let sums = if noise { pixels } else { 0 };
-        let slots = SlotBuffers::new(device, slot_count, prepared.stack_size, sums)?;
+        // The sums are kept only for the noise estimate (16 bytes per region pixel) and
+        // the auxiliary passes (32 more).
+        let sums = if noise || aov { pixels } else { 0 };
+        let slots = SlotBuffers::new(device, slot_count, prepared.stack_size, sums, aov)?;
         let bind_group = slots.bind_group(
             device,
             self.pipelines.trace_bind_group_layout(&prepared.features),
@@ -470,7 +500,8 @@ impl Renderer {
                     crate::gpu::layout::FLAG_STORE_SUM
                 } else {
                     0
-                },
+                }
+                | if aov { crate::gpu::layout::FLAG_AOV } else { 0 },
             ..base
         };
         let done = AtomicU64::new(0);
@@ -507,7 +538,18 @@ impl Renderer {
         } else {
             None
         };
-        Ok((stats, estimate))
+        let passes = if aov {
+            Some(slots.read_aov(
+                device,
+                queue,
+                (width, height),
+                prepared.samples_per_pixel(),
+                timeout,
+            )?)
+        } else {
+            None
+        };
+        Ok((stats, estimate, passes))
     }
 
     /// Records the display pass over any pair of textures into `encoder`: reads

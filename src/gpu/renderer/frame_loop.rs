@@ -5,12 +5,13 @@
 //! reading it back). `docs/embedding.md` walks through it.
 
 use super::Renderer;
+use crate::denoise::GuidePasses;
 use crate::film::LinearImage;
 use crate::gpu::RenderError;
 use crate::gpu::display::{TextureSize, check_texture};
 use crate::gpu::film::Film;
 use crate::gpu::gpu_scene::GpuScene;
-use crate::gpu::layout::FLAG_STORE_SUM;
+use crate::gpu::layout::{FLAG_AOV, FLAG_STORE_SUM};
 use crate::gpu::pipelines::DISPLAY_FORMAT;
 use crate::gpu::readback::{create_texture, read_texture, wait};
 use crate::gpu::shaders::{SLOT_WORKGROUP_SIZE, WORKGROUP_SIZE};
@@ -106,7 +107,13 @@ impl Renderer {
                 slot_count: film.slot_count,
                 iteration_budget: self.iteration_budget,
                 // The scene's own flags (its integrator) kept.
-                flags: FLAG_STORE_SUM | scene.prepared.frame.flags,
+                flags: FLAG_STORE_SUM
+                    | scene.prepared.frame.flags
+                    | if film.aov && scene.prepared.features.aov {
+                        FLAG_AOV
+                    } else {
+                        0
+                    },
                 ..scene.frame_for(film.width(), film.height())
             };
             let pixels = u64::from(film.width()) * u64::from(film.height());
@@ -349,6 +356,34 @@ impl Renderer {
     ) -> Result<NoiseEstimate, RenderError> {
         self.finish(device, queue, scene, film)?;
         film.slots.read_noise(
+            device,
+            queue,
+            (film.width(), film.height()),
+            film.samples(),
+            None,
+        )
+    }
+
+    /// Waits for every sample asked of `film` ([`Renderer::finish`]) and reads its
+    /// auxiliary passes back (blocking): the mean over its [`Film::samples`] samples
+    /// of the camera rays' first-hit albedo, shading normal and depth
+    /// (`shaders/aov.wgsl`), the guides of the denoiser.
+    ///
+    /// Errors: [`RenderError::NoAov`] for a film or scene made without
+    /// [`super::RendererOptions::aov`]; as [`Renderer::finish`];
+    /// [`RenderError::Readback`] or [`RenderError::DeviceLost`] if the readback fails.
+    pub fn read_aov(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &GpuScene,
+        film: &mut Film,
+    ) -> Result<GuidePasses, RenderError> {
+        if !(film.aov && scene.prepared.features.aov) {
+            return Err(RenderError::NoAov);
+        }
+        self.finish(device, queue, scene, film)?;
+        film.slots.read_aov(
             device,
             queue,
             (film.width(), film.height()),

@@ -23,6 +23,7 @@ use anyhow::{Context, Result, anyhow, bail};
 use gpu_render::gpu::{
     AdapterChoice, Film, GpuScene, Renderer, RendererOptions, read_texture, select_adapter,
 };
+use gpu_render::low_level::denoise::DenoiseSettings;
 use gpu_render::output;
 use gpu_render::scene::{self, Camera, RenderSettings, Scene};
 use winit::application::ApplicationHandler;
@@ -169,6 +170,7 @@ impl ApplicationHandler for App<'_> {
                 match event.logical_key.as_ref() {
                     Key::Character(c) if c.eq_ignore_ascii_case("s") => viewer.save(),
                     Key::Character(c) if c.eq_ignore_ascii_case("n") => viewer.show_noise(),
+                    Key::Character(c) if c.eq_ignore_ascii_case("d") => viewer.toggle_denoise(),
                     Key::Named(NamedKey::Escape) => {
                         event_loop.exit();
                         Ok(())
@@ -257,6 +259,10 @@ struct Viewer {
     first_frame: Option<Instant>,
     cursor: PhysicalPosition<f64>,
     drag: Option<(Drag, PhysicalPosition<f64>)>,
+    /// Whether the renderer records the passes the denoiser needs (`--denoise`).
+    can_denoise: bool,
+    /// Whether the window shows the film denoised (the D key).
+    denoised: bool,
 }
 
 /// What a reload needs of the command line.
@@ -315,6 +321,7 @@ impl Viewer {
             &device,
             RendererOptions {
                 surface_format: Some(config.format),
+                aov: args.denoise,
                 ..RendererOptions::default()
             },
         )
@@ -373,7 +380,23 @@ impl Viewer {
             first_frame: None,
             cursor: PhysicalPosition::new(0.0, 0.0),
             drag: None,
+            can_denoise: args.denoise,
+            denoised: args.denoise,
         })
+    }
+
+    /// The D key: switches between the denoised and the raw film (with `--denoise`).
+    fn toggle_denoise(&mut self) -> Result<()> {
+        if self.can_denoise {
+            self.denoised = !self.denoised;
+            self.status = Some(if self.denoised { "denoised" } else { "raw" }.to_owned());
+        } else {
+            self.status = Some("start the viewer with --denoise to denoise".to_owned());
+        }
+        self.title_written = None;
+        self.update_title();
+        self.window.request_redraw();
+        Ok(())
     }
 
     /// Whether another frame would add samples (or `--frames` are not done yet).
@@ -480,6 +503,15 @@ impl Viewer {
             &mut self.film,
             samples,
         )?;
+        if self.denoised {
+            self.renderer.encode_denoise(
+                &self.device,
+                &self.queue,
+                &mut encoder,
+                &mut self.film,
+                &DenoiseSettings::default(),
+            )?;
+        }
         let offscreen_view = self.offscreen.create_view(&Default::default());
         self.draw_into(&mut encoder, &offscreen_view)?;
         if self.copy_to_surface {
@@ -520,7 +552,12 @@ impl Viewer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        self.renderer.draw(&mut pass, &self.scene, &self.film)?;
+        if self.denoised {
+            self.renderer
+                .draw_denoised(&mut pass, &self.scene, &self.film)?;
+        } else {
+            self.renderer.draw(&mut pass, &self.scene, &self.film)?;
+        }
         Ok(())
     }
 
