@@ -342,7 +342,7 @@ fn path_closest_hit(path: ptr<function, PathState>, trace: TraceRay) {
         return;
     }
     let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
-    let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv);
+    let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.color);
     // Emission, weighted against next-event estimation where that could have found it;
     // shadow_origin still holds the previous hit's, where that estimation sampled from.
     if max_component(material.emission) > 0.0 && emits_towards(hit, ray.direction, material.two_sided != 0u) {
@@ -501,7 +501,7 @@ fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
                                           Ray((*path).shadow_origin, sample.wi), trace.best_t);
             let light_material = materials[light_hit.material];
             if light_material.emission_layer != NO_IMAGE {
-                radiance = shading_emission(light_material, light_hit.position, light_hit.normal, light_hit.uv);
+                radiance = shading_emission(light_material, light_hit.position, light_hit.normal, light_hit.uv, light_hit.uv1);
             }
         }
         //#endif

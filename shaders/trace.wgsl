@@ -129,7 +129,7 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
         return;
     }
     let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
-    let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv);
+    let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.color);
     let entering = dot(ray.direction, hit.normal) < 0.0;
     // Shading happens on the side the ray came from.
     let ng = select(-hit.normal, hit.normal, entering);

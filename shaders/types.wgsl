@@ -87,17 +87,28 @@ struct Triangle {
 
 const NO_ATTRIBUTES: u32 = 0xffffffffu;
 
-// Vertex normals and texture coordinates of a mesh triangle, corner by corner.
+// Vertex normals, texture coordinates (two sets) and colours of a mesh triangle,
+// corner by corner.
 struct TriangleAttributes {
     n0: vec3<f32>,
     has_normals: u32,
     n1: vec3<f32>,
     has_uvs: u32,
     n2: vec3<f32>,
-    _pad0: u32,
+    has_colors: u32,
     uv01: vec4<f32>,
     uv2: vec2<f32>,
+    has_uvs1: u32,
+    _pad0: u32,
+    uv1_01: vec4<f32>,
+    uv1_2: vec2<f32>,
     _pad1: vec2<u32>,
+    c0: vec3<f32>,
+    _pad2: u32,
+    c1: vec3<f32>,
+    _pad3: u32,
+    c2: vec3<f32>,
+    _pad4: u32,
 }
 
 const MATERIAL_LAMBERT: u32 = 0u;
@@ -164,10 +175,18 @@ struct Material {
     emission_width: u32,
     emission_height: u32,
     emission_wrap: u32,
+    // The texture coordinate set (0 or 1) of each texture: bit UV_SLOT_* set for 1.
+    uv_sets: u32,
     _pad0: u32,
     _pad1: u32,
-    _pad2: u32,
+    // The affine maps of the textures' coordinates: texture s (UV_SLOT_*) maps uv to
+    // (dot(uv_rows[2s].xyz, (uv, 1)), dot(uv_rows[2s+1].xyz, (uv, 1))).
+    uv_rows: array<vec4<f32>, 6>,
 }
+
+const UV_SLOT_ALBEDO: u32 = 0u;
+const UV_SLOT_METALLIC_ROUGHNESS: u32 = 1u;
+const UV_SLOT_EMISSION: u32 = 2u;
 
 const LIGHT_POINT: u32 = 0u;
 const LIGHT_DIRECTIONAL: u32 = 1u;

@@ -158,6 +158,8 @@ impl Instance {
                     .normals
                     .map(|n| order.map(|k| (self.normal_matrix * n[k]).normalize_or(facing))),
                 uvs: object.uvs.map(|uv| order.map(|k| uv[k])),
+                uvs1: object.uvs1.map(|uv| order.map(|k| uv[k])),
+                colors: object.colors.map(|c| order.map(|k| c[k])),
             }
         });
         (
@@ -253,13 +255,11 @@ impl InstancedMesh {
                 .normals
                 .as_ref()
                 .map(|normals| order.map(|i| normals[i]));
-            let uvs = mesh.uvs.as_ref().map(|uvs| order.map(|i| uvs[i]));
-            let attributes = (normals.is_some() || uvs.is_some()).then(|| {
-                stored
-                    .triangle_attributes
-                    .push(TriangleAttributes { normals, uvs });
-                (stored.triangle_attributes.len() - 1) as u32
-            });
+            let attributes =
+                TriangleAttributes::of_corners(mesh, order, normals).map(|attributes| {
+                    stored.triangle_attributes.push(attributes);
+                    (stored.triangle_attributes.len() - 1) as u32
+                });
             stored.triangles.push(TriangleShape {
                 vertices,
                 material: mesh.material,
@@ -290,6 +290,8 @@ fn same_geometry(a: &Mesh, b: &Mesh) -> bool {
         && a.positions == b.positions
         && a.normals == b.normals
         && a.uvs == b.uvs
+        && a.uvs1 == b.uvs1
+        && a.colors == b.colors
 }
 
 /// The scene's meshes grouped by identical geometry ([`Mesh::positions`], normals,
@@ -365,6 +367,8 @@ mod tests {
             positions: vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y],
             normals: Some(vec![DVec3::Z; 4]),
             uvs: None,
+            uvs1: None,
+            colors: None,
             triangles: vec![[0, 1, 2], [0, 2, 3]],
             material: 0,
             instances,
@@ -459,6 +463,8 @@ mod tests {
             positions: positions.clone(),
             normals: None,
             uvs: None,
+            uvs1: None,
+            colors: None,
             triangles,
             material: 0,
             instances: vec![],

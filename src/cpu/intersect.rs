@@ -48,6 +48,10 @@ pub struct Hit {
     /// Texture coordinates: a mesh triangle's vertex coordinates interpolated at the
     /// hit, else `(0, 0)`.
     pub uv: DVec2,
+    /// The second set of texture coordinates, likewise.
+    pub uv1: DVec2,
+    /// A mesh triangle's vertex colours interpolated at the hit, else white (1, 1, 1).
+    pub color: DVec3,
     /// Barycentric coordinates of the hit in a triangle (weights of its three
     /// corners), else `(1, 0, 0)`.
     pub barycentrics: DVec3,
@@ -191,7 +195,8 @@ pub fn hit_record_keyed(geometry: &SceneGeometry, key: HitKey, ray: &Ray, t: f64
 }
 
 /// A hit without vertex attributes: its shading normal is its geometric normal, its
-/// texture coordinates `(0, 0)`, its barycentric coordinates `(1, 0, 0)`.
+/// texture coordinates `(0, 0)`, its colour white, its barycentric coordinates
+/// `(1, 0, 0)`.
 pub fn flat_hit(prim: PrimRef, t: f64, normal: DVec3, material: u32, position: DVec3) -> Hit {
     Hit {
         t,
@@ -201,6 +206,8 @@ pub fn flat_hit(prim: PrimRef, t: f64, normal: DVec3, material: u32, position: D
         prim,
         shading_normal: normal,
         uv: DVec2::ZERO,
+        uv1: DVec2::ZERO,
+        color: DVec3::ONE,
         barycentrics: DVec3::X,
         instance: None,
     }
@@ -230,7 +237,8 @@ fn triangle_hit(
 }
 
 /// Fills a triangle hit's shading normal (its vertex normals interpolated at its
-/// barycentric coordinates) and texture coordinates from its world-space `attributes`.
+/// barycentric coordinates), texture coordinates and vertex colour from its
+/// world-space `attributes`.
 pub fn apply_triangle_attributes(hit: &mut Hit, attributes: &TriangleAttributes) {
     let b = hit.barycentrics;
     if let Some(n) = attributes.normals {
@@ -244,6 +252,12 @@ pub fn apply_triangle_attributes(hit: &mut Hit, attributes: &TriangleAttributes)
     }
     if let Some(uv) = attributes.uvs {
         hit.uv = uv[0] * b.x + uv[1] * b.y + uv[2] * b.z;
+    }
+    if let Some(uv) = attributes.uvs1 {
+        hit.uv1 = uv[0] * b.x + uv[1] * b.y + uv[2] * b.z;
+    }
+    if let Some(c) = attributes.colors {
+        hit.color = c[0] * b.x + c[1] * b.y + c[2] * b.z;
     }
 }
 

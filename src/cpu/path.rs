@@ -221,7 +221,8 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
             &scene.images,
             hit.position,
             hit.normal,
-            hit.uv,
+            [hit.uv, hit.uv1],
+            hit.color,
         );
         // Emission, weighted against next-event estimation where that could have
         // found it.
@@ -453,7 +454,7 @@ fn sample_emitter(
         &scene.images,
         light_hit.position,
         light_hit.normal,
-        light_hit.uv,
+        [light_hit.uv, light_hit.uv1],
     );
     (
         light_sample_contribution(scene, material, n, wo, wi, pdf, radiance, mis),

@@ -325,7 +325,8 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumSta
         &scene.images,
         position,
         hit.normal,
-        hit.uv,
+        [hit.uv, hit.uv1],
+        hit.color,
     );
     let material = &material;
     let entering = ray.direction.dot(hit.normal) < 0.0;

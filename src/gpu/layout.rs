@@ -423,13 +423,27 @@ pub struct GpuMaterial {
     pub emission_height: u32,
     /// Its wrap modes: the `WRAP_*` code along `u` in bits 0-7, along `v` in bits 8-15.
     pub emission_wrap: u32,
+    /// The texture coordinate set (0 or 1) each texture reads: the albedo texture's in
+    /// bit 0, the metallic/roughness texture's in bit 1, the emission texture's in bit 2
+    /// (`UV_SLOT_*`).
+    pub uv_sets: u32,
     /// Padding.
     pub _pad0: u32,
     /// Padding.
     pub _pad1: u32,
-    /// Padding.
-    pub _pad2: u32,
+    /// The affine maps of the textures' coordinates, two rows each: texture `s`
+    /// (`UV_SLOT_*`) maps `(u, v)` to `(rows[2s]·(u, v, 1), rows[2s+1]·(u, v, 1))`
+    /// (the last lane unused); see [`crate::scene::TextureTransform`].
+    pub uv_rows: [[f32; 4]; 6],
 }
+
+/// [`GpuMaterial::uv_rows`] and [`GpuMaterial::uv_sets`]: the albedo texture.
+pub const UV_SLOT_ALBEDO: u32 = 0;
+/// [`GpuMaterial::uv_rows`] and [`GpuMaterial::uv_sets`]: the metallic/roughness
+/// texture.
+pub const UV_SLOT_METALLIC_ROUGHNESS: u32 = 1;
+/// [`GpuMaterial::uv_rows`] and [`GpuMaterial::uv_sets`]: the emission texture.
+pub const UV_SLOT_EMISSION: u32 = 2;
 
 /// The shading attributes of one mesh triangle (`TriangleAttributes` in WGSL): vertex
 /// normals and texture coordinates in the order of the triangle's corners; see
@@ -448,14 +462,34 @@ pub struct GpuTriangleAttributes {
     pub has_uvs: u32,
     /// Unit normal at the third corner.
     pub n2: [f32; 3],
-    /// Padding.
-    pub _pad0: u32,
+    /// 1 when the vertex colours are given, else 0 (white is used).
+    pub has_colors: u32,
     /// Texture coordinates of the first and second corners.
     pub uv01: [f32; 4],
     /// Texture coordinates of the third corner.
     pub uv2: [f32; 2],
+    /// 1 when the second set of texture coordinates is given, else 0 (`(0, 0)`).
+    pub has_uvs1: u32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Second-set texture coordinates of the first and second corners.
+    pub uv1_01: [f32; 4],
+    /// Second-set texture coordinates of the third corner.
+    pub uv1_2: [f32; 2],
     /// Padding.
     pub _pad1: [u32; 2],
+    /// Linear RGB colour at the first corner.
+    pub c0: [f32; 3],
+    /// Padding.
+    pub _pad2: u32,
+    /// Linear RGB colour at the second corner.
+    pub c1: [f32; 3],
+    /// Padding.
+    pub _pad3: u32,
+    /// Linear RGB colour at the third corner.
+    pub c2: [f32; 3],
+    /// Padding.
+    pub _pad4: u32,
 }
 
 /// A light (`Light` in WGSL).

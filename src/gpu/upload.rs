@@ -11,7 +11,8 @@ use super::layout::{
     LIGHT_DIRECTIONAL, LIGHT_POINT, MAPPING_PLANAR, MAPPING_SPHERICAL, MAPPING_UV,
     MATERIAL_BLINN_PHONG, MATERIAL_COOK_TORRANCE, MATERIAL_DIELECTRIC, MATERIAL_EMISSIVE,
     MATERIAL_LAMBERT, MATERIAL_MIRROR, MATERIAL_OREN_NAYAR, MATERIAL_PBR, MATERIAL_TABULATED,
-    NO_ATTRIBUTES, NO_IMAGE, WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT, WRAP_REPEAT,
+    NO_ATTRIBUTES, NO_IMAGE, UV_SLOT_ALBEDO, UV_SLOT_EMISSION, UV_SLOT_METALLIC_ROUGHNESS,
+    WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT, WRAP_REPEAT,
 };
 use crate::accel::{
     BrdfMapCdfs, BvhNode, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry,
@@ -62,6 +63,7 @@ impl SceneRecords {
     /// Converts the materials and lights of `scene` (already in lighting space) and
     /// the primitives and BVH of its `geometry`.
     pub fn new(scene: &Scene, geometry: &SceneGeometry) -> Self {
+        let shift_uvs = may_shift_uvs(scene);
         let mut records = Self {
             spheres: geometry
                 .spheres
@@ -93,13 +95,13 @@ impl SceneRecords {
             triangle_attributes: geometry
                 .triangle_attributes
                 .iter()
-                .map(triangle_attributes_record)
+                .map(|a| triangle_attributes_record(a, shift_uvs))
                 .collect(),
             bvh_nodes: geometry.bvh.nodes.clone(),
             bvh_prims: geometry.bvh.prims.iter().map(|p| p.0).collect(),
             ..Self::default()
         };
-        records.append_instances(geometry);
+        records.append_instances(geometry, shift_uvs);
         for polygon in &geometry.polygons {
             let first_vertex = records.polygon_points.len();
             records
@@ -122,7 +124,7 @@ impl SceneRecords {
     /// Appends the instanced meshes (triangles, attributes, trees with their node and
     /// primitive indices shifted to where they land) and the instances' records, and
     /// renames the scene tree's instance references to their records' node index.
-    fn append_instances(&mut self, geometry: &SceneGeometry) {
+    fn append_instances(&mut self, geometry: &SceneGeometry, shift_uvs: bool) {
         if geometry.instances.is_empty() {
             return;
         }
@@ -139,7 +141,7 @@ impl SceneRecords {
             self.triangle_attributes.extend(
                 mesh.triangle_attributes
                     .iter()
-                    .map(triangle_attributes_record),
+                    .map(|a| triangle_attributes_record(a, shift_uvs)),
             );
             let first_node = index(self.bvh_nodes.len());
             let first_prim = index(self.bvh_prims.len());
@@ -381,10 +383,48 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
         emission_height,
         emission_wrap: wrap_code(material.emission_wrap[0])
             | wrap_code(material.emission_wrap[1]) << 8,
+        uv_sets: [
+            (UV_SLOT_ALBEDO, &material.texture_transform),
+            (
+                UV_SLOT_METALLIC_ROUGHNESS,
+                &material.metallic_roughness_transform,
+            ),
+            (UV_SLOT_EMISSION, &material.emission_transform),
+        ]
+        .iter()
+        .fold(0, |sets, &(slot, t)| sets | u32::from(t.set == 1) << slot),
         _pad0: 0,
         _pad1: 0,
-        _pad2: 0,
+        uv_rows: [
+            &material.texture_transform,
+            &material.metallic_roughness_transform,
+            &material.emission_transform,
+        ]
+        .map(|t| {
+            t.rows
+                .map(|row| [row.x as f32, row.y as f32, row.z as f32, 0.0])
+        })
+        .concat()
+        .try_into()
+        .unwrap_or_default(),
     }
+}
+
+/// Whether the texture coordinates of `scene`'s meshes may be moved by whole repeats
+/// ([`uvs_near_origin`]): not when a material maps its texture coordinates by more
+/// than an offset (`KHR_texture_transform`'s rotation or scale), under which whole
+/// repeats of the coordinates are not whole repeats of the texture. Such a mesh keeps
+/// its coordinates as they are, in `f32`.
+pub fn may_shift_uvs(scene: &Scene) -> bool {
+    scene.materials.iter().all(|m| {
+        [
+            &m.texture_transform,
+            &m.metallic_roughness_transform,
+            &m.emission_transform,
+        ]
+        .iter()
+        .all(|t| t.is_linear_identity())
+    })
 }
 
 /// A triangle's texture coordinates moved, on each axis, by a whole even number of
@@ -424,17 +464,26 @@ fn wrap_code(wrap: TextureWrap) -> u32 {
 
 /// The record of one mesh triangle's shading attributes (zeros where absent), its
 /// texture coordinates moved near the origin ([`uvs_near_origin`]) so that `f32`
-/// keeps their fraction.
-pub fn triangle_attributes_record(attributes: &TriangleAttributes) -> GpuTriangleAttributes {
+/// keeps their fraction, where `shift_uvs` ([`may_shift_uvs`]).
+pub fn triangle_attributes_record(
+    attributes: &TriangleAttributes,
+    shift_uvs: bool,
+) -> GpuTriangleAttributes {
     let normals = attributes.normals.unwrap_or([DVec3::ZERO; 3]);
-    let uvs = uvs_near_origin(attributes.uvs.unwrap_or_default());
+    let near = |uvs: Option<[DVec2; 3]>| {
+        let uvs = uvs.unwrap_or_default();
+        if shift_uvs { uvs_near_origin(uvs) } else { uvs }
+    };
+    let uvs = near(attributes.uvs);
+    let uvs1 = near(attributes.uvs1);
+    let colors = attributes.colors.unwrap_or([DVec3::ONE; 3]);
     GpuTriangleAttributes {
         n0: vec3(normals[0]),
         has_normals: u32::from(attributes.normals.is_some()),
         n1: vec3(normals[1]),
         has_uvs: u32::from(attributes.uvs.is_some()),
         n2: vec3(normals[2]),
-        _pad0: 0,
+        has_colors: u32::from(attributes.colors.is_some()),
         uv01: [
             uvs[0].x as f32,
             uvs[0].y as f32,
@@ -442,7 +491,22 @@ pub fn triangle_attributes_record(attributes: &TriangleAttributes) -> GpuTriangl
             uvs[1].y as f32,
         ],
         uv2: [uvs[2].x as f32, uvs[2].y as f32],
+        has_uvs1: u32::from(attributes.uvs1.is_some()),
+        _pad0: 0,
+        uv1_01: [
+            uvs1[0].x as f32,
+            uvs1[0].y as f32,
+            uvs1[1].x as f32,
+            uvs1[1].y as f32,
+        ],
+        uv1_2: [uvs1[2].x as f32, uvs1[2].y as f32],
         _pad1: [0; 2],
+        c0: vec3(colors[0]),
+        _pad2: 0,
+        c1: vec3(colors[1]),
+        _pad3: 0,
+        c2: vec3(colors[2]),
+        _pad4: 0,
     }
 }
 
@@ -830,6 +894,8 @@ mod tests {
             positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
             normals: Some(vec![DVec3::Z; 3]),
             uvs: None,
+            uvs1: None,
+            colors: None,
             triangles: vec![[0, 1, 2]],
             material: 1,
             instances: vec![

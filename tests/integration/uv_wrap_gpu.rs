@@ -58,6 +58,8 @@ fn quad(material: u32, x: f64) -> Mesh {
             DVec2::new(2.25, -1.25),
             DVec2::new(-1.25, -1.25),
         ]),
+        uvs1: None,
+        colors: None,
         triangles: vec![[0, 1, 2], [0, 2, 3]],
         material,
         instances: vec![DMat4::from_translation(DVec3::new(x, 0.0, 0.0))],

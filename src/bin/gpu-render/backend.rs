@@ -480,6 +480,8 @@ mod tests {
             positions: vec![glam::DVec3::ZERO, glam::DVec3::X, glam::DVec3::Y],
             normals: None,
             uvs: None,
+            uvs1: None,
+            colors: None,
             triangles: vec![[0, 1, 2]],
             material: 0,
             instances: vec![glam::DMat4::IDENTITY],

@@ -24,7 +24,9 @@ use super::{
     MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES, TextureRef, WrapMode, error, read_file,
 };
 use crate::echo::short;
-use crate::scene::{Camera, Light, MAX_RADIANCE, Material, MaterialKind, SceneError};
+use crate::scene::{
+    Camera, Light, MAX_RADIANCE, Material, MaterialKind, SceneError, TextureTransform,
+};
 
 /// Luminous efficacy used to turn `KHR_lights_punctual`'s photometric intensities into
 /// our radiometric ones, in lm/W: 683, the peak of the photopic curve at 555 nm (the
@@ -41,6 +43,7 @@ const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_ior",
     "KHR_materials_transmission",
     "KHR_mesh_quantization",
+    "KHR_texture_transform",
 ];
 /// `KHR_mesh_quantization`, which widens the component types of vertex attributes.
 const MESH_QUANTIZATION: &str = "KHR_mesh_quantization";
@@ -67,6 +70,12 @@ const TEXCOORD_TYPES: &[DataType] = &[
     DataType::I16,
     DataType::U16,
 ];
+/// Largest offset or scale (in size) of a `KHR_texture_transform` accepted: beyond it
+/// an `f32` texture coordinate keeps less than 1/16 of a repeat.
+const MAX_TEXTURE_TRANSFORM: f64 = 1e6;
+/// Component types of `COLOR_0`: `FLOAT` and normalized unsigned bytes and shorts
+/// (glTF 2.0 §3.7.2.1).
+const COLOR_TYPES: &[DataType] = &[DataType::F32, DataType::U8, DataType::U16];
 /// Index of refraction of `KHR_materials_ior`'s default (and of glass without it).
 const DEFAULT_IOR: f64 = 1.5;
 /// Most validation problems quoted in one error message.
@@ -491,17 +500,17 @@ struct Importer<'a> {
     model: ImportedModel,
     budget: Budget,
     textures: Textures,
-    /// glTF material index (`None`: the default material) → index in the model and the
-    /// texture coordinate set its meshes are read with.
-    materials: HashMap<Option<usize>, (u32, u32)>,
+    /// glTF material index (`None`: the default material) → index in the model and
+    /// whether a texture of it reads `TEXCOORD_1`.
+    materials: HashMap<Option<usize>, (u32, bool)>,
     /// Warnings already given once per file.
     warned: BTreeSet<&'static str>,
     /// The primitives skipped for being points or lines (`mesh N, primitive P: MODE`).
     not_triangles: Vec<String>,
     /// How many primitives of triangles were read.
     triangle_primitives: usize,
-    /// The primitives with vertex colours, which are not stored (`mesh N, primitive P:
-    /// COLOR_0`).
+    /// The primitives with vertex colour sets beyond `COLOR_0`, which are not read
+    /// (`mesh N, primitive P: COLOR_1`).
     vertex_colors: Vec<String>,
 }
 
@@ -688,10 +697,10 @@ impl Importer<'_> {
             }
         }
         if !self.vertex_colors.is_empty() {
-            // Vertex colours multiply the base colour (glTF 2.0 §3.7.2.1); the renderers
-            // have no per-vertex colour yet, so the model shades without them.
+            // COLOR_0 multiplies the base colour (glTF 2.0 §3.9.2); further sets have no
+            // meaning the specification gives.
             self.warn(format!(
-                "vertex colours are present but not yet shaded; they are ignored ({})",
+                "only COLOR_0 multiplies the base colour; further vertex colour sets are ignored ({})",
                 quote_list(&self.vertex_colors, "; ")
             ));
         }
@@ -741,14 +750,16 @@ impl Importer<'_> {
             }
             self.triangle_primitives += 1;
             // The material first: it decides which texture coordinates to read.
-            let (material, uv_set) = self.material(primitive.material().index())?;
+            let (material, uses_set1) = self.material(primitive.material().index())?;
             // The JSON's keys, not `Primitive::attributes`, which unwraps each key.
             let json = &self.document.as_json().meshes[mesh.index()].primitives[primitive.index()];
             let colors: Vec<String> = json
                 .attributes
                 .keys()
                 .filter_map(|semantic| match semantic {
-                    Checked::Valid(::gltf::Semantic::Colors(set)) => Some(format!("COLOR_{set}")),
+                    Checked::Valid(::gltf::Semantic::Colors(set)) if *set > 0 => {
+                        Some(format!("COLOR_{set}"))
+                    }
                     _ => None,
                 })
                 .collect();
@@ -757,7 +768,7 @@ impl Importer<'_> {
                     .push(format!("{name}: {}", colors.join(", ")));
             }
             let raw = self
-                .primitive(&primitive, &name, uv_set)
+                .primitive(&primitive, &name, uses_set1)
                 .map_err(|e| self.fail(format!("{name}: {e}")))?;
             self.budget
                 .charge_instances(instances.len())
@@ -775,15 +786,15 @@ impl Importer<'_> {
         Ok(())
     }
 
-    /// Reads one primitive's positions, normals, texture coordinates (set `uv_set`, the
-    /// one its material's textures use) and triangles (its mode is one of the three of
-    /// triangles); `name` (mesh and primitive) is for warnings, the caller prefixes it to
-    /// errors.
+    /// Reads one primitive's positions, normals, texture coordinates (`TEXCOORD_0`, and
+    /// `TEXCOORD_1` when `uses_set1`: a texture of its material reads it), vertex
+    /// colours (`COLOR_0`) and triangles (its mode is one of the three of triangles);
+    /// `name` (mesh and primitive) is for warnings, the caller prefixes it to errors.
     fn primitive(
         &mut self,
         primitive: &::gltf::Primitive<'_>,
         name: &str,
-        uv_set: u32,
+        uses_set1: bool,
     ) -> Result<RawMesh, String> {
         let mode = primitive.mode();
         let positions_accessor = primitive
@@ -851,45 +862,28 @@ impl Importer<'_> {
             }
             None => None,
         };
-        let mut uv_accessor = primitive.get(&::gltf::Semantic::TexCoords(uv_set));
-        let mut uv_name = format!("TEXCOORD_{uv_set}");
-        if uv_accessor.is_none() && uv_set != 0 {
-            // A texture that names a set the primitive lacks is invalid (glTF 2.0
-            // §5.30, textureInfo.texCoord); the first set is the likeliest intent.
-            uv_accessor = primitive.get(&::gltf::Semantic::TexCoords(0));
-            self.warn(format!(
-                "{name}: its material's textures use {uv_name}, which it does not have; {}",
-                if uv_accessor.is_some() {
-                    "TEXCOORD_0 is used"
-                } else {
-                    "it has no texture coordinates"
+        let uvs = self.texcoords(primitive, name, 0, count)?;
+        let uvs1 = if uses_set1 {
+            match self.texcoords(primitive, name, 1, count)? {
+                Some(uvs1) => Some(uvs1),
+                None => {
+                    // A texture that names a set the primitive lacks is invalid (glTF 2.0
+                    // §5.30, textureInfo.texCoord); the first set is the likeliest intent.
+                    self.warn(format!(
+                        "{name}: its material's textures use TEXCOORD_1, which it does not have; {}",
+                        if uvs.is_some() {
+                            "TEXCOORD_0 is used"
+                        } else {
+                            "it has no texture coordinates"
+                        }
+                    ));
+                    uvs.clone()
                 }
-            ));
-            uv_name = "TEXCOORD_0".into();
-        }
-        let uvs = match uv_accessor {
-            Some(accessor) => {
-                same_count(&accessor, &uv_name)?;
-                let values = read(
-                    &accessor,
-                    &Expect {
-                        name: &uv_name,
-                        dimensions: Dimensions::Vec2,
-                        types: TEXCOORD_TYPES,
-                        normalized: Normalized::Either,
-                    },
-                    &self.buffers,
-                )?;
-                self.check_quantization(&accessor, name, &uv_name, true);
-                Some(
-                    values
-                        .chunks_exact(2)
-                        .map(|c| DVec2::new(c[0], c[1]))
-                        .collect(),
-                )
             }
-            None => None,
+        } else {
+            None
         };
+        let colors = self.colors(primitive, name, count);
         let indices: Vec<u32> = match primitive.indices() {
             Some(accessor) => read(
                 &accessor,
@@ -918,8 +912,108 @@ impl Importer<'_> {
             positions,
             normals,
             uvs,
+            uvs1,
+            colors,
             triangles,
         })
+    }
+
+    /// Reads `TEXCOORD_{set}` of `primitive` (of `count` vertices), if it has it.
+    fn texcoords(
+        &mut self,
+        primitive: &::gltf::Primitive<'_>,
+        name: &str,
+        set: u32,
+        count: usize,
+    ) -> Result<Option<Vec<DVec2>>, String> {
+        let Some(accessor) = primitive.get(&::gltf::Semantic::TexCoords(set)) else {
+            return Ok(None);
+        };
+        let uv_name = format!("TEXCOORD_{set}");
+        if accessor.count() != count {
+            return Err(format!(
+                "{uv_name} has {} elements but POSITION has {count}",
+                accessor.count()
+            ));
+        }
+        let values = read(
+            &accessor,
+            &Expect {
+                name: &uv_name,
+                dimensions: Dimensions::Vec2,
+                types: TEXCOORD_TYPES,
+                normalized: Normalized::Either,
+            },
+            &self.buffers,
+        )?;
+        self.check_quantization(&accessor, name, &uv_name, true);
+        Ok(Some(
+            values
+                .chunks_exact(2)
+                .map(|c| DVec2::new(c[0], c[1]))
+                .collect(),
+        ))
+    }
+
+    /// Reads `COLOR_0` of `primitive` (of `count` vertices), if it has it: `VEC3` or
+    /// `VEC4` of floats or normalized unsigned bytes or shorts (glTF 2.0 §3.7.2.1), the
+    /// alpha of `VEC4` left out (alpha modes are not supported; a warning says so when
+    /// it is not 1). An accessor that breaks these rules is left out with a warning:
+    /// the model still renders, in its materials' colours.
+    fn colors(
+        &mut self,
+        primitive: &::gltf::Primitive<'_>,
+        name: &str,
+        count: usize,
+    ) -> Option<Vec<DVec3>> {
+        let accessor = primitive.get(&::gltf::Semantic::Colors(0))?;
+        let dimensions = accessor.dimensions();
+        let read_colors = || -> Result<Vec<f64>, String> {
+            if accessor.count() != count {
+                return Err(format!(
+                    "COLOR_0 has {} elements but POSITION has {count}",
+                    accessor.count()
+                ));
+            }
+            if !matches!(dimensions, Dimensions::Vec3 | Dimensions::Vec4) {
+                return Err(format!(
+                    "COLOR_0 (accessor {}) holds {dimensions:?} elements, expected Vec3 or Vec4",
+                    accessor.index()
+                ));
+            }
+            read(
+                &accessor,
+                &Expect {
+                    name: "COLOR_0",
+                    dimensions,
+                    types: COLOR_TYPES,
+                    normalized: Normalized::Always,
+                },
+                &self.buffers,
+            )
+        };
+        let values = match read_colors() {
+            Ok(values) => values,
+            Err(e) => {
+                self.warn(format!("{name}: {e}; the vertex colours are ignored"));
+                return None;
+            }
+        };
+        let components = dimensions.multiplicity();
+        if components == 4 && values.chunks_exact(4).any(|c| c[3] != 1.0) {
+            self.warn_once(
+                "color alpha",
+                format!(
+                    "{name}: COLOR_0 has alpha below 1, which is ignored (alpha modes are not supported): the surface is opaque"
+                ),
+            );
+        }
+        Some(
+            values
+                .chunks_exact(components)
+                .map(|c| DVec3::new(c[0], c[1], c[2]))
+                .collect(),
+        )
     }
 
     /// Warns (once per file) when `accessor` holds one of the component types that only
@@ -957,11 +1051,11 @@ impl Importer<'_> {
 
     /// The model's index of glTF material `index` (`None`: the default material, glTF
     /// 2.0 §3.9.6), mapping it on first use.
-    fn material(&mut self, index: Option<usize>) -> Result<(u32, u32), SceneError> {
+    fn material(&mut self, index: Option<usize>) -> Result<(u32, bool), SceneError> {
         if let Some(&known) = self.materials.get(&index) {
             return Ok(known);
         }
-        let (imported, uv_set) = match index.and_then(|i| self.document.materials().nth(i)) {
+        let (imported, uses_set1) = match index.and_then(|i| self.document.materials().nth(i)) {
             Some(material) => self.map_material(&material)?,
             None => (
                 ImportedMaterial {
@@ -978,21 +1072,21 @@ impl Importer<'_> {
                     metallic_roughness_texture: None,
                     emissive_texture: None,
                 },
-                0,
+                false,
             ),
         };
         let ours = self.model.materials.len() as u32;
         self.model.materials.push(imported);
-        self.materials.insert(index, (ours, uv_set));
-        Ok((ours, uv_set))
+        self.materials.insert(index, (ours, uses_set1));
+        Ok((ours, uses_set1))
     }
 
     /// Maps a glTF metallic-roughness material onto ours (the table in `docs/models.md`),
-    /// with the texture coordinate set its meshes are read with ([`Importer::uv_set`]).
+    /// with whether one of its textures reads `TEXCOORD_1`.
     fn map_material(
         &mut self,
         material: &::gltf::Material<'_>,
-    ) -> Result<(ImportedMaterial, u32), SceneError> {
+    ) -> Result<(ImportedMaterial, bool), SceneError> {
         let name = describe("material", material.index().unwrap_or(0), material.name());
         let pbr = material.pbr_metallic_roughness();
         let [r, g, b, _alpha] = pbr.base_color_factor().map(f64::from);
@@ -1105,23 +1199,13 @@ impl Importer<'_> {
             Some(info) => Some(self.texture(&info, Encoding::Color, &name, "emissiveTexture")?),
             None => None,
         };
-        let uv_set = self.uv_set(
-            &name,
-            &[
-                (
-                    "baseColorTexture",
-                    pbr.base_color_texture().map(|t| t.tex_coord()),
-                ),
-                (
-                    "metallicRoughnessTexture",
-                    pbr.metallic_roughness_texture().map(|t| t.tex_coord()),
-                ),
-                (
-                    "emissiveTexture",
-                    material.emissive_texture().map(|t| t.tex_coord()),
-                ),
-            ],
-        );
+        let uses_set1 = [
+            &base_color_texture,
+            &metallic_roughness_texture,
+            &emissive_texture,
+        ]
+        .iter()
+        .any(|t| t.is_some_and(|t| t.transform.set == 1));
         let imported = ImportedMaterial {
             name: material.name().map_or_else(|| name.clone(), str::to_string),
             material: ours,
@@ -1129,51 +1213,11 @@ impl Importer<'_> {
             metallic_roughness_texture,
             emissive_texture,
         };
-        Ok((imported, uv_set))
+        Ok((imported, uses_set1))
     }
 
-    /// The texture coordinate set (`TEXCOORD_n`) for the meshes of `material`, whose
-    /// textures the renderers use ask for the sets in `slots` (`None`: no such texture).
-    /// A mesh carries one set, so when they disagree the set most of them use is taken
-    /// (on a tie the base colour's, else the lowest), with a warning naming the textures
-    /// that are then mapped by the wrong set.
-    fn uv_set(&mut self, material: &str, slots: &[(&str, Option<u32>)]) -> u32 {
-        let used: Vec<(&str, u32)> = slots
-            .iter()
-            .filter_map(|&(slot, set)| set.map(|set| (slot, set)))
-            .collect();
-        let Some(&(_, first)) = used.first() else {
-            return 0;
-        };
-        if used.iter().all(|&(_, set)| set == first) {
-            return first;
-        }
-        let count = |set: u32| used.iter().filter(|&&(_, s)| s == set).count();
-        let base = used
-            .iter()
-            .find(|&&(slot, _)| slot == "baseColorTexture")
-            .map(|&(_, set)| set);
-        let chosen = used
-            .iter()
-            .map(|&(_, set)| set)
-            .max_by_key(|&set| (count(set), Some(set) == base, std::cmp::Reverse(set)))
-            .unwrap_or(0);
-        let describe = |&(slot, set): &(&str, u32)| format!("{slot}: TEXCOORD_{set}");
-        let wrong: Vec<&str> = used
-            .iter()
-            .filter(|&&(_, set)| set != chosen)
-            .map(|&(slot, _)| slot)
-            .collect();
-        self.warn(format!(
-            "{material}: its textures use different texture coordinate sets ({}), and a mesh is read with one: TEXCOORD_{chosen}, so {} {} mapped by the wrong coordinates",
-            used.iter().map(describe).collect::<Vec<_>>().join(", "),
-            wrong.join(" and "),
-            if wrong.len() == 1 { "is" } else { "are" }
-        ));
-        chosen
-    }
-
-    /// Loads the image of a material's texture and keeps its sampler's wrap modes.
+    /// Loads the image of a material's texture and keeps its sampler's wrap modes, its
+    /// texture coordinate set and `KHR_texture_transform` ([`Importer::transform`]).
     fn texture(
         &mut self,
         info: &::gltf::texture::Info<'_>,
@@ -1222,11 +1266,53 @@ impl Importer<'_> {
             WrappingMode::ClampToEdge => WrapMode::ClampToEdge,
             WrappingMode::MirroredRepeat => WrapMode::MirroredRepeat,
         };
+        let transform = self.transform(info, material, slot)?;
         Ok(TextureRef {
             image: index,
             wrap_u: wrap(sampler.wrap_s()),
             wrap_v: wrap(sampler.wrap_t()),
+            transform,
         })
+    }
+
+    /// The texture coordinate set of a texture (its `texCoord`, or the one its
+    /// `KHR_texture_transform` overrides it with) and the extension's offset, rotation
+    /// and scale as one map ([`TextureTransform::offset_rotation_scale`]). A set beyond 1
+    /// is read as `TEXCOORD_0`, with a warning (no texture of the Khronos samples asks
+    /// for one). A transform with a value that is not finite, or an offset or scale
+    /// beyond [`MAX_TEXTURE_TRANSFORM`] in size (where `f32` coordinates on the GPU keep
+    /// no fraction of a texel), is an error.
+    fn transform(
+        &mut self,
+        info: &::gltf::texture::Info<'_>,
+        material: &str,
+        slot: &str,
+    ) -> Result<TextureTransform, SceneError> {
+        let mut set = info.tex_coord();
+        let mut transform = TextureTransform::IDENTITY;
+        if let Some(extension) = info.texture_transform() {
+            set = extension.tex_coord().unwrap_or(set);
+            let offset = DVec2::from_array(extension.offset().map(f64::from));
+            let rotation = f64::from(extension.rotation());
+            let scale = DVec2::from_array(extension.scale().map(f64::from));
+            let in_range =
+                |v: DVec2| v.is_finite() && v.abs().max_element() <= MAX_TEXTURE_TRANSFORM;
+            if !(in_range(offset) && in_range(scale) && rotation.is_finite()) {
+                return Err(self.fail(format!(
+                    "{material}: {slot}: KHR_texture_transform offset {offset}, rotation {rotation} and scale {scale} must be finite, the offset and scale at most {} in size",
+                    short(MAX_TEXTURE_TRANSFORM)
+                )));
+            }
+            transform = TextureTransform::offset_rotation_scale(0, offset, rotation, scale);
+        }
+        if set > 1 {
+            self.warn(format!(
+                "{material}: {slot} uses TEXCOORD_{set}, but only TEXCOORD_0 and TEXCOORD_1 are read; TEXCOORD_0 is used"
+            ));
+            set = 0;
+        }
+        transform.set = set;
+        Ok(transform)
     }
 
     /// Keeps the first perspective camera placed by a node.

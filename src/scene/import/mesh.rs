@@ -38,6 +38,8 @@ pub(super) struct RawMesh {
     pub positions: Vec<DVec3>,
     pub normals: Option<Vec<DVec3>>,
     pub uvs: Option<Vec<DVec2>>,
+    pub uvs1: Option<Vec<DVec2>>,
+    pub colors: Option<Vec<DVec3>>,
     pub triangles: Vec<[u32; 3]>,
 }
 
@@ -57,6 +59,8 @@ pub(super) fn finish_mesh(
         positions,
         normals,
         uvs,
+        uvs1,
+        colors,
         triangles,
     } = raw;
     let mut warn = |message: String| warnings.push(format!("{}: {message}", file.display()));
@@ -87,24 +91,71 @@ pub(super) fn finish_mesh(
             None => Some(unit),
         }
     });
-    let uvs = uvs.and_then(|uvs| {
-        if uvs.len() != count {
+    let mut check_uvs = |uvs: Option<Vec<DVec2>>, what: &str| {
+        uvs.and_then(|uvs| {
+            if uvs.len() != count {
+                warn(format!(
+                    "{name}: {} {what} for {count} vertices; the {what} are ignored",
+                    uvs.len()
+                ));
+                return None;
+            }
+            match uvs.iter().position(|uv| !uv.is_finite()) {
+                Some(i) => {
+                    warn(format!(
+                        "{name}: the {what} of vertex {i} are not finite ({}); the {what} are ignored",
+                        uvs[i]
+                    ));
+                    None
+                }
+                None => Some(uvs),
+            }
+        })
+    };
+    let uvs = check_uvs(uvs, "texture coordinates");
+    let uvs1 = check_uvs(uvs1, "second texture coordinates");
+    let colors = colors.and_then(|colors| {
+        if colors.len() != count {
             warn(format!(
-                "{name}: {} texture coordinates for {count} vertices; the texture coordinates are ignored",
-                uvs.len()
+                "{name}: {} vertex colours for {count} vertices; the vertex colours are ignored",
+                colors.len()
             ));
             return None;
         }
-        match uvs.iter().position(|uv| !uv.is_finite()) {
-            Some(i) => {
-                warn(format!(
-                    "{name}: the texture coordinates of vertex {i} are not finite ({}); the texture coordinates are ignored",
-                    uvs[i]
-                ));
-                None
-            }
-            None => Some(uvs),
+        if let Some(i) = colors.iter().position(|c| c.is_nan()) {
+            warn(format!(
+                "{name}: the colour of vertex {i} is not a number ({}); the vertex colours are ignored",
+                colors[i]
+            ));
+            return None;
         }
+        // Colours are reflectances: outside [0, 1] a surface would reflect more light
+        // than it receives (or less than none).
+        let outside = colors
+            .iter()
+            .filter(|c| c.min_element() < 0.0 || c.max_element() > 1.0)
+            .count();
+        if outside > 0 {
+            warn(format!(
+                "{name}: {outside} vertex colour{} outside [0, 1] (the first at vertex {}: {}); clamped",
+                if outside == 1 { "" } else { "s" },
+                colors
+                    .iter()
+                    .position(|c| c.min_element() < 0.0 || c.max_element() > 1.0)
+                    .unwrap_or(0),
+                colors
+                    .iter()
+                    .find(|c| c.min_element() < 0.0 || c.max_element() > 1.0)
+                    .copied()
+                    .unwrap_or_default(),
+            ));
+        }
+        Some(
+            colors
+                .into_iter()
+                .map(|c| c.clamp(DVec3::ZERO, DVec3::ONE))
+                .collect(),
+        )
     });
     let total = triangles.len();
     let mut kept = Vec::with_capacity(total);
@@ -138,6 +189,8 @@ pub(super) fn finish_mesh(
         positions,
         normals,
         uvs,
+        uvs1,
+        colors,
         triangles: kept,
         material,
         instances: vec![glam::DMat4::IDENTITY],
@@ -145,7 +198,8 @@ pub(super) fn finish_mesh(
 }
 
 /// Bytes an imported vertex may hold: its position and normal (`DVec3`, 24 bytes
-/// each) and texture coordinates (`DVec2`, 16 bytes).
+/// each) and texture coordinates (`DVec2`, 16 bytes). Vertex colours and a second set
+/// of texture coordinates, which few meshes have, are not counted.
 pub(super) const BYTES_PER_VERTEX: u64 = 64;
 /// Bytes of an imported triangle (three `u32` indices).
 pub(super) const BYTES_PER_TRIANGLE: u64 = 12;
@@ -261,6 +315,8 @@ mod tests {
             positions,
             normals: None,
             uvs: None,
+            uvs1: None,
+            colors: None,
             triangles,
         }
     }

@@ -271,6 +271,8 @@ pub fn blob(rings: usize, segments: usize) -> Mesh {
         positions,
         normals: Some(normals),
         uvs: Some(uvs),
+        uvs1: None,
+        colors: None,
         triangles,
         material: 1,
         instances: vec![],

@@ -290,6 +290,8 @@ fn instanced_million_scene(
                         .collect(),
                 ),
                 uvs: None,
+                uvs1: None,
+                colors: None,
                 triangles: triangles
                     .iter()
                     .map(|&[a, b, c]| if mirrored { [a, c, b] } else { [a, b, c] })
@@ -306,6 +308,8 @@ fn instanced_million_scene(
                 positions: positions.clone(),
                 normals: Some(normals.clone()),
                 uvs: None,
+                uvs1: None,
+                colors: None,
                 triangles: triangles.clone(),
                 material,
                 instances: vec![transform],

@@ -431,6 +431,7 @@ pub(super) fn map_material(
             image,
             wrap_u: wrap,
             wrap_v: wrap,
+            transform: crate::scene::TextureTransform::IDENTITY,
         }))
     };
     let base_color_texture =
