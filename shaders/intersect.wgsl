@@ -117,6 +117,13 @@ fn triangle_barycentrics(p: vec3<f32>, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f3
 }
 //#endif
 
+// Whether a camera ray (`depth` 0) along `direction` passes through the back face of
+// a material that culls back faces (glTF doubleSided false, glTF 2.0 §3.9.5) at a hit
+// of geometric normal `normal`. CPU twin: culls_back_face.
+fn culls_back_face(cull_back_faces: bool, depth: u32, direction: vec3<f32>, normal: vec3<f32>) -> bool {
+    return cull_back_faces && depth == 0u && dot(direction, normal) > 0.0;
+}
+
 //#if MESH_ATTRIBUTES
 // Fills a mesh triangle hit's shading normal (the interpolated vertex normals, kept
 // only where they are not degenerate and face the geometric normal's side), texture

@@ -342,6 +342,11 @@ fn path_closest_hit(path: ptr<function, PathState>, trace: TraceRay) {
         return;
     }
     let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
+    if culls_back_face(materials[hit.material].cull_back_faces != 0u, (*path).depth, ray.direction, hit.normal) {
+        (*path).origin = offset_ray_origin(hit.position, hit.normal, frame.offset_scale);
+        (*path).phase = PHASE_PASS_THROUGH;
+        return;
+    }
     let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.color);
     // Emission, weighted against next-event estimation where that could have found it;
     // shadow_origin still holds the previous hit's, where that estimation sampled from.

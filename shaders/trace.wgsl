@@ -129,6 +129,11 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
         return;
     }
     let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
+    if culls_back_face(materials[hit.material].cull_back_faces != 0u, (*path).depth, ray.direction, hit.normal) {
+        (*path).origin = offset_ray_origin(hit.position, hit.normal, frame.offset_scale);
+        (*path).phase = PHASE_PASS_THROUGH;
+        return;
+    }
     let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.color);
     let entering = dot(ray.direction, hit.normal) < 0.0;
     // Shading happens on the side the ray came from.

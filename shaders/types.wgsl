@@ -177,7 +177,8 @@ struct Material {
     emission_wrap: u32,
     // The texture coordinate set (0 or 1) of each texture: bit UV_SLOT_* set for 1.
     uv_sets: u32,
-    _pad0: u32,
+    // 1 when camera rays pass through the back faces of flat shapes of this material.
+    cull_back_faces: u32,
     _pad1: u32,
     // The affine maps of the textures' coordinates: texture s (UV_SLOT_*) maps uv to
     // (dot(uv_rows[2s].xyz, (uv, 1)), dot(uv_rows[2s+1].xyz, (uv, 1))).
@@ -265,6 +266,9 @@ const PHASE_START_SAMPLE: u32 = 6u;
 const PHASE_IDLE: u32 = 7u;
 // A slot whose pixel is done (PHASE_EMITTER is 8).
 const PHASE_FETCH_PIXEL: u32 = 9u;
+// A camera ray met the back face of a single-sided material: it goes on from just
+// beyond it (culls_back_face).
+const PHASE_PASS_THROUGH: u32 = 10u;
 
 // The state of one slot's path tree between dispatches: its pixel and sample, the
 // sums, the ray being shaded (origin, direction, weight, depth, medium) and, while its

@@ -225,6 +225,12 @@ fn shade_step(slot: u32, path: ptr<function, PathState>, trace: ptr<function, Tr
         }
         //#endif
     }
+    if (*path).phase == PHASE_PASS_THROUGH {
+        // The camera ray again, from beyond the back face it passed (culls_back_face).
+        (*path).rays += 1u;
+        start_trace(trace, (*path).origin, (*path).direction, bitcast<f32>(0x7f800000u), false);
+        (*path).phase = PHASE_CLOSEST;
+    }
     if (*path).phase == PHASE_NEXT_LIGHT {
         // Lights behind the surface cast no ray: skip them here. At least one light
         // per step, so that any budget makes progress: the step itself was charged an

@@ -236,6 +236,16 @@ fn triangle_hit(
     hit
 }
 
+/// Whether a camera ray (`depth` 0) travelling along `direction` passes through the
+/// surface it hit, of geometric normal `normal` (as the shape defines it): the back
+/// face of a material that culls back faces (glTF's `doubleSided: false`, glTF 2.0
+/// §3.9.5: "back-face culling is enabled"). Such a ray goes on from just beyond the
+/// surface, without a bounce. Spheres' outsides are their fronts; a plane's front is
+/// the side its normal points to.
+pub fn culls_back_face(cull_back_faces: bool, depth: u32, direction: DVec3, normal: DVec3) -> bool {
+    cull_back_faces && depth == 0 && direction.dot(normal) > 0.0
+}
+
 /// Fills a triangle hit's shading normal (its vertex normals interpolated at its
 /// barycentric coordinates), texture coordinates and vertex colour from its
 /// world-space `attributes`.

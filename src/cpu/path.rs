@@ -23,7 +23,7 @@ use super::bxdf::{
     pdf_ggx_visible_normal, reflect_direction, sample_beckmann_normal, sample_blinn_phong_half,
     sample_ggx_visible_normal, surface_response,
 };
-use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
+use super::intersect::{Hit, Ray, culls_back_face, offset_ray_origin, shadow_terminator_point};
 use super::tabulated::{pdf_tabulated, sample_tabulated};
 use super::trace::{
     PreparedScene, add_contribution, direct_light, finite_radiance, keep_on_side,
@@ -216,8 +216,14 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
             add_contribution(&mut radiance, throughput * background);
             break;
         };
+        let record = &scene.materials[hit.material as usize];
+        if culls_back_face(record.cull_back_faces, depth, ray.direction, hit.normal) {
+            // Through the back face: the same camera ray from just beyond it.
+            ray.origin = offset_ray_origin(hit.position, hit.normal, geometry.offset_scale);
+            continue;
+        }
         let material = shading_material(
-            &scene.materials[hit.material as usize],
+            record,
             &scene.images,
             hit.position,
             hit.normal,

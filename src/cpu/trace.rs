@@ -6,7 +6,7 @@
 use glam::DVec3;
 
 use super::bxdf::{eval_brdf, has_base_brdf, reflect_direction, surface_response};
-use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
+use super::intersect::{Hit, Ray, culls_back_face, offset_ray_origin, shadow_terminator_point};
 use super::path::path_radiance;
 use super::traverse::{intersect_scene, occluded};
 use crate::accel::SceneGeometry;
@@ -228,6 +228,23 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
             );
             continue;
         };
+        let material = &scene.materials[hit.material as usize];
+        if culls_back_face(
+            material.cull_back_faces,
+            entry.depth,
+            entry.ray.direction,
+            hit.normal,
+        ) {
+            let origin = offset_ray_origin(hit.position, hit.normal, scene.geometry.offset_scale);
+            stack.push(StackEntry {
+                ray: Ray {
+                    origin,
+                    ..entry.ray
+                },
+                ..entry
+            });
+            continue;
+        }
         let shaded = shade_hit(scene, &entry.ray, &hit, &entry.medium);
         add_contribution(&mut radiance, entry.weight * shaded.radiance);
         rays += shaded.shadow_rays;

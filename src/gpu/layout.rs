@@ -427,8 +427,9 @@ pub struct GpuMaterial {
     /// bit 0, the metallic/roughness texture's in bit 1, the emission texture's in bit 2
     /// (`UV_SLOT_*`).
     pub uv_sets: u32,
-    /// Padding.
-    pub _pad0: u32,
+    /// 1 when camera rays pass through the back faces of flat shapes of this material
+    /// (glTF `doubleSided: false`).
+    pub cull_back_faces: u32,
     /// Padding.
     pub _pad1: u32,
     /// The affine maps of the textures' coordinates, two rows each: texture `s`

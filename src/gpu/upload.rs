@@ -393,7 +393,7 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
         ]
         .iter()
         .fold(0, |sets, &(slot, t)| sets | u32::from(t.set == 1) << slot),
-        _pad0: 0,
+        cull_back_faces: u32::from(material.cull_back_faces),
         _pad1: 0,
         uv_rows: [
             &material.texture_transform,

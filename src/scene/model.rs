@@ -387,6 +387,12 @@ pub struct Material {
     /// to (spheres always emit on both). The path integrator's rule: Whitted shows
     /// emission on either side.
     pub two_sided: bool,
+    /// Whether camera rays pass through the back faces of flat shapes (polygons,
+    /// triangles, meshes) of this material: glTF's `doubleSided: false` (glTF 2.0
+    /// §3.9.5, back-face culling). Secondary and shadow rays see both faces, so that a
+    /// single-sided surface still reflects, refracts (a closed glass mesh) and casts
+    /// shadows as a rasteriser's shadow map would. Default false: both faces show.
+    pub cull_back_faces: bool,
 }
 
 impl Material {
@@ -424,6 +430,7 @@ impl Material {
             emission_wrap: [TextureWrap::Repeat; 2],
             emission_transform: TextureTransform::IDENTITY,
             two_sided: false,
+            cull_back_faces: false,
         }
     }
 

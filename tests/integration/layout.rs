@@ -153,7 +153,7 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 emission_height,
                 emission_wrap,
                 uv_sets,
-                _pad0,
+                cull_back_faces,
                 _pad1,
                 uv_rows,
             }),

@@ -1066,6 +1066,8 @@ impl Importer<'_> {
                         diffuse: DVec3::ONE,
                         metallic: 0.0,
                         roughness: 1.0,
+                        // The default material is single-sided (§3.9.6).
+                        cull_back_faces: true,
                         ..Material::blank(MaterialKind::Pbr)
                     },
                     base_color_texture: None,
@@ -1181,8 +1183,10 @@ impl Importer<'_> {
             }
         };
         // glTF's doubleSided lights both sides of a surface: an emitter emits from both.
+        // Without it, camera rays cull the back faces (glTF 2.0 §3.9.5).
         let ours = Material {
             two_sided: material.double_sided() && ours.emission != DVec3::ZERO,
+            cull_back_faces: !material.double_sided(),
             ..ours
         };
         let base_color_texture = match pbr.base_color_texture() {
