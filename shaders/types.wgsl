@@ -191,12 +191,17 @@ const UV_SLOT_EMISSION: u32 = 2u;
 
 const LIGHT_POINT: u32 = 0u;
 const LIGHT_DIRECTIONAL: u32 = 1u;
+const LIGHT_SPOT: u32 = 2u;
 
 struct Light {
     position_or_direction: vec3<f32>,
     kind: u32,
     power: vec3<f32>,
-    _pad: u32,
+    // A spot light's cone: the cosines of its inner and outer half-angles.
+    cos_inner: f32,
+    // A spot light's unit axis (the direction it shines along).
+    spot_direction: vec3<f32>,
+    cos_outer: f32,
 }
 
 // One node of the BVH (twin of `accel::BvhNode`): an inner node's children are

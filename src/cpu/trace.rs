@@ -443,24 +443,52 @@ pub struct LightSample {
     pub cos_i: f64,
 }
 
+/// The fraction of a spot light's intensity that leaves it towards a point in direction
+/// `-wi` (`wi`: unit, from the point to the light), for a cone along `direction` with
+/// the cosines `cos_inner` and `cos_outer` of its half-angles: 1 inside the inner
+/// cone, 0 outside the outer one, and between them `t²` with `t = (cos θ − cos_outer)
+/// / max(cos_inner − cos_outer, 0.001)` (KHR_lights_punctual, "Spot", its reference
+/// implementation: the square makes the fall-off smooth at the outer edge).
+pub fn spot_attenuation(direction: DVec3, wi: DVec3, cos_inner: f64, cos_outer: f64) -> f64 {
+    let scale = 1.0 / (cos_inner - cos_outer).max(0.001);
+    let t = ((direction.dot(-wi) - cos_outer) * scale).clamp(0.0, 1.0);
+    t * t
+}
+
 /// The geometry of `light` seen from `origin` with shading normal `n`, or `None` when
-/// it contributes nothing and casts no shadow ray: a light below `n`, or a point
-/// light at a zero, denormal or NaN distance.
+/// it contributes nothing and casts no shadow ray: a light below `n`, a point or spot
+/// light at a zero, denormal or NaN distance, or a point outside a spot light's cone.
 pub fn sample_light(light: &Light, origin: DVec3, n: DVec3) -> Option<LightSample> {
+    let point = |position: DVec3, intensity: DVec3| {
+        let to_light = position - origin;
+        let distance_squared = to_light.length_squared();
+        // Zero, denormal or NaN distance: no contribution (see the constant).
+        if distance_squared.is_nan() || distance_squared < MIN_LIGHT_DISTANCE_SQUARED {
+            return None;
+        }
+        let distance = distance_squared.sqrt();
+        // Inverse-square law: E = I / r² on a surface facing the light.
+        Some((to_light / distance, distance, intensity / distance_squared))
+    };
     let (wi, distance, irradiance) = match *light {
         Light::Point {
             position,
             intensity,
+        } => point(position, intensity)?,
+        Light::Spot {
+            position,
+            direction,
+            intensity,
+            cos_inner,
+            cos_outer,
         } => {
-            let to_light = position - origin;
-            let distance_squared = to_light.length_squared();
-            // Zero, denormal or NaN distance: no contribution (see the constant).
-            if distance_squared.is_nan() || distance_squared < MIN_LIGHT_DISTANCE_SQUARED {
+            let (wi, distance, irradiance) = point(position, intensity)?;
+            let attenuation = spot_attenuation(direction, wi, cos_inner, cos_outer);
+            // Outside the outer cone: no light and no shadow ray.
+            if attenuation <= 0.0 {
                 return None;
             }
-            let distance = distance_squared.sqrt();
-            // Inverse-square law: E = I / r² on a surface facing the light.
-            (to_light / distance, distance, intensity / distance_squared)
+            (wi, distance, irradiance * attenuation)
         }
         Light::Directional {
             direction,

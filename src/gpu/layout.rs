@@ -497,14 +497,18 @@ pub struct GpuTriangleAttributes {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuLight {
-    /// Point light: position. Directional light: unit direction of travel.
+    /// Point and spot light: position. Directional light: unit direction of travel.
     pub position_or_direction: [f32; 3],
     /// One of the `LIGHT_*` constants.
     pub kind: u32,
-    /// Point light: intensity in W/sr. Directional light: irradiance in W/m².
+    /// Point and spot light: intensity in W/sr. Directional light: irradiance in W/m².
     pub power: [f32; 3],
-    /// Padding.
-    pub _pad: u32,
+    /// Spot light: cosine of the inner cone's half-angle (else 0).
+    pub cos_inner: f32,
+    /// Spot light: the unit axis of its cone (else zero).
+    pub spot_direction: [f32; 3],
+    /// Spot light: cosine of the outer cone's half-angle (else 0).
+    pub cos_outer: f32,
 }
 
 /// Uniforms of the display pass (`DisplayUniforms` in WGSL).
@@ -566,6 +570,8 @@ pub const NO_INSTANCE: u32 = u32::MAX;
 pub const LIGHT_POINT: u32 = 0;
 /// `Light.kind` value for a directional light.
 pub const LIGHT_DIRECTIONAL: u32 = 1;
+/// `Light.kind` value for a spot light.
+pub const LIGHT_SPOT: u32 = 2;
 
 #[cfg(test)]
 mod tests {

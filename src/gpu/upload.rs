@@ -8,7 +8,7 @@ use glam::{DVec2, DVec3};
 use super::layout::{
     DISTRIBUTION_BECKMANN, DISTRIBUTION_GGX, FRESNEL_EXACT, FRESNEL_SCHLICK, FrameUniforms,
     GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle, GpuTriangleAttributes,
-    LIGHT_DIRECTIONAL, LIGHT_POINT, MAPPING_PLANAR, MAPPING_SPHERICAL, MAPPING_UV,
+    LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_SPOT, MAPPING_PLANAR, MAPPING_SPHERICAL, MAPPING_UV,
     MATERIAL_BLINN_PHONG, MATERIAL_COOK_TORRANCE, MATERIAL_DIELECTRIC, MATERIAL_EMISSIVE,
     MATERIAL_LAMBERT, MATERIAL_MIRROR, MATERIAL_OREN_NAYAR, MATERIAL_PBR, MATERIAL_TABULATED,
     NO_ATTRIBUTES, NO_IMAGE, UV_SLOT_ALBEDO, UV_SLOT_EMISSION, UV_SLOT_METALLIC_ROUGHNESS,
@@ -540,21 +540,35 @@ pub fn image_layers(images: &[Image], cdfs: &BrdfMapCdfs) -> (u32, u32, u32, Vec
 
 /// The record of one light.
 pub fn light_record(light: &Light) -> GpuLight {
-    let (position_or_direction, kind, power) = match light {
-        Light::Point {
-            position,
-            intensity,
-        } => (*position, LIGHT_POINT, *intensity),
-        Light::Directional {
-            direction,
-            irradiance,
-        } => (*direction, LIGHT_DIRECTIONAL, *irradiance),
-    };
-    GpuLight {
+    let record = |position_or_direction: DVec3, kind: u32, power: DVec3| GpuLight {
         position_or_direction: vec3(position_or_direction),
         kind,
         power: vec3(power),
-        _pad: 0,
+        cos_inner: 0.0,
+        spot_direction: [0.0; 3],
+        cos_outer: 0.0,
+    };
+    match light {
+        Light::Point {
+            position,
+            intensity,
+        } => record(*position, LIGHT_POINT, *intensity),
+        Light::Spot {
+            position,
+            direction,
+            intensity,
+            cos_inner,
+            cos_outer,
+        } => GpuLight {
+            cos_inner: *cos_inner as f32,
+            spot_direction: vec3(*direction),
+            cos_outer: *cos_outer as f32,
+            ..record(*position, LIGHT_SPOT, *intensity)
+        },
+        Light::Directional {
+            direction,
+            irradiance,
+        } => record(*direction, LIGHT_DIRECTIONAL, *irradiance),
     }
 }
 

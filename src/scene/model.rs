@@ -453,6 +453,23 @@ pub enum Light {
         /// Radiant intensity per channel in W/sr (scalar intensity times colour).
         intensity: DVec3,
     },
+    /// A point light whose intensity falls off towards the edge of a cone
+    /// (`KHR_lights_punctual`'s spot light): full inside the inner cone, none outside
+    /// the outer one, and between them the square of `(cos θ − cos_outer) / (cos_inner
+    /// − cos_outer)` (the extension's reference implementation, smooth at both edges),
+    /// θ being the angle from `direction` ([`crate::cpu::trace::spot_attenuation`]).
+    Spot {
+        /// Position in scene units.
+        position: DVec3,
+        /// Unit direction the cone points along (from the light into the scene).
+        direction: DVec3,
+        /// Radiant intensity per channel in W/sr along the cone's axis.
+        intensity: DVec3,
+        /// Cosine of the inner cone's half-angle, in (`cos_outer`, 1].
+        cos_inner: f64,
+        /// Cosine of the outer cone's half-angle, in [0, 1).
+        cos_outer: f64,
+    },
     /// A light at infinity (the sun).
     Directional {
         /// Unit direction in which the light travels (from the light into the scene).

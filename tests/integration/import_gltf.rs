@@ -739,14 +739,51 @@ fn punctual_lights_convert_to_our_units() {
     // -z turned -90° about x points down.
     assert_close(direction, DVec3::new(0.0, -1.0, 0.0), 1e-6);
     assert_close(irradiance, DVec3::splat(1366.0 / LUMENS_PER_WATT), 1e-12);
-    assert!(matches!(model.lights[2], Light::Point { position, .. } if position.y == 5.0));
+    // A spot light along the node's -z, its cone from the angles (inner defaults to 0).
+    let Light::Spot {
+        position,
+        direction,
+        intensity,
+        cos_inner,
+        cos_outer,
+    } = model.lights[2]
+    else {
+        panic!("not a spot light: {:?}", model.lights[2]);
+    };
+    assert_eq!(position, DVec3::new(0.0, 5.0, 0.0));
+    assert_eq!(direction, DVec3::NEG_Z);
+    assert_close(intensity, DVec3::splat(0.1), 1e-7);
+    assert_eq!(cos_inner, 1.0);
+    assert_eq!(cos_outer, f64::from(0.5f32).cos());
     let warnings = model.warnings.join("\n");
-    assert!(
-        warnings.contains("light 2 on node 3 is a spot light"),
-        "{warnings}"
-    );
+    assert!(!warnings.contains("spot"), "{warnings}");
     assert!(warnings.contains("light 2: range is ignored"), "{warnings}");
     assert_eq!(model.lights_or_default(), model.lights);
+
+    // Cones out of order or beyond a right angle: located errors.
+    for (cone, angles) in [
+        (
+            r#"{"innerConeAngle":0.6,"outerConeAngle":0.5}"#,
+            "innerConeAngle 0.6 and outerConeAngle 0.5",
+        ),
+        (
+            r#"{"innerConeAngle":0.5,"outerConeAngle":0.5}"#,
+            "innerConeAngle 0.5 and outerConeAngle 0.5",
+        ),
+        (
+            r#"{"outerConeAngle":2}"#,
+            "innerConeAngle 0 and outerConeAngle 2",
+        ),
+    ] {
+        let body = body.replace(r#"{"outerConeAngle":0.5}"#, cone);
+        let message = failure("cone.gltf", doc.embedded(&body).as_bytes());
+        assert!(
+            message.contains(&format!(
+                "cone.gltf: light 2 on node 3: spot {angles} must satisfy 0 <= inner < outer <= pi/2"
+            )),
+            "{message}"
+        );
+    }
 }
 
 /// A PNG file's bytes.

@@ -164,7 +164,9 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 position_or_direction,
                 kind,
                 power,
-                _pad
+                cos_inner,
+                spot_direction,
+                cos_outer
             }),
         ),
         (
@@ -400,6 +402,7 @@ fn constants_match() {
         ("NO_IMAGE", NO_IMAGE),
         ("LIGHT_POINT", LIGHT_POINT),
         ("LIGHT_DIRECTIONAL", LIGHT_DIRECTIONAL),
+        ("LIGHT_SPOT", LIGHT_SPOT),
         ("FLAG_STORE_SUM", FLAG_STORE_SUM),
         ("FLAG_SIMULATE_LOOP_CUT", FLAG_SIMULATE_LOOP_CUT),
         ("ERROR_LOOP_CUT", ERROR_LOOP_CUT),

@@ -459,3 +459,82 @@ fn the_texture_settings_test_shows_no_red_x() {
     assert!(red(&shown.image) > 0, "no red pixels");
     gpu_agrees("texture-settings-test", &scene);
 }
+
+/// A spot light 2 above a white floor, pointing down, its cones 0.2 and 0.4 rad
+/// (`KHR_lights_punctual`'s spot), of intensity π W/sr: the floor's radiance is
+/// `h / d³` times the cone's attenuation.
+fn spot_scene() -> Scene {
+    let mut floor = quad(0, vec![]);
+    floor.positions.iter_mut().for_each(|p| *p *= 4.0);
+    floor.instances = vec![DMat4::IDENTITY];
+    let mut scene = scene(vec![Material::lambert(DVec3::ONE)], vec![floor], vec![]);
+    scene.lights = vec![Light::Spot {
+        position: DVec3::new(0.0, 0.0, SPOT_HEIGHT),
+        direction: DVec3::NEG_Z,
+        intensity: DVec3::splat(std::f64::consts::PI),
+        cos_inner: INNER.cos(),
+        cos_outer: OUTER.cos(),
+    }];
+    scene
+}
+
+const SPOT_HEIGHT: f64 = 2.0;
+const INNER: f64 = 0.2;
+const OUTER: f64 = 0.4;
+
+#[test]
+fn a_spot_light_s_cone_edges_land_where_its_angles_say() {
+    let scene = spot_scene();
+    let cpu = gpu_render::cpu::render(&scene, None);
+    let row = HEIGHT / 2;
+    let half_width =
+        EYE_Z * (FOV_Y_DEGREES.to_radians() / 2.0).tan() * f64::from(WIDTH) / f64::from(HEIGHT);
+    let x_of =
+        |column: u32| ((f64::from(column) + 0.5) / f64::from(WIDTH) * 2.0 - 1.0) * half_width;
+    let pixel_size = 2.0 * half_width / f64::from(WIDTH);
+    // The outer edge: the last lit pixel right of the centre is where the outer cone
+    // meets the floor, h·tan(outer), within the pixel and its sample's jitter.
+    let last_lit = (WIDTH / 2..WIDTH)
+        .take_while(|&c| colour(&cpu.image, (c, row)).x > 0.0)
+        .last()
+        .expect("the centre is lit");
+    let edge = SPOT_HEIGHT * OUTER.tan();
+    assert!(
+        (x_of(last_lit) - edge).abs() < 1.5 * pixel_size,
+        "the light ends at x = {}, the outer cone at {edge}",
+        x_of(last_lit)
+    );
+    // Inside the inner cone the full inverse-square light; halfway between the cones
+    // (in angle) the reference implementation's ((cos θ − cos o)/(cos i − cos o))².
+    let radiance = |x: f64, attenuation: f64| {
+        let d = (x * x + SPOT_HEIGHT * SPOT_HEIGHT).sqrt();
+        SPOT_HEIGHT / d.powi(3) * attenuation
+    };
+    let inside = pixel_of(0.5 * SPOT_HEIGHT * INNER.tan(), 0.0);
+    let expected = radiance(x_of(inside.0), 1.0);
+    assert_colour_within(
+        "inner cone",
+        &cpu.image,
+        inside,
+        DVec3::splat(expected),
+        0.01 * expected,
+    );
+    let middle = (INNER + OUTER) / 2.0;
+    let halfway = pixel_of(SPOT_HEIGHT * middle.tan(), 0.0);
+    let cosine = SPOT_HEIGHT / (x_of(halfway.0).powi(2) + SPOT_HEIGHT.powi(2)).sqrt();
+    let t = (cosine - OUTER.cos()) / (INNER.cos() - OUTER.cos());
+    let expected = radiance(x_of(halfway.0), t * t);
+    // The attenuation changes by about 6% across a pixel here.
+    assert_colour_within(
+        "between the cones",
+        &cpu.image,
+        halfway,
+        DVec3::splat(expected),
+        0.06 * expected,
+    );
+    gpu_agrees("spot-whitted", &scene);
+    let mut path = scene.clone();
+    path.render.integrator = gpu_render::scene::Integrator::Path;
+    path.render.samples_per_pixel = 2;
+    gpu_agrees("spot-path", &path);
+}

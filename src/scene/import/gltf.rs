@@ -1417,11 +1417,39 @@ impl Importer<'_> {
         };
         let converted = match light.kind() {
             Kind::Point => point,
-            Kind::Spot { .. } => {
-                self.warn(format!(
-                    "{name} on {node} is a spot light; imported as a point light of the same intensity (the cone is ignored)"
-                ));
-                point
+            Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => {
+                // §KHR_lights_punctual: 0 ≤ inner < outer ≤ π/2 (defaults 0 and π/4).
+                let (inner, outer) = (f64::from(inner_cone_angle), f64::from(outer_cone_angle));
+                let right_angle = std::f64::consts::FRAC_PI_2;
+                // π/2 given in f32 lies a little above it in f64.
+                let ordered = (0.0..right_angle).contains(&inner)
+                    && outer > inner
+                    && outer <= right_angle + 1e-6;
+                if !ordered {
+                    return Err(self.fail(format!(
+                        "{name} on {node}: spot innerConeAngle {} and outerConeAngle {} must satisfy 0 <= inner < outer <= pi/2",
+                        short(inner_cone_angle),
+                        short(outer_cone_angle)
+                    )));
+                }
+                // Spot lights shine along the node's local -z, as directional ones.
+                let direction = world.transform_vector3(-DVec3::Z).normalize_or_zero();
+                if direction == DVec3::ZERO {
+                    self.warn(format!(
+                        "{name} on {node}: its transform leaves no direction (singular); ignored"
+                    ));
+                    return Ok(());
+                }
+                Light::Spot {
+                    position,
+                    direction,
+                    intensity: strength,
+                    cos_inner: inner.cos(),
+                    cos_outer: outer.min(right_angle).cos().max(0.0),
+                }
             }
             Kind::Directional => {
                 // §KHR_lights_punctual: directional lights shine along the node's local -z.

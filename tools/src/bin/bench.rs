@@ -671,7 +671,10 @@ fn traversal_figures(scene: &gpu_render::scene::Scene) {
                     geometry.offset_scale,
                 );
                 let (direction, distance) = match scene.lights.first() {
-                    Some(gpu_render::scene::Light::Point { position, .. }) => {
+                    Some(
+                        gpu_render::scene::Light::Point { position, .. }
+                        | gpu_render::scene::Light::Spot { position, .. },
+                    ) => {
                         let to_light = *position - origin;
                         (to_light.normalize(), to_light.length())
                     }
