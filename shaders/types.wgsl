@@ -44,6 +44,9 @@ const FLAG_STORE_SUM: u32 = 1u;
 // FrameUniforms.flags, for tests: traversals leave their loop early without reaching
 // an exit, as a driver that cuts loops makes them do.
 const FLAG_SIMULATE_LOOP_CUT: u32 = 2u;
+// FrameUniforms.flags: the camera is orthographic; tan_half_fov_y holds half the view's
+// height in scene units (camera_ray_origin).
+const FLAG_ORTHOGRAPHIC: u32 = 8u;
 
 // A sphere through its anchor (its point nearest the origin) with the outward normal
 // there: see src/scene/sphere.rs.

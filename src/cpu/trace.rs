@@ -163,16 +163,14 @@ pub fn trace_pixel(scene: &PreparedScene, x: u32, y: u32) -> PixelResult {
     let mut rays = 0;
     for index in 0..settings.samples_per_pixel {
         let (dx, dy) = scene.samples.offset(x, y, index);
-        let direction = scene.camera.ray_direction(
-            f64::from(x) + dx,
-            f64::from(y) + dy,
-            settings.width,
-            settings.height,
-        );
-        let primary = Ray {
-            origin: scene.camera.eye,
-            direction,
-        };
+        let (px, py) = (f64::from(x) + dx, f64::from(y) + dy);
+        let direction = scene
+            .camera
+            .ray_direction(px, py, settings.width, settings.height);
+        let origin = scene
+            .camera
+            .ray_origin(px, py, settings.width, settings.height);
+        let primary = Ray { origin, direction };
         let (radiance, sample_rays) = match settings.integrator {
             Integrator::Whitted => trace_radiance(scene, primary),
             Integrator::Path => path_radiance(scene, primary, y * settings.width + x, index),

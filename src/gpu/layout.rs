@@ -13,7 +13,8 @@ use bytemuck::{Pod, Zeroable};
 pub struct FrameUniforms {
     /// Camera position.
     pub eye: [f32; 3],
-    /// Tangent of half the vertical field of view.
+    /// Tangent of half the vertical field of view; with [`FLAG_ORTHOGRAPHIC`], half
+    /// the view's height in scene units.
     pub tan_half_fov_y: f32,
     /// Unit view direction.
     pub forward: [f32; 3],
@@ -114,6 +115,9 @@ pub const FLAG_STORE_SUM: u32 = 1;
 /// `FrameUniforms.flags`, for tests: traversals leave their loop without reaching an
 /// exit, as a driver that cuts loops makes them do.
 pub const FLAG_SIMULATE_LOOP_CUT: u32 = 2;
+/// `FrameUniforms.flags`: the camera is orthographic, and `tan_half_fov_y` holds half
+/// the view's height in scene units ([`crate::camera::CameraFrame::ray_origin`]).
+pub const FLAG_ORTHOGRAPHIC: u32 = 8;
 
 /// One traversal of one ray, resumable (`TraceRay` in WGSL). Only the shaders read and
 /// write it; the host zeroes it (`TRACE_IDLE`).

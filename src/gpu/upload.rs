@@ -6,13 +6,13 @@
 use glam::{DVec2, DVec3};
 
 use super::layout::{
-    DISTRIBUTION_BECKMANN, DISTRIBUTION_GGX, FRESNEL_EXACT, FRESNEL_SCHLICK, FrameUniforms,
-    GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle, GpuTriangleAttributes,
-    LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_SPOT, MAPPING_PLANAR, MAPPING_SPHERICAL, MAPPING_UV,
-    MATERIAL_BLINN_PHONG, MATERIAL_COOK_TORRANCE, MATERIAL_DIELECTRIC, MATERIAL_EMISSIVE,
-    MATERIAL_LAMBERT, MATERIAL_MIRROR, MATERIAL_OREN_NAYAR, MATERIAL_PBR, MATERIAL_TABULATED,
-    NO_ATTRIBUTES, NO_IMAGE, UV_SLOT_ALBEDO, UV_SLOT_EMISSION, UV_SLOT_METALLIC_ROUGHNESS,
-    WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT, WRAP_REPEAT,
+    DISTRIBUTION_BECKMANN, DISTRIBUTION_GGX, FLAG_ORTHOGRAPHIC, FRESNEL_EXACT, FRESNEL_SCHLICK,
+    FrameUniforms, GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle,
+    GpuTriangleAttributes, LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_SPOT, MAPPING_PLANAR,
+    MAPPING_SPHERICAL, MAPPING_UV, MATERIAL_BLINN_PHONG, MATERIAL_COOK_TORRANCE,
+    MATERIAL_DIELECTRIC, MATERIAL_EMISSIVE, MATERIAL_LAMBERT, MATERIAL_MIRROR, MATERIAL_OREN_NAYAR,
+    MATERIAL_PBR, MATERIAL_TABULATED, NO_ATTRIBUTES, NO_IMAGE, UV_SLOT_ALBEDO, UV_SLOT_EMISSION,
+    UV_SLOT_METALLIC_ROUGHNESS, WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT, WRAP_REPEAT,
 };
 use crate::accel::{
     BrdfMapCdfs, BvhNode, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry,
@@ -572,6 +572,16 @@ pub fn light_record(light: &Light) -> GpuLight {
     }
 }
 
+/// `FrameUniforms::tan_half_fov_y` and the `FrameUniforms::flags` bit of `camera`'s
+/// projection: `tan(fov_y / 2)` and 0 for a pinhole camera, the half view height and
+/// [`FLAG_ORTHOGRAPHIC`] for an orthographic one.
+pub fn projection_uniforms(camera: &CameraFrame) -> (f64, u32) {
+    match camera.orthographic_half_height {
+        Some(half_height) => (half_height, FLAG_ORTHOGRAPHIC),
+        None => (camera.tan_half_fov_y, 0),
+    }
+}
+
 /// The constants of a trace of `scene` (in lighting space) with `geometry`, covering
 /// the whole image and all its samples with no slots yet: the scheduler fills in the
 /// region, sample range, slot count and budget of each trace.
@@ -581,9 +591,10 @@ pub fn frame_uniforms(scene: &Scene, geometry: &SceneGeometry) -> FrameUniforms 
     let count = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
     // The same stack the CPU reference starts its camera rays with.
     let camera_medium = MediumStack::from_outermost_first(&scene.camera_medium());
+    let (tan_half_fov_y, projection_flag) = projection_uniforms(&camera);
     FrameUniforms {
         eye: vec3(camera.eye),
-        tan_half_fov_y: camera.tan_half_fov_y as f32,
+        tan_half_fov_y: tan_half_fov_y as f32,
         forward: vec3(camera.forward),
         aspect: camera.aspect as f32,
         right: vec3(camera.right),
@@ -610,7 +621,7 @@ pub fn frame_uniforms(scene: &Scene, geometry: &SceneGeometry) -> FrameUniforms 
         slot_count: 0,
         stack_size: settings.stack_size,
         iteration_budget: u32::MAX,
-        flags: 0,
+        flags: projection_flag,
         offset_scale: geometry.offset_scale as f32,
         min_ray_weight: settings.min_ray_weight as f32,
         lattice_generator: crate::camera::lattice_generator(settings.samples_per_pixel),
@@ -642,6 +653,7 @@ mod tests {
                 look_at: DVec3::ZERO,
                 up: DVec3::Y,
                 fov_y_degrees: 60.0,
+                orthographic_half_height: None,
             },
             environment: Environment {
                 background: DVec3::new(0.1, 0.2, 0.3),

@@ -158,7 +158,7 @@ pub enum LightingSpace {
     NaiveGamma,
 }
 
-/// A pinhole camera.
+/// A pinhole camera, or an orthographic one.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
     /// Centre of projection.
@@ -167,8 +167,15 @@ pub struct Camera {
     pub look_at: DVec3,
     /// Approximate up direction (non-zero, not parallel to the view direction).
     pub up: DVec3,
-    /// Full vertical field of view in degrees, in (0, 180).
+    /// Full vertical field of view in degrees, in (0, 180) (unused by an
+    /// orthographic camera).
     pub fov_y_degrees: f64,
+    /// For an orthographic camera (glTF's `orthographic` projection), half the height
+    /// of the view in scene units (finite, > 0; glTF's `ymag`): its rays are parallel,
+    /// along the view direction, from points of the plane through `eye` facing it,
+    /// `half_height` above and below `eye` and the image's aspect times that either
+    /// side. `None`: a pinhole camera of `fov_y_degrees`.
+    pub orthographic_half_height: Option<f64>,
 }
 
 /// Light that does not come from a light source.

@@ -886,6 +886,7 @@ fn materials_map_with_their_textures_and_wrap_modes() {
             look_at: DVec3::ZERO,
             up: DVec3::Y,
             fov_y_degrees: 40.0,
+            orthographic_half_height: None,
         },
         environment: Default::default(),
         materials: vec![],
@@ -1585,10 +1586,18 @@ fn unsupported_features_that_are_not_required_are_warnings() {
         warnings.contains("node 1: its transform is singular"),
         "{warnings}"
     );
-    assert!(
-        warnings.contains("camera 0 on node 2 is orthographic"),
-        "{warnings}"
-    );
+    assert!(!warnings.contains("orthographic"), "{warnings}");
     assert_eq!(model.meshes[0].instances.len(), 1);
-    assert!(model.camera.is_none());
+    // The orthographic camera is imported: half its view height is ymag.
+    let camera = model.camera.expect("a camera");
+    assert_eq!(camera.camera.orthographic_half_height, Some(1.0));
+    assert_eq!(camera.aspect_ratio, Some(1.0));
+
+    // xmag or ymag of zero (or a node scale of zero): a located error.
+    let body = body.replace(r#""ymag":1,"#, r#""ymag":0,"#);
+    let message = failure("flat.gltf", doc.embedded(&body).as_bytes());
+    assert!(
+        message.contains("flat.gltf: camera 0 on node 2: orthographic xmag 1 and ymag 0 (times the node's scale) must be positive, finite and at most 1000000000000000"),
+        "{message}"
+    );
 }

@@ -391,6 +391,7 @@ fn map_ke_loads_an_emission_texture_that_the_scene_keeps() {
             look_at: DVec3::ZERO,
             up: DVec3::Y,
             fov_y_degrees: 40.0,
+            orthographic_half_height: None,
         },
         environment: Default::default(),
         materials: vec![],

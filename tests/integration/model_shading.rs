@@ -27,6 +27,7 @@ fn camera() -> Camera {
         look_at: DVec3::ZERO,
         up: DVec3::Y,
         fov_y_degrees: FOV_Y_DEGREES,
+        orthographic_half_height: None,
     }
 }
 
@@ -537,4 +538,50 @@ fn a_spot_light_s_cone_edges_land_where_its_angles_say() {
     path.render.integrator = gpu_render::scene::Integrator::Path;
     path.render.samples_per_pixel = 2;
     gpu_agrees("spot-path", &path);
+}
+
+/// An orthographic camera (glTF's `orthographic` projection) looking down the z axis
+/// at two quads of the same size, one at z = 0 and one 5 further away: the far one
+/// looks exactly as large (parallel rays), and the view spans `2·ymag` in height.
+#[test]
+fn an_orthographic_camera_shows_parallel_edges_and_ymag_as_the_half_height() {
+    let half_height = 1.5;
+    let mut scene = scene(
+        vec![
+            Material::lambert(DVec3::ONE),
+            Material::lambert(DVec3::splat(0.5)),
+        ],
+        vec![
+            quad(0, vec![at(-1.2)]),
+            quad(1, vec![DMat4::from_translation(DVec3::new(1.2, 0.0, -5.0))]),
+        ],
+        vec![],
+    );
+    scene.camera.orthographic_half_height = Some(half_height);
+    scene.render.width = 96;
+    scene.render.height = 48;
+    let cpu = gpu_render::cpu::render(&scene, None);
+    // Each quad's rows and columns of lit pixels: 1.8 units of the 3 the height spans,
+    // both the same, whatever the distance (under perspective the far one would be
+    // 7.5/12.5 as large).
+    let extent = |value: f32| {
+        let lit =
+            |x: u32, y: u32| (cpu.image.pixels[(y * 96 + x) as usize][0] - value).abs() < 1e-3;
+        let columns = (0..96).filter(|&x| (0..48).any(|y| lit(x, y))).count();
+        let rows = (0..48).filter(|&y| (0..96).any(|x| lit(x, y))).count();
+        (columns, rows)
+    };
+    let pixels = 1.8 / (2.0 * half_height) * 48.0;
+    for (value, name) in [(1.0, "near"), (0.5, "far")] {
+        let (columns, rows) = extent(value);
+        assert!(
+            (columns as f64 - pixels).abs() <= 1.0 && (rows as f64 - pixels).abs() <= 1.0,
+            "{name} quad: {columns} x {rows} pixels, expected {pixels} x {pixels}"
+        );
+    }
+    gpu_agrees("orthographic-whitted", &scene);
+    let mut path = scene.clone();
+    path.render.integrator = gpu_render::scene::Integrator::Path;
+    path.render.samples_per_pixel = 2;
+    gpu_agrees("orthographic-path", &path);
 }

@@ -95,6 +95,7 @@ fn scene() -> Scene {
             look_at: DVec3::ZERO,
             up: DVec3::Y,
             fov_y_degrees: 18.0,
+            orthographic_half_height: None,
         },
         environment: Environment::default(),
         material_names: modes.iter().map(|m| format!("{m:?}")).collect(),

@@ -73,6 +73,8 @@ const TEXCOORD_TYPES: &[DataType] = &[
 /// Largest offset or scale (in size) of a `KHR_texture_transform` accepted: beyond it
 /// an `f32` texture coordinate keeps less than 1/16 of a repeat.
 const MAX_TEXTURE_TRANSFORM: f64 = 1e6;
+/// Largest half view height of an orthographic camera accepted, in scene units.
+const MAX_ORTHOGRAPHIC_SIZE: f64 = 1e15;
 /// Component types of `COLOR_0`: `FLOAT` and normalized unsigned bytes and shorts
 /// (glTF 2.0 §3.7.2.1).
 const COLOR_TYPES: &[DataType] = &[DataType::F32, DataType::U8, DataType::U16];
@@ -1327,29 +1329,53 @@ impl Importer<'_> {
         world: DMat4,
     ) -> Result<(), SceneError> {
         let name = describe("camera", camera.index(), camera.name());
-        let Projection::Perspective(perspective) = camera.projection() else {
-            self.warn(format!(
-                "{name} on {node} is orthographic, which is not supported; ignored"
-            ));
-            return Ok(());
-        };
         if self.model.camera.is_some() {
             self.warn(format!(
                 "{name} on {node}: only the first camera is imported; ignored"
             ));
             return Ok(());
         }
-        let yfov = f64::from(perspective.yfov());
-        if !(yfov > 0.0 && yfov < std::f64::consts::PI) {
-            return Err(self.fail(format!("{name}: yfov {yfov} rad is not in (0, π)")));
-        }
-        let aspect_ratio = perspective.aspect_ratio().map(f64::from);
-        if aspect_ratio.is_some_and(|a| !(a.is_finite() && a > 0.0)) {
-            return Err(self.fail(format!(
-                "{name}: aspectRatio {} is not positive",
-                aspect_ratio.unwrap_or_default()
-            )));
-        }
+        // A perspective camera's vertical field of view, or an orthographic one's half
+        // height (in its node's space; the node's scale applies) and xmag/ymag.
+        let (fov_y_degrees, orthographic, aspect_ratio) = match camera.projection() {
+            Projection::Perspective(perspective) => {
+                let yfov = f64::from(perspective.yfov());
+                if !(yfov > 0.0 && yfov < std::f64::consts::PI) {
+                    return Err(self.fail(format!("{name}: yfov {yfov} rad is not in (0, π)")));
+                }
+                let aspect_ratio = perspective.aspect_ratio().map(f64::from);
+                if aspect_ratio.is_some_and(|a| !(a.is_finite() && a > 0.0)) {
+                    return Err(self.fail(format!(
+                        "{name}: aspectRatio {} is not positive",
+                        aspect_ratio.unwrap_or_default()
+                    )));
+                }
+                (yfov.to_degrees(), None, aspect_ratio)
+            }
+            Projection::Orthographic(orthographic) => {
+                // glTF 2.0 §5.13: xmag and ymag must not be zero and should not be
+                // negative; a negative one is taken by its size.
+                let (xmag, ymag) = (
+                    f64::from(orthographic.xmag()).abs(),
+                    f64::from(orthographic.ymag()).abs(),
+                );
+                let half_height = ymag * world.transform_vector3(DVec3::Y).length();
+                let usable = |v: f64| v.is_finite() && v > 0.0 && v <= MAX_ORTHOGRAPHIC_SIZE;
+                if !(usable(xmag) && usable(half_height)) {
+                    return Err(self.fail(format!(
+                        "{name} on {node}: orthographic xmag {} and ymag {} (times the node's scale) must be positive, finite and at most {}",
+                        short(orthographic.xmag()),
+                        short(orthographic.ymag()),
+                        short(MAX_ORTHOGRAPHIC_SIZE)
+                    )));
+                }
+                (
+                    super::DEFAULT_FOV_Y_DEGREES,
+                    Some(half_height),
+                    Some(xmag / ymag),
+                )
+            }
+        };
         // glTF 2.0 §3.10.1: the camera looks along its local -z with +y up.
         let eye = world.transform_point3(DVec3::ZERO);
         let forward = world.transform_vector3(-DVec3::Z).normalize_or_zero();
@@ -1366,7 +1392,8 @@ impl Importer<'_> {
                 eye,
                 look_at: eye + forward,
                 up,
-                fov_y_degrees: yfov.to_degrees(),
+                fov_y_degrees,
+                orthographic_half_height: orthographic,
             },
             aspect_ratio,
         });
