@@ -34,6 +34,8 @@ struct Hit {
     uv1: vec2<f32>,
     // A mesh triangle's interpolated vertex colour, else white.
     color: vec3<f32>,
+    // A mesh triangle's interpolated tangent (w: the bitangent's handedness), else 0.
+    tangent: vec4<f32>,
     // Barycentric coordinates in a triangle, else (1, 0, 0).
     barycentrics: vec3<f32>,
     // The instance of an instanced mesh's triangle (its record's node index; `prim`
@@ -45,7 +47,7 @@ struct Hit {
 // coordinates (0, 0), colour white.
 fn flat_hit(prim: u32, t: f32, normal: vec3<f32>, material: u32, position: vec3<f32>) -> Hit {
     return Hit(t, normal, material, true, position, prim, normal, vec2<f32>(0.0),
-               vec2<f32>(0.0), vec3<f32>(1.0), vec3<f32>(1.0, 0.0, 0.0), NO_INSTANCE);
+               vec2<f32>(0.0), vec3<f32>(1.0), vec4<f32>(0.0), vec3<f32>(1.0, 0.0, 0.0), NO_INSTANCE);
 }
 
 //#if MESH_ATTRIBUTES
@@ -86,6 +88,13 @@ fn world_attributes(index: u32, instance: u32, facing: vec3<f32>) -> TriangleAtt
         let c1 = attributes.c1;
         attributes.c1 = select(c1, attributes.c2, placed.mirrored);
         attributes.c2 = select(attributes.c2, c1, placed.mirrored);
+        // Tangents through the linear part, renormalised (zero where they vanish), the
+        // handedness flipped under a mirroring transform. CPU twin: world_tangent.
+        let t1 = world_tangent(placed, attributes.t1);
+        let t2 = world_tangent(placed, attributes.t2);
+        attributes.t0 = world_tangent(placed, attributes.t0);
+        attributes.t1 = select(t1, t2, placed.mirrored);
+        attributes.t2 = select(t2, t1, placed.mirrored);
     }
     //#endif
     return attributes;
@@ -148,6 +157,9 @@ fn apply_triangle_attributes(hit: ptr<function, Hit>, attributes: TriangleAttrib
     }
     if attributes.has_colors != 0u {
         (*hit).color = attributes.c0 * b.x + attributes.c1 * b.y + attributes.c2 * b.z;
+    }
+    if attributes.has_tangents != 0u {
+        (*hit).tangent = attributes.t0 * b.x + attributes.t1 * b.y + attributes.t2 * b.z;
     }
 }
 

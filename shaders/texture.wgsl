@@ -126,6 +126,42 @@ fn shading_material(material: Material, position: vec3<f32>, normal: vec3<f32>, 
     return shaded;
 }
 
+// The shading normal at a hit with a normal map: `shading_normal` (N) turned by the
+// tangent-space texel, normalize(T·x + B·y + N·z) with (x, y, z) = (2·texel - 1)·(scale,
+// scale, 1), T the tangent made orthogonal to N, B = sign(w)·(N × T) (glTF 2.0 §3.9.3);
+// shading_normal itself without a map or usable tangent, or where the result vanishes
+// or leaves the geometric normal's side. Twin of mapped_normal (src/texture.rs).
+fn mapped_normal(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, uv1: vec2<f32>, shading_normal: vec3<f32>, tangent: vec4<f32>) -> vec3<f32> {
+    //#if TEXTURES
+    if material.normal_layer == NO_IMAGE {
+        return shading_normal;
+    }
+    let along = tangent.xyz;
+    let t = along - shading_normal * dot(shading_normal, along);
+    let t_squared = dot(t, t);
+    if !(t_squared > 0.0) {
+        return shading_normal;
+    }
+    let unit_t = t * inverseSqrt(t_squared);
+    let b = cross(shading_normal, unit_t) * select(1.0, -1.0, tangent.w < 0.0);
+    let st = texture_coordinates(material, UV_SLOT_NORMAL, position, normal, uv, uv1);
+    let wrap = vec2<u32>(material.normal_wrap & 0xffu, (material.normal_wrap >> 8u) & 0xffu);
+    let texel = sample_texture(material.normal_layer, material.normal_width, material.normal_height, st, wrap);
+    let m = vec3<f32>((2.0 * texel.x - 1.0) * material.normal_scale,
+                      (2.0 * texel.y - 1.0) * material.normal_scale, 2.0 * texel.z - 1.0);
+    let mapped = unit_t * m.x + b * m.y + shading_normal * m.z;
+    let m_squared = dot(mapped, mapped);
+    if !(m_squared > 0.0) {
+        return shading_normal;
+    }
+    let unit = mapped * inverseSqrt(m_squared);
+    if dot(unit, normal) > 0.0 {
+        return unit;
+    }
+    //#endif
+    return shading_normal;
+}
+
 // The albedo at a hit at `position` with geometric normal `normal`, mesh texture
 // coordinates `uv` and `uv1` (sets 0 and 1) and vertex colour `color` (white off a
 // mesh with colours): material.diffuse times `color` (glTF 2.0 §3.9.2), times the

@@ -164,7 +164,8 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
     let outside_ior = 1.0;
     //#endif
     //#if MESH_ATTRIBUTES
-    let ns = select(-hit.shading_normal, hit.shading_normal, entering);
+    let mapped = mapped_normal(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.shading_normal, hit.tangent);
+    let ns = select(-mapped, mapped, entering);
     let n = shading_frame_normal(ray.direction, ng, ns);
     let lifted = shadow_terminator_point(hit, ng);
     //#else

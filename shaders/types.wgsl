@@ -102,7 +102,7 @@ struct TriangleAttributes {
     uv01: vec4<f32>,
     uv2: vec2<f32>,
     has_uvs1: u32,
-    _pad0: u32,
+    has_tangents: u32,
     uv1_01: vec4<f32>,
     uv1_2: vec2<f32>,
     _pad1: vec2<u32>,
@@ -112,6 +112,10 @@ struct TriangleAttributes {
     _pad3: u32,
     c2: vec3<f32>,
     _pad4: u32,
+    // Unit tangents, the bitangent's handedness in w (normal maps).
+    t0: vec4<f32>,
+    t1: vec4<f32>,
+    t2: vec4<f32>,
 }
 
 const MATERIAL_LAMBERT: u32 = 0u;
@@ -182,15 +186,22 @@ struct Material {
     uv_sets: u32,
     // 1 when camera rays pass through the back faces of flat shapes of this material.
     cull_back_faces: u32,
-    _pad1: u32,
+    // The tangent-space normal map (linear data), or NO_IMAGE.
+    normal_layer: u32,
     // The affine maps of the textures' coordinates: texture s (UV_SLOT_*) maps uv to
     // (dot(uv_rows[2s].xyz, (uv, 1)), dot(uv_rows[2s+1].xyz, (uv, 1))).
-    uv_rows: array<vec4<f32>, 6>,
+    uv_rows: array<vec4<f32>, 8>,
+    normal_width: u32,
+    normal_height: u32,
+    // Wrap modes as u in bits 0-7 and v in bits 8-15.
+    normal_wrap: u32,
+    normal_scale: f32,
 }
 
 const UV_SLOT_ALBEDO: u32 = 0u;
 const UV_SLOT_METALLIC_ROUGHNESS: u32 = 1u;
 const UV_SLOT_EMISSION: u32 = 2u;
+const UV_SLOT_NORMAL: u32 = 3u;
 
 const LIGHT_POINT: u32 = 0u;
 const LIGHT_DIRECTIONAL: u32 = 1u;

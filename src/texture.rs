@@ -198,6 +198,58 @@ pub fn shading_emission(
     }
 }
 
+/// The shading normal at a hit with a normal map: `shading_normal` (the interpolated
+/// vertex normal `N`, unit, on the side of the geometric `normal`) turned by the
+/// tangent-space texel of `material.normal_texture` at its own coordinates, `n =
+/// normalize(T·x + B·y + N·z)` with `(x, y, z) = (2·texel − 1)·(scale, scale, 1)`
+/// (glTF 2.0 §3.9.3, `normalTexture`), `T` the interpolated `tangent` made orthogonal
+/// to `N` (Gram-Schmidt) and `B = sign(w)·(N × T)`. `shading_normal` itself without a
+/// normal map, without a usable tangent (zero, or along `N`), or where the result
+/// vanishes or leaves the geometric normal's side. Twin of `mapped_normal` in
+/// `shaders/texture.wgsl`.
+pub fn mapped_normal(
+    material: &Material,
+    images: &[Image],
+    position: DVec3,
+    normal: DVec3,
+    uvs: [DVec2; 2],
+    shading_normal: DVec3,
+    tangent: glam::DVec4,
+) -> DVec3 {
+    let Some(index) = material.normal_texture else {
+        return shading_normal;
+    };
+    let along = tangent.truncate();
+    let t = along - shading_normal * shading_normal.dot(along);
+    let length_squared = t.length_squared();
+    if length_squared.is_nan() || length_squared <= 0.0 {
+        return shading_normal;
+    }
+    let t = t / length_squared.sqrt();
+    let handedness = if tangent.w < 0.0 { -1.0 } else { 1.0 };
+    let b = shading_normal.cross(t) * handedness;
+    let transform = &material.normal_transform;
+    let (u, v) = texture_coordinates(material, transform, position, normal, uvs);
+    let texel = sample_texture(&images[index as usize], u, v, material.normal_wrap);
+    let scale = material.normal_scale;
+    let m = DVec3::new(
+        (2.0 * texel.x - 1.0) * scale,
+        (2.0 * texel.y - 1.0) * scale,
+        2.0 * texel.z - 1.0,
+    );
+    let mapped = t * m.x + b * m.y + shading_normal * m.z;
+    let length_squared = mapped.length_squared();
+    if length_squared.is_nan() || length_squared <= 0.0 {
+        return shading_normal;
+    }
+    let mapped = mapped / length_squared.sqrt();
+    if mapped.dot(normal) > 0.0 {
+        mapped
+    } else {
+        shading_normal
+    }
+}
+
 /// The mean texel of an image (per channel, over every texel): the mean of a texture
 /// over its whole area. Next-event estimation picks a textured emitter by its material's
 /// emission times this mean ([`crate::accel::AreaLights`]): the power of the emitter if

@@ -1,7 +1,7 @@
 //! The primitive lists both tracers intersect, and [`SceneGeometry`], which holds them
 //! with the BVH over them.
 
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, DVec4};
 
 use super::bvh::{Aabb32, BuildMethod, Bvh};
 use super::instance::{Instance, InstancedMesh, mesh_groups};
@@ -133,13 +133,23 @@ pub struct TriangleAttributes {
     pub uvs1: Option<[DVec2; 3]>,
     /// Linear RGB vertex colours, if the mesh has them.
     pub colors: Option<[DVec3; 3]>,
+    /// Unit tangents with the bitangent's handedness in `w`, if the mesh has them.
+    pub tangents: Option<[DVec4; 3]>,
 }
 
 impl TriangleAttributes {
     /// The attributes of the triangle of `mesh` whose corners are `order`, without
     /// normals; `None` when the mesh has none of them.
-    pub fn of_corners(mesh: &Mesh, order: [usize; 3], normals: Option<[DVec3; 3]>) -> Option<Self> {
+    pub fn of_corners(
+        mesh: &Mesh,
+        order: [usize; 3],
+        normals: Option<[DVec3; 3]>,
+        transform: Option<&glam::DMat3>,
+    ) -> Option<Self> {
         let attributes = Self {
+            tangents: mesh.tangents.as_ref().map(|t| {
+                order.map(|i| transform.map_or(t[i], |m| super::instance::world_tangent(m, t[i])))
+            }),
             normals,
             uvs: mesh.uvs.as_ref().map(|uvs| order.map(|i| uvs[i])),
             uvs1: mesh.uvs1.as_ref().map(|uvs| order.map(|i| uvs[i])),
@@ -148,7 +158,8 @@ impl TriangleAttributes {
         (attributes.normals.is_some()
             || attributes.uvs.is_some()
             || attributes.uvs1.is_some()
-            || attributes.colors.is_some())
+            || attributes.colors.is_some()
+            || attributes.tangents.is_some())
         .then_some(attributes)
     }
 }
@@ -384,10 +395,12 @@ impl SceneGeometry {
                     order.map(|i| (normal_matrix * normals[i]).normalize_or(facing))
                 });
                 let attributes =
-                    TriangleAttributes::of_corners(mesh, order, normals).map(|attributes| {
-                        self.triangle_attributes.push(attributes);
-                        (self.triangle_attributes.len() - 1) as u32
-                    });
+                    TriangleAttributes::of_corners(mesh, order, normals, Some(&linear)).map(
+                        |attributes| {
+                            self.triangle_attributes.push(attributes);
+                            (self.triangle_attributes.len() - 1) as u32
+                        },
+                    );
                 self.triangles.push(TriangleShape {
                     vertices,
                     material: mesh.material,

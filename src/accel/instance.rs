@@ -14,7 +14,7 @@
 use std::collections::HashMap;
 use std::hash::{DefaultHasher, Hasher};
 
-use glam::{DAffine3, DMat3, DMat4, DVec3};
+use glam::{DAffine3, DMat3, DMat4, DVec3, DVec4};
 
 use super::bvh::{Aabb32, BuildMethod, Bvh};
 use super::geometry::{PrimKind, PrimRef, TriangleAttributes, TriangleShape};
@@ -160,6 +160,9 @@ impl Instance {
                 uvs: object.uvs.map(|uv| order.map(|k| uv[k])),
                 uvs1: object.uvs1.map(|uv| order.map(|k| uv[k])),
                 colors: object.colors.map(|c| order.map(|k| c[k])),
+                tangents: object
+                    .tangents
+                    .map(|t| order.map(|k| world_tangent(&self.object_to_world.matrix3, t[k]))),
             }
         });
         (
@@ -256,7 +259,7 @@ impl InstancedMesh {
                 .as_ref()
                 .map(|normals| order.map(|i| normals[i]));
             let attributes =
-                TriangleAttributes::of_corners(mesh, order, normals).map(|attributes| {
+                TriangleAttributes::of_corners(mesh, order, normals, None).map(|attributes| {
                     stored.triangle_attributes.push(attributes);
                     (stored.triangle_attributes.len() - 1) as u32
                 });
@@ -283,6 +286,21 @@ impl InstancedMesh {
     }
 }
 
+/// A tangent (`w`: the bitangent's handedness) moved by the linear part `linear` of an
+/// object-to-world transform: the direction through it, renormalised (zero where it
+/// vanishes, which disables the normal map there), the handedness flipped under a
+/// mirroring transform, whose normal matrix turns `normal × tangent` around. Twin of
+/// `world_tangent` in `shaders/instance.wgsl`.
+pub fn world_tangent(linear: &glam::DMat3, tangent: DVec4) -> DVec4 {
+    let direction = (*linear * tangent.truncate()).normalize_or_zero();
+    let w = if linear.determinant() < 0.0 {
+        -tangent.w
+    } else {
+        tangent.w
+    };
+    direction.extend(w)
+}
+
 /// Whether two meshes have the same geometry and attributes (the same file's same
 /// mesh, placed twice): they may then share one [`InstancedMesh`].
 fn same_geometry(a: &Mesh, b: &Mesh) -> bool {
@@ -292,6 +310,7 @@ fn same_geometry(a: &Mesh, b: &Mesh) -> bool {
         && a.uvs == b.uvs
         && a.uvs1 == b.uvs1
         && a.colors == b.colors
+        && a.tangents == b.tangents
 }
 
 /// The scene's meshes grouped by identical geometry ([`Mesh::positions`], normals,
@@ -369,6 +388,7 @@ mod tests {
             uvs: None,
             uvs1: None,
             colors: None,
+            tangents: None,
             triangles: vec![[0, 1, 2], [0, 2, 3]],
             material: 0,
             instances,
@@ -465,6 +485,7 @@ mod tests {
             uvs: None,
             uvs1: None,
             colors: None,
+            tangents: None,
             triangles,
             material: 0,
             instances: vec![],

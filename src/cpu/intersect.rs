@@ -3,7 +3,7 @@
 //! self-intersection offset. The scene-level queries (`intersect_scene`, `occluded`)
 //! traverse the BVH in [`super::traverse`].
 
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, DVec4};
 
 use crate::accel::{
     HitKey, InstanceId, PrimKind, PrimRef, SceneGeometry, TriangleAttributes, TriangleShape,
@@ -52,6 +52,9 @@ pub struct Hit {
     pub uv1: DVec2,
     /// A mesh triangle's vertex colours interpolated at the hit, else white (1, 1, 1).
     pub color: DVec3,
+    /// A mesh triangle's vertex tangents interpolated at the hit (`w`: the bitangent's
+    /// handedness, interpolated too; its sign is used), else zero (no normal map).
+    pub tangent: DVec4,
     /// Barycentric coordinates of the hit in a triangle (weights of its three
     /// corners), else `(1, 0, 0)`.
     pub barycentrics: DVec3,
@@ -208,6 +211,7 @@ pub fn flat_hit(prim: PrimRef, t: f64, normal: DVec3, material: u32, position: D
         uv: DVec2::ZERO,
         uv1: DVec2::ZERO,
         color: DVec3::ONE,
+        tangent: DVec4::ZERO,
         barycentrics: DVec3::X,
         instance: None,
     }
@@ -268,6 +272,9 @@ pub fn apply_triangle_attributes(hit: &mut Hit, attributes: &TriangleAttributes)
     }
     if let Some(c) = attributes.colors {
         hit.color = c[0] * b.x + c[1] * b.y + c[2] * b.z;
+    }
+    if let Some(t) = attributes.tangents {
+        hit.tangent = t[0] * b.x + t[1] * b.y + t[2] * b.z;
     }
 }
 

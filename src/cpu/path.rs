@@ -39,7 +39,7 @@ use crate::sample::{
     sample_triangle_barycentrics,
 };
 use crate::scene::{Material, MaterialKind, MediumStack, MicrofacetDistribution};
-use crate::texture::{shading_emission, shading_material};
+use crate::texture::{mapped_normal, shading_emission, shading_material};
 
 /// Bounces after which Russian roulette may end a path.
 pub const ROULETTE_DEPTH: u32 = 3;
@@ -247,11 +247,16 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
         }
         let entering = ray.direction.dot(hit.normal) < 0.0;
         let ng = if entering { hit.normal } else { -hit.normal };
-        let ns = if entering {
-            hit.shading_normal
-        } else {
-            -hit.shading_normal
-        };
+        let mapped = mapped_normal(
+            record,
+            &scene.images,
+            hit.position,
+            hit.normal,
+            [hit.uv, hit.uv1],
+            hit.shading_normal,
+            hit.tangent,
+        );
+        let ns = if entering { mapped } else { -mapped };
         let n = shading_frame_normal(ray.direction, ng, ns);
         let wo = -ray.direction;
         let outside_ior = medium.medium_outside_ior(entering);

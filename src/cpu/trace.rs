@@ -15,7 +15,7 @@ use crate::camera::{CameraFrame, SamplePattern};
 use crate::noise::luminance_m2_step;
 pub use crate::scene::MediumStack;
 use crate::scene::{Image, Integrator, Light, Material, RenderSettings, Scene};
-use crate::texture::shading_material;
+use crate::texture::{mapped_normal, shading_material};
 
 /// The scene in the form the tracer reads: colours in the lighting space, the geometry
 /// with its BVH, the camera basis.
@@ -348,11 +348,16 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumSta
     // Shading happens on the side the ray came from.
     let ng = if entering { hit.normal } else { -hit.normal };
     let outside_ior = medium.medium_outside_ior(entering);
-    let ns = if entering {
-        hit.shading_normal
-    } else {
-        -hit.shading_normal
-    };
+    let mapped = mapped_normal(
+        &scene.materials[hit.material as usize],
+        &scene.images,
+        position,
+        hit.normal,
+        [hit.uv, hit.uv1],
+        hit.shading_normal,
+        hit.tangent,
+    );
+    let ns = if entering { mapped } else { -mapped };
     let n = shading_frame_normal(ray.direction, ng, ns);
     let wo = -ray.direction;
     let mut response = surface_response(material, ray.direction, n, entering, outside_ior);

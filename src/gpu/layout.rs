@@ -434,12 +434,20 @@ pub struct GpuMaterial {
     /// 1 when camera rays pass through the back faces of flat shapes of this material
     /// (glTF `doubleSided: false`).
     pub cull_back_faces: u32,
-    /// Padding.
-    pub _pad1: u32,
+    /// Layer of the normal map in the image array, or [`NO_IMAGE`].
+    pub normal_layer: u32,
     /// The affine maps of the textures' coordinates, two rows each: texture `s`
     /// (`UV_SLOT_*`) maps `(u, v)` to `(rows[2s]·(u, v, 1), rows[2s+1]·(u, v, 1))`
     /// (the last lane unused); see [`crate::scene::TextureTransform`].
-    pub uv_rows: [[f32; 4]; 6],
+    pub uv_rows: [[f32; 4]; 8],
+    /// Width of the normal map in texels.
+    pub normal_width: u32,
+    /// Height of the normal map in texels.
+    pub normal_height: u32,
+    /// Its wrap modes: the `WRAP_*` code along `u` in bits 0-7, along `v` in bits 8-15.
+    pub normal_wrap: u32,
+    /// glTF's `normalTexture.scale`.
+    pub normal_scale: f32,
 }
 
 /// [`GpuMaterial::uv_rows`] and [`GpuMaterial::uv_sets`]: the albedo texture.
@@ -449,6 +457,8 @@ pub const UV_SLOT_ALBEDO: u32 = 0;
 pub const UV_SLOT_METALLIC_ROUGHNESS: u32 = 1;
 /// [`GpuMaterial::uv_rows`] and [`GpuMaterial::uv_sets`]: the emission texture.
 pub const UV_SLOT_EMISSION: u32 = 2;
+/// [`GpuMaterial::uv_rows`] and [`GpuMaterial::uv_sets`]: the normal map.
+pub const UV_SLOT_NORMAL: u32 = 3;
 
 /// The shading attributes of one mesh triangle (`TriangleAttributes` in WGSL): vertex
 /// normals and texture coordinates in the order of the triangle's corners; see
@@ -475,8 +485,8 @@ pub struct GpuTriangleAttributes {
     pub uv2: [f32; 2],
     /// 1 when the second set of texture coordinates is given, else 0 (`(0, 0)`).
     pub has_uvs1: u32,
-    /// Padding.
-    pub _pad0: u32,
+    /// 1 when tangents are given (normal maps), else 0.
+    pub has_tangents: u32,
     /// Second-set texture coordinates of the first and second corners.
     pub uv1_01: [f32; 4],
     /// Second-set texture coordinates of the third corner.
@@ -495,6 +505,12 @@ pub struct GpuTriangleAttributes {
     pub c2: [f32; 3],
     /// Padding.
     pub _pad4: u32,
+    /// Unit tangent and bitangent handedness at the first corner.
+    pub t0: [f32; 4],
+    /// Unit tangent and bitangent handedness at the second corner.
+    pub t1: [f32; 4],
+    /// Unit tangent and bitangent handedness at the third corner.
+    pub t2: [f32; 4],
 }
 
 /// A light (`Light` in WGSL).

@@ -12,7 +12,8 @@ use super::layout::{
     MAPPING_SPHERICAL, MAPPING_UV, MATERIAL_BLINN_PHONG, MATERIAL_COOK_TORRANCE,
     MATERIAL_DIELECTRIC, MATERIAL_EMISSIVE, MATERIAL_LAMBERT, MATERIAL_MIRROR, MATERIAL_OREN_NAYAR,
     MATERIAL_PBR, MATERIAL_TABULATED, NO_ATTRIBUTES, NO_IMAGE, UV_SLOT_ALBEDO, UV_SLOT_EMISSION,
-    UV_SLOT_METALLIC_ROUGHNESS, WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT, WRAP_REPEAT,
+    UV_SLOT_METALLIC_ROUGHNESS, UV_SLOT_NORMAL, WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT,
+    WRAP_REPEAT,
 };
 use crate::accel::{
     BrdfMapCdfs, BvhNode, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry,
@@ -335,6 +336,7 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
     let (metallic_roughness_layer, metallic_roughness_width, metallic_roughness_height) =
         image(material.metallic_roughness_texture);
     let (emission_layer, emission_width, emission_height) = image(material.emission_texture);
+    let (normal_layer, normal_width, normal_height) = image(material.normal_texture);
     GpuMaterial {
         diffuse: vec3(material.diffuse),
         shininess: material.shininess as f32,
@@ -390,15 +392,17 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
                 &material.metallic_roughness_transform,
             ),
             (UV_SLOT_EMISSION, &material.emission_transform),
+            (UV_SLOT_NORMAL, &material.normal_transform),
         ]
         .iter()
         .fold(0, |sets, &(slot, t)| sets | u32::from(t.set == 1) << slot),
         cull_back_faces: u32::from(material.cull_back_faces),
-        _pad1: 0,
+        normal_layer,
         uv_rows: [
             &material.texture_transform,
             &material.metallic_roughness_transform,
             &material.emission_transform,
+            &material.normal_transform,
         ]
         .map(|t| {
             t.rows
@@ -407,6 +411,10 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
         .concat()
         .try_into()
         .unwrap_or_default(),
+        normal_width,
+        normal_height,
+        normal_wrap: wrap_code(material.normal_wrap[0]) | wrap_code(material.normal_wrap[1]) << 8,
+        normal_scale: material.normal_scale as f32,
     }
 }
 
@@ -421,6 +429,7 @@ pub fn may_shift_uvs(scene: &Scene) -> bool {
             &m.texture_transform,
             &m.metallic_roughness_transform,
             &m.emission_transform,
+            &m.normal_transform,
         ]
         .iter()
         .all(|t| t.is_linear_identity())
@@ -477,6 +486,10 @@ pub fn triangle_attributes_record(
     let uvs = near(attributes.uvs);
     let uvs1 = near(attributes.uvs1);
     let colors = attributes.colors.unwrap_or([DVec3::ONE; 3]);
+    let tangents = attributes
+        .tangents
+        .unwrap_or_default()
+        .map(|t| t.as_vec4().to_array());
     GpuTriangleAttributes {
         n0: vec3(normals[0]),
         has_normals: u32::from(attributes.normals.is_some()),
@@ -492,7 +505,7 @@ pub fn triangle_attributes_record(
         ],
         uv2: [uvs[2].x as f32, uvs[2].y as f32],
         has_uvs1: u32::from(attributes.uvs1.is_some()),
-        _pad0: 0,
+        has_tangents: u32::from(attributes.tangents.is_some()),
         uv1_01: [
             uvs1[0].x as f32,
             uvs1[0].y as f32,
@@ -507,6 +520,9 @@ pub fn triangle_attributes_record(
         _pad3: 0,
         c2: vec3(colors[2]),
         _pad4: 0,
+        t0: tangents[0],
+        t1: tangents[1],
+        t2: tangents[2],
     }
 }
 
@@ -922,6 +938,7 @@ mod tests {
             uvs: None,
             uvs1: None,
             colors: None,
+            tangents: None,
             triangles: vec![[0, 1, 2]],
             material: 1,
             instances: vec![

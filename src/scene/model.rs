@@ -52,6 +52,10 @@ pub struct Mesh {
     /// Linear RGB vertex colours in [0, 1], parallel to `positions`, multiplying the
     /// albedo (glTF's `COLOR_0`, OBJ's `v x y z r g b`).
     pub colors: Option<Vec<DVec3>>,
+    /// Unit tangents (`xyz`) with the bitangent's handedness (`w`, ±1), parallel to
+    /// `positions`, for normal maps: glTF's `TANGENT`, or MikkTSpace's from the
+    /// normals and texture coordinates; the bitangent is `w · (normal × tangent)`.
+    pub tangents: Option<Vec<glam::DVec4>>,
     /// Triangles as three vertex indices, counter-clockwise seen from the front.
     pub triangles: Vec<[u32; 3]>,
     /// Index into [`Scene::materials`].
@@ -389,6 +393,16 @@ pub struct Material {
     pub emission_wrap: [TextureWrap; 2],
     /// The coordinates of the emission texture.
     pub emission_transform: TextureTransform,
+    /// Index into [`Scene::images`] of a tangent-space normal map (linear data, glTF's
+    /// `normalTexture`): where a mesh has tangents, the shading normal becomes
+    /// `normalize(T·x + B·y + N·z)` with `(x, y, z) = (2·texel − 1)·(scale, scale, 1)`.
+    pub normal_texture: Option<u32>,
+    /// Wrap modes of the normal map along `u` and `v`.
+    pub normal_wrap: [TextureWrap; 2],
+    /// The coordinates of the normal map.
+    pub normal_transform: TextureTransform,
+    /// glTF's `normalTexture.scale`: the map's x and y are multiplied by it (finite).
+    pub normal_scale: f64,
     /// Whether flat shapes (polygons, triangles, meshes) of this material emit
     /// `emission` from both sides; by default only from the side their normal points
     /// to (spheres always emit on both). The path integrator's rule: Whitted shows
@@ -436,6 +450,10 @@ impl Material {
             emission_texture: None,
             emission_wrap: [TextureWrap::Repeat; 2],
             emission_transform: TextureTransform::IDENTITY,
+            normal_texture: None,
+            normal_wrap: [TextureWrap::Repeat; 2],
+            normal_transform: TextureTransform::IDENTITY,
+            normal_scale: 1.0,
             two_sided: false,
             cull_back_faces: false,
         }

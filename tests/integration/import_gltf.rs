@@ -1076,7 +1076,7 @@ fn texture_transforms_are_read_as_offset_rotation_and_scale() {
 }
 
 #[test]
-fn occlusion_textures_are_left_to_the_path_tracer_and_normal_textures_warned_about() {
+fn occlusion_textures_are_left_to_the_path_tracer_and_normal_maps_need_normals() {
     let (mut doc, _) = triangle_doc();
     let body = two_uv_sets(&mut doc, None, None, None).replace(
         r#""name":"multi","#,
@@ -1085,15 +1085,18 @@ fn occlusion_textures_are_left_to_the_path_tracer_and_normal_textures_warned_abo
     let model = imported("baked.gltf", doc.embedded(&body).as_bytes());
     assert!(model.warnings.is_empty(), "{:?}", model.warnings);
     let body = body.replace(r#""occlusionTexture""#, r#""normalTexture""#);
+    // A normal map on a triangle without NORMAL or TANGENT: no tangents can be made.
     let model = imported("bumpy.gltf", doc.embedded(&body).as_bytes());
     assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
     assert!(
         model.warnings[0].ends_with(
-            "bumpy.gltf: material 0 ('baked'): normalTexture is not supported yet; ignored (the surface shades with its mesh normals)"
+            "bumpy.gltf: mesh 0, primitive 0: its material's normalTexture needs tangents, and without TANGENT they are generated from NORMAL and the normal map's texture coordinates, which it lacks; the normal map is not applied"
         ),
         "{:?}",
         model.warnings
     );
+    assert!(model.materials[0].normal_texture.is_some());
+    assert_eq!(model.meshes[0].tangents, None);
 }
 
 #[test]
@@ -1600,4 +1603,88 @@ fn unsupported_features_that_are_not_required_are_warnings() {
         message.contains("flat.gltf: camera 0 on node 2: orthographic xmag 1 and ymag 0 (times the node's scale) must be positive, finite and at most 1000000000000000"),
         "{message}"
     );
+}
+
+/// A quad facing +z (normals +z, `v` down the image as `y` falls) with a normal map of
+/// 2 × 2 different tilts, with or without a `TANGENT` of +x and handedness +1 (the
+/// bitangent `normal × tangent` = +y, up the image: glTF's "+Y is up").
+fn normal_mapped_quad(with_tangents: bool) -> (Doc, String) {
+    let mut doc = Doc::default();
+    let positions = doc.vec3(&[
+        [-1.0, -1.0, 0.0],
+        [1.0, -1.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [-1.0, 1.0, 0.0],
+    ]);
+    let normals = doc.vec3(&[[0.0, 0.0, 1.0]; 4]);
+    let uvs = doc.vec2(&[[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]);
+    let tangents = doc.vec4(&[[1.0, 0.0, 0.0, 1.0]; 4]);
+    let indices = doc.indices(&[0, 1, 2, 0, 2, 3]);
+    let png = png(
+        2,
+        2,
+        &[
+            [200, 128, 220, 255],
+            [60, 128, 220, 255],
+            [128, 200, 220, 255],
+            [128, 60, 220, 255],
+        ],
+    );
+    let uri = format!(
+        "data:image/png;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&png)
+    );
+    let tangent = if with_tangents {
+        format!(r#","TANGENT":{tangents}"#)
+    } else {
+        String::new()
+    };
+    let body = format!(
+        r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+           "meshes":[{{"primitives":[{{"attributes":{{"POSITION":{positions},"NORMAL":{normals},"TEXCOORD_0":{uvs}{tangent}}},"indices":{indices},"material":0}}]}}],
+           "materials":[{{"normalTexture":{{"index":0,"scale":0.8}},"pbrMetallicRoughness":{{"metallicFactor":0}}}}],
+           "textures":[{{"source":0}}],"images":[{{"uri":"{uri}"}}]"#
+    );
+    (doc, body)
+}
+
+#[test]
+fn generated_tangents_give_the_image_given_ones_give() {
+    let (doc, body) = normal_mapped_quad(true);
+    let given = imported("given.gltf", doc.embedded(&body).as_bytes());
+    let (doc, body) = normal_mapped_quad(false);
+    let generated = imported("generated.gltf", doc.embedded(&body).as_bytes());
+    assert!(given.warnings.is_empty(), "{:?}", given.warnings);
+    assert!(generated.warnings.is_empty(), "{:?}", generated.warnings);
+    // MikkTSpace's tangents are the given ones: +x, handedness +1.
+    for tangent in generated.meshes[0].tangents.as_ref().expect("generated") {
+        assert!(
+            (*tangent - glam::DVec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-6,
+            "{tangent}"
+        );
+    }
+    assert_eq!(given.materials[0].material.normal_scale, f64::from(0.8f32));
+    // Rendered, the same image; and a different one without the normal map.
+    let settings = gpu_render::scene::RenderSettings {
+        width: 32,
+        height: 24,
+        ..Default::default()
+    };
+    let render = |model: &ImportedModel| {
+        let mut scene = model.into_scene(settings);
+        scene.camera.eye = DVec3::new(0.0, 0.0, 4.0);
+        scene.camera.look_at = DVec3::ZERO;
+        gpu_render::cpu::render(&scene, None).image.pixels
+    };
+    let (a, b) = (render(&given), render(&generated));
+    let largest = a
+        .iter()
+        .zip(&b)
+        .map(|(p, q)| (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0f32, f32::max))
+        .fold(0.0, f32::max);
+    assert!(largest < 1e-5, "images differ by {largest}");
+    let mut flat = given.clone();
+    flat.materials[0].normal_texture = None;
+    let c = render(&flat);
+    assert!(a.iter().zip(&c).any(|(p, q)| (p[0] - q[0]).abs() > 1e-2));
 }

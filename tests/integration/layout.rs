@@ -154,8 +154,12 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 emission_wrap,
                 uv_sets,
                 cull_back_faces,
-                _pad1,
+                normal_layer,
                 uv_rows,
+                normal_width,
+                normal_height,
+                normal_wrap,
+                normal_scale,
             }),
         ),
         (
@@ -250,7 +254,7 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 uv01,
                 uv2,
                 has_uvs1,
-                _pad0,
+                has_tangents,
                 uv1_01,
                 uv1_2,
                 _pad1,
@@ -259,7 +263,10 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 c1,
                 _pad3,
                 c2,
-                _pad4
+                _pad4,
+                t0,
+                t1,
+                t2
             }),
         ),
         (

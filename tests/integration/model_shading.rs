@@ -83,6 +83,7 @@ fn quad(material: u32, instances: Vec<DMat4>) -> Mesh {
         ]),
         uvs1: None,
         colors: None,
+        tangents: None,
         triangles: vec![[0, 1, 2], [0, 2, 3]],
         material,
         instances,
@@ -584,4 +585,84 @@ fn an_orthographic_camera_shows_parallel_edges_and_ymag_as_the_half_height() {
     path.render.integrator = gpu_render::scene::Integrator::Path;
     path.render.samples_per_pixel = 2;
     gpu_agrees("orthographic-path", &path);
+}
+
+/// A 1 × 1 normal map whose one texel is the tangent-space normal `n` (encoded as
+/// `(n + 1) / 2`, linear data).
+fn normal_map(n: DVec3) -> Image {
+    let texel = (n + DVec3::ONE) / 2.0;
+    Image {
+        path: "<normal map>".into(),
+        width: 1,
+        height: 1,
+        texels: vec![[texel.x as f32, texel.y as f32, texel.z as f32, 1.0]],
+    }
+}
+
+/// Three quads facing +z, tangent +x: normal-mapped 30° towards +x, flat, and mapped
+/// 30° towards −x (the mirror twin), lit at a grazing angle from +x.
+fn normal_mapped_scene() -> Scene {
+    let tilt = 30f64.to_radians();
+    let mapped = |image: u32| Material {
+        normal_texture: Some(image),
+        texture_mapping: TextureMapping::Uv,
+        ..Material::lambert(DVec3::splat(0.8))
+    };
+    let meshes = (0..3)
+        .map(|i| {
+            let mut mesh = quad(i, vec![at(-3.0 + 2.0 * f64::from(i))]);
+            mesh.tangents = Some(vec![glam::DVec4::new(1.0, 0.0, 0.0, 1.0); 4]);
+            mesh
+        })
+        .collect();
+    let mut scene = scene(
+        vec![mapped(0), Material::lambert(DVec3::splat(0.8)), mapped(1)],
+        meshes,
+        vec![
+            normal_map(DVec3::new(tilt.sin(), 0.0, tilt.cos())),
+            normal_map(DVec3::new(-tilt.sin(), 0.0, tilt.cos())),
+        ],
+    );
+    scene.lights = vec![Light::Directional {
+        direction: -GRAZING,
+        irradiance: DVec3::splat(std::f64::consts::PI),
+    }];
+    scene
+}
+
+/// Towards the grazing light: from +x, 11° above the quads' plane.
+const GRAZING: DVec3 = DVec3::new(0.980_580_675_690_920_2, 0.0, 0.196_116_135_138_184_04);
+
+#[test]
+fn a_normal_mapped_quad_tilted_toward_a_grazing_light_is_brighter_than_its_mirror_twin() {
+    let scene = normal_mapped_scene();
+    let cpu = gpu_render::cpu::render(&scene, None);
+    let tilt = 30f64.to_radians();
+    let value = |centre: f64| colour(&cpu.image, pixel_at_uv(centre, 0.5, 0.5)).x;
+    let (toward, flat, away) = (value(-3.0), value(-1.0), value(1.0));
+    // Lambert under irradiance π: 0.8 · cos between the (mapped) normal and the light.
+    let expected = |n: DVec3| 0.8 * n.dot(GRAZING).max(0.0);
+    assert!(
+        (toward - expected(DVec3::new(tilt.sin(), 0.0, tilt.cos()))).abs() < 1e-3,
+        "{toward}"
+    );
+    assert!((flat - expected(DVec3::Z)).abs() < 1e-3, "{flat}");
+    assert!(toward > 3.0 * flat && flat > away, "{toward} {flat} {away}");
+    assert_eq!(away, 0.0, "turned away from the light");
+    gpu_agrees("normal-map-whitted", &scene);
+    let mut path = scene.clone();
+    path.render.integrator = gpu_render::scene::Integrator::Path;
+    path.render.samples_per_pixel = 2;
+    gpu_agrees("normal-map-path", &path);
+    // Instanced and mirrored placements move the tangents (and flip their handedness).
+    let mut placed = scene.clone();
+    placed.meshes[0].instances = vec![
+        at(-3.0),
+        at(1.0) * DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
+    ];
+    placed.meshes.truncate(2);
+    let cpu = gpu_render::cpu::render(&placed, None);
+    // Mirrored, the map's +x tilt points to −x: away from the light.
+    assert_eq!(colour(&cpu.image, pixel_at_uv(1.0, 0.5, 0.5)).x, 0.0);
+    gpu_agrees("normal-map-instanced", &placed);
 }

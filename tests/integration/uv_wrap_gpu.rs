@@ -60,6 +60,7 @@ fn quad(material: u32, x: f64) -> Mesh {
         ]),
         uvs1: None,
         colors: None,
+        tangents: None,
         triangles: vec![[0, 1, 2], [0, 2, 3]],
         material,
         instances: vec![DMat4::from_translation(DVec3::new(x, 0.0, 0.0))],

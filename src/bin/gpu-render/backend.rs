@@ -482,6 +482,7 @@ mod tests {
             uvs: None,
             uvs1: None,
             colors: None,
+            tangents: None,
             triangles: vec![[0, 1, 2]],
             material: 0,
             instances: vec![glam::DMat4::IDENTITY],

@@ -504,7 +504,7 @@ struct Importer<'a> {
     textures: Textures,
     /// glTF material index (`None`: the default material) → index in the model and
     /// whether a texture of it reads `TEXCOORD_1`.
-    materials: HashMap<Option<usize>, (u32, bool)>,
+    materials: HashMap<Option<usize>, MaterialUse>,
     /// Warnings already given once per file.
     warned: BTreeSet<&'static str>,
     /// The primitives skipped for being points or lines (`mesh N, primitive P: MODE`).
@@ -514,6 +514,18 @@ struct Importer<'a> {
     /// The primitives with vertex colour sets beyond `COLOR_0`, which are not read
     /// (`mesh N, primitive P: COLOR_1`).
     vertex_colors: Vec<String>,
+}
+
+/// What a primitive's reading depends on in its material.
+#[derive(Debug, Clone, Copy)]
+struct MaterialUse {
+    /// Index in the model's materials.
+    index: u32,
+    /// Whether a texture reads `TEXCOORD_1`.
+    uses_set1: bool,
+    /// The texture coordinate set of its normal map, if it has one: the primitive then
+    /// needs tangents.
+    normal_set: Option<u32>,
 }
 
 /// `what N ('name')`, or `what N` for an unnamed element.
@@ -752,7 +764,8 @@ impl Importer<'_> {
             }
             self.triangle_primitives += 1;
             // The material first: it decides which texture coordinates to read.
-            let (material, uses_set1) = self.material(primitive.material().index())?;
+            let uses = self.material(primitive.material().index())?;
+            let material = uses.index;
             // The JSON's keys, not `Primitive::attributes`, which unwraps each key.
             let json = &self.document.as_json().meshes[mesh.index()].primitives[primitive.index()];
             let colors: Vec<String> = json
@@ -770,7 +783,7 @@ impl Importer<'_> {
                     .push(format!("{name}: {}", colors.join(", ")));
             }
             let raw = self
-                .primitive(&primitive, &name, uses_set1)
+                .primitive(&primitive, &name, uses)
                 .map_err(|e| self.fail(format!("{name}: {e}")))?;
             self.budget
                 .charge_instances(instances.len())
@@ -796,8 +809,9 @@ impl Importer<'_> {
         &mut self,
         primitive: &::gltf::Primitive<'_>,
         name: &str,
-        uses_set1: bool,
+        uses: MaterialUse,
     ) -> Result<RawMesh, String> {
+        let uses_set1 = uses.uses_set1;
         let mode = primitive.mode();
         let positions_accessor = primitive
             .get(&::gltf::Semantic::Positions)
@@ -910,14 +924,97 @@ impl Importer<'_> {
                 indices.len() % 3
             ));
         }
-        Ok(RawMesh {
+        let Some(normal_set) = uses.normal_set else {
+            return Ok(RawMesh {
+                positions,
+                normals,
+                uvs,
+                uvs1,
+                colors,
+                tangents: None,
+                triangles,
+            });
+        };
+        let tangents = self.tangents(primitive, name, count)?;
+        let raw = RawMesh {
             positions,
             normals,
             uvs,
             uvs1,
             colors,
+            tangents,
             triangles,
-        })
+        };
+        if raw.tangents.is_some() {
+            return Ok(raw);
+        }
+        // No TANGENT: MikkTSpace's, from the normals and the normal map's coordinates.
+        let map_uvs = if normal_set == 1 { &raw.uvs1 } else { &raw.uvs };
+        let generated = match (&raw.normals, map_uvs.clone()) {
+            (Some(_), Some(map_uvs)) => super::tangents::with_mikktspace_tangents(
+                RawMesh {
+                    positions: raw.positions.clone(),
+                    normals: raw.normals.clone(),
+                    uvs: raw.uvs.clone(),
+                    uvs1: raw.uvs1.clone(),
+                    colors: raw.colors.clone(),
+                    tangents: None,
+                    triangles: raw.triangles.clone(),
+                },
+                &map_uvs,
+            ),
+            _ => None,
+        };
+        match generated {
+            Some(with_tangents) => Ok(with_tangents),
+            None => {
+                self.warn(format!(
+                    "{name}: its material's normalTexture needs tangents, and without TANGENT they are generated from NORMAL and the normal map's texture coordinates, which {}; the normal map is not applied",
+                    if raw.normals.is_none() || map_uvs.is_none() {
+                        "it lacks"
+                    } else {
+                        "do not give any"
+                    }
+                ));
+                Ok(raw)
+            }
+        }
+    }
+
+    /// Reads `TANGENT` of `primitive` (of `count` vertices), if it has it: `VEC4` of
+    /// floats, or under `KHR_mesh_quantization` normalized signed bytes or shorts.
+    fn tangents(
+        &mut self,
+        primitive: &::gltf::Primitive<'_>,
+        name: &str,
+        count: usize,
+    ) -> Result<Option<Vec<glam::DVec4>>, String> {
+        let Some(accessor) = primitive.get(&::gltf::Semantic::Tangents) else {
+            return Ok(None);
+        };
+        if accessor.count() != count {
+            return Err(format!(
+                "TANGENT has {} elements but POSITION has {count}",
+                accessor.count()
+            ));
+        }
+        let values = read(
+            &accessor,
+            &Expect {
+                name: "TANGENT",
+                dimensions: Dimensions::Vec4,
+                types: NORMAL_TYPES,
+                normalized: Normalized::Always,
+            },
+            &self.buffers,
+        )?;
+        self.check_quantization(&accessor, name, "TANGENT", false);
+        Ok(Some(
+            values
+                .chunks_exact(4)
+                .map(|c| glam::DVec4::new(c[0], c[1], c[2], c[3]))
+                .collect(),
+        ))
     }
 
     /// Reads `TEXCOORD_{set}` of `primitive` (of `count` vertices), if it has it.
@@ -1053,36 +1150,44 @@ impl Importer<'_> {
 
     /// The model's index of glTF material `index` (`None`: the default material, glTF
     /// 2.0 §3.9.6), mapping it on first use.
-    fn material(&mut self, index: Option<usize>) -> Result<(u32, bool), SceneError> {
+    fn material(&mut self, index: Option<usize>) -> Result<MaterialUse, SceneError> {
         if let Some(&known) = self.materials.get(&index) {
             return Ok(known);
         }
-        let (imported, uses_set1) = match index.and_then(|i| self.document.materials().nth(i)) {
-            Some(material) => self.map_material(&material)?,
-            None => (
-                ImportedMaterial {
-                    name: "default".into(),
-                    // glTF's default material: white, fully metallic and rough... which is
-                    // black under Whitted lighting; a white dielectric PBR is what viewers show.
-                    material: Material {
-                        diffuse: DVec3::ONE,
-                        metallic: 0.0,
-                        roughness: 1.0,
-                        // The default material is single-sided (§3.9.6).
-                        cull_back_faces: true,
-                        ..Material::blank(MaterialKind::Pbr)
+        let (imported, uses_set1, normal_set) =
+            match index.and_then(|i| self.document.materials().nth(i)) {
+                Some(material) => self.map_material(&material)?,
+                None => (
+                    ImportedMaterial {
+                        name: "default".into(),
+                        // glTF's default material: white, fully metallic and rough... which is
+                        // black under Whitted lighting; a white dielectric PBR is what viewers show.
+                        material: Material {
+                            diffuse: DVec3::ONE,
+                            metallic: 0.0,
+                            roughness: 1.0,
+                            // The default material is single-sided (§3.9.6).
+                            cull_back_faces: true,
+                            ..Material::blank(MaterialKind::Pbr)
+                        },
+                        base_color_texture: None,
+                        metallic_roughness_texture: None,
+                        emissive_texture: None,
+                        normal_texture: None,
                     },
-                    base_color_texture: None,
-                    metallic_roughness_texture: None,
-                    emissive_texture: None,
-                },
-                false,
-            ),
-        };
+                    false,
+                    None,
+                ),
+            };
         let ours = self.model.materials.len() as u32;
         self.model.materials.push(imported);
-        self.materials.insert(index, (ours, uses_set1));
-        Ok((ours, uses_set1))
+        let uses = MaterialUse {
+            index: ours,
+            uses_set1,
+            normal_set,
+        };
+        self.materials.insert(index, uses);
+        Ok(uses)
     }
 
     /// Maps a glTF metallic-roughness material onto ours (the table in `docs/models.md`),
@@ -1090,7 +1195,7 @@ impl Importer<'_> {
     fn map_material(
         &mut self,
         material: &::gltf::Material<'_>,
-    ) -> Result<(ImportedMaterial, bool), SceneError> {
+    ) -> Result<(ImportedMaterial, bool, Option<u32>), SceneError> {
         let name = describe("material", material.index().unwrap_or(0), material.name());
         let pbr = material.pbr_metallic_roughness();
         let [r, g, b, _alpha] = pbr.base_color_factor().map(f64::from);
@@ -1117,11 +1222,6 @@ impl Importer<'_> {
             self.warn(format!(
                 "{name}: alphaMode {:?} is not supported; the material is opaque",
                 material.alpha_mode()
-            ));
-        }
-        if material.normal_texture().is_some() {
-            self.warn(format!(
-                "{name}: normalTexture is not supported yet; ignored (the surface shades with its mesh normals)"
             ));
         }
         // occlusionTexture is left out without a warning: baked ambient occlusion is a
@@ -1205,10 +1305,45 @@ impl Importer<'_> {
             Some(info) => Some(self.texture(&info, Encoding::Color, &name, "emissiveTexture")?),
             None => None,
         };
+        let (normal_texture, normal_scale) = match material.normal_texture() {
+            Some(normal) => {
+                let scale = f64::from(normal.scale());
+                if !scale.is_finite() {
+                    return Err(
+                        self.fail(format!("{name}: normalTexture scale {scale} is not finite"))
+                    );
+                }
+                let mut set = normal.tex_coord();
+                if set > 1 {
+                    self.warn(format!(
+                        "{name}: normalTexture uses TEXCOORD_{set}, but only TEXCOORD_0 and TEXCOORD_1 are read; TEXCOORD_0 is used"
+                    ));
+                    set = 0;
+                }
+                let transform = TextureTransform {
+                    set,
+                    ..TextureTransform::IDENTITY
+                };
+                let texture = self.texture_of(
+                    normal.texture(),
+                    transform,
+                    Encoding::Data,
+                    &name,
+                    "normalTexture",
+                )?;
+                (Some(texture), scale)
+            }
+            None => (None, 1.0),
+        };
+        let ours = Material {
+            normal_scale,
+            ..ours
+        };
         let uses_set1 = [
             &base_color_texture,
             &metallic_roughness_texture,
             &emissive_texture,
+            &normal_texture,
         ]
         .iter()
         .any(|t| t.is_some_and(|t| t.transform.set == 1));
@@ -1218,8 +1353,9 @@ impl Importer<'_> {
             base_color_texture,
             metallic_roughness_texture,
             emissive_texture,
+            normal_texture,
         };
-        Ok((imported, uses_set1))
+        Ok((imported, uses_set1, normal_texture.map(|t| t.transform.set)))
     }
 
     /// Loads the image of a material's texture and keeps its sampler's wrap modes, its
@@ -1231,7 +1367,20 @@ impl Importer<'_> {
         material: &str,
         slot: &str,
     ) -> Result<TextureRef, SceneError> {
-        let texture = info.texture();
+        let transform = self.transform(info, material, slot)?;
+        self.texture_of(info.texture(), transform, encoding, material, slot)
+    }
+
+    /// Loads the image of `texture` and keeps its sampler's wrap modes, with the
+    /// coordinates `transform` describes.
+    fn texture_of(
+        &mut self,
+        texture: ::gltf::texture::Texture<'_>,
+        transform: TextureTransform,
+        encoding: Encoding,
+        material: &str,
+        slot: &str,
+    ) -> Result<TextureRef, SceneError> {
         let image = texture.source();
         let image_name = describe("image", image.index(), image.name());
         let fail = |e: String| error(self.path, format!("{material}: {slot}: {image_name}: {e}"));
@@ -1272,7 +1421,6 @@ impl Importer<'_> {
             WrappingMode::ClampToEdge => WrapMode::ClampToEdge,
             WrappingMode::MirroredRepeat => WrapMode::MirroredRepeat,
         };
-        let transform = self.transform(info, material, slot)?;
         Ok(TextureRef {
             image: index,
             wrap_u: wrap(sampler.wrap_s()),

@@ -40,6 +40,7 @@ pub(super) struct RawMesh {
     pub uvs: Option<Vec<DVec2>>,
     pub uvs1: Option<Vec<DVec2>>,
     pub colors: Option<Vec<DVec3>>,
+    pub tangents: Option<Vec<glam::DVec4>>,
     pub triangles: Vec<[u32; 3]>,
 }
 
@@ -61,6 +62,7 @@ pub(super) fn finish_mesh(
         uvs,
         uvs1,
         colors,
+        tangents,
         triangles,
     } = raw;
     let mut warn = |message: String| warnings.push(format!("{}: {message}", file.display()));
@@ -157,6 +159,38 @@ pub(super) fn finish_mesh(
                 .collect(),
         )
     });
+    let tangents = tangents.and_then(|tangents| {
+        if tangents.len() != count {
+            warn(format!(
+                "{name}: {} tangents for {count} vertices; the tangents are ignored (the normal map with them)",
+                tangents.len()
+            ));
+            return None;
+        }
+        // Unit xyz and w = ±1 (glTF 2.0 §3.7.2.1); a zero or non-finite tangent
+        // leaves its vertex without a normal map rather than the whole mesh.
+        let usable = |t: &glam::DVec4| t.is_finite() && t.truncate().length_squared() > 0.0;
+        let bad = tangents.iter().filter(|t| !usable(t)).count();
+        if bad > 0 {
+            warn(format!(
+                "{name}: {bad} tangent{} zero or not finite; the normal map is not applied there",
+                if bad == 1 { " is" } else { "s are" }
+            ));
+        }
+        Some(
+            tangents
+                .into_iter()
+                .map(|t| {
+                    if usable(&t) {
+                        let w = if t.w < 0.0 { -1.0 } else { 1.0 };
+                        t.truncate().normalize_or_zero().extend(w)
+                    } else {
+                        glam::DVec4::ZERO
+                    }
+                })
+                .collect(),
+        )
+    });
     let total = triangles.len();
     let mut kept = Vec::with_capacity(total);
     for (t, triangle) in triangles.into_iter().enumerate() {
@@ -191,6 +225,7 @@ pub(super) fn finish_mesh(
         uvs,
         uvs1,
         colors,
+        tangents,
         triangles: kept,
         material,
         instances: vec![glam::DMat4::IDENTITY],
@@ -317,6 +352,7 @@ mod tests {
             uvs: None,
             uvs1: None,
             colors: None,
+            tangents: None,
             triangles,
         }
     }

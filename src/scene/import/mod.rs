@@ -38,6 +38,7 @@ mod gltf;
 mod mesh;
 mod obj;
 mod place;
+mod tangents;
 mod texture;
 
 use std::path::{Path, PathBuf};
@@ -115,6 +116,9 @@ pub struct ImportedMesh {
     /// Linear RGB vertex colours in [0, 1] (glTF `COLOR_0`, OBJ `v x y z r g b`),
     /// parallel to `positions`, multiplying the material's albedo.
     pub colors: Option<Vec<DVec3>>,
+    /// Unit tangents with the bitangent's handedness in `w` (±1), parallel to
+    /// `positions`, for a normal map: glTF `TANGENT`, or MikkTSpace's.
+    pub tangents: Option<Vec<glam::DVec4>>,
     /// Triangles as indices into `positions`, counter-clockwise seen from the front (the
     /// side the right-hand-rule normal points to). Degenerate triangles were dropped.
     pub triangles: Vec<[u32; 3]>,
@@ -144,6 +148,9 @@ pub struct ImportedMaterial {
     pub metallic_roughness_texture: Option<TextureRef>,
     /// glTF's `emissiveTexture`: a colour texture multiplying `material.emission`.
     pub emissive_texture: Option<TextureRef>,
+    /// glTF's `normalTexture`: a tangent-space normal map (linear data), with its
+    /// `scale` in `material.normal_scale`.
+    pub normal_texture: Option<TextureRef>,
 }
 
 /// A material's use of a texture.

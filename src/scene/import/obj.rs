@@ -129,6 +129,7 @@ fn parse_obj_within(
                     base_color_texture: None,
                     metallic_roughness_texture: None,
                     emissive_texture: None,
+                    normal_texture: None,
                 });
                 model.materials.len() as u32 - 1
             }),
@@ -355,6 +356,7 @@ impl FaceGroup {
             normals: attribute(&self.vertices, 2, &file.normals),
             uvs: attribute(&self.vertices, 1, &file.texcoords),
             uvs1: None,
+            tangents: None,
             colors: (!file.colors.is_empty()).then(|| {
                 self.vertices
                     .iter()

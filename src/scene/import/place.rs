@@ -103,6 +103,7 @@ impl ImportedModel {
                     uvs: mesh.uvs.clone(),
                     uvs1: mesh.uvs1.clone(),
                     colors: mesh.colors.clone(),
+                    tangents: mesh.tangents.clone(),
                     triangles: mesh.triangles.clone(),
                     material: material.unwrap_or(material_base + mesh.material),
                     instances: transforms
@@ -161,6 +162,18 @@ impl ImportedModel {
                 material.emission_texture = Some(scene_image(scene, image));
                 material.texture_mapping = TextureMapping::Uv;
                 material.emission_wrap = [texture_wrap(wrap_u), texture_wrap(wrap_v)];
+            }
+            if let Some(TextureRef {
+                image,
+                wrap_u,
+                wrap_v,
+                transform,
+            }) = imported.normal_texture
+            {
+                material.normal_transform = transform;
+                material.normal_texture = Some(scene_image(scene, image));
+                material.texture_mapping = TextureMapping::Uv;
+                material.normal_wrap = [texture_wrap(wrap_u), texture_wrap(wrap_v)];
             }
             scene.materials.push(material);
             scene

@@ -273,6 +273,7 @@ pub fn blob(rings: usize, segments: usize) -> Mesh {
         uvs: Some(uvs),
         uvs1: None,
         colors: None,
+        tangents: None,
         triangles,
         material: 1,
         instances: vec![],

@@ -293,6 +293,7 @@ fn instanced_million_scene(
                 uvs: None,
                 uvs1: None,
                 colors: None,
+                tangents: None,
                 triangles: triangles
                     .iter()
                     .map(|&[a, b, c]| if mirrored { [a, c, b] } else { [a, b, c] })
@@ -311,6 +312,7 @@ fn instanced_million_scene(
                 uvs: None,
                 uvs1: None,
                 colors: None,
+                tangents: None,
                 triangles: triangles.clone(),
                 material,
                 instances: vec![transform],

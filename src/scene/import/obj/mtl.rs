@@ -603,6 +603,7 @@ pub(super) fn map_material(
         base_color_texture,
         metallic_roughness_texture: None,
         emissive_texture,
+        normal_texture: None,
     })
 }
 
