@@ -48,11 +48,12 @@ struct FirstHitAov {
 // hit something). Twin of first_hit_aov.
 fn first_hit_aov(ray: Ray, trace: TraceRay) -> FirstHitAov {
     let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
-    let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv);
+    let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.color);
     let entering = dot(ray.direction, hit.normal) < 0.0;
     let ng = select(-hit.normal, hit.normal, entering);
     //#if MESH_ATTRIBUTES
-    let ns = select(-hit.shading_normal, hit.shading_normal, entering);
+    let mapped = mapped_normal(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.shading_normal, hit.tangent);
+    let ns = select(-mapped, mapped, entering);
     let n = shading_frame_normal(ray.direction, ng, ns);
     //#else
     let n = ng;
@@ -74,6 +75,12 @@ fn add_first_hit_aov(pixel: u32, origin: vec3<f32>, direction: vec3<f32>, trace:
     let at = aov_index(pixel);
     if trace.best_prim == NO_PRIM {
         accumulation[at + 1u].w += 1.0;
+        return;
+    }
+    // A single-sided back face the camera ray passes through: the ray traced again
+    // from beyond it adds the sample (first_hit_aov's loop on the CPU).
+    let passed = hit_record_keyed(trace.best_prim, trace.best_instance, Ray(origin, direction), trace.best_t);
+    if culls_back_face(materials[passed.material].cull_back_faces != 0u, 0u, direction, passed.normal) {
         return;
     }
     let first = first_hit_aov(Ray(origin, direction), trace);

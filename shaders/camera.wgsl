@@ -4,6 +4,7 @@
 // sample count is computed once on the host (camera::lattice_generator) and arrives in
 // frame.lattice_generator.
 
+#import types
 #import bindings
 #import sample
 
@@ -47,11 +48,28 @@ fn sample_offset(px: u32, py: u32, index: u32) -> vec2<f32> {
     return (cell + jitter) / vec2<f32>(grid);
 }
 
-// Unit direction through image position (x, y) in pixels from the top-left corner.
+// Unit direction through image position (x, y) in pixels from the top-left corner: the
+// view direction for an orthographic camera.
 fn camera_ray_direction(x: f32, y: f32) -> vec3<f32> {
+    if (frame.flags & FLAG_ORTHOGRAPHIC) != 0u {
+        return frame.forward;
+    }
     let ndc_x = 2.0 * x / f32(frame.width) - 1.0;
     let ndc_y = 1.0 - 2.0 * y / f32(frame.height);
     return normalize(frame.forward
         + frame.right * (ndc_x * frame.aspect * frame.tan_half_fov_y)
         + frame.up * (ndc_y * frame.tan_half_fov_y));
+}
+
+// Where the ray through image position (x, y) starts: the eye, or for an orthographic
+// camera (frame.tan_half_fov_y then holds the half view height) the point of the view
+// plane the position maps to. CPU twin: CameraFrame::ray_origin.
+fn camera_ray_origin(x: f32, y: f32) -> vec3<f32> {
+    if (frame.flags & FLAG_ORTHOGRAPHIC) == 0u {
+        return frame.eye;
+    }
+    let ndc_x = 2.0 * x / f32(frame.width) - 1.0;
+    let ndc_y = 1.0 - 2.0 * y / f32(frame.height);
+    return frame.eye + frame.right * (ndc_x * frame.aspect * frame.tan_half_fov_y)
+        + frame.up * (ndc_y * frame.tan_half_fov_y);
 }

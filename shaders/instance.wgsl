@@ -44,6 +44,16 @@ fn instance_normal(instance: Instance, n: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(dot(instance.w2o_x, n), dot(instance.w2o_y, n), dot(instance.w2o_z, n));
 }
 
+// A mesh-space tangent (w: the bitangent's handedness) in world space: through the
+// linear part, renormalised (zero where it vanishes), the handedness flipped under a
+// mirroring transform. CPU twin: world_tangent (src/accel/instance.rs).
+fn world_tangent(instance: Instance, t: vec4<f32>) -> vec4<f32> {
+    let d = instance.o2w_x * t.x + instance.o2w_y * t.y + instance.o2w_z * t.z;
+    let length_squared = dot(d, d);
+    let direction = select(vec3<f32>(0.0), d * inverseSqrt(length_squared), length_squared > 0.0);
+    return vec4<f32>(direction, select(t.w, -t.w, instance.mirrored));
+}
+
 // Mesh triangle `index` of instance `record` in world space, as a flattened placement
 // stores it: corners moved, corners 1 and 2 swapped under a mirroring transform (which
 // keeps the winding normal facing out), the instance's material. CPU twin:

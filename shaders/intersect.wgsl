@@ -30,6 +30,12 @@ struct Hit {
     shading_normal: vec3<f32>,
     // A mesh triangle's interpolated texture coordinates, else (0, 0).
     uv: vec2<f32>,
+    // The second set of texture coordinates, likewise.
+    uv1: vec2<f32>,
+    // A mesh triangle's interpolated vertex colour, else white.
+    color: vec3<f32>,
+    // A mesh triangle's interpolated tangent (w: the bitangent's handedness), else 0.
+    tangent: vec4<f32>,
     // Barycentric coordinates in a triangle, else (1, 0, 0).
     barycentrics: vec3<f32>,
     // The instance of an instanced mesh's triangle (its record's node index; `prim`
@@ -37,10 +43,11 @@ struct Hit {
     instance: u32,
 }
 
-// A hit without vertex attributes: shading normal = geometric normal.
+// A hit without vertex attributes: shading normal = geometric normal, texture
+// coordinates (0, 0), colour white.
 fn flat_hit(prim: u32, t: f32, normal: vec3<f32>, material: u32, position: vec3<f32>) -> Hit {
     return Hit(t, normal, material, true, position, prim, normal, vec2<f32>(0.0),
-               vec3<f32>(1.0, 0.0, 0.0), NO_INSTANCE);
+               vec2<f32>(0.0), vec3<f32>(1.0), vec4<f32>(0.0), vec3<f32>(1.0, 0.0, 0.0), NO_INSTANCE);
 }
 
 //#if MESH_ATTRIBUTES
@@ -57,7 +64,7 @@ fn world_triangle(prim: u32, instance: u32) -> Triangle {
 
 // A triangle's shading attributes in world space: an instanced mesh's normals through
 // the normal matrix, normalised (one that vanishes becomes `facing`, the world winding
-// normal), corners 1 and 2 swapped under a mirroring transform. CPU twin:
+// normal), corners 1 and 2 (of every attribute) swapped under a mirroring transform. CPU twin:
 // Instance::world_triangle.
 fn world_attributes(index: u32, instance: u32, facing: vec3<f32>) -> TriangleAttributes {
     var attributes = triangle_attributes[index];
@@ -75,6 +82,19 @@ fn world_attributes(index: u32, instance: u32, facing: vec3<f32>) -> TriangleAtt
         let uv1 = attributes.uv01.zw;
         attributes.uv01 = vec4<f32>(attributes.uv01.xy, select(uv1, attributes.uv2, placed.mirrored));
         attributes.uv2 = select(attributes.uv2, uv1, placed.mirrored);
+        let second1 = attributes.uv1_01.zw;
+        attributes.uv1_01 = vec4<f32>(attributes.uv1_01.xy, select(second1, attributes.uv1_2, placed.mirrored));
+        attributes.uv1_2 = select(attributes.uv1_2, second1, placed.mirrored);
+        let c1 = attributes.c1;
+        attributes.c1 = select(c1, attributes.c2, placed.mirrored);
+        attributes.c2 = select(attributes.c2, c1, placed.mirrored);
+        // Tangents through the linear part, renormalised (zero where they vanish), the
+        // handedness flipped under a mirroring transform. CPU twin: world_tangent.
+        let t1 = world_tangent(placed, attributes.t1);
+        let t2 = world_tangent(placed, attributes.t2);
+        attributes.t0 = world_tangent(placed, attributes.t0);
+        attributes.t1 = select(t1, t2, placed.mirrored);
+        attributes.t2 = select(t2, t1, placed.mirrored);
     }
     //#endif
     return attributes;
@@ -110,10 +130,17 @@ fn triangle_barycentrics(p: vec3<f32>, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f3
 }
 //#endif
 
+// Whether a camera ray (`depth` 0) along `direction` passes through the back face of
+// a material that culls back faces (glTF doubleSided false, glTF 2.0 §3.9.5) at a hit
+// of geometric normal `normal`. CPU twin: culls_back_face.
+fn culls_back_face(cull_back_faces: bool, depth: u32, direction: vec3<f32>, normal: vec3<f32>) -> bool {
+    return cull_back_faces && depth == 0u && dot(direction, normal) > 0.0;
+}
+
 //#if MESH_ATTRIBUTES
 // Fills a mesh triangle hit's shading normal (the interpolated vertex normals, kept
-// only where they are not degenerate and face the geometric normal's side) and texture
-// coordinates from its world-space `attributes`. CPU twin: triangle_hit.
+// only where they are not degenerate and face the geometric normal's side), texture
+// coordinates and vertex colour from its world-space `attributes`. CPU twin: triangle_hit.
 fn apply_triangle_attributes(hit: ptr<function, Hit>, attributes: TriangleAttributes) {
     let b = (*hit).barycentrics;
     if attributes.has_normals != 0u {
@@ -128,6 +155,15 @@ fn apply_triangle_attributes(hit: ptr<function, Hit>, attributes: TriangleAttrib
     }
     if attributes.has_uvs != 0u {
         (*hit).uv = attributes.uv01.xy * b.x + attributes.uv01.zw * b.y + attributes.uv2 * b.z;
+    }
+    if attributes.has_uvs1 != 0u {
+        (*hit).uv1 = attributes.uv1_01.xy * b.x + attributes.uv1_01.zw * b.y + attributes.uv1_2 * b.z;
+    }
+    if attributes.has_colors != 0u {
+        (*hit).color = attributes.c0 * b.x + attributes.c1 * b.y + attributes.c2 * b.z;
+    }
+    if attributes.has_tangents != 0u {
+        (*hit).tangent = attributes.t0 * b.x + attributes.t1 * b.y + attributes.t2 * b.z;
     }
 }
 

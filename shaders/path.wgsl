@@ -342,7 +342,12 @@ fn path_closest_hit(path: ptr<function, PathState>, trace: TraceRay) {
         return;
     }
     let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
-    let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv);
+    if culls_back_face(materials[hit.material].cull_back_faces != 0u, (*path).depth, ray.direction, hit.normal) {
+        (*path).origin = offset_ray_origin(hit.position, hit.normal, frame.offset_scale);
+        (*path).phase = PHASE_PASS_THROUGH;
+        return;
+    }
+    let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.color);
     // Emission, weighted against next-event estimation where that could have found it;
     // shadow_origin still holds the previous hit's, where that estimation sampled from.
     if max_component(material.emission) > 0.0 && emits_towards(hit, ray.direction, material.two_sided != 0u) {
@@ -362,7 +367,8 @@ fn path_closest_hit(path: ptr<function, PathState>, trace: TraceRay) {
     let outside_ior = 1.0;
     //#endif
     //#if MESH_ATTRIBUTES
-    let ns = select(-hit.shading_normal, hit.shading_normal, entering);
+    let mapped = mapped_normal(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.shading_normal, hit.tangent);
+    let ns = select(-mapped, mapped, entering);
     let n = shading_frame_normal(ray.direction, ng, ns);
     let lifted = shadow_terminator_point(hit, ng);
     //#else
@@ -501,7 +507,7 @@ fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
                                           Ray((*path).shadow_origin, sample.wi), trace.best_t);
             let light_material = materials[light_hit.material];
             if light_material.emission_layer != NO_IMAGE {
-                radiance = shading_emission(light_material, light_hit.position, light_hit.normal, light_hit.uv);
+                radiance = shading_emission(light_material, light_hit.position, light_hit.normal, light_hit.uv, light_hit.uv1);
             }
         }
         //#endif

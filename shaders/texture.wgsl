@@ -35,17 +35,21 @@ fn tangent_frame(n: vec3<f32>) -> TangentFrame {
 //#if TEXTURES
 // Spherical: u = ½ - atan2(n.z, n.x)/(2π), v = acos(n.y)/π. Planar: u = p·t/scale,
 // v = p·b/scale on the tangent frame of the geometric normal. UV: the mesh's
-// interpolated coordinates `uv`.
-fn texture_coordinates(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> vec2<f32> {
+// interpolated coordinates of the texture's set (`uv`: set 0, `uv1`: set 1). Then the
+// texture's affine map, material.uv_rows[2·slot] and [2·slot + 1] (UV_SLOT_*).
+fn texture_coordinates(material: Material, slot: u32, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, uv1: vec2<f32>) -> vec2<f32> {
+    var mapped: vec2<f32>;
     if material.texture_mapping == MAPPING_UV {
-        return uv;
-    }
-    if material.texture_mapping == MAPPING_SPHERICAL {
+        mapped = select(uv, uv1, (material.uv_sets & (1u << slot)) != 0u);
+    } else if material.texture_mapping == MAPPING_SPHERICAL {
         let y = clamp(normal.y, -1.0, 1.0);
-        return vec2<f32>(0.5 - atan2(normal.z, normal.x) / (2.0 * PI), acos(y) / PI);
+        mapped = vec2<f32>(0.5 - atan2(normal.z, normal.x) / (2.0 * PI), acos(y) / PI);
+    } else {
+        let tangents = tangent_frame(normal);
+        mapped = vec2<f32>(dot(position, tangents.t), dot(position, tangents.b)) / material.texture_scale;
     }
-    let tangents = tangent_frame(normal);
-    return vec2<f32>(dot(position, tangents.t), dot(position, tangents.b)) / material.texture_scale;
+    let p = vec3<f32>(mapped, 1.0);
+    return vec2<f32>(dot(material.uv_rows[2u * slot].xyz, p), dot(material.uv_rows[2u * slot + 1u].xyz, p));
 }
 //#endif
 
@@ -102,15 +106,14 @@ fn sample_brdf_map(layer: u32, size: u32, theta_i: f32, theta_r: f32) -> vec3<f3
 // The material at a hit: its albedo from shading_albedo, its emission from
 // shading_emission, and its metalness and perceptual roughness times the blue and green
 // channels of the metallic/roughness texture where there is one (glTF 2.0 §3.9.2),
-// looked up at the albedo texture's coordinates. Twin of shading_material
-// (src/texture.rs).
-fn shading_material(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> Material {
+// looked up at its own coordinates. Twin of shading_material (src/texture.rs).
+fn shading_material(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, uv1: vec2<f32>, color: vec3<f32>) -> Material {
     var shaded = material;
-    shaded.diffuse = shading_albedo(material, position, normal, uv);
-    shaded.emission = shading_emission(material, position, normal, uv);
+    shaded.diffuse = shading_albedo(material, position, normal, uv, uv1, color);
+    shaded.emission = shading_emission(material, position, normal, uv, uv1);
     //#if TEXTURES
     if material.metallic_roughness_layer != NO_IMAGE {
-        let st = texture_coordinates(material, position, normal, uv);
+        let st = texture_coordinates(material, UV_SLOT_METALLIC_ROUGHNESS, position, normal, uv, uv1);
         let wrap = vec2<u32>(material.metallic_roughness_wrap & 0xffu,
                              (material.metallic_roughness_wrap >> 8u) & 0xffu);
         let texel = sample_texture(material.metallic_roughness_layer,
@@ -123,27 +126,67 @@ fn shading_material(material: Material, position: vec3<f32>, normal: vec3<f32>, 
     return shaded;
 }
 
-// The albedo at a hit at `position` with geometric normal `normal` and mesh texture
-// coordinates `uv`: material.diffuse, times the albedo texture where there is one.
-fn shading_albedo(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> vec3<f32> {
+// The shading normal at a hit with a normal map: `shading_normal` (N) turned by the
+// tangent-space texel, normalize(T·x + B·y + N·z) with (x, y, z) = (2·texel - 1)·(scale,
+// scale, 1), T the tangent made orthogonal to N, B = sign(w)·(N × T) (glTF 2.0 §3.9.3);
+// shading_normal itself without a map or usable tangent, or where the result vanishes
+// or leaves the geometric normal's side. Twin of mapped_normal (src/texture.rs).
+fn mapped_normal(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, uv1: vec2<f32>, shading_normal: vec3<f32>, tangent: vec4<f32>) -> vec3<f32> {
     //#if TEXTURES
-    if material.texture_layer != NO_IMAGE {
-        let st = texture_coordinates(material, position, normal, uv);
-        let wrap = vec2<u32>(material.texture_wrap_u, material.texture_wrap_v);
-        return material.diffuse * sample_texture(material.texture_layer, material.texture_width, material.texture_height, st, wrap);
+    if material.normal_layer == NO_IMAGE {
+        return shading_normal;
+    }
+    let along = tangent.xyz;
+    let t = along - shading_normal * dot(shading_normal, along);
+    let t_squared = dot(t, t);
+    if !(t_squared > 0.0) {
+        return shading_normal;
+    }
+    let unit_t = t * inverseSqrt(t_squared);
+    let b = cross(shading_normal, unit_t) * select(1.0, -1.0, tangent.w < 0.0);
+    let st = texture_coordinates(material, UV_SLOT_NORMAL, position, normal, uv, uv1);
+    let wrap = vec2<u32>(material.normal_wrap & 0xffu, (material.normal_wrap >> 8u) & 0xffu);
+    let texel = sample_texture(material.normal_layer, material.normal_width, material.normal_height, st, wrap);
+    let m = vec3<f32>((2.0 * texel.x - 1.0) * material.normal_scale,
+                      (2.0 * texel.y - 1.0) * material.normal_scale, 2.0 * texel.z - 1.0);
+    let mapped = unit_t * m.x + b * m.y + shading_normal * m.z;
+    let m_squared = dot(mapped, mapped);
+    if !(m_squared > 0.0) {
+        return shading_normal;
+    }
+    let unit = mapped * inverseSqrt(m_squared);
+    if dot(unit, normal) > 0.0 {
+        return unit;
     }
     //#endif
-    return material.diffuse;
+    return shading_normal;
+}
+
+// The albedo at a hit at `position` with geometric normal `normal`, mesh texture
+// coordinates `uv` and `uv1` (sets 0 and 1) and vertex colour `color` (white off a
+// mesh with colours): material.diffuse times `color` (glTF 2.0 §3.9.2), times the
+// albedo texture where there is one.
+fn shading_albedo(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, uv1: vec2<f32>, color: vec3<f32>) -> vec3<f32> {
+    let albedo = material.diffuse * color;
+    //#if TEXTURES
+    if material.texture_layer != NO_IMAGE {
+        let st = texture_coordinates(material, UV_SLOT_ALBEDO, position, normal, uv, uv1);
+        let wrap = vec2<u32>(material.texture_wrap_u, material.texture_wrap_v);
+        return albedo * sample_texture(material.texture_layer, material.texture_width, material.texture_height, st, wrap);
+    }
+    //#endif
+    return albedo;
 }
 
 // The emitted radiance at a point at `position` with geometric normal `normal` and mesh
-// texture coordinates `uv`: material.emission, times the emission texture where there
-// is one (glTF 2.0 §3.9.3: emissiveFactor times the texel), at the albedo texture's
-// coordinates. Twin of shading_emission (src/texture.rs).
-fn shading_emission(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>) -> vec3<f32> {
+// texture coordinates `uv` and `uv1`: material.emission, times the emission texture
+// where there is one (glTF 2.0 §3.9.3: emissiveFactor times the texel), at its own
+// coordinates; vertex colours do not tint it. Twin of shading_emission
+// (src/texture.rs).
+fn shading_emission(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, uv1: vec2<f32>) -> vec3<f32> {
     //#if TEXTURES
     if material.emission_layer != NO_IMAGE {
-        let st = texture_coordinates(material, position, normal, uv);
+        let st = texture_coordinates(material, UV_SLOT_EMISSION, position, normal, uv, uv1);
         let wrap = vec2<u32>(material.emission_wrap & 0xffu, (material.emission_wrap >> 8u) & 0xffu);
         return material.emission * sample_texture(material.emission_layer, material.emission_width,
                                                   material.emission_height, st, wrap);

@@ -64,9 +64,19 @@ struct LightSample {
 // `n` is the shading normal (facing the incoming ray): a light lights the point when it
 // is above `n` and its shadow ray, from the lifted point, reaches it. CPU twin:
 // direct_light.
+// The fraction of a spot light's intensity towards a point in direction -wi: 1 inside
+// the inner cone, 0 outside the outer one, t² between them with t = (cos θ -
+// cos_outer) / max(cos_inner - cos_outer, 0.001) (KHR_lights_punctual's reference
+// implementation). CPU twin: spot_attenuation.
+fn spot_attenuation(direction: vec3<f32>, wi: vec3<f32>, cos_inner: f32, cos_outer: f32) -> f32 {
+    let scale = 1.0 / max(cos_inner - cos_outer, 0.001);
+    let t = clamp((dot(direction, -wi) - cos_outer) * scale, 0.0, 1.0);
+    return t * t;
+}
+
 fn sample_light(light: Light, origin: vec3<f32>, n: vec3<f32>) -> LightSample {
     var sample = LightSample(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0, false);
-    if light.kind == LIGHT_POINT {
+    if light.kind == LIGHT_POINT || light.kind == LIGHT_SPOT {
         let to_light = light.position_or_direction - origin;
         let distance_squared = dot(to_light, to_light);
         if !(distance_squared >= MIN_LIGHT_DISTANCE_SQUARED) {
@@ -76,6 +86,14 @@ fn sample_light(light: Light, origin: vec3<f32>, n: vec3<f32>) -> LightSample {
         sample.wi = to_light / sample.distance;
         // Inverse-square law: E = I / r² on a surface facing the light.
         sample.irradiance = light.power / distance_squared;
+        if light.kind == LIGHT_SPOT {
+            let attenuation = spot_attenuation(light.spot_direction, sample.wi, light.cos_inner, light.cos_outer);
+            // Outside the outer cone: no light and no shadow ray.
+            if !(attenuation > 0.0) {
+                return sample;
+            }
+            sample.irradiance *= attenuation;
+        }
     } else {
         sample.wi = -light.position_or_direction;
         sample.distance = bitcast<f32>(0x7f800000u); // +infinity
@@ -129,7 +147,12 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
         return;
     }
     let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
-    let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv);
+    if culls_back_face(materials[hit.material].cull_back_faces != 0u, (*path).depth, ray.direction, hit.normal) {
+        (*path).origin = offset_ray_origin(hit.position, hit.normal, frame.offset_scale);
+        (*path).phase = PHASE_PASS_THROUGH;
+        return;
+    }
+    let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.color);
     let entering = dot(ray.direction, hit.normal) < 0.0;
     // Shading happens on the side the ray came from.
     let ng = select(-hit.normal, hit.normal, entering);
@@ -141,7 +164,8 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
     let outside_ior = 1.0;
     //#endif
     //#if MESH_ATTRIBUTES
-    let ns = select(-hit.shading_normal, hit.shading_normal, entering);
+    let mapped = mapped_normal(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.shading_normal, hit.tangent);
+    let ns = select(-mapped, mapped, entering);
     let n = shading_frame_normal(ray.direction, ng, ns);
     let lifted = shadow_terminator_point(hit, ng);
     //#else

@@ -60,6 +60,9 @@ struct DenoiseUniforms {
     sigma_luminance: f32,
     sigma_albedo: f32,
 }
+// FrameUniforms.flags: the camera is orthographic; tan_half_fov_y holds half the view's
+// height in scene units (camera_ray_origin).
+const FLAG_ORTHOGRAPHIC: u32 = 16u;
 
 // A sphere through its anchor (its point nearest the origin) with the outward normal
 // there: see src/scene/sphere.rs.
@@ -103,17 +106,32 @@ struct Triangle {
 
 const NO_ATTRIBUTES: u32 = 0xffffffffu;
 
-// Vertex normals and texture coordinates of a mesh triangle, corner by corner.
+// Vertex normals, texture coordinates (two sets) and colours of a mesh triangle,
+// corner by corner.
 struct TriangleAttributes {
     n0: vec3<f32>,
     has_normals: u32,
     n1: vec3<f32>,
     has_uvs: u32,
     n2: vec3<f32>,
-    _pad0: u32,
+    has_colors: u32,
     uv01: vec4<f32>,
     uv2: vec2<f32>,
+    has_uvs1: u32,
+    has_tangents: u32,
+    uv1_01: vec4<f32>,
+    uv1_2: vec2<f32>,
     _pad1: vec2<u32>,
+    c0: vec3<f32>,
+    _pad2: u32,
+    c1: vec3<f32>,
+    _pad3: u32,
+    c2: vec3<f32>,
+    _pad4: u32,
+    // Unit tangents, the bitangent's handedness in w (normal maps).
+    t0: vec4<f32>,
+    t1: vec4<f32>,
+    t2: vec4<f32>,
 }
 
 const MATERIAL_LAMBERT: u32 = 0u;
@@ -180,19 +198,40 @@ struct Material {
     emission_width: u32,
     emission_height: u32,
     emission_wrap: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // The texture coordinate set (0 or 1) of each texture: bit UV_SLOT_* set for 1.
+    uv_sets: u32,
+    // 1 when camera rays pass through the back faces of flat shapes of this material.
+    cull_back_faces: u32,
+    // The tangent-space normal map (linear data), or NO_IMAGE.
+    normal_layer: u32,
+    // The affine maps of the textures' coordinates: texture s (UV_SLOT_*) maps uv to
+    // (dot(uv_rows[2s].xyz, (uv, 1)), dot(uv_rows[2s+1].xyz, (uv, 1))).
+    uv_rows: array<vec4<f32>, 8>,
+    normal_width: u32,
+    normal_height: u32,
+    // Wrap modes as u in bits 0-7 and v in bits 8-15.
+    normal_wrap: u32,
+    normal_scale: f32,
 }
+
+const UV_SLOT_ALBEDO: u32 = 0u;
+const UV_SLOT_METALLIC_ROUGHNESS: u32 = 1u;
+const UV_SLOT_EMISSION: u32 = 2u;
+const UV_SLOT_NORMAL: u32 = 3u;
 
 const LIGHT_POINT: u32 = 0u;
 const LIGHT_DIRECTIONAL: u32 = 1u;
+const LIGHT_SPOT: u32 = 2u;
 
 struct Light {
     position_or_direction: vec3<f32>,
     kind: u32,
     power: vec3<f32>,
-    _pad: u32,
+    // A spot light's cone: the cosines of its inner and outer half-angles.
+    cos_inner: f32,
+    // A spot light's unit axis (the direction it shines along).
+    spot_direction: vec3<f32>,
+    cos_outer: f32,
 }
 
 // One node of the BVH (twin of `accel::BvhNode`): an inner node's children are
@@ -262,6 +301,9 @@ const PHASE_START_SAMPLE: u32 = 6u;
 const PHASE_IDLE: u32 = 7u;
 // A slot whose pixel is done (PHASE_EMITTER is 8).
 const PHASE_FETCH_PIXEL: u32 = 9u;
+// A camera ray met the back face of a single-sided material: it goes on from just
+// beyond it (culls_back_face).
+const PHASE_PASS_THROUGH: u32 = 10u;
 
 // The state of one slot's path tree between dispatches: its pixel and sample, the
 // sums, the ray being shaded (origin, direction, weight, depth, medium) and, while its

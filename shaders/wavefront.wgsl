@@ -132,8 +132,9 @@ fn start_sample(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) 
     let xy = image_position(path);
     let offset = sample_offset(xy.x, xy.y, (*path).sample);
     let direction = camera_ray_direction(f32(xy.x) + offset.x, f32(xy.y) + offset.y);
+    let origin = camera_ray_origin(f32(xy.x) + offset.x, f32(xy.y) + offset.y);
     (*path).radiance = vec3<f32>(0.0);
-    (*path).origin = frame.eye;
+    (*path).origin = origin;
     (*path).direction = direction;
     (*path).weight = vec3<f32>(1.0);
     (*path).depth = 0u;
@@ -142,7 +143,7 @@ fn start_sample(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) 
     (*path).stack_len = 0u;
     (*path).held_top = 0u;
     (*path).rays += 1u;
-    start_trace(trace, frame.eye, direction, bitcast<f32>(0x7f800000u), false);
+    start_trace(trace, origin, direction, bitcast<f32>(0x7f800000u), false);
     (*path).phase = PHASE_CLOSEST;
 }
 
@@ -238,6 +239,12 @@ fn shade_step(slot: u32, path: ptr<function, PathState>, trace: ptr<function, Tr
             path_consume_emitter(path, *trace);
         }
         //#endif
+    }
+    if (*path).phase == PHASE_PASS_THROUGH {
+        // The camera ray again, from beyond the back face it passed (culls_back_face).
+        (*path).rays += 1u;
+        start_trace(trace, (*path).origin, (*path).direction, bitcast<f32>(0x7f800000u), false);
+        (*path).phase = PHASE_CLOSEST;
     }
     if (*path).phase == PHASE_NEXT_LIGHT {
         // Lights behind the surface cast no ray: skip them here. At least one light

@@ -22,6 +22,9 @@ pub struct CameraFrame {
     pub tan_half_fov_y: f64,
     /// Width over height.
     pub aspect: f64,
+    /// An orthographic camera's half view height in scene units
+    /// ([`Camera::orthographic_half_height`]); `None` for a pinhole camera.
+    pub orthographic_half_height: Option<f64>,
 }
 
 impl CameraFrame {
@@ -37,18 +40,38 @@ impl CameraFrame {
             up,
             tan_half_fov_y: (camera.fov_y_degrees.to_radians() * 0.5).tan(),
             aspect: f64::from(width) / f64::from(height),
+            orthographic_half_height: camera.orthographic_half_height,
         }
     }
 
     /// The unit direction of the ray through image position (`x`, `y`) in pixels,
-    /// measured from the top-left corner of the image (pixel centres at `i + 0.5`).
+    /// measured from the top-left corner of the image (pixel centres at `i + 0.5`):
+    /// the view direction itself for an orthographic camera.
     pub fn ray_direction(&self, x: f64, y: f64, width: u32, height: u32) -> DVec3 {
+        if self.orthographic_half_height.is_some() {
+            return self.forward;
+        }
         let ndc_x = 2.0 * x / f64::from(width) - 1.0;
         let ndc_y = 1.0 - 2.0 * y / f64::from(height);
         (self.forward
             + self.right * (ndc_x * self.aspect * self.tan_half_fov_y)
             + self.up * (ndc_y * self.tan_half_fov_y))
             .normalize()
+    }
+
+    /// Where the ray through image position (`x`, `y`) starts: the eye for a pinhole
+    /// camera; for an orthographic one the point of the view plane through the eye
+    /// that the position maps to, `eye + right·(ndc_x·aspect·h) + up·(ndc_y·h)` with
+    /// `h` the half height (glTF 2.0 §3.10.3, the orthographic projection).
+    pub fn ray_origin(&self, x: f64, y: f64, width: u32, height: u32) -> DVec3 {
+        let Some(half_height) = self.orthographic_half_height else {
+            return self.eye;
+        };
+        let ndc_x = 2.0 * x / f64::from(width) - 1.0;
+        let ndc_y = 1.0 - 2.0 * y / f64::from(height);
+        self.eye
+            + self.right * (ndc_x * self.aspect * half_height)
+            + self.up * (ndc_y * half_height)
     }
 }
 
@@ -279,6 +302,7 @@ mod tests {
             look_at: DVec3::new(0.0, 0.0, -1.0),
             up: DVec3::Y,
             fov_y_degrees: 90.0,
+            orthographic_half_height: None,
         };
         let frame = CameraFrame::new(&camera, 200, 100);
         let d = frame.ray_direction(100.0, 50.0, 200, 100);

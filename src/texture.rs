@@ -12,10 +12,12 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use glam::{DVec2, DVec3};
 
-use crate::scene::{Image, Material, TextureMapping, TextureWrap};
+use crate::scene::{Image, Material, TextureMapping, TextureTransform, TextureWrap};
 
 /// Texture coordinates of a hit at `position` with unit geometric normal `normal`
-/// (as the shape defines it, not flipped towards the ray).
+/// (as the shape defines it, not flipped towards the ray) for a texture whose
+/// coordinates `transform` describes, then transformed by it
+/// ([`TextureTransform::apply`]).
 ///
 /// - Spherical: longitude and latitude of the normal, which on a sphere is the
 ///   direction from its centre: `u = ½ - atan2(n.z, n.x)/(2π)`, `v = acos(n.y)/π`
@@ -23,27 +25,30 @@ use crate::scene::{Image, Material, TextureMapping, TextureWrap};
 /// - Planar: the position projected on the tangent frame of the normal
 ///   ([`tangent_frame`]): `u = p·t / scale`, `v = p·b / scale`; on a floor with
 ///   `n = +y` that is `u = x / scale`, `v = z / scale`.
-/// - UV: the hit's interpolated mesh texture coordinates `uv` (`(0, 0)` off a mesh).
+/// - UV: the hit's interpolated mesh texture coordinates of the set
+///   `transform.set`: `uv` (set 0) or `uv1` (set 1), `(0, 0)` off a mesh.
 pub fn texture_coordinates(
     material: &Material,
+    transform: &TextureTransform,
     position: DVec3,
     normal: DVec3,
-    uv: DVec2,
+    uvs: [DVec2; 2],
 ) -> (f64, f64) {
-    match material.texture_mapping {
-        TextureMapping::Uv => (uv.x, uv.y),
+    let mapped = match material.texture_mapping {
+        TextureMapping::Uv => uvs[(transform.set == 1) as usize],
         TextureMapping::Spherical => {
             let y = normal.y.clamp(-1.0, 1.0);
-            (0.5 - normal.z.atan2(normal.x) / (2.0 * PI), y.acos() / PI)
+            DVec2::new(0.5 - normal.z.atan2(normal.x) / (2.0 * PI), y.acos() / PI)
         }
         TextureMapping::Planar => {
             let (t, b) = tangent_frame(normal);
-            (
+            DVec2::new(
                 position.dot(t) / material.texture_scale,
                 position.dot(b) / material.texture_scale,
             )
         }
-    }
+    };
+    transform.apply(mapped).into()
 }
 
 /// The tangent `t` and bitangent `b` of the planar mapping for unit normal `n`:
@@ -124,19 +129,21 @@ fn bilinear(image: &Image, xs: [u32; 2], ys: [u32; 2], fx: f64, fy: f64) -> DVec
 }
 
 /// The metalness and perceptual roughness at a hit at `position` with geometric normal
-/// `normal` and mesh texture coordinates `uv`: `material.metallic` and
+/// `normal` and mesh texture coordinates `uvs` (sets 0 and 1): `material.metallic` and
 /// `material.roughness`, times the blue and green channels of the metallic/roughness
-/// texture where there is one (glTF 2.0 §3.9.2), at the albedo texture's coordinates.
+/// texture where there is one (glTF 2.0 §3.9.2), at its own coordinates
+/// (`metallic_roughness_transform`).
 pub fn shading_metallic_roughness(
     material: &Material,
     images: &[Image],
     position: DVec3,
     normal: DVec3,
-    uv: DVec2,
+    uvs: [DVec2; 2],
 ) -> (f64, f64) {
     match material.metallic_roughness_texture {
         Some(index) => {
-            let (u, v) = texture_coordinates(material, position, normal, uv);
+            let transform = &material.metallic_roughness_transform;
+            let (u, v) = texture_coordinates(material, transform, position, normal, uvs);
             let image = &images[index as usize];
             let texel = sample_texture(image, u, v, material.metallic_roughness_wrap);
             (material.metallic * texel.z, material.roughness * texel.y)
@@ -154,36 +161,92 @@ pub fn shading_material(
     images: &[Image],
     position: DVec3,
     normal: DVec3,
-    uv: DVec2,
+    uvs: [DVec2; 2],
+    color: DVec3,
 ) -> Material {
     let mut shaded = *material;
-    shaded.diffuse = shading_albedo(material, images, position, normal, uv);
+    shaded.diffuse = shading_albedo(material, images, position, normal, uvs, color);
     (shaded.metallic, shaded.roughness) =
-        shading_metallic_roughness(material, images, position, normal, uv);
-    shaded.emission = shading_emission(material, images, position, normal, uv);
+        shading_metallic_roughness(material, images, position, normal, uvs);
+    shaded.emission = shading_emission(material, images, position, normal, uvs);
     shaded
 }
 
 /// The emitted radiance at a point at `position` with geometric normal `normal` and
-/// mesh texture coordinates `uv`: `material.emission`, times the emission texture
-/// where there is one (glTF 2.0 §3.9.3: the emissive colour is `emissiveFactor` times
-/// the texel), at the albedo texture's coordinates. Every place that evaluates emission
-/// calls it: a ray's hit and the point next-event estimation sampled on an emitter.
-/// Twin of `shading_emission` in `shaders/texture.wgsl`.
+/// mesh texture coordinates `uvs` (sets 0 and 1): `material.emission`, times the
+/// emission texture where there is one (glTF 2.0 §3.9.3: the emissive colour is
+/// `emissiveFactor` times the texel), at its own coordinates (`emission_transform`).
+/// Vertex colours do not tint emission (glTF's `COLOR_0` multiplies the base colour
+/// only). Every place that evaluates emission calls it: a ray's hit and the point
+/// next-event estimation sampled on an emitter. Twin of `shading_emission` in
+/// `shaders/texture.wgsl`.
 pub fn shading_emission(
     material: &Material,
     images: &[Image],
     position: DVec3,
     normal: DVec3,
-    uv: DVec2,
+    uvs: [DVec2; 2],
 ) -> DVec3 {
     match material.emission_texture {
         Some(index) => {
-            let (u, v) = texture_coordinates(material, position, normal, uv);
+            let transform = &material.emission_transform;
+            let (u, v) = texture_coordinates(material, transform, position, normal, uvs);
             let image = &images[index as usize];
             material.emission * sample_texture(image, u, v, material.emission_wrap)
         }
         None => material.emission,
+    }
+}
+
+/// The shading normal at a hit with a normal map: `shading_normal` (the interpolated
+/// vertex normal `N`, unit, on the side of the geometric `normal`) turned by the
+/// tangent-space texel of `material.normal_texture` at its own coordinates, `n =
+/// normalize(T·x + B·y + N·z)` with `(x, y, z) = (2·texel − 1)·(scale, scale, 1)`
+/// (glTF 2.0 §3.9.3, `normalTexture`), `T` the interpolated `tangent` made orthogonal
+/// to `N` (Gram-Schmidt) and `B = sign(w)·(N × T)`. `shading_normal` itself without a
+/// normal map, without a usable tangent (zero, or along `N`), or where the result
+/// vanishes or leaves the geometric normal's side. Twin of `mapped_normal` in
+/// `shaders/texture.wgsl`.
+pub fn mapped_normal(
+    material: &Material,
+    images: &[Image],
+    position: DVec3,
+    normal: DVec3,
+    uvs: [DVec2; 2],
+    shading_normal: DVec3,
+    tangent: glam::DVec4,
+) -> DVec3 {
+    let Some(index) = material.normal_texture else {
+        return shading_normal;
+    };
+    let along = tangent.truncate();
+    let t = along - shading_normal * shading_normal.dot(along);
+    let length_squared = t.length_squared();
+    if length_squared.is_nan() || length_squared <= 0.0 {
+        return shading_normal;
+    }
+    let t = t / length_squared.sqrt();
+    let handedness = if tangent.w < 0.0 { -1.0 } else { 1.0 };
+    let b = shading_normal.cross(t) * handedness;
+    let transform = &material.normal_transform;
+    let (u, v) = texture_coordinates(material, transform, position, normal, uvs);
+    let texel = sample_texture(&images[index as usize], u, v, material.normal_wrap);
+    let scale = material.normal_scale;
+    let m = DVec3::new(
+        (2.0 * texel.x - 1.0) * scale,
+        (2.0 * texel.y - 1.0) * scale,
+        2.0 * texel.z - 1.0,
+    );
+    let mapped = t * m.x + b * m.y + shading_normal * m.z;
+    let length_squared = mapped.length_squared();
+    if length_squared.is_nan() || length_squared <= 0.0 {
+        return shading_normal;
+    }
+    let mapped = mapped / length_squared.sqrt();
+    if mapped.dot(normal) > 0.0 {
+        mapped
+    } else {
+        shading_normal
     }
 }
 
@@ -199,21 +262,26 @@ pub fn mean_texel(image: &Image) -> DVec3 {
     sum / image.texels.len().max(1) as f64
 }
 
-/// The albedo at a hit at `position` with geometric normal `normal` and mesh texture
-/// coordinates `uv`: `material.diffuse`, times the albedo texture where there is one.
+/// The albedo at a hit at `position` with geometric normal `normal`, mesh texture
+/// coordinates `uvs` (sets 0 and 1) and vertex colour `color` (white off a mesh with
+/// colours): `material.diffuse` times `color` (glTF 2.0 §3.9.2: `COLOR_0` multiplies
+/// the base colour), times the albedo texture where there is one.
 pub fn shading_albedo(
     material: &Material,
     images: &[Image],
     position: DVec3,
     normal: DVec3,
-    uv: DVec2,
+    uvs: [DVec2; 2],
+    color: DVec3,
 ) -> DVec3 {
+    let albedo = material.diffuse * color;
     match material.albedo_texture {
         Some(index) => {
-            let (u, v) = texture_coordinates(material, position, normal, uv);
+            let transform = &material.texture_transform;
+            let (u, v) = texture_coordinates(material, transform, position, normal, uvs);
             let image = &images[index as usize];
-            material.diffuse * sample_texture(image, u, v, material.texture_wrap)
+            albedo * sample_texture(image, u, v, material.texture_wrap)
         }
-        None => material.diffuse,
+        None => albedo,
     }
 }

@@ -1,7 +1,7 @@
 //! The primitive lists both tracers intersect, and [`SceneGeometry`], which holds them
 //! with the BVH over them.
 
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, DVec4};
 
 use super::bvh::{Aabb32, BuildMethod, Bvh};
 use super::instance::{Instance, InstancedMesh, mesh_groups};
@@ -129,6 +129,39 @@ pub struct TriangleAttributes {
     pub normals: Option<[DVec3; 3]>,
     /// Vertex texture coordinates, if the mesh has them.
     pub uvs: Option<[DVec2; 3]>,
+    /// The second set of vertex texture coordinates, if the mesh has it.
+    pub uvs1: Option<[DVec2; 3]>,
+    /// Linear RGB vertex colours, if the mesh has them.
+    pub colors: Option<[DVec3; 3]>,
+    /// Unit tangents with the bitangent's handedness in `w`, if the mesh has them.
+    pub tangents: Option<[DVec4; 3]>,
+}
+
+impl TriangleAttributes {
+    /// The attributes of the triangle of `mesh` whose corners are `order`, without
+    /// normals; `None` when the mesh has none of them.
+    pub fn of_corners(
+        mesh: &Mesh,
+        order: [usize; 3],
+        normals: Option<[DVec3; 3]>,
+        transform: Option<&glam::DMat3>,
+    ) -> Option<Self> {
+        let attributes = Self {
+            tangents: mesh.tangents.as_ref().map(|t| {
+                order.map(|i| transform.map_or(t[i], |m| super::instance::world_tangent(m, t[i])))
+            }),
+            normals,
+            uvs: mesh.uvs.as_ref().map(|uvs| order.map(|i| uvs[i])),
+            uvs1: mesh.uvs1.as_ref().map(|uvs| order.map(|i| uvs[i])),
+            colors: mesh.colors.as_ref().map(|colors| order.map(|i| colors[i])),
+        };
+        (attributes.normals.is_some()
+            || attributes.uvs.is_some()
+            || attributes.uvs1.is_some()
+            || attributes.colors.is_some()
+            || attributes.tangents.is_some())
+        .then_some(attributes)
+    }
 }
 
 /// A scene's primitives by kind and the BVH over the bounded ones: what both tracers
@@ -361,12 +394,13 @@ impl SceneGeometry {
                 let normals = mesh.normals.as_ref().map(|normals| {
                     order.map(|i| (normal_matrix * normals[i]).normalize_or(facing))
                 });
-                let uvs = mesh.uvs.as_ref().map(|uvs| order.map(|i| uvs[i]));
-                let attributes = (normals.is_some() || uvs.is_some()).then(|| {
-                    self.triangle_attributes
-                        .push(TriangleAttributes { normals, uvs });
-                    (self.triangle_attributes.len() - 1) as u32
-                });
+                let attributes =
+                    TriangleAttributes::of_corners(mesh, order, normals, Some(&linear)).map(
+                        |attributes| {
+                            self.triangle_attributes.push(attributes);
+                            (self.triangle_attributes.len() - 1) as u32
+                        },
+                    );
                 self.triangles.push(TriangleShape {
                     vertices,
                     material: mesh.material,

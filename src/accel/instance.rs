@@ -14,7 +14,7 @@
 use std::collections::HashMap;
 use std::hash::{DefaultHasher, Hasher};
 
-use glam::{DAffine3, DMat3, DMat4, DVec3};
+use glam::{DAffine3, DMat3, DMat4, DVec3, DVec4};
 
 use super::bvh::{Aabb32, BuildMethod, Bvh};
 use super::geometry::{PrimKind, PrimRef, TriangleAttributes, TriangleShape};
@@ -158,6 +158,11 @@ impl Instance {
                     .normals
                     .map(|n| order.map(|k| (self.normal_matrix * n[k]).normalize_or(facing))),
                 uvs: object.uvs.map(|uv| order.map(|k| uv[k])),
+                uvs1: object.uvs1.map(|uv| order.map(|k| uv[k])),
+                colors: object.colors.map(|c| order.map(|k| c[k])),
+                tangents: object
+                    .tangents
+                    .map(|t| order.map(|k| world_tangent(&self.object_to_world.matrix3, t[k]))),
             }
         });
         (
@@ -253,13 +258,11 @@ impl InstancedMesh {
                 .normals
                 .as_ref()
                 .map(|normals| order.map(|i| normals[i]));
-            let uvs = mesh.uvs.as_ref().map(|uvs| order.map(|i| uvs[i]));
-            let attributes = (normals.is_some() || uvs.is_some()).then(|| {
-                stored
-                    .triangle_attributes
-                    .push(TriangleAttributes { normals, uvs });
-                (stored.triangle_attributes.len() - 1) as u32
-            });
+            let attributes =
+                TriangleAttributes::of_corners(mesh, order, normals, None).map(|attributes| {
+                    stored.triangle_attributes.push(attributes);
+                    (stored.triangle_attributes.len() - 1) as u32
+                });
             stored.triangles.push(TriangleShape {
                 vertices,
                 material: mesh.material,
@@ -283,6 +286,21 @@ impl InstancedMesh {
     }
 }
 
+/// A tangent (`w`: the bitangent's handedness) moved by the linear part `linear` of an
+/// object-to-world transform: the direction through it, renormalised (zero where it
+/// vanishes, which disables the normal map there), the handedness flipped under a
+/// mirroring transform, whose normal matrix turns `normal × tangent` around. Twin of
+/// `world_tangent` in `shaders/instance.wgsl`.
+pub fn world_tangent(linear: &glam::DMat3, tangent: DVec4) -> DVec4 {
+    let direction = (*linear * tangent.truncate()).normalize_or_zero();
+    let w = if linear.determinant() < 0.0 {
+        -tangent.w
+    } else {
+        tangent.w
+    };
+    direction.extend(w)
+}
+
 /// Whether two meshes have the same geometry and attributes (the same file's same
 /// mesh, placed twice): they may then share one [`InstancedMesh`].
 fn same_geometry(a: &Mesh, b: &Mesh) -> bool {
@@ -290,6 +308,9 @@ fn same_geometry(a: &Mesh, b: &Mesh) -> bool {
         && a.positions == b.positions
         && a.normals == b.normals
         && a.uvs == b.uvs
+        && a.uvs1 == b.uvs1
+        && a.colors == b.colors
+        && a.tangents == b.tangents
 }
 
 /// The scene's meshes grouped by identical geometry ([`Mesh::positions`], normals,
@@ -365,6 +386,9 @@ mod tests {
             positions: vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y],
             normals: Some(vec![DVec3::Z; 4]),
             uvs: None,
+            uvs1: None,
+            colors: None,
+            tangents: None,
             triangles: vec![[0, 1, 2], [0, 2, 3]],
             material: 0,
             instances,
@@ -459,6 +483,9 @@ mod tests {
             positions: positions.clone(),
             normals: None,
             uvs: None,
+            uvs1: None,
+            colors: None,
+            tangents: None,
             triangles,
             material: 0,
             instances: vec![],

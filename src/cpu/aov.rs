@@ -22,12 +22,12 @@
 
 use glam::DVec3;
 
-use super::intersect::Ray;
+use super::intersect::{Ray, culls_back_face, offset_ray_origin};
 use super::trace::{PreparedScene, shading_frame_normal};
 use super::traverse::intersect_scene;
 use crate::denoise::GuidePasses;
 use crate::scene::{Material, MaterialKind, Scene};
-use crate::texture::shading_material;
+use crate::texture::{mapped_normal, shading_material};
 
 /// What a camera ray's first hit contributes to the auxiliary passes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -54,20 +54,43 @@ pub fn aov_albedo(material: &Material) -> DVec3 {
 
 /// The first hit of the camera ray `ray` as the auxiliary passes see it, `None` when
 /// the ray escapes.
+/// A camera ray passes through the back faces of single-sided materials
+/// ([`culls_back_face`]), as the image's does, and the hit is shaded with its vertex
+/// colour, both texture-coordinate sets and its normal map, as the image's is.
 pub fn first_hit_aov(scene: &PreparedScene, ray: &Ray) -> Option<FirstHitAov> {
-    let hit = intersect_scene(&scene.geometry, ray, f64::INFINITY)?;
+    let mut ray = *ray;
+    let hit = loop {
+        let hit = intersect_scene(&scene.geometry, &ray, f64::INFINITY)?;
+        let record = &scene.materials[hit.material as usize];
+        if !culls_back_face(record.cull_back_faces, 0, ray.direction, hit.normal) {
+            break hit;
+        }
+        ray.origin = offset_ray_origin(hit.position, hit.normal, scene.geometry.offset_scale);
+    };
+    let record = &scene.materials[hit.material as usize];
+    let uvs = [hit.uv, hit.uv1];
     let material = shading_material(
-        &scene.materials[hit.material as usize],
+        record,
         &scene.images,
         hit.position,
         hit.normal,
-        hit.uv,
+        uvs,
+        hit.color,
+    );
+    let mapped = mapped_normal(
+        record,
+        &scene.images,
+        hit.position,
+        hit.normal,
+        uvs,
+        hit.shading_normal,
+        hit.tangent,
     );
     let entering = ray.direction.dot(hit.normal) < 0.0;
     let (ng, ns) = if entering {
-        (hit.normal, hit.shading_normal)
+        (hit.normal, mapped)
     } else {
-        (-hit.normal, -hit.shading_normal)
+        (-hit.normal, -mapped)
     };
     Some(FirstHitAov {
         albedo: aov_albedo(&material),

@@ -3,7 +3,7 @@
 //! self-intersection offset. The scene-level queries (`intersect_scene`, `occluded`)
 //! traverse the BVH in [`super::traverse`].
 
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, DVec4};
 
 use crate::accel::{
     HitKey, InstanceId, PrimKind, PrimRef, SceneGeometry, TriangleAttributes, TriangleShape,
@@ -48,6 +48,13 @@ pub struct Hit {
     /// Texture coordinates: a mesh triangle's vertex coordinates interpolated at the
     /// hit, else `(0, 0)`.
     pub uv: DVec2,
+    /// The second set of texture coordinates, likewise.
+    pub uv1: DVec2,
+    /// A mesh triangle's vertex colours interpolated at the hit, else white (1, 1, 1).
+    pub color: DVec3,
+    /// A mesh triangle's vertex tangents interpolated at the hit (`w`: the bitangent's
+    /// handedness, interpolated too; its sign is used), else zero (no normal map).
+    pub tangent: DVec4,
     /// Barycentric coordinates of the hit in a triangle (weights of its three
     /// corners), else `(1, 0, 0)`.
     pub barycentrics: DVec3,
@@ -191,7 +198,8 @@ pub fn hit_record_keyed(geometry: &SceneGeometry, key: HitKey, ray: &Ray, t: f64
 }
 
 /// A hit without vertex attributes: its shading normal is its geometric normal, its
-/// texture coordinates `(0, 0)`, its barycentric coordinates `(1, 0, 0)`.
+/// texture coordinates `(0, 0)`, its colour white, its barycentric coordinates
+/// `(1, 0, 0)`.
 pub fn flat_hit(prim: PrimRef, t: f64, normal: DVec3, material: u32, position: DVec3) -> Hit {
     Hit {
         t,
@@ -201,6 +209,9 @@ pub fn flat_hit(prim: PrimRef, t: f64, normal: DVec3, material: u32, position: D
         prim,
         shading_normal: normal,
         uv: DVec2::ZERO,
+        uv1: DVec2::ZERO,
+        color: DVec3::ONE,
+        tangent: DVec4::ZERO,
         barycentrics: DVec3::X,
         instance: None,
     }
@@ -229,8 +240,19 @@ fn triangle_hit(
     hit
 }
 
+/// Whether a camera ray (`depth` 0) travelling along `direction` passes through the
+/// surface it hit, of geometric normal `normal` (as the shape defines it): the back
+/// face of a material that culls back faces (glTF's `doubleSided: false`, glTF 2.0
+/// §3.9.5: "back-face culling is enabled"). Such a ray goes on from just beyond the
+/// surface, without a bounce. Spheres' outsides are their fronts; a plane's front is
+/// the side its normal points to.
+pub fn culls_back_face(cull_back_faces: bool, depth: u32, direction: DVec3, normal: DVec3) -> bool {
+    cull_back_faces && depth == 0 && direction.dot(normal) > 0.0
+}
+
 /// Fills a triangle hit's shading normal (its vertex normals interpolated at its
-/// barycentric coordinates) and texture coordinates from its world-space `attributes`.
+/// barycentric coordinates), texture coordinates and vertex colour from its
+/// world-space `attributes`.
 pub fn apply_triangle_attributes(hit: &mut Hit, attributes: &TriangleAttributes) {
     let b = hit.barycentrics;
     if let Some(n) = attributes.normals {
@@ -244,6 +266,15 @@ pub fn apply_triangle_attributes(hit: &mut Hit, attributes: &TriangleAttributes)
     }
     if let Some(uv) = attributes.uvs {
         hit.uv = uv[0] * b.x + uv[1] * b.y + uv[2] * b.z;
+    }
+    if let Some(uv) = attributes.uvs1 {
+        hit.uv1 = uv[0] * b.x + uv[1] * b.y + uv[2] * b.z;
+    }
+    if let Some(c) = attributes.colors {
+        hit.color = c[0] * b.x + c[1] * b.y + c[2] * b.z;
+    }
+    if let Some(t) = attributes.tangents {
+        hit.tangent = t[0] * b.x + t[1] * b.y + t[2] * b.z;
     }
 }
 

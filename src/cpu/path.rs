@@ -23,7 +23,7 @@ use super::bxdf::{
     pdf_ggx_visible_normal, reflect_direction, sample_beckmann_normal, sample_blinn_phong_half,
     sample_ggx_visible_normal, surface_response,
 };
-use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
+use super::intersect::{Hit, Ray, culls_back_face, offset_ray_origin, shadow_terminator_point};
 use super::tabulated::{pdf_tabulated, sample_tabulated};
 use super::trace::{
     PreparedScene, add_contribution, direct_light, finite_radiance, keep_on_side,
@@ -39,7 +39,7 @@ use crate::sample::{
     sample_triangle_barycentrics,
 };
 use crate::scene::{Material, MaterialKind, MediumStack, MicrofacetDistribution};
-use crate::texture::{shading_emission, shading_material};
+use crate::texture::{mapped_normal, shading_emission, shading_material};
 
 /// Bounces after which Russian roulette may end a path.
 pub const ROULETTE_DEPTH: u32 = 3;
@@ -216,12 +216,19 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
             add_contribution(&mut radiance, throughput * background);
             break;
         };
+        let record = &scene.materials[hit.material as usize];
+        if culls_back_face(record.cull_back_faces, depth, ray.direction, hit.normal) {
+            // Through the back face: the same camera ray from just beyond it.
+            ray.origin = offset_ray_origin(hit.position, hit.normal, geometry.offset_scale);
+            continue;
+        }
         let material = shading_material(
-            &scene.materials[hit.material as usize],
+            record,
             &scene.images,
             hit.position,
             hit.normal,
-            hit.uv,
+            [hit.uv, hit.uv1],
+            hit.color,
         );
         // Emission, weighted against next-event estimation where that could have
         // found it.
@@ -240,11 +247,16 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
         }
         let entering = ray.direction.dot(hit.normal) < 0.0;
         let ng = if entering { hit.normal } else { -hit.normal };
-        let ns = if entering {
-            hit.shading_normal
-        } else {
-            -hit.shading_normal
-        };
+        let mapped = mapped_normal(
+            record,
+            &scene.images,
+            hit.position,
+            hit.normal,
+            [hit.uv, hit.uv1],
+            hit.shading_normal,
+            hit.tangent,
+        );
+        let ns = if entering { mapped } else { -mapped };
         let n = shading_frame_normal(ray.direction, ng, ns);
         let wo = -ray.direction;
         let outside_ior = medium.medium_outside_ior(entering);
@@ -453,7 +465,7 @@ fn sample_emitter(
         &scene.images,
         light_hit.position,
         light_hit.normal,
-        light_hit.uv,
+        [light_hit.uv, light_hit.uv1],
     );
     (
         light_sample_contribution(scene, material, n, wo, wi, pdf, radiance, mis),

@@ -6,7 +6,7 @@
 use glam::DVec3;
 
 use super::bxdf::{eval_brdf, has_base_brdf, reflect_direction, surface_response};
-use super::intersect::{Hit, Ray, offset_ray_origin, shadow_terminator_point};
+use super::intersect::{Hit, Ray, culls_back_face, offset_ray_origin, shadow_terminator_point};
 use super::path::path_radiance;
 use super::traverse::{intersect_scene, occluded};
 use crate::accel::SceneGeometry;
@@ -15,7 +15,7 @@ use crate::camera::{CameraFrame, SamplePattern};
 use crate::noise::luminance_m2_step;
 pub use crate::scene::MediumStack;
 use crate::scene::{Image, Integrator, Light, Material, RenderSettings, Scene};
-use crate::texture::shading_material;
+use crate::texture::{mapped_normal, shading_material};
 
 /// The scene in the form the tracer reads: colours in the lighting space, the geometry
 /// with its BVH, the camera basis.
@@ -163,16 +163,14 @@ pub fn trace_pixel(scene: &PreparedScene, x: u32, y: u32) -> PixelResult {
     let mut rays = 0;
     for index in 0..settings.samples_per_pixel {
         let (dx, dy) = scene.samples.offset(x, y, index);
-        let direction = scene.camera.ray_direction(
-            f64::from(x) + dx,
-            f64::from(y) + dy,
-            settings.width,
-            settings.height,
-        );
-        let primary = Ray {
-            origin: scene.camera.eye,
-            direction,
-        };
+        let (px, py) = (f64::from(x) + dx, f64::from(y) + dy);
+        let direction = scene
+            .camera
+            .ray_direction(px, py, settings.width, settings.height);
+        let origin = scene
+            .camera
+            .ray_origin(px, py, settings.width, settings.height);
+        let primary = Ray { origin, direction };
         let (radiance, sample_rays) = match settings.integrator {
             Integrator::Whitted => trace_radiance(scene, primary),
             Integrator::Path => path_radiance(scene, primary, y * settings.width + x, index),
@@ -228,6 +226,23 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
             );
             continue;
         };
+        let material = &scene.materials[hit.material as usize];
+        if culls_back_face(
+            material.cull_back_faces,
+            entry.depth,
+            entry.ray.direction,
+            hit.normal,
+        ) {
+            let origin = offset_ray_origin(hit.position, hit.normal, scene.geometry.offset_scale);
+            stack.push(StackEntry {
+                ray: Ray {
+                    origin,
+                    ..entry.ray
+                },
+                ..entry
+            });
+            continue;
+        }
         let shaded = shade_hit(scene, &entry.ray, &hit, &entry.medium);
         add_contribution(&mut radiance, entry.weight * shaded.radiance);
         rays += shaded.shadow_rays;
@@ -325,18 +340,24 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumSta
         &scene.images,
         position,
         hit.normal,
-        hit.uv,
+        [hit.uv, hit.uv1],
+        hit.color,
     );
     let material = &material;
     let entering = ray.direction.dot(hit.normal) < 0.0;
     // Shading happens on the side the ray came from.
     let ng = if entering { hit.normal } else { -hit.normal };
     let outside_ior = medium.medium_outside_ior(entering);
-    let ns = if entering {
-        hit.shading_normal
-    } else {
-        -hit.shading_normal
-    };
+    let mapped = mapped_normal(
+        &scene.materials[hit.material as usize],
+        &scene.images,
+        position,
+        hit.normal,
+        [hit.uv, hit.uv1],
+        hit.shading_normal,
+        hit.tangent,
+    );
+    let ns = if entering { mapped } else { -mapped };
     let n = shading_frame_normal(ray.direction, ng, ns);
     let wo = -ray.direction;
     let mut response = surface_response(material, ray.direction, n, entering, outside_ior);
@@ -425,24 +446,52 @@ pub struct LightSample {
     pub cos_i: f64,
 }
 
+/// The fraction of a spot light's intensity that leaves it towards a point in direction
+/// `-wi` (`wi`: unit, from the point to the light), for a cone along `direction` with
+/// the cosines `cos_inner` and `cos_outer` of its half-angles: 1 inside the inner
+/// cone, 0 outside the outer one, and between them `t²` with `t = (cos θ − cos_outer)
+/// / max(cos_inner − cos_outer, 0.001)` (KHR_lights_punctual, "Spot", its reference
+/// implementation: the square makes the fall-off smooth at the outer edge).
+pub fn spot_attenuation(direction: DVec3, wi: DVec3, cos_inner: f64, cos_outer: f64) -> f64 {
+    let scale = 1.0 / (cos_inner - cos_outer).max(0.001);
+    let t = ((direction.dot(-wi) - cos_outer) * scale).clamp(0.0, 1.0);
+    t * t
+}
+
 /// The geometry of `light` seen from `origin` with shading normal `n`, or `None` when
-/// it contributes nothing and casts no shadow ray: a light below `n`, or a point
-/// light at a zero, denormal or NaN distance.
+/// it contributes nothing and casts no shadow ray: a light below `n`, a point or spot
+/// light at a zero, denormal or NaN distance, or a point outside a spot light's cone.
 pub fn sample_light(light: &Light, origin: DVec3, n: DVec3) -> Option<LightSample> {
+    let point = |position: DVec3, intensity: DVec3| {
+        let to_light = position - origin;
+        let distance_squared = to_light.length_squared();
+        // Zero, denormal or NaN distance: no contribution (see the constant).
+        if distance_squared.is_nan() || distance_squared < MIN_LIGHT_DISTANCE_SQUARED {
+            return None;
+        }
+        let distance = distance_squared.sqrt();
+        // Inverse-square law: E = I / r² on a surface facing the light.
+        Some((to_light / distance, distance, intensity / distance_squared))
+    };
     let (wi, distance, irradiance) = match *light {
         Light::Point {
             position,
             intensity,
+        } => point(position, intensity)?,
+        Light::Spot {
+            position,
+            direction,
+            intensity,
+            cos_inner,
+            cos_outer,
         } => {
-            let to_light = position - origin;
-            let distance_squared = to_light.length_squared();
-            // Zero, denormal or NaN distance: no contribution (see the constant).
-            if distance_squared.is_nan() || distance_squared < MIN_LIGHT_DISTANCE_SQUARED {
+            let (wi, distance, irradiance) = point(position, intensity)?;
+            let attenuation = spot_attenuation(direction, wi, cos_inner, cos_outer);
+            // Outside the outer cone: no light and no shadow ray.
+            if attenuation <= 0.0 {
                 return None;
             }
-            let distance = distance_squared.sqrt();
-            // Inverse-square law: E = I / r² on a surface facing the light.
-            (to_light / distance, distance, intensity / distance_squared)
+            (wi, distance, irradiance * attenuation)
         }
         Light::Directional {
             direction,

@@ -129,11 +129,15 @@ impl ShaderFeatures {
                 m.albedo_texture.is_some()
                     || m.metallic_roughness_texture.is_some()
                     || m.emission_texture.is_some()
+                    || m.normal_texture.is_some()
             }),
-            mesh_attributes: scene
-                .meshes
-                .iter()
-                .any(|m| m.normals.is_some() || m.uvs.is_some()),
+            mesh_attributes: scene.meshes.iter().any(|m| {
+                m.normals.is_some()
+                    || m.uvs.is_some()
+                    || m.uvs1.is_some()
+                    || m.colors.is_some()
+                    || m.tangents.is_some()
+            }),
             instances: crate::accel::instance::has_instances(&scene.meshes),
             path: scene.render.integrator == crate::scene::Integrator::Path,
             environment_map: scene.environment.map.is_some(),

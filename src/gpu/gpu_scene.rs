@@ -8,7 +8,7 @@ use std::time::Duration;
 use wgpu::util::DeviceExt;
 
 use super::ShaderFeatures;
-use super::layout::{DisplayUniforms, FrameUniforms};
+use super::layout::{DisplayUniforms, FLAG_ORTHOGRAPHIC, FrameUniforms};
 use super::pipelines::TracePipelines;
 use super::scene_buffers::DeviceScene;
 use crate::accel::BvhStats;
@@ -156,9 +156,12 @@ impl GpuScene {
             &self.dielectric_spheres,
         ));
         let v = |d: glam::DVec3| d.as_vec3().to_array();
+        let (tan_half_fov_y, projection_flag) = super::upload::projection_uniforms(&camera);
+        let flags = (self.prepared.frame.flags & !FLAG_ORTHOGRAPHIC) | projection_flag;
         FrameUniforms {
             eye: v(camera.eye),
-            tan_half_fov_y: camera.tan_half_fov_y as f32,
+            tan_half_fov_y: tan_half_fov_y as f32,
+            flags,
             forward: v(camera.forward),
             aspect: camera.aspect as f32,
             right: v(camera.right),

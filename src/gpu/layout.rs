@@ -13,7 +13,8 @@ use bytemuck::{Pod, Zeroable};
 pub struct FrameUniforms {
     /// Camera position.
     pub eye: [f32; 3],
-    /// Tangent of half the vertical field of view.
+    /// Tangent of half the vertical field of view; with [`FLAG_ORTHOGRAPHIC`], half
+    /// the view's height in scene units.
     pub tan_half_fov_y: f32,
     /// Unit view direction.
     pub forward: [f32; 3],
@@ -118,6 +119,9 @@ pub const FLAG_SIMULATE_LOOP_CUT: u32 = 2;
 /// normal: two `vec4<f32>` per pixel, `shaders/aov.wgsl`) in the accumulation buffer,
 /// after the sample sums; only modules with [`super::ShaderFeatures::aov`] do.
 pub const FLAG_AOV: u32 = 8;
+/// `FrameUniforms.flags`: the camera is orthographic, and `tan_half_fov_y` holds half
+/// the view's height in scene units ([`crate::camera::CameraFrame::ray_origin`]).
+pub const FLAG_ORTHOGRAPHIC: u32 = 16;
 
 /// One traversal of one ray, resumable (`TraceRay` in WGSL). Only the shaders read and
 /// write it; the host zeroes it (`TRACE_IDLE`).
@@ -427,13 +431,38 @@ pub struct GpuMaterial {
     pub emission_height: u32,
     /// Its wrap modes: the `WRAP_*` code along `u` in bits 0-7, along `v` in bits 8-15.
     pub emission_wrap: u32,
-    /// Padding.
-    pub _pad0: u32,
-    /// Padding.
-    pub _pad1: u32,
-    /// Padding.
-    pub _pad2: u32,
+    /// The texture coordinate set (0 or 1) each texture reads: the albedo texture's in
+    /// bit 0, the metallic/roughness texture's in bit 1, the emission texture's in bit 2
+    /// (`UV_SLOT_*`).
+    pub uv_sets: u32,
+    /// 1 when camera rays pass through the back faces of flat shapes of this material
+    /// (glTF `doubleSided: false`).
+    pub cull_back_faces: u32,
+    /// Layer of the normal map in the image array, or [`NO_IMAGE`].
+    pub normal_layer: u32,
+    /// The affine maps of the textures' coordinates, two rows each: texture `s`
+    /// (`UV_SLOT_*`) maps `(u, v)` to `(rows[2s]·(u, v, 1), rows[2s+1]·(u, v, 1))`
+    /// (the last lane unused); see [`crate::scene::TextureTransform`].
+    pub uv_rows: [[f32; 4]; 8],
+    /// Width of the normal map in texels.
+    pub normal_width: u32,
+    /// Height of the normal map in texels.
+    pub normal_height: u32,
+    /// Its wrap modes: the `WRAP_*` code along `u` in bits 0-7, along `v` in bits 8-15.
+    pub normal_wrap: u32,
+    /// glTF's `normalTexture.scale`.
+    pub normal_scale: f32,
 }
+
+/// [`GpuMaterial::uv_rows`] and [`GpuMaterial::uv_sets`]: the albedo texture.
+pub const UV_SLOT_ALBEDO: u32 = 0;
+/// [`GpuMaterial::uv_rows`] and [`GpuMaterial::uv_sets`]: the metallic/roughness
+/// texture.
+pub const UV_SLOT_METALLIC_ROUGHNESS: u32 = 1;
+/// [`GpuMaterial::uv_rows`] and [`GpuMaterial::uv_sets`]: the emission texture.
+pub const UV_SLOT_EMISSION: u32 = 2;
+/// [`GpuMaterial::uv_rows`] and [`GpuMaterial::uv_sets`]: the normal map.
+pub const UV_SLOT_NORMAL: u32 = 3;
 
 /// The shading attributes of one mesh triangle (`TriangleAttributes` in WGSL): vertex
 /// normals and texture coordinates in the order of the triangle's corners; see
@@ -452,28 +481,58 @@ pub struct GpuTriangleAttributes {
     pub has_uvs: u32,
     /// Unit normal at the third corner.
     pub n2: [f32; 3],
-    /// Padding.
-    pub _pad0: u32,
+    /// 1 when the vertex colours are given, else 0 (white is used).
+    pub has_colors: u32,
     /// Texture coordinates of the first and second corners.
     pub uv01: [f32; 4],
     /// Texture coordinates of the third corner.
     pub uv2: [f32; 2],
+    /// 1 when the second set of texture coordinates is given, else 0 (`(0, 0)`).
+    pub has_uvs1: u32,
+    /// 1 when tangents are given (normal maps), else 0.
+    pub has_tangents: u32,
+    /// Second-set texture coordinates of the first and second corners.
+    pub uv1_01: [f32; 4],
+    /// Second-set texture coordinates of the third corner.
+    pub uv1_2: [f32; 2],
     /// Padding.
     pub _pad1: [u32; 2],
+    /// Linear RGB colour at the first corner.
+    pub c0: [f32; 3],
+    /// Padding.
+    pub _pad2: u32,
+    /// Linear RGB colour at the second corner.
+    pub c1: [f32; 3],
+    /// Padding.
+    pub _pad3: u32,
+    /// Linear RGB colour at the third corner.
+    pub c2: [f32; 3],
+    /// Padding.
+    pub _pad4: u32,
+    /// Unit tangent and bitangent handedness at the first corner.
+    pub t0: [f32; 4],
+    /// Unit tangent and bitangent handedness at the second corner.
+    pub t1: [f32; 4],
+    /// Unit tangent and bitangent handedness at the third corner.
+    pub t2: [f32; 4],
 }
 
 /// A light (`Light` in WGSL).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuLight {
-    /// Point light: position. Directional light: unit direction of travel.
+    /// Point and spot light: position. Directional light: unit direction of travel.
     pub position_or_direction: [f32; 3],
     /// One of the `LIGHT_*` constants.
     pub kind: u32,
-    /// Point light: intensity in W/sr. Directional light: irradiance in W/m².
+    /// Point and spot light: intensity in W/sr. Directional light: irradiance in W/m².
     pub power: [f32; 3],
-    /// Padding.
-    pub _pad: u32,
+    /// Spot light: cosine of the inner cone's half-angle (else 0).
+    pub cos_inner: f32,
+    /// Spot light: the unit axis of its cone (else zero).
+    pub spot_direction: [f32; 3],
+    /// Spot light: cosine of the outer cone's half-angle (else 0).
+    pub cos_outer: f32,
 }
 
 /// Uniforms of one step of the denoiser (`DenoiseUniforms` in WGSL,
@@ -558,6 +617,8 @@ pub const NO_INSTANCE: u32 = u32::MAX;
 pub const LIGHT_POINT: u32 = 0;
 /// `Light.kind` value for a directional light.
 pub const LIGHT_DIRECTIONAL: u32 = 1;
+/// `Light.kind` value for a spot light.
+pub const LIGHT_SPOT: u32 = 2;
 
 #[cfg(test)]
 mod tests {

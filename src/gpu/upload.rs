@@ -6,12 +6,14 @@
 use glam::{DVec2, DVec3};
 
 use super::layout::{
-    DISTRIBUTION_BECKMANN, DISTRIBUTION_GGX, FRESNEL_EXACT, FRESNEL_SCHLICK, FrameUniforms,
-    GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle, GpuTriangleAttributes,
-    LIGHT_DIRECTIONAL, LIGHT_POINT, MAPPING_PLANAR, MAPPING_SPHERICAL, MAPPING_UV,
-    MATERIAL_BLINN_PHONG, MATERIAL_COOK_TORRANCE, MATERIAL_DIELECTRIC, MATERIAL_EMISSIVE,
-    MATERIAL_LAMBERT, MATERIAL_MIRROR, MATERIAL_OREN_NAYAR, MATERIAL_PBR, MATERIAL_TABULATED,
-    NO_ATTRIBUTES, NO_IMAGE, WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT, WRAP_REPEAT,
+    DISTRIBUTION_BECKMANN, DISTRIBUTION_GGX, FLAG_ORTHOGRAPHIC, FRESNEL_EXACT, FRESNEL_SCHLICK,
+    FrameUniforms, GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle,
+    GpuTriangleAttributes, LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_SPOT, MAPPING_PLANAR,
+    MAPPING_SPHERICAL, MAPPING_UV, MATERIAL_BLINN_PHONG, MATERIAL_COOK_TORRANCE,
+    MATERIAL_DIELECTRIC, MATERIAL_EMISSIVE, MATERIAL_LAMBERT, MATERIAL_MIRROR, MATERIAL_OREN_NAYAR,
+    MATERIAL_PBR, MATERIAL_TABULATED, NO_ATTRIBUTES, NO_IMAGE, UV_SLOT_ALBEDO, UV_SLOT_EMISSION,
+    UV_SLOT_METALLIC_ROUGHNESS, UV_SLOT_NORMAL, WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT,
+    WRAP_REPEAT,
 };
 use crate::accel::{
     BrdfMapCdfs, BvhNode, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry,
@@ -62,6 +64,7 @@ impl SceneRecords {
     /// Converts the materials and lights of `scene` (already in lighting space) and
     /// the primitives and BVH of its `geometry`.
     pub fn new(scene: &Scene, geometry: &SceneGeometry) -> Self {
+        let shift_uvs = may_shift_uvs(scene);
         let mut records = Self {
             spheres: geometry
                 .spheres
@@ -93,13 +96,13 @@ impl SceneRecords {
             triangle_attributes: geometry
                 .triangle_attributes
                 .iter()
-                .map(triangle_attributes_record)
+                .map(|a| triangle_attributes_record(a, shift_uvs))
                 .collect(),
             bvh_nodes: geometry.bvh.nodes.clone(),
             bvh_prims: geometry.bvh.prims.iter().map(|p| p.0).collect(),
             ..Self::default()
         };
-        records.append_instances(geometry);
+        records.append_instances(geometry, shift_uvs);
         for polygon in &geometry.polygons {
             let first_vertex = records.polygon_points.len();
             records
@@ -122,7 +125,7 @@ impl SceneRecords {
     /// Appends the instanced meshes (triangles, attributes, trees with their node and
     /// primitive indices shifted to where they land) and the instances' records, and
     /// renames the scene tree's instance references to their records' node index.
-    fn append_instances(&mut self, geometry: &SceneGeometry) {
+    fn append_instances(&mut self, geometry: &SceneGeometry, shift_uvs: bool) {
         if geometry.instances.is_empty() {
             return;
         }
@@ -139,7 +142,7 @@ impl SceneRecords {
             self.triangle_attributes.extend(
                 mesh.triangle_attributes
                     .iter()
-                    .map(triangle_attributes_record),
+                    .map(|a| triangle_attributes_record(a, shift_uvs)),
             );
             let first_node = index(self.bvh_nodes.len());
             let first_prim = index(self.bvh_prims.len());
@@ -333,6 +336,7 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
     let (metallic_roughness_layer, metallic_roughness_width, metallic_roughness_height) =
         image(material.metallic_roughness_texture);
     let (emission_layer, emission_width, emission_height) = image(material.emission_texture);
+    let (normal_layer, normal_width, normal_height) = image(material.normal_texture);
     GpuMaterial {
         diffuse: vec3(material.diffuse),
         shininess: material.shininess as f32,
@@ -381,10 +385,55 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
         emission_height,
         emission_wrap: wrap_code(material.emission_wrap[0])
             | wrap_code(material.emission_wrap[1]) << 8,
-        _pad0: 0,
-        _pad1: 0,
-        _pad2: 0,
+        uv_sets: [
+            (UV_SLOT_ALBEDO, &material.texture_transform),
+            (
+                UV_SLOT_METALLIC_ROUGHNESS,
+                &material.metallic_roughness_transform,
+            ),
+            (UV_SLOT_EMISSION, &material.emission_transform),
+            (UV_SLOT_NORMAL, &material.normal_transform),
+        ]
+        .iter()
+        .fold(0, |sets, &(slot, t)| sets | u32::from(t.set == 1) << slot),
+        cull_back_faces: u32::from(material.cull_back_faces),
+        normal_layer,
+        uv_rows: [
+            &material.texture_transform,
+            &material.metallic_roughness_transform,
+            &material.emission_transform,
+            &material.normal_transform,
+        ]
+        .map(|t| {
+            t.rows
+                .map(|row| [row.x as f32, row.y as f32, row.z as f32, 0.0])
+        })
+        .concat()
+        .try_into()
+        .unwrap_or_default(),
+        normal_width,
+        normal_height,
+        normal_wrap: wrap_code(material.normal_wrap[0]) | wrap_code(material.normal_wrap[1]) << 8,
+        normal_scale: material.normal_scale as f32,
     }
+}
+
+/// Whether the texture coordinates of `scene`'s meshes may be moved by whole repeats
+/// ([`uvs_near_origin`]): not when a material maps its texture coordinates by more
+/// than an offset (`KHR_texture_transform`'s rotation or scale), under which whole
+/// repeats of the coordinates are not whole repeats of the texture. Such a mesh keeps
+/// its coordinates as they are, in `f32`.
+pub fn may_shift_uvs(scene: &Scene) -> bool {
+    scene.materials.iter().all(|m| {
+        [
+            &m.texture_transform,
+            &m.metallic_roughness_transform,
+            &m.emission_transform,
+            &m.normal_transform,
+        ]
+        .iter()
+        .all(|t| t.is_linear_identity())
+    })
 }
 
 /// A triangle's texture coordinates moved, on each axis, by a whole even number of
@@ -424,17 +473,30 @@ fn wrap_code(wrap: TextureWrap) -> u32 {
 
 /// The record of one mesh triangle's shading attributes (zeros where absent), its
 /// texture coordinates moved near the origin ([`uvs_near_origin`]) so that `f32`
-/// keeps their fraction.
-pub fn triangle_attributes_record(attributes: &TriangleAttributes) -> GpuTriangleAttributes {
+/// keeps their fraction, where `shift_uvs` ([`may_shift_uvs`]).
+pub fn triangle_attributes_record(
+    attributes: &TriangleAttributes,
+    shift_uvs: bool,
+) -> GpuTriangleAttributes {
     let normals = attributes.normals.unwrap_or([DVec3::ZERO; 3]);
-    let uvs = uvs_near_origin(attributes.uvs.unwrap_or_default());
+    let near = |uvs: Option<[DVec2; 3]>| {
+        let uvs = uvs.unwrap_or_default();
+        if shift_uvs { uvs_near_origin(uvs) } else { uvs }
+    };
+    let uvs = near(attributes.uvs);
+    let uvs1 = near(attributes.uvs1);
+    let colors = attributes.colors.unwrap_or([DVec3::ONE; 3]);
+    let tangents = attributes
+        .tangents
+        .unwrap_or_default()
+        .map(|t| t.as_vec4().to_array());
     GpuTriangleAttributes {
         n0: vec3(normals[0]),
         has_normals: u32::from(attributes.normals.is_some()),
         n1: vec3(normals[1]),
         has_uvs: u32::from(attributes.uvs.is_some()),
         n2: vec3(normals[2]),
-        _pad0: 0,
+        has_colors: u32::from(attributes.colors.is_some()),
         uv01: [
             uvs[0].x as f32,
             uvs[0].y as f32,
@@ -442,7 +504,25 @@ pub fn triangle_attributes_record(attributes: &TriangleAttributes) -> GpuTriangl
             uvs[1].y as f32,
         ],
         uv2: [uvs[2].x as f32, uvs[2].y as f32],
+        has_uvs1: u32::from(attributes.uvs1.is_some()),
+        has_tangents: u32::from(attributes.tangents.is_some()),
+        uv1_01: [
+            uvs1[0].x as f32,
+            uvs1[0].y as f32,
+            uvs1[1].x as f32,
+            uvs1[1].y as f32,
+        ],
+        uv1_2: [uvs1[2].x as f32, uvs1[2].y as f32],
         _pad1: [0; 2],
+        c0: vec3(colors[0]),
+        _pad2: 0,
+        c1: vec3(colors[1]),
+        _pad3: 0,
+        c2: vec3(colors[2]),
+        _pad4: 0,
+        t0: tangents[0],
+        t1: tangents[1],
+        t2: tangents[2],
     }
 }
 
@@ -476,21 +556,45 @@ pub fn image_layers(images: &[Image], cdfs: &BrdfMapCdfs) -> (u32, u32, u32, Vec
 
 /// The record of one light.
 pub fn light_record(light: &Light) -> GpuLight {
-    let (position_or_direction, kind, power) = match light {
-        Light::Point {
-            position,
-            intensity,
-        } => (*position, LIGHT_POINT, *intensity),
-        Light::Directional {
-            direction,
-            irradiance,
-        } => (*direction, LIGHT_DIRECTIONAL, *irradiance),
-    };
-    GpuLight {
+    let record = |position_or_direction: DVec3, kind: u32, power: DVec3| GpuLight {
         position_or_direction: vec3(position_or_direction),
         kind,
         power: vec3(power),
-        _pad: 0,
+        cos_inner: 0.0,
+        spot_direction: [0.0; 3],
+        cos_outer: 0.0,
+    };
+    match light {
+        Light::Point {
+            position,
+            intensity,
+        } => record(*position, LIGHT_POINT, *intensity),
+        Light::Spot {
+            position,
+            direction,
+            intensity,
+            cos_inner,
+            cos_outer,
+        } => GpuLight {
+            cos_inner: *cos_inner as f32,
+            spot_direction: vec3(*direction),
+            cos_outer: *cos_outer as f32,
+            ..record(*position, LIGHT_SPOT, *intensity)
+        },
+        Light::Directional {
+            direction,
+            irradiance,
+        } => record(*direction, LIGHT_DIRECTIONAL, *irradiance),
+    }
+}
+
+/// `FrameUniforms::tan_half_fov_y` and the `FrameUniforms::flags` bit of `camera`'s
+/// projection: `tan(fov_y / 2)` and 0 for a pinhole camera, the half view height and
+/// [`FLAG_ORTHOGRAPHIC`] for an orthographic one.
+pub fn projection_uniforms(camera: &CameraFrame) -> (f64, u32) {
+    match camera.orthographic_half_height {
+        Some(half_height) => (half_height, FLAG_ORTHOGRAPHIC),
+        None => (camera.tan_half_fov_y, 0),
     }
 }
 
@@ -503,9 +607,10 @@ pub fn frame_uniforms(scene: &Scene, geometry: &SceneGeometry) -> FrameUniforms 
     let count = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
     // The same stack the CPU reference starts its camera rays with.
     let camera_medium = MediumStack::from_outermost_first(&scene.camera_medium());
+    let (tan_half_fov_y, projection_flag) = projection_uniforms(&camera);
     FrameUniforms {
         eye: vec3(camera.eye),
-        tan_half_fov_y: camera.tan_half_fov_y as f32,
+        tan_half_fov_y: tan_half_fov_y as f32,
         forward: vec3(camera.forward),
         aspect: camera.aspect as f32,
         right: vec3(camera.right),
@@ -532,7 +637,7 @@ pub fn frame_uniforms(scene: &Scene, geometry: &SceneGeometry) -> FrameUniforms 
         slot_count: 0,
         stack_size: settings.stack_size,
         iteration_budget: u32::MAX,
-        flags: 0,
+        flags: projection_flag,
         offset_scale: geometry.offset_scale as f32,
         min_ray_weight: settings.min_ray_weight as f32,
         lattice_generator: crate::camera::lattice_generator(settings.samples_per_pixel),
@@ -564,6 +669,7 @@ mod tests {
                 look_at: DVec3::ZERO,
                 up: DVec3::Y,
                 fov_y_degrees: 60.0,
+                orthographic_half_height: None,
             },
             environment: Environment {
                 background: DVec3::new(0.1, 0.2, 0.3),
@@ -830,6 +936,9 @@ mod tests {
             positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
             normals: Some(vec![DVec3::Z; 3]),
             uvs: None,
+            uvs1: None,
+            colors: None,
+            tangents: None,
             triangles: vec![[0, 1, 2]],
             material: 1,
             instances: vec![

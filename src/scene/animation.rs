@@ -210,6 +210,7 @@ mod tests {
             look_at: DVec3::Z,
             up: DVec3::X,
             fov_y_degrees: 30.0,
+            orthographic_half_height: None,
         };
         let camera = path.frame_camera(&base, 12);
         assert_eq!(camera.eye.x, 12.0);

@@ -46,6 +46,16 @@ pub struct Mesh {
     pub normals: Option<Vec<DVec3>>,
     /// Texture coordinates, parallel to `positions` (`v` down, as image rows run).
     pub uvs: Option<Vec<DVec2>>,
+    /// A second set of texture coordinates (glTF's `TEXCOORD_1`), parallel to
+    /// `positions`, for the textures whose [`TextureTransform::set`] is 1.
+    pub uvs1: Option<Vec<DVec2>>,
+    /// Linear RGB vertex colours in [0, 1], parallel to `positions`, multiplying the
+    /// albedo (glTF's `COLOR_0`, OBJ's `v x y z r g b`).
+    pub colors: Option<Vec<DVec3>>,
+    /// Unit tangents (`xyz`) with the bitangent's handedness (`w`, ±1), parallel to
+    /// `positions`, for normal maps: glTF's `TANGENT`, or MikkTSpace's from the
+    /// normals and texture coordinates; the bitangent is `w · (normal × tangent)`.
+    pub tangents: Option<Vec<glam::DVec4>>,
     /// Triangles as three vertex indices, counter-clockwise seen from the front.
     pub triangles: Vec<[u32; 3]>,
     /// Index into [`Scene::materials`].
@@ -152,7 +162,7 @@ pub enum LightingSpace {
     NaiveGamma,
 }
 
-/// A pinhole camera.
+/// A pinhole camera, or an orthographic one.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
     /// Centre of projection.
@@ -161,8 +171,15 @@ pub struct Camera {
     pub look_at: DVec3,
     /// Approximate up direction (non-zero, not parallel to the view direction).
     pub up: DVec3,
-    /// Full vertical field of view in degrees, in (0, 180).
+    /// Full vertical field of view in degrees, in (0, 180) (unused by an
+    /// orthographic camera).
     pub fov_y_degrees: f64,
+    /// For an orthographic camera (glTF's `orthographic` projection), half the height
+    /// of the view in scene units (finite, > 0; glTF's `ymag`): its rays are parallel,
+    /// along the view direction, from points of the plane through `eye` facing it,
+    /// `half_height` above and below `eye` and the image's aspect times that either
+    /// side. `None`: a pinhole camera of `fov_y_degrees`.
+    pub orthographic_half_height: Option<f64>,
 }
 
 /// Light that does not come from a light source.
@@ -250,6 +267,60 @@ pub enum TextureWrap {
     ClampToEdge,
 }
 
+/// How a texture's coordinates are made from a hit's texture coordinates: which set
+/// of the mesh's it reads and the affine map applied to them (glTF's `texCoord` and
+/// `KHR_texture_transform`). Planar and spherical mappings are transformed too, but
+/// always read their one set.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TextureTransform {
+    /// The texture coordinate set of a UV-mapped texture: 0 ([`Mesh::uvs`]) or 1
+    /// ([`Mesh::uvs1`]).
+    pub set: u32,
+    /// The affine map `(u, v) ↦ (rows[0]·(u, v, 1), rows[1]·(u, v, 1))`, finite.
+    pub rows: [DVec3; 2],
+}
+
+impl TextureTransform {
+    /// Set 0, untransformed.
+    pub const IDENTITY: Self = Self {
+        set: 0,
+        rows: [DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.0, 1.0, 0.0)],
+    };
+
+    /// The transform of `KHR_texture_transform`: `T · R · S`, the scale first, then the
+    /// rotation by `rotation` radians (counter-clockwise in UV space, which is clockwise
+    /// on the image since `v` runs down), then the offset; the extension's matrix
+    /// `R = [[cos, sin], [-sin, cos]]`.
+    pub fn offset_rotation_scale(set: u32, offset: DVec2, rotation: f64, scale: DVec2) -> Self {
+        let (sin, cos) = rotation.sin_cos();
+        Self {
+            set,
+            rows: [
+                DVec3::new(cos * scale.x, sin * scale.y, offset.x),
+                DVec3::new(-sin * scale.x, cos * scale.y, offset.y),
+            ],
+        }
+    }
+
+    /// Whether the map moves coordinates in any way but by an offset: then whole
+    /// repeats of the untransformed coordinates are not whole repeats of the texture.
+    pub fn is_linear_identity(&self) -> bool {
+        self.rows[0].truncate() == glam::DVec2::X && self.rows[1].truncate() == glam::DVec2::Y
+    }
+
+    /// The transformed coordinates of `uv`.
+    pub fn apply(&self, uv: DVec2) -> DVec2 {
+        let p = uv.extend(1.0);
+        DVec2::new(self.rows[0].dot(p), self.rows[1].dot(p))
+    }
+}
+
+impl Default for TextureTransform {
+    fn default() -> Self {
+        Self::IDENTITY
+    }
+}
+
 /// A material. One flat record for all kinds (fields a kind does not use are zero),
 /// which is exactly what the GPU receives.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -300,6 +371,8 @@ pub struct Material {
     pub texture_scale: f64,
     /// Wrap modes of the albedo texture along `u` and `v`.
     pub texture_wrap: [TextureWrap; 2],
+    /// The coordinates of the albedo texture.
+    pub texture_transform: TextureTransform,
     /// Index into [`Scene::images`] of the tabulated BRDF (Tabulated).
     pub brdf_map: Option<u32>,
     /// Index into [`Scene::images`] of a texture of linear data whose green channel
@@ -309,6 +382,8 @@ pub struct Material {
     pub metallic_roughness_texture: Option<u32>,
     /// Wrap modes of the metallic/roughness texture along `u` and `v`.
     pub metallic_roughness_wrap: [TextureWrap; 2],
+    /// The coordinates of the metallic/roughness texture.
+    pub metallic_roughness_transform: TextureTransform,
     /// Index into [`Scene::images`] of a colour texture multiplying `emission`
     /// (glTF's `emissiveTexture`, OBJ's `map_Ke`), looked up with the albedo
     /// texture's coordinates (`texture_mapping`) wherever emission is evaluated,
@@ -316,11 +391,29 @@ pub struct Material {
     pub emission_texture: Option<u32>,
     /// Wrap modes of the emission texture along `u` and `v`.
     pub emission_wrap: [TextureWrap; 2],
+    /// The coordinates of the emission texture.
+    pub emission_transform: TextureTransform,
+    /// Index into [`Scene::images`] of a tangent-space normal map (linear data, glTF's
+    /// `normalTexture`): where a mesh has tangents, the shading normal becomes
+    /// `normalize(T·x + B·y + N·z)` with `(x, y, z) = (2·texel − 1)·(scale, scale, 1)`.
+    pub normal_texture: Option<u32>,
+    /// Wrap modes of the normal map along `u` and `v`.
+    pub normal_wrap: [TextureWrap; 2],
+    /// The coordinates of the normal map.
+    pub normal_transform: TextureTransform,
+    /// glTF's `normalTexture.scale`: the map's x and y are multiplied by it (finite).
+    pub normal_scale: f64,
     /// Whether flat shapes (polygons, triangles, meshes) of this material emit
     /// `emission` from both sides; by default only from the side their normal points
     /// to (spheres always emit on both). The path integrator's rule: Whitted shows
     /// emission on either side.
     pub two_sided: bool,
+    /// Whether camera rays pass through the back faces of flat shapes (polygons,
+    /// triangles, meshes) of this material: glTF's `doubleSided: false` (glTF 2.0
+    /// §3.9.5, back-face culling). Secondary and shadow rays see both faces, so that a
+    /// single-sided surface still reflects, refracts (a closed glass mesh) and casts
+    /// shadows as a rasteriser's shadow map would. Default false: both faces show.
+    pub cull_back_faces: bool,
 }
 
 impl Material {
@@ -349,12 +442,20 @@ impl Material {
             texture_mapping: TextureMapping::Planar,
             texture_scale: 1.0,
             texture_wrap: [TextureWrap::Repeat; 2],
+            texture_transform: TextureTransform::IDENTITY,
             brdf_map: None,
             metallic_roughness_texture: None,
             metallic_roughness_wrap: [TextureWrap::Repeat; 2],
+            metallic_roughness_transform: TextureTransform::IDENTITY,
             emission_texture: None,
             emission_wrap: [TextureWrap::Repeat; 2],
+            emission_transform: TextureTransform::IDENTITY,
+            normal_texture: None,
+            normal_wrap: [TextureWrap::Repeat; 2],
+            normal_transform: TextureTransform::IDENTITY,
+            normal_scale: 1.0,
             two_sided: false,
+            cull_back_faces: false,
         }
     }
 
@@ -376,6 +477,23 @@ pub enum Light {
         position: DVec3,
         /// Radiant intensity per channel in W/sr (scalar intensity times colour).
         intensity: DVec3,
+    },
+    /// A point light whose intensity falls off towards the edge of a cone
+    /// (`KHR_lights_punctual`'s spot light): full inside the inner cone, none outside
+    /// the outer one, and between them the square of `(cos θ − cos_outer) / (cos_inner
+    /// − cos_outer)` (the extension's reference implementation, smooth at both edges),
+    /// θ being the angle from `direction` ([`crate::cpu::trace::spot_attenuation`]).
+    Spot {
+        /// Position in scene units.
+        position: DVec3,
+        /// Unit direction the cone points along (from the light into the scene).
+        direction: DVec3,
+        /// Radiant intensity per channel in W/sr along the cone's axis.
+        intensity: DVec3,
+        /// Cosine of the inner cone's half-angle, in (`cos_outer`, 1].
+        cos_inner: f64,
+        /// Cosine of the outer cone's half-angle, in [0, 1).
+        cos_outer: f64,
     },
     /// A light at infinity (the sun).
     Directional {

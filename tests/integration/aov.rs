@@ -43,6 +43,7 @@ fn plane_scene(material: Material, images: Vec<Image>, samples: u32) -> Scene {
             look_at: DVec3::ZERO,
             up: DVec3::Y,
             fov_y_degrees: FOV_Y_DEGREES,
+            orthographic_half_height: None,
         },
         environment: Environment::default(),
         material_names: vec!["plane".into()],
@@ -228,9 +229,10 @@ fn a_textured_albedo_pass_is_the_texel() {
             let point = scene.camera.eye + direction * t;
             let (u, v) = gpu_render::low_level::texture::texture_coordinates(
                 &scene.materials[0],
+                &scene.materials[0].texture_transform,
                 point,
                 DVec3::Z,
-                DVec2::ZERO,
+                [DVec2::ZERO; 2],
             );
             let (tx, ty) = (u * 8.0 - 0.5, v * 8.0 - 0.5);
             let inside = |p: f64| (0.05..=0.95).contains(&p.rem_euclid(2.0));

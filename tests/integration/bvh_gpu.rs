@@ -96,6 +96,7 @@ fn scene_of(shapes: Vec<Shape>) -> Scene {
             look_at: DVec3::ZERO,
             up: DVec3::Y,
             fov_y_degrees: 40.0,
+            orthographic_half_height: None,
         },
         environment: Environment::default(),
         materials: vec![Material::lambert(DVec3::splat(0.5))],

@@ -165,6 +165,7 @@ fn the_camera_sees_the_emissive_texture() {
         look_at: DVec3::new(0.2, 1.2, 0.15),
         up: DVec3::Z,
         fov_y_degrees: 40.0,
+        orthographic_half_height: None,
     };
     for integrator in [Integrator::Whitted, Integrator::Path] {
         let mut s = scene(camera, None, integrator);
@@ -227,6 +228,7 @@ fn floor_camera() -> Camera {
         look_at: DVec3::ZERO,
         up: DVec3::Y,
         fov_y_degrees: 0.1,
+        orthographic_half_height: None,
     }
 }
 
@@ -337,6 +339,7 @@ fn emissive_textures_render_alike_on_both_backends() {
         look_at: DVec3::new(0.2, 0.6, 0.0),
         up: DVec3::Y,
         fov_y_degrees: 50.0,
+        orthographic_half_height: None,
     };
     let mut whitted = scene(camera, Some(0.5), Integrator::Whitted);
     whitted.lights.push(Light::Directional {

@@ -41,6 +41,7 @@ fn sphere_under(map: EnvironmentMap, rho: f64, integrator: Integrator, max_depth
             look_at: DVec3::ZERO,
             up: DVec3::Y,
             fov_y_degrees: 40.0,
+            orthographic_half_height: None,
         },
         environment: Environment {
             map: Some(Arc::new(map)),

@@ -102,6 +102,7 @@ fn scaled_scene(s: f64) -> Scene {
             look_at: v(0.0, 0.5, 0.0),
             up: DVec3::Y,
             fov_y_degrees: 50.0,
+            orthographic_half_height: None,
         },
         environment: Environment {
             background: DVec3::new(0.2, 0.3, 0.5),
@@ -251,6 +252,7 @@ fn floor_scene(sphere_radius: Option<f64>) -> Scene {
             look_at: DVec3::new(0.0, 0.0, 0.0),
             up: DVec3::Y,
             fov_y_degrees: 50.0,
+            orthographic_half_height: None,
         },
         environment: Environment::default(),
         materials: vec![
@@ -370,6 +372,7 @@ fn grazing_and_tangent_rays_are_finite_and_acne_free() {
             look_at: DVec3::new(0.0, 1.0 - angle.tan(), -1.0),
             up: DVec3::Y,
             fov_y_degrees: 0.15,
+            orthographic_half_height: None,
         },
         environment: Environment::default(),
         materials: vec![Material::lambert(DVec3::splat(0.7))],
@@ -393,6 +396,7 @@ fn grazing_and_tangent_rays_are_finite_and_acne_free() {
             look_at: DVec3::ZERO,
             up: DVec3::Y,
             fov_y_degrees: 30.0,
+            orthographic_half_height: None,
         },
         environment: Environment {
             background: DVec3::splat(0.1),
@@ -562,6 +566,7 @@ fn mesh_scene(mesh: &[[DVec3; 3]], eye: DVec3, look_at: DVec3, fov_y_degrees: f6
                 DVec3::Y
             },
             fov_y_degrees,
+            orthographic_half_height: None,
         },
         environment: Environment::default(),
         materials: vec![emissive(1.0)],
@@ -633,6 +638,7 @@ fn camera_inside_glass_sees_the_background() {
             look_at: DVec3::new(0.3, 0.1, -1.0),
             up: DVec3::Y,
             fov_y_degrees: 70.0,
+            orthographic_half_height: None,
         },
         environment: Environment {
             background: DVec3::new(0.5, 0.25, 1.0),
@@ -712,6 +718,7 @@ fn glass_scene(outer_ior: f64, inner_ior: Option<f64>) -> Scene {
             look_at: DVec3::new(0.0, 0.6, 0.0),
             up: DVec3::Y,
             fov_y_degrees: 40.0,
+            orthographic_half_height: None,
         },
         environment: Environment {
             background: DVec3::new(0.3, 0.35, 0.45),
@@ -848,6 +855,7 @@ fn degenerate_lights_never_produce_nan_or_infinity() {
         look_at: DVec3::new(0.0, 0.0, 0.0),
         up: DVec3::Z,
         fov_y_degrees: 40.0,
+        orthographic_half_height: None,
     };
     scene.render = settings(17, 17, 1);
     for position in [
@@ -1001,6 +1009,7 @@ fn camera_inside_nested_dielectrics_starts_in_the_innermost() {
             look_at: DVec3::new(0.2, -0.1, -1.0),
             up: DVec3::Y,
             fov_y_degrees: 60.0,
+            orthographic_half_height: None,
         },
         environment: Environment {
             background: DVec3::ONE,
@@ -1077,6 +1086,7 @@ fn triangle_floor(half: f64) -> Scene {
             look_at: DVec3::ZERO,
             up: DVec3::Y,
             fov_y_degrees: 60.0,
+            orthographic_half_height: None,
         },
         environment: Environment {
             background: DVec3::new(0.2, 0.3, 0.5),

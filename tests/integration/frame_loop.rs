@@ -282,6 +282,7 @@ fn a_camera_move_uploads_only_the_trace_constants_and_equals_a_fresh_upload() {
     let moved = Camera {
         eye: scene.camera.eye + glam::DVec3::new(0.7, 0.4, -0.3),
         fov_y_degrees: scene.camera.fov_y_degrees * 0.9,
+        orthographic_half_height: None,
         ..scene.camera
     };
     renderer

@@ -28,6 +28,7 @@ fn scene(samples_per_pixel: u32) -> Scene {
             look_at: DVec3::new(0.0, 0.5, 0.0),
             up: DVec3::Y,
             fov_y_degrees: 50.0,
+            orthographic_half_height: None,
         },
         environment: Environment::default(),
         materials: vec![Material::lambert(DVec3::splat(0.6))],

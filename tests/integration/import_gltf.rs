@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use base64::Engine;
-use glam::{DMat4, DQuat, DVec3};
+use glam::{DMat4, DQuat, DVec2, DVec3};
 use gpu_render::low_level::camera::CameraFrame;
 use gpu_render::low_level::color::srgb_decode;
 use gpu_render::scene::import::{
@@ -51,6 +51,19 @@ impl Doc {
         let view = self.view(&bytes);
         self.accessor(format!(
             r#"{{"bufferView":{view},"componentType":5126,"count":{},"type":"VEC3"}}"#,
+            data.len()
+        ))
+    }
+
+    fn vec4(&mut self, data: &[[f32; 4]]) -> usize {
+        let bytes: Vec<u8> = data
+            .iter()
+            .flatten()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let view = self.view(&bytes);
+        self.accessor(format!(
+            r#"{{"bufferView":{view},"componentType":5126,"count":{},"type":"VEC4"}}"#,
             data.len()
         ))
     }
@@ -526,7 +539,7 @@ fn points_and_lines_are_skipped_with_one_warning() {
 }
 
 #[test]
-fn vertex_colours_are_named_in_one_warning() {
+fn vertex_colours_are_read_and_further_sets_named_in_one_warning() {
     let (mut doc, _) = triangle_doc();
     let rgb = doc.integers(
         "VEC3",
@@ -543,11 +556,72 @@ fn vertex_colours_are_named_in_one_warning() {
     );
     let model = imported("colours.gltf", doc.embedded(&body).as_bytes());
     assert_eq!(model.meshes.len(), 3);
+    // Normalized bytes read as [0, 1], linear (glTF 2.0 §3.7.2.1).
+    let primaries = Some(vec![DVec3::X, DVec3::Y, DVec3::Z]);
+    assert_eq!(model.meshes[0].colors, primaries);
+    assert_eq!(model.meshes[1].colors, None);
+    assert_eq!(model.meshes[2].colors, primaries);
     assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
     assert!(
         model.warnings[0].ends_with(
-            "colours.gltf: vertex colours are present but not yet shaded; they are ignored (mesh 0 ('painted'), primitive 0: COLOR_0; mesh 0 ('painted'), primitive 2: COLOR_0, COLOR_1)"
+            "colours.gltf: only COLOR_0 multiplies the base colour; further vertex colour sets are ignored (mesh 0 ('painted'), primitive 2: COLOR_1)"
         ),
+        "{:?}",
+        model.warnings
+    );
+}
+
+#[test]
+fn float_and_short_vertex_colours_read_with_alpha_and_range_warned_about() {
+    let (mut doc, _) = triangle_doc();
+    // VEC4 floats: one out of range (clamped), one alpha below 1 (ignored).
+    let rgba = doc.vec4(&[
+        [0.25, 0.5, 0.75, 1.0],
+        [2.0, 0.0, 0.0, 0.5],
+        [0.0, 0.0, 1.0, 1.0],
+    ]);
+    let body = format!(
+        r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+           "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"COLOR_0":{rgba}}},"indices":1}}]}}]"#
+    );
+    let model = imported("rgba.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(
+        model.meshes[0].colors,
+        Some(vec![DVec3::new(0.25, 0.5, 0.75), DVec3::X, DVec3::Z])
+    );
+    assert_eq!(model.warnings.len(), 2, "{:?}", model.warnings);
+    assert!(
+        model.warnings.iter().any(|w| w.ends_with(
+            "rgba.gltf: mesh 0, primitive 0: COLOR_0 has alpha below 1, which is ignored (alpha modes are not supported): the surface is opaque"
+        )),
+        "{:?}",
+        model.warnings
+    );
+    assert!(
+        model.warnings.iter().any(|w| w.ends_with(
+            "rgba.gltf: mesh 0, primitive 0: 1 vertex colour outside [0, 1] (the first at vertex 1: [2, 0, 0]); clamped"
+        )),
+        "{:?}",
+        model.warnings
+    );
+
+    // Unnormalized shorts are not colours: left out, with a warning, the model renders.
+    let (mut doc, _) = triangle_doc();
+    let rgb = doc.integers(
+        "VEC3",
+        5123,
+        false,
+        &[vec![1, 0, 0], vec![0, 1, 0], vec![0, 0, 1]],
+    );
+    let body = format!(
+        r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+           "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"COLOR_0":{rgb}}},"indices":1}}]}}]"#
+    );
+    let model = imported("shorts.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(model.meshes[0].colors, None);
+    assert!(
+        model.warnings[0].contains("COLOR_0 (accessor")
+            && model.warnings[0].ends_with("; the vertex colours are ignored"),
         "{:?}",
         model.warnings
     );
@@ -665,14 +739,51 @@ fn punctual_lights_convert_to_our_units() {
     // -z turned -90° about x points down.
     assert_close(direction, DVec3::new(0.0, -1.0, 0.0), 1e-6);
     assert_close(irradiance, DVec3::splat(1366.0 / LUMENS_PER_WATT), 1e-12);
-    assert!(matches!(model.lights[2], Light::Point { position, .. } if position.y == 5.0));
+    // A spot light along the node's -z, its cone from the angles (inner defaults to 0).
+    let Light::Spot {
+        position,
+        direction,
+        intensity,
+        cos_inner,
+        cos_outer,
+    } = model.lights[2]
+    else {
+        panic!("not a spot light: {:?}", model.lights[2]);
+    };
+    assert_eq!(position, DVec3::new(0.0, 5.0, 0.0));
+    assert_eq!(direction, DVec3::NEG_Z);
+    assert_close(intensity, DVec3::splat(0.1), 1e-7);
+    assert_eq!(cos_inner, 1.0);
+    assert_eq!(cos_outer, f64::from(0.5f32).cos());
     let warnings = model.warnings.join("\n");
-    assert!(
-        warnings.contains("light 2 on node 3 is a spot light"),
-        "{warnings}"
-    );
+    assert!(!warnings.contains("spot"), "{warnings}");
     assert!(warnings.contains("light 2: range is ignored"), "{warnings}");
     assert_eq!(model.lights_or_default(), model.lights);
+
+    // Cones out of order or beyond a right angle: located errors.
+    for (cone, angles) in [
+        (
+            r#"{"innerConeAngle":0.6,"outerConeAngle":0.5}"#,
+            "innerConeAngle 0.6 and outerConeAngle 0.5",
+        ),
+        (
+            r#"{"innerConeAngle":0.5,"outerConeAngle":0.5}"#,
+            "innerConeAngle 0.5 and outerConeAngle 0.5",
+        ),
+        (
+            r#"{"outerConeAngle":2}"#,
+            "innerConeAngle 0 and outerConeAngle 2",
+        ),
+    ] {
+        let body = body.replace(r#"{"outerConeAngle":0.5}"#, cone);
+        let message = failure("cone.gltf", doc.embedded(&body).as_bytes());
+        assert!(
+            message.contains(&format!(
+                "cone.gltf: light 2 on node 3: spot {angles} must satisfy 0 <= inner < outer <= pi/2"
+            )),
+            "{message}"
+        );
+    }
 }
 
 /// A PNG file's bytes.
@@ -775,6 +886,7 @@ fn materials_map_with_their_textures_and_wrap_modes() {
             look_at: DVec3::ZERO,
             up: DVec3::Y,
             fov_y_degrees: 40.0,
+            orthographic_half_height: None,
         },
         environment: Default::default(),
         materials: vec![],
@@ -847,39 +959,50 @@ fn two_uv_sets(doc: &mut Doc, base: Option<u32>, mr: Option<u32>, emissive: Opti
 }
 
 #[test]
-fn textures_choose_the_texture_coordinate_set_they_use() {
-    let first_u = |model: &ImportedModel| model.meshes[0].uvs.as_ref().expect("uvs")[1].x;
-    // Every texture on TEXCOORD_1: it is the mesh's, without a warning.
+fn textures_read_the_texture_coordinate_set_they_ask_for() {
+    let first_u = |uvs: &Option<Vec<DVec2>>| uvs.as_ref().expect("uvs")[1].x;
+    let sets = |model: &ImportedModel| {
+        let m = &model.materials[0];
+        [
+            m.base_color_texture,
+            m.metallic_roughness_texture,
+            m.emissive_texture,
+        ]
+        .map(|t| t.map(|t| t.transform.set))
+    };
+    // Every texture on TEXCOORD_1: both sets are read, without a warning.
     let (mut doc, _) = triangle_doc();
     let body = two_uv_sets(&mut doc, Some(1), Some(1), Some(1));
     let model = imported("one.gltf", doc.embedded(&body).as_bytes());
     assert!(model.warnings.is_empty(), "{:?}", model.warnings);
-    assert_eq!(first_u(&model), 11.0);
-    assert!(model.materials[0].emissive_texture.is_some());
+    assert_eq!(first_u(&model.meshes[0].uvs), 1.0);
+    assert_eq!(first_u(&model.meshes[0].uvs1), 11.0);
+    assert_eq!(sets(&model), [Some(1); 3]);
 
-    // MultiUVTest: base colour on TEXCOORD_0, emission on TEXCOORD_1. A tie: the base
-    // colour's set, with a warning.
+    // MultiUVTest: base colour on TEXCOORD_0, emission on TEXCOORD_1: each its own.
     let (mut doc, _) = triangle_doc();
     let body = two_uv_sets(&mut doc, Some(0), None, Some(1));
     let model = imported("multi.gltf", doc.embedded(&body).as_bytes());
-    assert_eq!(first_u(&model), 1.0);
-    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    assert_eq!(first_u(&model.meshes[0].uvs), 1.0);
+    assert_eq!(first_u(&model.meshes[0].uvs1), 11.0);
+    assert_eq!(sets(&model), [Some(0), None, Some(1)]);
+
+    // No texture on TEXCOORD_1: the second set is not read.
+    let (mut doc, _) = triangle_doc();
+    let body = two_uv_sets(&mut doc, Some(0), Some(0), None);
+    let model = imported("zero.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(model.meshes[0].uvs1, None);
+
+    // A set beyond 1: TEXCOORD_0, with a warning.
+    let (mut doc, _) = triangle_doc();
+    let body = two_uv_sets(&mut doc, Some(2), None, None);
+    let model = imported("two.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(sets(&model), [Some(0), None, None]);
     assert!(
         model.warnings[0].ends_with(
-            "multi.gltf: material 0 ('multi'): its textures use different texture coordinate sets (baseColorTexture: TEXCOORD_0, emissiveTexture: TEXCOORD_1), and a mesh is read with one: TEXCOORD_0, so emissiveTexture is mapped by the wrong coordinates"
+            "two.gltf: material 0 ('multi'): baseColorTexture uses TEXCOORD_2, but only TEXCOORD_0 and TEXCOORD_1 are read; TEXCOORD_0 is used"
         ),
-        "{:?}",
-        model.warnings
-    );
-
-    // Two of three on TEXCOORD_1: the majority wins over the base colour.
-    let (mut doc, _) = triangle_doc();
-    let body = two_uv_sets(&mut doc, Some(0), Some(1), Some(1));
-    let model = imported("most.gltf", doc.embedded(&body).as_bytes());
-    assert_eq!(first_u(&model), 11.0);
-    assert!(
-        model.warnings[0]
-            .ends_with("TEXCOORD_1, so baseColorTexture is mapped by the wrong coordinates"),
         "{:?}",
         model.warnings
     );
@@ -888,7 +1011,7 @@ fn textures_choose_the_texture_coordinate_set_they_use() {
     let (mut doc, _) = triangle_doc();
     let body = two_uv_sets(&mut doc, None, None, Some(1)).replace(r#","TEXCOORD_1":3"#, "");
     let model = imported("missing.gltf", doc.embedded(&body).as_bytes());
-    assert_eq!(first_u(&model), 1.0);
+    assert_eq!(first_u(&model.meshes[0].uvs1), 1.0);
     assert!(
         model.warnings[0].ends_with(
             "missing.gltf: mesh 0, primitive 0: its material's textures use TEXCOORD_1, which it does not have; TEXCOORD_0 is used"
@@ -899,7 +1022,61 @@ fn textures_choose_the_texture_coordinate_set_they_use() {
 }
 
 #[test]
-fn occlusion_textures_are_left_to_the_path_tracer_and_normal_textures_warned_about() {
+fn texture_transforms_are_read_as_offset_rotation_and_scale() {
+    use gpu_render::scene::TextureTransform;
+    let transformed = |extension: &str| {
+        let (mut doc, _) = triangle_doc();
+        let body = two_uv_sets(&mut doc, Some(0), None, None).replace(
+            r#""baseColorTexture":{"index":0,"texCoord":0}"#,
+            &format!(
+                r#""baseColorTexture":{{"index":0,"texCoord":0,"extensions":{{"KHR_texture_transform":{extension}}}}}"#
+            ),
+        );
+        (doc, body)
+    };
+    let (doc, body) = transformed(
+        r#"{"offset":[0.5,-1],"rotation":1.5707963705062866,"scale":[2,3],"texCoord":1}"#,
+    );
+    let model = imported("transform.gltf", doc.embedded(&body).as_bytes());
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let transform = model.materials[0]
+        .base_color_texture
+        .expect("texture")
+        .transform;
+    // texCoord overridden by the extension; the second set read for it.
+    assert_eq!(transform.set, 1);
+    assert!(model.meshes[0].uvs1.is_some());
+    // T · R · S of (1, 0): scaled to (2, 0), rotated by 90° to (0, -2) (R =
+    // [[cos, sin], [-sin, cos]]), offset to (0.5, -3).
+    let p = transform.apply(DVec2::X);
+    assert!((p - DVec2::new(0.5, -3.0)).length() < 1e-6, "{p}");
+    let expected = TextureTransform::offset_rotation_scale(
+        1,
+        DVec2::new(0.5, -1.0),
+        f64::from(1.570_796_4_f32),
+        DVec2::new(2.0, 3.0),
+    );
+    assert_eq!(transform, expected);
+
+    // Bad input: a located error, never a silently wrong image.
+    for (extension, what) in [
+        (r#"{"scale":[1e7,1]}"#, "scale [10000000, 1]"),
+        (r#"{"offset":[1e300,0]}"#, "offset [inf, 0]"),
+    ] {
+        let (doc, body) = transformed(extension);
+        let message = failure("bad.gltf", doc.embedded(&body).as_bytes());
+        assert!(
+            message.contains(
+                "bad.gltf: material 0 ('multi'): baseColorTexture: KHR_texture_transform offset"
+            ) && message.contains(what)
+                && message.contains("must be finite, the offset and scale at most 1000000 in size"),
+            "{message}"
+        );
+    }
+}
+
+#[test]
+fn occlusion_textures_are_left_to_the_path_tracer_and_normal_maps_need_normals() {
     let (mut doc, _) = triangle_doc();
     let body = two_uv_sets(&mut doc, None, None, None).replace(
         r#""name":"multi","#,
@@ -908,15 +1085,18 @@ fn occlusion_textures_are_left_to_the_path_tracer_and_normal_textures_warned_abo
     let model = imported("baked.gltf", doc.embedded(&body).as_bytes());
     assert!(model.warnings.is_empty(), "{:?}", model.warnings);
     let body = body.replace(r#""occlusionTexture""#, r#""normalTexture""#);
+    // A normal map on a triangle without NORMAL or TANGENT: no tangents can be made.
     let model = imported("bumpy.gltf", doc.embedded(&body).as_bytes());
     assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
     assert!(
         model.warnings[0].ends_with(
-            "bumpy.gltf: material 0 ('baked'): normalTexture is not supported yet; ignored (the surface shades with its mesh normals)"
+            "bumpy.gltf: mesh 0, primitive 0: its material's normalTexture needs tangents, and without TANGENT they are generated from NORMAL and the normal map's texture coordinates, which it lacks; the normal map is not applied"
         ),
         "{:?}",
         model.warnings
     );
+    assert!(model.materials[0].normal_texture.is_some());
+    assert_eq!(model.meshes[0].tangents, None);
 }
 
 #[test]
@@ -1101,7 +1281,7 @@ fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
                 1,
             )
             .into_bytes(),
-            "the file requires the extension KHR_draco_mesh_compression, which is not supported (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_mesh_quantization). Its meshes are Draco-compressed (KHR_draco_mesh_compression), and Draco mesh compression is not supported: decompress the file first, e.g. with `gltf-transform cp IN OUT`",
+            "the file requires the extension KHR_draco_mesh_compression, which is not supported (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_mesh_quantization, KHR_texture_transform). Its meshes are Draco-compressed (KHR_draco_mesh_compression), and Draco mesh compression is not supported: decompress the file first, e.g. with `gltf-transform cp IN OUT`",
         ),
         (
             "meshopt required",
@@ -1111,17 +1291,17 @@ fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
                 1,
             )
             .into_bytes(),
-            "requires the extension EXT_meshopt_compression, which is not supported (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_mesh_quantization). Its buffers are meshopt-compressed (EXT_meshopt_compression), and meshopt compression is not supported: decompress the file first, e.g. with `gltfpack -i IN -o OUT`",
+            "requires the extension EXT_meshopt_compression, which is not supported (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_mesh_quantization, KHR_texture_transform). Its buffers are meshopt-compressed (EXT_meshopt_compression), and meshopt compression is not supported: decompress the file first, e.g. with `gltfpack -i IN -o OUT`",
         ),
         (
             "several required extensions",
             ok.replacen(
                 '{',
-                r#"{"extensionsRequired":["KHR_texture_transform","KHR_lights_punctual","KHR_materials_unlit","EXT_meshopt_compression"],"#,
+                r#"{"extensionsRequired":["KHR_materials_sheen","KHR_lights_punctual","KHR_materials_unlit","EXT_meshopt_compression"],"#,
                 1,
             )
             .into_bytes(),
-            "the file requires 3 extensions that are not supported: KHR_texture_transform, KHR_materials_unlit, EXT_meshopt_compression (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_mesh_quantization). Its buffers are meshopt-compressed (EXT_meshopt_compression)",
+            "the file requires 3 extensions that are not supported: KHR_materials_sheen, KHR_materials_unlit, EXT_meshopt_compression (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_mesh_quantization, KHR_texture_transform). Its buffers are meshopt-compressed (EXT_meshopt_compression)",
         ),
         (
             // As gltf-transform's BoxDraco.gltf: Draco used, not required, and no
@@ -1390,7 +1570,7 @@ fn degenerate_triangles_are_skipped_and_counted() {
 fn unsupported_features_that_are_not_required_are_warnings() {
     let (doc, meshes) = triangle_doc();
     let body = format!(
-        r#""extensionsUsed":["KHR_texture_transform"],"scenes":[{{"nodes":[0]}},{{"nodes":[]}}],
+        r#""extensionsUsed":["KHR_materials_sheen"],"scenes":[{{"nodes":[0]}},{{"nodes":[]}}],
            "nodes":[{{"mesh":0}},{{"mesh":0,"scale":[0,0,0]}},{{"camera":0}}],
            "cameras":[{{"type":"orthographic","orthographic":{{"xmag":1,"ymag":1,"zfar":10,"znear":0.1}}}}],{meshes}"#
     );
@@ -1401,7 +1581,7 @@ fn unsupported_features_that_are_not_required_are_warnings() {
     let model = parse_gltf(doc.embedded(&body).as_bytes(), Path::new("odd.gltf")).expect("imports");
     let warnings = model.warnings.join("\n");
     assert!(
-        warnings.contains("KHR_texture_transform, which is not supported"),
+        warnings.contains("KHR_materials_sheen, which is not supported"),
         "{warnings}"
     );
     assert!(warnings.contains("the file has 2 scenes"), "{warnings}");
@@ -1409,10 +1589,102 @@ fn unsupported_features_that_are_not_required_are_warnings() {
         warnings.contains("node 1: its transform is singular"),
         "{warnings}"
     );
-    assert!(
-        warnings.contains("camera 0 on node 2 is orthographic"),
-        "{warnings}"
-    );
+    assert!(!warnings.contains("orthographic"), "{warnings}");
     assert_eq!(model.meshes[0].instances.len(), 1);
-    assert!(model.camera.is_none());
+    // The orthographic camera is imported: half its view height is ymag.
+    let camera = model.camera.expect("a camera");
+    assert_eq!(camera.camera.orthographic_half_height, Some(1.0));
+    assert_eq!(camera.aspect_ratio, Some(1.0));
+
+    // xmag or ymag of zero (or a node scale of zero): a located error.
+    let body = body.replace(r#""ymag":1,"#, r#""ymag":0,"#);
+    let message = failure("flat.gltf", doc.embedded(&body).as_bytes());
+    assert!(
+        message.contains("flat.gltf: camera 0 on node 2: orthographic xmag 1 and ymag 0 (times the node's scale) must be positive, finite and at most 1000000000000000"),
+        "{message}"
+    );
+}
+
+/// A quad facing +z (normals +z, `v` down the image as `y` falls) with a normal map of
+/// 2 × 2 different tilts, with or without a `TANGENT` of +x and handedness +1 (the
+/// bitangent `normal × tangent` = +y, up the image: glTF's "+Y is up").
+fn normal_mapped_quad(with_tangents: bool) -> (Doc, String) {
+    let mut doc = Doc::default();
+    let positions = doc.vec3(&[
+        [-1.0, -1.0, 0.0],
+        [1.0, -1.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [-1.0, 1.0, 0.0],
+    ]);
+    let normals = doc.vec3(&[[0.0, 0.0, 1.0]; 4]);
+    let uvs = doc.vec2(&[[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]);
+    let tangents = doc.vec4(&[[1.0, 0.0, 0.0, 1.0]; 4]);
+    let indices = doc.indices(&[0, 1, 2, 0, 2, 3]);
+    let png = png(
+        2,
+        2,
+        &[
+            [200, 128, 220, 255],
+            [60, 128, 220, 255],
+            [128, 200, 220, 255],
+            [128, 60, 220, 255],
+        ],
+    );
+    let uri = format!(
+        "data:image/png;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&png)
+    );
+    let tangent = if with_tangents {
+        format!(r#","TANGENT":{tangents}"#)
+    } else {
+        String::new()
+    };
+    let body = format!(
+        r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+           "meshes":[{{"primitives":[{{"attributes":{{"POSITION":{positions},"NORMAL":{normals},"TEXCOORD_0":{uvs}{tangent}}},"indices":{indices},"material":0}}]}}],
+           "materials":[{{"normalTexture":{{"index":0,"scale":0.8}},"pbrMetallicRoughness":{{"metallicFactor":0}}}}],
+           "textures":[{{"source":0}}],"images":[{{"uri":"{uri}"}}]"#
+    );
+    (doc, body)
+}
+
+#[test]
+fn generated_tangents_give_the_image_given_ones_give() {
+    let (doc, body) = normal_mapped_quad(true);
+    let given = imported("given.gltf", doc.embedded(&body).as_bytes());
+    let (doc, body) = normal_mapped_quad(false);
+    let generated = imported("generated.gltf", doc.embedded(&body).as_bytes());
+    assert!(given.warnings.is_empty(), "{:?}", given.warnings);
+    assert!(generated.warnings.is_empty(), "{:?}", generated.warnings);
+    // MikkTSpace's tangents are the given ones: +x, handedness +1.
+    for tangent in generated.meshes[0].tangents.as_ref().expect("generated") {
+        assert!(
+            (*tangent - glam::DVec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-6,
+            "{tangent}"
+        );
+    }
+    assert_eq!(given.materials[0].material.normal_scale, f64::from(0.8f32));
+    // Rendered, the same image; and a different one without the normal map.
+    let settings = gpu_render::scene::RenderSettings {
+        width: 32,
+        height: 24,
+        ..Default::default()
+    };
+    let render = |model: &ImportedModel| {
+        let mut scene = model.into_scene(settings);
+        scene.camera.eye = DVec3::new(0.0, 0.0, 4.0);
+        scene.camera.look_at = DVec3::ZERO;
+        gpu_render::cpu::render(&scene, None).image.pixels
+    };
+    let (a, b) = (render(&given), render(&generated));
+    let largest = a
+        .iter()
+        .zip(&b)
+        .map(|(p, q)| (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0f32, f32::max))
+        .fold(0.0, f32::max);
+    assert!(largest < 1e-5, "images differ by {largest}");
+    let mut flat = given.clone();
+    flat.materials[0].normal_texture = None;
+    let c = render(&flat);
+    assert!(a.iter().zip(&c).any(|(p, q)| (p[0] - q[0]).abs() > 1e-2));
 }

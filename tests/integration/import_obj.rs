@@ -391,6 +391,7 @@ fn map_ke_loads_an_emission_texture_that_the_scene_keeps() {
             look_at: DVec3::ZERO,
             up: DVec3::Y,
             fov_y_degrees: 40.0,
+            orthographic_half_height: None,
         },
         environment: Default::default(),
         materials: vec![],
@@ -819,16 +820,25 @@ fn the_w_of_a_vertex_is_ignored() {
 }
 
 #[test]
-fn vertex_colours_are_read_with_one_warning() {
+fn vertex_colours_are_read_and_uncoloured_vertices_are_white() {
     let obj = "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nf 1 2 3\n";
     let model = imported(&[("colours.obj", obj)]);
     assert_eq!(model.meshes[0].triangles.len(), 1);
-    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
-    assert!(
-        model.warnings[0].contains("colours.obj:1: vertex colours"),
-        "{:?}",
-        model.warnings
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    assert_eq!(
+        model.meshes[0].colors,
+        Some(vec![DVec3::X, DVec3::Y, DVec3::Z])
     );
+    // Before and after the coloured ones, as tinyobjloader reads them: white.
+    let obj = "v 0 0 0\nv 1 0 0 0.5 0.5 0.5\nv 0 1 0\nf 1 2 3\n";
+    let model = imported(&[("some.obj", obj)]);
+    assert_eq!(
+        model.meshes[0].colors,
+        Some(vec![DVec3::ONE, DVec3::splat(0.5), DVec3::ONE])
+    );
+    // No colour anywhere: none.
+    let model = imported(&[("none.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")]);
+    assert_eq!(model.meshes[0].colors, None);
 }
 
 #[test]

@@ -59,6 +59,7 @@ fn furnace(material: Material, max_depth: u32) -> Scene {
             look_at: DVec3::new(1.0, 0.3, 0.0),
             up: DVec3::Y,
             fov_y_degrees: 90.0,
+            orthographic_half_height: None,
         },
         environment: Environment::default(),
         material_names: vec!["furnace".into()],
@@ -342,6 +343,7 @@ fn glossy_floor(material: Material) -> Scene {
             look_at: DVec3::new(0.0, 0.0, -1.0),
             up: DVec3::Y,
             fov_y_degrees: 50.0,
+            orthographic_half_height: None,
         },
         environment: Environment {
             background: DVec3::splat(0.4),

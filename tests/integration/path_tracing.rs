@@ -74,6 +74,7 @@ fn the_white_furnace_converges_to_the_geometric_series() {
         look_at: DVec3::new(1.0, 0.3, 0.0),
         up: DVec3::Y,
         fov_y_degrees: 90.0,
+        orthographic_half_height: None,
     };
     for (rho, depth) in [(0.0, 64), (0.5, 64), (0.8, 64), (0.8, 3)] {
         let furnace = Material {
@@ -111,6 +112,7 @@ fn floor_camera() -> Camera {
         look_at: DVec3::ZERO,
         up: DVec3::Y,
         fov_y_degrees: 0.1,
+        orthographic_half_height: None,
     }
 }
 
@@ -262,6 +264,7 @@ fn with_point_lights_and_no_bounces_path_tracing_is_whitted() {
             look_at: DVec3::new(0.0, 0.4, 0.0),
             up: DVec3::Y,
             fov_y_degrees: 40.0,
+            orthographic_half_height: None,
         },
     );
     s.lights = vec![
@@ -322,6 +325,7 @@ fn the_white_furnace_of_a_ggx_conductor_loses_only_what_single_scattering_loses(
         look_at: DVec3::new(1.0, 0.2, 0.3),
         up: DVec3::Y,
         fov_y_degrees: 90.0,
+        orthographic_half_height: None,
     };
     for roughness in [0.3, 0.7, 1.0] {
         let conductor = Material {

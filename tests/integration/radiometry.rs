@@ -25,6 +25,7 @@ fn furnace_scene(albedo: f64, radius: f64, intensity: f64) -> Scene {
             look_at: DVec3::new(1.0, 0.3, -0.4) * radius,
             up: DVec3::Y,
             fov_y_degrees: 100.0,
+            orthographic_half_height: None,
         },
         environment: Environment::default(),
         materials: vec![Material::lambert(DVec3::splat(albedo))],

@@ -49,6 +49,7 @@ fn scene(
             look_at,
             up: DVec3::Y,
             fov_y_degrees: 50.0,
+            orthographic_half_height: None,
         },
         environment: Environment {
             background: DVec3::new(0.2, 0.25, 0.35),

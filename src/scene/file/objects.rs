@@ -296,7 +296,7 @@ pub fn scene_extent(shapes: &[Shape], lights: &[Light], eye: DVec3) -> f64 {
         hi = hi.max(b);
     };
     for light in lights {
-        if let Light::Point { position, .. } = light {
+        if let Light::Point { position, .. } | Light::Spot { position, .. } = light {
             include(*position, *position);
         }
     }

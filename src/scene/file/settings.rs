@@ -86,6 +86,7 @@ pub fn camera(source: &Source<'_>, raw: Option<Spanned<RawCamera>>) -> Result<Ca
         look_at,
         up,
         fov_y_degrees,
+        orthographic_half_height: None,
     })
 }
 

@@ -29,6 +29,7 @@ pub fn default_camera(bounds: Option<(DVec3, DVec3)>, aspect: f64) -> Camera {
             look_at: DVec3::ZERO,
             up: DVec3::Y,
             fov_y_degrees: DEFAULT_FOV_Y_DEGREES,
+            orthographic_half_height: None,
         };
     };
     let aspect = if aspect.is_finite() && aspect > 0.0 {
@@ -55,6 +56,7 @@ pub fn default_camera(bounds: Option<(DVec3, DVec3)>, aspect: f64) -> Camera {
         look_at: center,
         up: DVec3::Y,
         fov_y_degrees: DEFAULT_FOV_Y_DEGREES,
+        orthographic_half_height: None,
     }
 }
 

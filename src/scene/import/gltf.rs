@@ -24,7 +24,9 @@ use super::{
     MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES, TextureRef, WrapMode, error, read_file,
 };
 use crate::echo::short;
-use crate::scene::{Camera, Light, MAX_RADIANCE, Material, MaterialKind, SceneError};
+use crate::scene::{
+    Camera, Light, MAX_RADIANCE, Material, MaterialKind, SceneError, TextureTransform,
+};
 
 /// Luminous efficacy used to turn `KHR_lights_punctual`'s photometric intensities into
 /// our radiometric ones, in lm/W: 683, the peak of the photopic curve at 555 nm (the
@@ -41,6 +43,7 @@ const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_ior",
     "KHR_materials_transmission",
     "KHR_mesh_quantization",
+    "KHR_texture_transform",
 ];
 /// `KHR_mesh_quantization`, which widens the component types of vertex attributes.
 const MESH_QUANTIZATION: &str = "KHR_mesh_quantization";
@@ -67,6 +70,14 @@ const TEXCOORD_TYPES: &[DataType] = &[
     DataType::I16,
     DataType::U16,
 ];
+/// Largest offset or scale (in size) of a `KHR_texture_transform` accepted: beyond it
+/// an `f32` texture coordinate keeps less than 1/16 of a repeat.
+const MAX_TEXTURE_TRANSFORM: f64 = 1e6;
+/// Largest half view height of an orthographic camera accepted, in scene units.
+const MAX_ORTHOGRAPHIC_SIZE: f64 = 1e15;
+/// Component types of `COLOR_0`: `FLOAT` and normalized unsigned bytes and shorts
+/// (glTF 2.0 §3.7.2.1).
+const COLOR_TYPES: &[DataType] = &[DataType::F32, DataType::U8, DataType::U16];
 /// Index of refraction of `KHR_materials_ior`'s default (and of glass without it).
 const DEFAULT_IOR: f64 = 1.5;
 /// Most validation problems quoted in one error message.
@@ -491,18 +502,30 @@ struct Importer<'a> {
     model: ImportedModel,
     budget: Budget,
     textures: Textures,
-    /// glTF material index (`None`: the default material) → index in the model and the
-    /// texture coordinate set its meshes are read with.
-    materials: HashMap<Option<usize>, (u32, u32)>,
+    /// glTF material index (`None`: the default material) → index in the model and
+    /// whether a texture of it reads `TEXCOORD_1`.
+    materials: HashMap<Option<usize>, MaterialUse>,
     /// Warnings already given once per file.
     warned: BTreeSet<&'static str>,
     /// The primitives skipped for being points or lines (`mesh N, primitive P: MODE`).
     not_triangles: Vec<String>,
     /// How many primitives of triangles were read.
     triangle_primitives: usize,
-    /// The primitives with vertex colours, which are not stored (`mesh N, primitive P:
-    /// COLOR_0`).
+    /// The primitives with vertex colour sets beyond `COLOR_0`, which are not read
+    /// (`mesh N, primitive P: COLOR_1`).
     vertex_colors: Vec<String>,
+}
+
+/// What a primitive's reading depends on in its material.
+#[derive(Debug, Clone, Copy)]
+struct MaterialUse {
+    /// Index in the model's materials.
+    index: u32,
+    /// Whether a texture reads `TEXCOORD_1`.
+    uses_set1: bool,
+    /// The texture coordinate set of its normal map, if it has one: the primitive then
+    /// needs tangents.
+    normal_set: Option<u32>,
 }
 
 /// `what N ('name')`, or `what N` for an unnamed element.
@@ -688,10 +711,10 @@ impl Importer<'_> {
             }
         }
         if !self.vertex_colors.is_empty() {
-            // Vertex colours multiply the base colour (glTF 2.0 §3.7.2.1); the renderers
-            // have no per-vertex colour yet, so the model shades without them.
+            // COLOR_0 multiplies the base colour (glTF 2.0 §3.9.2); further sets have no
+            // meaning the specification gives.
             self.warn(format!(
-                "vertex colours are present but not yet shaded; they are ignored ({})",
+                "only COLOR_0 multiplies the base colour; further vertex colour sets are ignored ({})",
                 quote_list(&self.vertex_colors, "; ")
             ));
         }
@@ -741,14 +764,17 @@ impl Importer<'_> {
             }
             self.triangle_primitives += 1;
             // The material first: it decides which texture coordinates to read.
-            let (material, uv_set) = self.material(primitive.material().index())?;
+            let uses = self.material(primitive.material().index())?;
+            let material = uses.index;
             // The JSON's keys, not `Primitive::attributes`, which unwraps each key.
             let json = &self.document.as_json().meshes[mesh.index()].primitives[primitive.index()];
             let colors: Vec<String> = json
                 .attributes
                 .keys()
                 .filter_map(|semantic| match semantic {
-                    Checked::Valid(::gltf::Semantic::Colors(set)) => Some(format!("COLOR_{set}")),
+                    Checked::Valid(::gltf::Semantic::Colors(set)) if *set > 0 => {
+                        Some(format!("COLOR_{set}"))
+                    }
                     _ => None,
                 })
                 .collect();
@@ -757,7 +783,7 @@ impl Importer<'_> {
                     .push(format!("{name}: {}", colors.join(", ")));
             }
             let raw = self
-                .primitive(&primitive, &name, uv_set)
+                .primitive(&primitive, &name, uses)
                 .map_err(|e| self.fail(format!("{name}: {e}")))?;
             self.budget
                 .charge_instances(instances.len())
@@ -775,16 +801,17 @@ impl Importer<'_> {
         Ok(())
     }
 
-    /// Reads one primitive's positions, normals, texture coordinates (set `uv_set`, the
-    /// one its material's textures use) and triangles (its mode is one of the three of
-    /// triangles); `name` (mesh and primitive) is for warnings, the caller prefixes it to
-    /// errors.
+    /// Reads one primitive's positions, normals, texture coordinates (`TEXCOORD_0`, and
+    /// `TEXCOORD_1` when `uses_set1`: a texture of its material reads it), vertex
+    /// colours (`COLOR_0`) and triangles (its mode is one of the three of triangles);
+    /// `name` (mesh and primitive) is for warnings, the caller prefixes it to errors.
     fn primitive(
         &mut self,
         primitive: &::gltf::Primitive<'_>,
         name: &str,
-        uv_set: u32,
+        uses: MaterialUse,
     ) -> Result<RawMesh, String> {
+        let uses_set1 = uses.uses_set1;
         let mode = primitive.mode();
         let positions_accessor = primitive
             .get(&::gltf::Semantic::Positions)
@@ -851,45 +878,28 @@ impl Importer<'_> {
             }
             None => None,
         };
-        let mut uv_accessor = primitive.get(&::gltf::Semantic::TexCoords(uv_set));
-        let mut uv_name = format!("TEXCOORD_{uv_set}");
-        if uv_accessor.is_none() && uv_set != 0 {
-            // A texture that names a set the primitive lacks is invalid (glTF 2.0
-            // §5.30, textureInfo.texCoord); the first set is the likeliest intent.
-            uv_accessor = primitive.get(&::gltf::Semantic::TexCoords(0));
-            self.warn(format!(
-                "{name}: its material's textures use {uv_name}, which it does not have; {}",
-                if uv_accessor.is_some() {
-                    "TEXCOORD_0 is used"
-                } else {
-                    "it has no texture coordinates"
+        let uvs = self.texcoords(primitive, name, 0, count)?;
+        let uvs1 = if uses_set1 {
+            match self.texcoords(primitive, name, 1, count)? {
+                Some(uvs1) => Some(uvs1),
+                None => {
+                    // A texture that names a set the primitive lacks is invalid (glTF 2.0
+                    // §5.30, textureInfo.texCoord); the first set is the likeliest intent.
+                    self.warn(format!(
+                        "{name}: its material's textures use TEXCOORD_1, which it does not have; {}",
+                        if uvs.is_some() {
+                            "TEXCOORD_0 is used"
+                        } else {
+                            "it has no texture coordinates"
+                        }
+                    ));
+                    uvs.clone()
                 }
-            ));
-            uv_name = "TEXCOORD_0".into();
-        }
-        let uvs = match uv_accessor {
-            Some(accessor) => {
-                same_count(&accessor, &uv_name)?;
-                let values = read(
-                    &accessor,
-                    &Expect {
-                        name: &uv_name,
-                        dimensions: Dimensions::Vec2,
-                        types: TEXCOORD_TYPES,
-                        normalized: Normalized::Either,
-                    },
-                    &self.buffers,
-                )?;
-                self.check_quantization(&accessor, name, &uv_name, true);
-                Some(
-                    values
-                        .chunks_exact(2)
-                        .map(|c| DVec2::new(c[0], c[1]))
-                        .collect(),
-                )
             }
-            None => None,
+        } else {
+            None
         };
+        let colors = self.colors(primitive, name, count);
         let indices: Vec<u32> = match primitive.indices() {
             Some(accessor) => read(
                 &accessor,
@@ -914,12 +924,195 @@ impl Importer<'_> {
                 indices.len() % 3
             ));
         }
-        Ok(RawMesh {
+        let Some(normal_set) = uses.normal_set else {
+            return Ok(RawMesh {
+                positions,
+                normals,
+                uvs,
+                uvs1,
+                colors,
+                tangents: None,
+                triangles,
+            });
+        };
+        let tangents = self.tangents(primitive, name, count)?;
+        let raw = RawMesh {
             positions,
             normals,
             uvs,
+            uvs1,
+            colors,
+            tangents,
             triangles,
-        })
+        };
+        if raw.tangents.is_some() {
+            return Ok(raw);
+        }
+        // No TANGENT: MikkTSpace's, from the normals and the normal map's coordinates.
+        let map_uvs = if normal_set == 1 { &raw.uvs1 } else { &raw.uvs };
+        let generated = match (&raw.normals, map_uvs.clone()) {
+            (Some(_), Some(map_uvs)) => super::tangents::with_mikktspace_tangents(
+                RawMesh {
+                    positions: raw.positions.clone(),
+                    normals: raw.normals.clone(),
+                    uvs: raw.uvs.clone(),
+                    uvs1: raw.uvs1.clone(),
+                    colors: raw.colors.clone(),
+                    tangents: None,
+                    triangles: raw.triangles.clone(),
+                },
+                &map_uvs,
+            ),
+            _ => None,
+        };
+        match generated {
+            Some(with_tangents) => Ok(with_tangents),
+            None => {
+                self.warn(format!(
+                    "{name}: its material's normalTexture needs tangents, and without TANGENT they are generated from NORMAL and the normal map's texture coordinates, which {}; the normal map is not applied",
+                    if raw.normals.is_none() || map_uvs.is_none() {
+                        "it lacks"
+                    } else {
+                        "do not give any"
+                    }
+                ));
+                Ok(raw)
+            }
+        }
+    }
+
+    /// Reads `TANGENT` of `primitive` (of `count` vertices), if it has it: `VEC4` of
+    /// floats, or under `KHR_mesh_quantization` normalized signed bytes or shorts.
+    fn tangents(
+        &mut self,
+        primitive: &::gltf::Primitive<'_>,
+        name: &str,
+        count: usize,
+    ) -> Result<Option<Vec<glam::DVec4>>, String> {
+        let Some(accessor) = primitive.get(&::gltf::Semantic::Tangents) else {
+            return Ok(None);
+        };
+        if accessor.count() != count {
+            return Err(format!(
+                "TANGENT has {} elements but POSITION has {count}",
+                accessor.count()
+            ));
+        }
+        let values = read(
+            &accessor,
+            &Expect {
+                name: "TANGENT",
+                dimensions: Dimensions::Vec4,
+                types: NORMAL_TYPES,
+                normalized: Normalized::Always,
+            },
+            &self.buffers,
+        )?;
+        self.check_quantization(&accessor, name, "TANGENT", false);
+        Ok(Some(
+            values
+                .chunks_exact(4)
+                .map(|c| glam::DVec4::new(c[0], c[1], c[2], c[3]))
+                .collect(),
+        ))
+    }
+
+    /// Reads `TEXCOORD_{set}` of `primitive` (of `count` vertices), if it has it.
+    fn texcoords(
+        &mut self,
+        primitive: &::gltf::Primitive<'_>,
+        name: &str,
+        set: u32,
+        count: usize,
+    ) -> Result<Option<Vec<DVec2>>, String> {
+        let Some(accessor) = primitive.get(&::gltf::Semantic::TexCoords(set)) else {
+            return Ok(None);
+        };
+        let uv_name = format!("TEXCOORD_{set}");
+        if accessor.count() != count {
+            return Err(format!(
+                "{uv_name} has {} elements but POSITION has {count}",
+                accessor.count()
+            ));
+        }
+        let values = read(
+            &accessor,
+            &Expect {
+                name: &uv_name,
+                dimensions: Dimensions::Vec2,
+                types: TEXCOORD_TYPES,
+                normalized: Normalized::Either,
+            },
+            &self.buffers,
+        )?;
+        self.check_quantization(&accessor, name, &uv_name, true);
+        Ok(Some(
+            values
+                .chunks_exact(2)
+                .map(|c| DVec2::new(c[0], c[1]))
+                .collect(),
+        ))
+    }
+
+    /// Reads `COLOR_0` of `primitive` (of `count` vertices), if it has it: `VEC3` or
+    /// `VEC4` of floats or normalized unsigned bytes or shorts (glTF 2.0 §3.7.2.1), the
+    /// alpha of `VEC4` left out (alpha modes are not supported; a warning says so when
+    /// it is not 1). An accessor that breaks these rules is left out with a warning:
+    /// the model still renders, in its materials' colours.
+    fn colors(
+        &mut self,
+        primitive: &::gltf::Primitive<'_>,
+        name: &str,
+        count: usize,
+    ) -> Option<Vec<DVec3>> {
+        let accessor = primitive.get(&::gltf::Semantic::Colors(0))?;
+        let dimensions = accessor.dimensions();
+        let read_colors = || -> Result<Vec<f64>, String> {
+            if accessor.count() != count {
+                return Err(format!(
+                    "COLOR_0 has {} elements but POSITION has {count}",
+                    accessor.count()
+                ));
+            }
+            if !matches!(dimensions, Dimensions::Vec3 | Dimensions::Vec4) {
+                return Err(format!(
+                    "COLOR_0 (accessor {}) holds {dimensions:?} elements, expected Vec3 or Vec4",
+                    accessor.index()
+                ));
+            }
+            read(
+                &accessor,
+                &Expect {
+                    name: "COLOR_0",
+                    dimensions,
+                    types: COLOR_TYPES,
+                    normalized: Normalized::Always,
+                },
+                &self.buffers,
+            )
+        };
+        let values = match read_colors() {
+            Ok(values) => values,
+            Err(e) => {
+                self.warn(format!("{name}: {e}; the vertex colours are ignored"));
+                return None;
+            }
+        };
+        let components = dimensions.multiplicity();
+        if components == 4 && values.chunks_exact(4).any(|c| c[3] != 1.0) {
+            self.warn_once(
+                "color alpha",
+                format!(
+                    "{name}: COLOR_0 has alpha below 1, which is ignored (alpha modes are not supported): the surface is opaque"
+                ),
+            );
+        }
+        Some(
+            values
+                .chunks_exact(components)
+                .map(|c| DVec3::new(c[0], c[1], c[2]))
+                .collect(),
+        )
     }
 
     /// Warns (once per file) when `accessor` holds one of the component types that only
@@ -957,42 +1150,52 @@ impl Importer<'_> {
 
     /// The model's index of glTF material `index` (`None`: the default material, glTF
     /// 2.0 §3.9.6), mapping it on first use.
-    fn material(&mut self, index: Option<usize>) -> Result<(u32, u32), SceneError> {
+    fn material(&mut self, index: Option<usize>) -> Result<MaterialUse, SceneError> {
         if let Some(&known) = self.materials.get(&index) {
             return Ok(known);
         }
-        let (imported, uv_set) = match index.and_then(|i| self.document.materials().nth(i)) {
-            Some(material) => self.map_material(&material)?,
-            None => (
-                ImportedMaterial {
-                    name: "default".into(),
-                    // glTF's default material: white, fully metallic and rough... which is
-                    // black under Whitted lighting; a white dielectric PBR is what viewers show.
-                    material: Material {
-                        diffuse: DVec3::ONE,
-                        metallic: 0.0,
-                        roughness: 1.0,
-                        ..Material::blank(MaterialKind::Pbr)
+        let (imported, uses_set1, normal_set) =
+            match index.and_then(|i| self.document.materials().nth(i)) {
+                Some(material) => self.map_material(&material)?,
+                None => (
+                    ImportedMaterial {
+                        name: "default".into(),
+                        // glTF's default material: white, fully metallic and rough... which is
+                        // black under Whitted lighting; a white dielectric PBR is what viewers show.
+                        material: Material {
+                            diffuse: DVec3::ONE,
+                            metallic: 0.0,
+                            roughness: 1.0,
+                            // The default material is single-sided (§3.9.6).
+                            cull_back_faces: true,
+                            ..Material::blank(MaterialKind::Pbr)
+                        },
+                        base_color_texture: None,
+                        metallic_roughness_texture: None,
+                        emissive_texture: None,
+                        normal_texture: None,
                     },
-                    base_color_texture: None,
-                    metallic_roughness_texture: None,
-                    emissive_texture: None,
-                },
-                0,
-            ),
-        };
+                    false,
+                    None,
+                ),
+            };
         let ours = self.model.materials.len() as u32;
         self.model.materials.push(imported);
-        self.materials.insert(index, (ours, uv_set));
-        Ok((ours, uv_set))
+        let uses = MaterialUse {
+            index: ours,
+            uses_set1,
+            normal_set,
+        };
+        self.materials.insert(index, uses);
+        Ok(uses)
     }
 
     /// Maps a glTF metallic-roughness material onto ours (the table in `docs/models.md`),
-    /// with the texture coordinate set its meshes are read with ([`Importer::uv_set`]).
+    /// with whether one of its textures reads `TEXCOORD_1`.
     fn map_material(
         &mut self,
         material: &::gltf::Material<'_>,
-    ) -> Result<(ImportedMaterial, u32), SceneError> {
+    ) -> Result<(ImportedMaterial, bool, Option<u32>), SceneError> {
         let name = describe("material", material.index().unwrap_or(0), material.name());
         let pbr = material.pbr_metallic_roughness();
         let [r, g, b, _alpha] = pbr.base_color_factor().map(f64::from);
@@ -1019,11 +1222,6 @@ impl Importer<'_> {
             self.warn(format!(
                 "{name}: alphaMode {:?} is not supported; the material is opaque",
                 material.alpha_mode()
-            ));
-        }
-        if material.normal_texture().is_some() {
-            self.warn(format!(
-                "{name}: normalTexture is not supported yet; ignored (the surface shades with its mesh normals)"
             ));
         }
         // occlusionTexture is left out without a warning: baked ambient occlusion is a
@@ -1087,8 +1285,10 @@ impl Importer<'_> {
             }
         };
         // glTF's doubleSided lights both sides of a surface: an emitter emits from both.
+        // Without it, camera rays cull the back faces (glTF 2.0 §3.9.5).
         let ours = Material {
             two_sided: material.double_sided() && ours.emission != DVec3::ZERO,
+            cull_back_faces: !material.double_sided(),
             ..ours
         };
         let base_color_texture = match pbr.base_color_texture() {
@@ -1105,75 +1305,61 @@ impl Importer<'_> {
             Some(info) => Some(self.texture(&info, Encoding::Color, &name, "emissiveTexture")?),
             None => None,
         };
-        let uv_set = self.uv_set(
-            &name,
-            &[
-                (
-                    "baseColorTexture",
-                    pbr.base_color_texture().map(|t| t.tex_coord()),
-                ),
-                (
-                    "metallicRoughnessTexture",
-                    pbr.metallic_roughness_texture().map(|t| t.tex_coord()),
-                ),
-                (
-                    "emissiveTexture",
-                    material.emissive_texture().map(|t| t.tex_coord()),
-                ),
-            ],
-        );
+        let (normal_texture, normal_scale) = match material.normal_texture() {
+            Some(normal) => {
+                let scale = f64::from(normal.scale());
+                if !scale.is_finite() {
+                    return Err(
+                        self.fail(format!("{name}: normalTexture scale {scale} is not finite"))
+                    );
+                }
+                let mut set = normal.tex_coord();
+                if set > 1 {
+                    self.warn(format!(
+                        "{name}: normalTexture uses TEXCOORD_{set}, but only TEXCOORD_0 and TEXCOORD_1 are read; TEXCOORD_0 is used"
+                    ));
+                    set = 0;
+                }
+                let transform = TextureTransform {
+                    set,
+                    ..TextureTransform::IDENTITY
+                };
+                let texture = self.texture_of(
+                    normal.texture(),
+                    transform,
+                    Encoding::Data,
+                    &name,
+                    "normalTexture",
+                )?;
+                (Some(texture), scale)
+            }
+            None => (None, 1.0),
+        };
+        let ours = Material {
+            normal_scale,
+            ..ours
+        };
+        let uses_set1 = [
+            &base_color_texture,
+            &metallic_roughness_texture,
+            &emissive_texture,
+            &normal_texture,
+        ]
+        .iter()
+        .any(|t| t.is_some_and(|t| t.transform.set == 1));
         let imported = ImportedMaterial {
             name: material.name().map_or_else(|| name.clone(), str::to_string),
             material: ours,
             base_color_texture,
             metallic_roughness_texture,
             emissive_texture,
+            normal_texture,
         };
-        Ok((imported, uv_set))
+        Ok((imported, uses_set1, normal_texture.map(|t| t.transform.set)))
     }
 
-    /// The texture coordinate set (`TEXCOORD_n`) for the meshes of `material`, whose
-    /// textures the renderers use ask for the sets in `slots` (`None`: no such texture).
-    /// A mesh carries one set, so when they disagree the set most of them use is taken
-    /// (on a tie the base colour's, else the lowest), with a warning naming the textures
-    /// that are then mapped by the wrong set.
-    fn uv_set(&mut self, material: &str, slots: &[(&str, Option<u32>)]) -> u32 {
-        let used: Vec<(&str, u32)> = slots
-            .iter()
-            .filter_map(|&(slot, set)| set.map(|set| (slot, set)))
-            .collect();
-        let Some(&(_, first)) = used.first() else {
-            return 0;
-        };
-        if used.iter().all(|&(_, set)| set == first) {
-            return first;
-        }
-        let count = |set: u32| used.iter().filter(|&&(_, s)| s == set).count();
-        let base = used
-            .iter()
-            .find(|&&(slot, _)| slot == "baseColorTexture")
-            .map(|&(_, set)| set);
-        let chosen = used
-            .iter()
-            .map(|&(_, set)| set)
-            .max_by_key(|&set| (count(set), Some(set) == base, std::cmp::Reverse(set)))
-            .unwrap_or(0);
-        let describe = |&(slot, set): &(&str, u32)| format!("{slot}: TEXCOORD_{set}");
-        let wrong: Vec<&str> = used
-            .iter()
-            .filter(|&&(_, set)| set != chosen)
-            .map(|&(slot, _)| slot)
-            .collect();
-        self.warn(format!(
-            "{material}: its textures use different texture coordinate sets ({}), and a mesh is read with one: TEXCOORD_{chosen}, so {} {} mapped by the wrong coordinates",
-            used.iter().map(describe).collect::<Vec<_>>().join(", "),
-            wrong.join(" and "),
-            if wrong.len() == 1 { "is" } else { "are" }
-        ));
-        chosen
-    }
-
-    /// Loads the image of a material's texture and keeps its sampler's wrap modes.
+    /// Loads the image of a material's texture and keeps its sampler's wrap modes, its
+    /// texture coordinate set and `KHR_texture_transform` ([`Importer::transform`]).
     fn texture(
         &mut self,
         info: &::gltf::texture::Info<'_>,
@@ -1181,7 +1367,20 @@ impl Importer<'_> {
         material: &str,
         slot: &str,
     ) -> Result<TextureRef, SceneError> {
-        let texture = info.texture();
+        let transform = self.transform(info, material, slot)?;
+        self.texture_of(info.texture(), transform, encoding, material, slot)
+    }
+
+    /// Loads the image of `texture` and keeps its sampler's wrap modes, with the
+    /// coordinates `transform` describes.
+    fn texture_of(
+        &mut self,
+        texture: ::gltf::texture::Texture<'_>,
+        transform: TextureTransform,
+        encoding: Encoding,
+        material: &str,
+        slot: &str,
+    ) -> Result<TextureRef, SceneError> {
         let image = texture.source();
         let image_name = describe("image", image.index(), image.name());
         let fail = |e: String| error(self.path, format!("{material}: {slot}: {image_name}: {e}"));
@@ -1226,7 +1425,48 @@ impl Importer<'_> {
             image: index,
             wrap_u: wrap(sampler.wrap_s()),
             wrap_v: wrap(sampler.wrap_t()),
+            transform,
         })
+    }
+
+    /// The texture coordinate set of a texture (its `texCoord`, or the one its
+    /// `KHR_texture_transform` overrides it with) and the extension's offset, rotation
+    /// and scale as one map ([`TextureTransform::offset_rotation_scale`]). A set beyond 1
+    /// is read as `TEXCOORD_0`, with a warning (no texture of the Khronos samples asks
+    /// for one). A transform with a value that is not finite, or an offset or scale
+    /// beyond [`MAX_TEXTURE_TRANSFORM`] in size (where `f32` coordinates on the GPU keep
+    /// no fraction of a texel), is an error.
+    fn transform(
+        &mut self,
+        info: &::gltf::texture::Info<'_>,
+        material: &str,
+        slot: &str,
+    ) -> Result<TextureTransform, SceneError> {
+        let mut set = info.tex_coord();
+        let mut transform = TextureTransform::IDENTITY;
+        if let Some(extension) = info.texture_transform() {
+            set = extension.tex_coord().unwrap_or(set);
+            let offset = DVec2::from_array(extension.offset().map(f64::from));
+            let rotation = f64::from(extension.rotation());
+            let scale = DVec2::from_array(extension.scale().map(f64::from));
+            let in_range =
+                |v: DVec2| v.is_finite() && v.abs().max_element() <= MAX_TEXTURE_TRANSFORM;
+            if !(in_range(offset) && in_range(scale) && rotation.is_finite()) {
+                return Err(self.fail(format!(
+                    "{material}: {slot}: KHR_texture_transform offset {offset}, rotation {rotation} and scale {scale} must be finite, the offset and scale at most {} in size",
+                    short(MAX_TEXTURE_TRANSFORM)
+                )));
+            }
+            transform = TextureTransform::offset_rotation_scale(0, offset, rotation, scale);
+        }
+        if set > 1 {
+            self.warn(format!(
+                "{material}: {slot} uses TEXCOORD_{set}, but only TEXCOORD_0 and TEXCOORD_1 are read; TEXCOORD_0 is used"
+            ));
+            set = 0;
+        }
+        transform.set = set;
+        Ok(transform)
     }
 
     /// Keeps the first perspective camera placed by a node.
@@ -1237,29 +1477,53 @@ impl Importer<'_> {
         world: DMat4,
     ) -> Result<(), SceneError> {
         let name = describe("camera", camera.index(), camera.name());
-        let Projection::Perspective(perspective) = camera.projection() else {
-            self.warn(format!(
-                "{name} on {node} is orthographic, which is not supported; ignored"
-            ));
-            return Ok(());
-        };
         if self.model.camera.is_some() {
             self.warn(format!(
                 "{name} on {node}: only the first camera is imported; ignored"
             ));
             return Ok(());
         }
-        let yfov = f64::from(perspective.yfov());
-        if !(yfov > 0.0 && yfov < std::f64::consts::PI) {
-            return Err(self.fail(format!("{name}: yfov {yfov} rad is not in (0, π)")));
-        }
-        let aspect_ratio = perspective.aspect_ratio().map(f64::from);
-        if aspect_ratio.is_some_and(|a| !(a.is_finite() && a > 0.0)) {
-            return Err(self.fail(format!(
-                "{name}: aspectRatio {} is not positive",
-                aspect_ratio.unwrap_or_default()
-            )));
-        }
+        // A perspective camera's vertical field of view, or an orthographic one's half
+        // height (in its node's space; the node's scale applies) and xmag/ymag.
+        let (fov_y_degrees, orthographic, aspect_ratio) = match camera.projection() {
+            Projection::Perspective(perspective) => {
+                let yfov = f64::from(perspective.yfov());
+                if !(yfov > 0.0 && yfov < std::f64::consts::PI) {
+                    return Err(self.fail(format!("{name}: yfov {yfov} rad is not in (0, π)")));
+                }
+                let aspect_ratio = perspective.aspect_ratio().map(f64::from);
+                if aspect_ratio.is_some_and(|a| !(a.is_finite() && a > 0.0)) {
+                    return Err(self.fail(format!(
+                        "{name}: aspectRatio {} is not positive",
+                        aspect_ratio.unwrap_or_default()
+                    )));
+                }
+                (yfov.to_degrees(), None, aspect_ratio)
+            }
+            Projection::Orthographic(orthographic) => {
+                // glTF 2.0 §5.13: xmag and ymag must not be zero and should not be
+                // negative; a negative one is taken by its size.
+                let (xmag, ymag) = (
+                    f64::from(orthographic.xmag()).abs(),
+                    f64::from(orthographic.ymag()).abs(),
+                );
+                let half_height = ymag * world.transform_vector3(DVec3::Y).length();
+                let usable = |v: f64| v.is_finite() && v > 0.0 && v <= MAX_ORTHOGRAPHIC_SIZE;
+                if !(usable(xmag) && usable(half_height)) {
+                    return Err(self.fail(format!(
+                        "{name} on {node}: orthographic xmag {} and ymag {} (times the node's scale) must be positive, finite and at most {}",
+                        short(orthographic.xmag()),
+                        short(orthographic.ymag()),
+                        short(MAX_ORTHOGRAPHIC_SIZE)
+                    )));
+                }
+                (
+                    super::DEFAULT_FOV_Y_DEGREES,
+                    Some(half_height),
+                    Some(xmag / ymag),
+                )
+            }
+        };
         // glTF 2.0 §3.10.1: the camera looks along its local -z with +y up.
         let eye = world.transform_point3(DVec3::ZERO);
         let forward = world.transform_vector3(-DVec3::Z).normalize_or_zero();
@@ -1276,7 +1540,8 @@ impl Importer<'_> {
                 eye,
                 look_at: eye + forward,
                 up,
-                fov_y_degrees: yfov.to_degrees(),
+                fov_y_degrees,
+                orthographic_half_height: orthographic,
             },
             aspect_ratio,
         });
@@ -1327,11 +1592,39 @@ impl Importer<'_> {
         };
         let converted = match light.kind() {
             Kind::Point => point,
-            Kind::Spot { .. } => {
-                self.warn(format!(
-                    "{name} on {node} is a spot light; imported as a point light of the same intensity (the cone is ignored)"
-                ));
-                point
+            Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => {
+                // §KHR_lights_punctual: 0 ≤ inner < outer ≤ π/2 (defaults 0 and π/4).
+                let (inner, outer) = (f64::from(inner_cone_angle), f64::from(outer_cone_angle));
+                let right_angle = std::f64::consts::FRAC_PI_2;
+                // π/2 given in f32 lies a little above it in f64.
+                let ordered = (0.0..right_angle).contains(&inner)
+                    && outer > inner
+                    && outer <= right_angle + 1e-6;
+                if !ordered {
+                    return Err(self.fail(format!(
+                        "{name} on {node}: spot innerConeAngle {} and outerConeAngle {} must satisfy 0 <= inner < outer <= pi/2",
+                        short(inner_cone_angle),
+                        short(outer_cone_angle)
+                    )));
+                }
+                // Spot lights shine along the node's local -z, as directional ones.
+                let direction = world.transform_vector3(-DVec3::Z).normalize_or_zero();
+                if direction == DVec3::ZERO {
+                    self.warn(format!(
+                        "{name} on {node}: its transform leaves no direction (singular); ignored"
+                    ));
+                    return Ok(());
+                }
+                Light::Spot {
+                    position,
+                    direction,
+                    intensity: strength,
+                    cos_inner: inner.cos(),
+                    cos_outer: outer.min(right_angle).cos().max(0.0),
+                }
             }
             Kind::Directional => {
                 // §KHR_lights_punctual: directional lights shine along the node's local -z.

@@ -38,6 +38,9 @@ pub(super) struct RawMesh {
     pub positions: Vec<DVec3>,
     pub normals: Option<Vec<DVec3>>,
     pub uvs: Option<Vec<DVec2>>,
+    pub uvs1: Option<Vec<DVec2>>,
+    pub colors: Option<Vec<DVec3>>,
+    pub tangents: Option<Vec<glam::DVec4>>,
     pub triangles: Vec<[u32; 3]>,
 }
 
@@ -57,6 +60,9 @@ pub(super) fn finish_mesh(
         positions,
         normals,
         uvs,
+        uvs1,
+        colors,
+        tangents,
         triangles,
     } = raw;
     let mut warn = |message: String| warnings.push(format!("{}: {message}", file.display()));
@@ -87,24 +93,103 @@ pub(super) fn finish_mesh(
             None => Some(unit),
         }
     });
-    let uvs = uvs.and_then(|uvs| {
-        if uvs.len() != count {
+    let mut check_uvs = |uvs: Option<Vec<DVec2>>, what: &str| {
+        uvs.and_then(|uvs| {
+            if uvs.len() != count {
+                warn(format!(
+                    "{name}: {} {what} for {count} vertices; the {what} are ignored",
+                    uvs.len()
+                ));
+                return None;
+            }
+            match uvs.iter().position(|uv| !uv.is_finite()) {
+                Some(i) => {
+                    warn(format!(
+                        "{name}: the {what} of vertex {i} are not finite ({}); the {what} are ignored",
+                        uvs[i]
+                    ));
+                    None
+                }
+                None => Some(uvs),
+            }
+        })
+    };
+    let uvs = check_uvs(uvs, "texture coordinates");
+    let uvs1 = check_uvs(uvs1, "second texture coordinates");
+    let colors = colors.and_then(|colors| {
+        if colors.len() != count {
             warn(format!(
-                "{name}: {} texture coordinates for {count} vertices; the texture coordinates are ignored",
-                uvs.len()
+                "{name}: {} vertex colours for {count} vertices; the vertex colours are ignored",
+                colors.len()
             ));
             return None;
         }
-        match uvs.iter().position(|uv| !uv.is_finite()) {
-            Some(i) => {
-                warn(format!(
-                    "{name}: the texture coordinates of vertex {i} are not finite ({}); the texture coordinates are ignored",
-                    uvs[i]
-                ));
-                None
-            }
-            None => Some(uvs),
+        if let Some(i) = colors.iter().position(|c| c.is_nan()) {
+            warn(format!(
+                "{name}: the colour of vertex {i} is not a number ({}); the vertex colours are ignored",
+                colors[i]
+            ));
+            return None;
         }
+        // Colours are reflectances: outside [0, 1] a surface would reflect more light
+        // than it receives (or less than none).
+        let outside = colors
+            .iter()
+            .filter(|c| c.min_element() < 0.0 || c.max_element() > 1.0)
+            .count();
+        if outside > 0 {
+            warn(format!(
+                "{name}: {outside} vertex colour{} outside [0, 1] (the first at vertex {}: {}); clamped",
+                if outside == 1 { "" } else { "s" },
+                colors
+                    .iter()
+                    .position(|c| c.min_element() < 0.0 || c.max_element() > 1.0)
+                    .unwrap_or(0),
+                colors
+                    .iter()
+                    .find(|c| c.min_element() < 0.0 || c.max_element() > 1.0)
+                    .copied()
+                    .unwrap_or_default(),
+            ));
+        }
+        Some(
+            colors
+                .into_iter()
+                .map(|c| c.clamp(DVec3::ZERO, DVec3::ONE))
+                .collect(),
+        )
+    });
+    let tangents = tangents.and_then(|tangents| {
+        if tangents.len() != count {
+            warn(format!(
+                "{name}: {} tangents for {count} vertices; the tangents are ignored (the normal map with them)",
+                tangents.len()
+            ));
+            return None;
+        }
+        // Unit xyz and w = ±1 (glTF 2.0 §3.7.2.1); a zero or non-finite tangent
+        // leaves its vertex without a normal map rather than the whole mesh.
+        let usable = |t: &glam::DVec4| t.is_finite() && t.truncate().length_squared() > 0.0;
+        let bad = tangents.iter().filter(|t| !usable(t)).count();
+        if bad > 0 {
+            warn(format!(
+                "{name}: {bad} tangent{} zero or not finite; the normal map is not applied there",
+                if bad == 1 { " is" } else { "s are" }
+            ));
+        }
+        Some(
+            tangents
+                .into_iter()
+                .map(|t| {
+                    if usable(&t) {
+                        let w = if t.w < 0.0 { -1.0 } else { 1.0 };
+                        t.truncate().normalize_or_zero().extend(w)
+                    } else {
+                        glam::DVec4::ZERO
+                    }
+                })
+                .collect(),
+        )
     });
     let total = triangles.len();
     let mut kept = Vec::with_capacity(total);
@@ -138,6 +223,9 @@ pub(super) fn finish_mesh(
         positions,
         normals,
         uvs,
+        uvs1,
+        colors,
+        tangents,
         triangles: kept,
         material,
         instances: vec![glam::DMat4::IDENTITY],
@@ -145,7 +233,8 @@ pub(super) fn finish_mesh(
 }
 
 /// Bytes an imported vertex may hold: its position and normal (`DVec3`, 24 bytes
-/// each) and texture coordinates (`DVec2`, 16 bytes).
+/// each) and texture coordinates (`DVec2`, 16 bytes). Vertex colours and a second set
+/// of texture coordinates, which few meshes have, are not counted.
 pub(super) const BYTES_PER_VERTEX: u64 = 64;
 /// Bytes of an imported triangle (three `u32` indices).
 pub(super) const BYTES_PER_TRIANGLE: u64 = 12;
@@ -261,6 +350,9 @@ mod tests {
             positions,
             normals: None,
             uvs: None,
+            uvs1: None,
+            colors: None,
+            tangents: None,
             triangles,
         }
     }

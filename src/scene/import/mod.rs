@@ -38,6 +38,7 @@ mod gltf;
 mod mesh;
 mod obj;
 mod place;
+mod tangents;
 mod texture;
 
 use std::path::{Path, PathBuf};
@@ -49,7 +50,7 @@ pub use self::gltf::{LUMENS_PER_WATT, import_gltf, import_gltf_with, parse_gltf}
 use self::mesh::Budget;
 pub use self::obj::{DEFAULT_OBJ_ALBEDO, import_obj, import_obj_with, parse_obj};
 pub use self::place::{MODEL_BACKGROUND, ModelPlacement, is_model_path};
-use super::{Camera, Image, Light, Material, SceneError};
+use super::{Camera, Image, Light, Material, SceneError, TextureTransform};
 
 /// Largest model file (OBJ, MTL, glTF, GLB or external glTF buffer) accepted, in bytes
 /// (512 MiB); a larger one is refused before it is read.
@@ -109,6 +110,15 @@ pub struct ImportedMesh {
     /// (glTF's convention and our textures'; OBJ's upward `v` is flipped to `1 - v` on
     /// import), so `(0, 0)` is the first texel of the image's top row.
     pub uvs: Option<Vec<DVec2>>,
+    /// A second set of texture coordinates (glTF `TEXCOORD_1`, read when a texture of
+    /// the mesh's material asks for it), like `uvs`.
+    pub uvs1: Option<Vec<DVec2>>,
+    /// Linear RGB vertex colours in [0, 1] (glTF `COLOR_0`, OBJ `v x y z r g b`),
+    /// parallel to `positions`, multiplying the material's albedo.
+    pub colors: Option<Vec<DVec3>>,
+    /// Unit tangents with the bitangent's handedness in `w` (±1), parallel to
+    /// `positions`, for a normal map: glTF `TANGENT`, or MikkTSpace's.
+    pub tangents: Option<Vec<glam::DVec4>>,
     /// Triangles as indices into `positions`, counter-clockwise seen from the front (the
     /// side the right-hand-rule normal points to). Degenerate triangles were dropped.
     pub triangles: Vec<[u32; 3]>,
@@ -138,10 +148,13 @@ pub struct ImportedMaterial {
     pub metallic_roughness_texture: Option<TextureRef>,
     /// glTF's `emissiveTexture`: a colour texture multiplying `material.emission`.
     pub emissive_texture: Option<TextureRef>,
+    /// glTF's `normalTexture`: a tangent-space normal map (linear data), with its
+    /// `scale` in `material.normal_scale`.
+    pub normal_texture: Option<TextureRef>,
 }
 
 /// A material's use of a texture.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TextureRef {
     /// Index into [`ImportedModel::images`].
     pub image: u32,
@@ -149,6 +162,9 @@ pub struct TextureRef {
     pub wrap_u: WrapMode,
     /// How `v` outside [0, 1] wraps (glTF sampler `wrapT`; MTL `-clamp`).
     pub wrap_v: WrapMode,
+    /// Which texture coordinate set it reads (glTF `texCoord`, 0 or 1) and how they
+    /// are transformed (`KHR_texture_transform`); the identity on set 0 for OBJ.
+    pub transform: TextureTransform,
 }
 
 /// How texture coordinates outside [0, 1] are brought back into the image (glTF 2.0

@@ -129,6 +129,7 @@ fn parse_obj_within(
                     base_color_texture: None,
                     metallic_roughness_texture: None,
                     emissive_texture: None,
+                    normal_texture: None,
                 });
                 model.materials.len() as u32 - 1
             }),
@@ -141,7 +142,7 @@ fn parse_obj_within(
         budget
             .charge_mesh(group.vertices.len(), group.triangles.len())
             .map_err(|e| error(path, e))?;
-        let raw = group.into_raw_mesh(&file.positions, &file.texcoords, &file.normals);
+        let raw = group.into_raw_mesh(&file);
         if let Some(mesh) = finish_mesh(name, path, raw, material, &mut model.warnings)
             .map_err(|e| error(path, e))?
         {
@@ -260,6 +261,10 @@ fn list<'a>(names: impl Iterator<Item = &'a str>) -> String {
 /// What an OBJ file holds, read but not yet made into meshes.
 struct ObjFile {
     positions: Vec<DVec3>,
+    /// Vertex colours (`v x y z r g b`), parallel to `positions` from the first
+    /// coloured vertex on (white for those before it and those without); empty when no
+    /// vertex has one.
+    colors: Vec<DVec3>,
     /// Texture coordinates, `v` already flipped to grow downwards (ours and glTF's
     /// convention: OBJ's row 0 of the image is at `v` = 1).
     texcoords: Vec<DVec2>,
@@ -333,7 +338,7 @@ impl FaceGroup {
 
     /// The group's geometry for the checks of [`finish_mesh`]: an attribute that only
     /// some vertices have is passed short, which drops it with a warning.
-    fn into_raw_mesh(self, positions: &[DVec3], texcoords: &[DVec2], normals: &[DVec3]) -> RawMesh {
+    fn into_raw_mesh(self, file: &ObjFile) -> RawMesh {
         fn attribute<T: Copy>(vertices: &[[u32; 3]], slot: usize, values: &[T]) -> Option<Vec<T>> {
             let present: Vec<T> = vertices
                 .iter()
@@ -346,10 +351,18 @@ impl FaceGroup {
             positions: self
                 .vertices
                 .iter()
-                .map(|corner| positions[corner[0] as usize])
+                .map(|corner| file.positions[corner[0] as usize])
                 .collect(),
-            normals: attribute(&self.vertices, 2, normals),
-            uvs: attribute(&self.vertices, 1, texcoords),
+            normals: attribute(&self.vertices, 2, &file.normals),
+            uvs: attribute(&self.vertices, 1, &file.texcoords),
+            uvs1: None,
+            tangents: None,
+            colors: (!file.colors.is_empty()).then(|| {
+                self.vertices
+                    .iter()
+                    .map(|corner| file.colors[corner[0] as usize])
+                    .collect()
+            }),
             triangles: self.triangles,
         }
     }
@@ -366,7 +379,6 @@ struct Notes {
     normals_without_vn: Counted<usize>,
     empty_usemtl: Counted<usize>,
     empty_mtllib: Counted<usize>,
-    vertex_colours: Counted<usize>,
     /// MTL `newmtl` statements without a name.
     nameless_materials: Counted<usize>,
     /// Statements that are not read, by keyword: the first line, in order of first use
@@ -465,11 +477,6 @@ impl Notes {
                 times(self.empty_mtllib.count)
             ));
         }
-        if let Some(line) = self.vertex_colours.first {
-            warnings.push(format!(
-                "{file}:{line}: vertex colours (`v x y z r g b`) are read but not yet shaded; the model shows its materials' colours"
-            ));
-        }
         if let Some(line) = self.nameless_materials.first {
             warnings.push(format!(
                 "{file}:{line}: `newmtl` without a material name{}; the material is skipped",
@@ -541,6 +548,7 @@ impl<'p> ObjReader<'p> {
             progress,
             file: ObjFile {
                 positions: Vec::new(),
+                colors: Vec::new(),
                 texcoords: Vec::new(),
                 normals: Vec::new(),
                 groups: Vec::new(),
@@ -653,16 +661,16 @@ impl<'p> ObjReader<'p> {
                 }
                 // `w` weighs rational curves' control points; a polygon's vertex is
                 // where x y z say (tinyobjloader and assimp ignore it too).
-                for word in &values[3..] {
-                    let what = if values.len() == 4 {
-                        "position w"
-                    } else {
-                        "vertex colour"
-                    };
-                    number(path, n, *word, what, notes)?;
+                if values.len() == 4 {
+                    number(path, n, values[3], "position w", notes)?;
                 }
+                let mut color = None;
                 if values.len() == 6 {
-                    notes.vertex_colours.note(|| n);
+                    let mut rgb = [0.0; 3];
+                    for (value, word) in rgb.iter_mut().zip(&values[3..]) {
+                        *value = finite(path, n, *word, "vertex colour", notes)?;
+                    }
+                    color = Some(DVec3::from(rgb));
                 }
                 if self.file.positions.len() == MAX_MODEL_VERTICES {
                     return Err(at(
@@ -675,6 +683,13 @@ impl<'p> ObjReader<'p> {
                     ));
                 }
                 self.file.positions.push(DVec3::from(position));
+                // Vertices without a colour among coloured ones are white, as
+                // tinyobjloader reads them.
+                if color.is_some() || !self.file.colors.is_empty() {
+                    let vertex = self.file.positions.len() - 1;
+                    self.file.colors.resize(vertex, DVec3::ONE);
+                    self.file.colors.push(color.unwrap_or(DVec3::ONE));
+                }
             }
             "vt" => {
                 if !(1..=3).contains(&values.len()) {

@@ -101,6 +101,9 @@ impl ImportedModel {
                     positions: mesh.positions.clone(),
                     normals: if smooth { mesh.normals.clone() } else { None },
                     uvs: mesh.uvs.clone(),
+                    uvs1: mesh.uvs1.clone(),
+                    colors: mesh.colors.clone(),
+                    tangents: mesh.tangents.clone(),
                     triangles: mesh.triangles.clone(),
                     material: material.unwrap_or(material_base + mesh.material),
                     instances: transforms
@@ -128,8 +131,10 @@ impl ImportedModel {
                 image,
                 wrap_u,
                 wrap_v,
+                transform,
             }) = imported.base_color_texture
             {
+                material.texture_transform = transform;
                 material.albedo_texture = Some(scene_image(scene, image));
                 material.texture_mapping = TextureMapping::Uv;
                 material.texture_wrap = [texture_wrap(wrap_u), texture_wrap(wrap_v)];
@@ -138,8 +143,10 @@ impl ImportedModel {
                 image,
                 wrap_u,
                 wrap_v,
+                transform,
             }) = imported.metallic_roughness_texture
             {
+                material.metallic_roughness_transform = transform;
                 material.metallic_roughness_texture = Some(scene_image(scene, image));
                 material.texture_mapping = TextureMapping::Uv;
                 material.metallic_roughness_wrap = [texture_wrap(wrap_u), texture_wrap(wrap_v)];
@@ -148,11 +155,25 @@ impl ImportedModel {
                 image,
                 wrap_u,
                 wrap_v,
+                transform,
             }) = imported.emissive_texture
             {
+                material.emission_transform = transform;
                 material.emission_texture = Some(scene_image(scene, image));
                 material.texture_mapping = TextureMapping::Uv;
                 material.emission_wrap = [texture_wrap(wrap_u), texture_wrap(wrap_v)];
+            }
+            if let Some(TextureRef {
+                image,
+                wrap_u,
+                wrap_v,
+                transform,
+            }) = imported.normal_texture
+            {
+                material.normal_transform = transform;
+                material.normal_texture = Some(scene_image(scene, image));
+                material.texture_mapping = TextureMapping::Uv;
+                material.normal_wrap = [texture_wrap(wrap_u), texture_wrap(wrap_v)];
             }
             scene.materials.push(material);
             scene

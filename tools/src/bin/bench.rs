@@ -177,6 +177,7 @@ fn million_triangle_scene() -> gpu_render::scene::Scene {
             look_at: DVec3::new(0.0, 0.0, -1.0),
             up: DVec3::Y,
             fov_y_degrees: 55.0,
+            orthographic_half_height: None,
         },
         environment: Environment {
             background: DVec3::new(0.35, 0.45, 0.6),
@@ -290,6 +291,9 @@ fn instanced_million_scene(
                         .collect(),
                 ),
                 uvs: None,
+                uvs1: None,
+                colors: None,
+                tangents: None,
                 triangles: triangles
                     .iter()
                     .map(|&[a, b, c]| if mirrored { [a, c, b] } else { [a, b, c] })
@@ -306,6 +310,9 @@ fn instanced_million_scene(
                 positions: positions.clone(),
                 normals: Some(normals.clone()),
                 uvs: None,
+                uvs1: None,
+                colors: None,
+                tangents: None,
                 triangles: triangles.clone(),
                 material,
                 instances: vec![transform],
@@ -672,7 +679,10 @@ fn traversal_figures(scene: &gpu_render::scene::Scene) {
                     geometry.offset_scale,
                 );
                 let (direction, distance) = match scene.lights.first() {
-                    Some(gpu_render::scene::Light::Point { position, .. }) => {
+                    Some(
+                        gpu_render::scene::Light::Point { position, .. }
+                        | gpu_render::scene::Light::Spot { position, .. },
+                    ) => {
                         let to_light = *position - origin;
                         (to_light.normalize(), to_light.length())
                     }

@@ -154,6 +154,19 @@ fn rounded_to_f32(scene: &gpu_render::scene::Scene) -> gpu_render::scene::Scene 
                 *position = v(*position);
                 *intensity = v(*intensity);
             }
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                cos_inner,
+                cos_outer,
+            } => {
+                *position = v(*position);
+                *direction = v(*direction);
+                *intensity = v(*intensity);
+                *cos_inner = x(*cos_inner);
+                *cos_outer = x(*cos_outer);
+            }
             Light::Directional {
                 direction,
                 irradiance,

@@ -89,6 +89,7 @@ mod tests {
             look_at: DVec3::new(0.0, 0.5, 0.0),
             up: DVec3::Y,
             fov_y_degrees: 45.0,
+            orthographic_half_height: None,
         }
     }
 

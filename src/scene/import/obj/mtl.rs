@@ -431,6 +431,7 @@ pub(super) fn map_material(
             image,
             wrap_u: wrap,
             wrap_v: wrap,
+            transform: crate::scene::TextureTransform::IDENTITY,
         }))
     };
     let base_color_texture =
@@ -602,6 +603,7 @@ pub(super) fn map_material(
         base_color_texture,
         metallic_roughness_texture: None,
         emissive_texture,
+        normal_texture: None,
     })
 }
 
