@@ -22,7 +22,7 @@
 
 use glam::DVec3;
 
-use super::intersect::{Ray, culls_back_face, offset_ray_origin};
+use super::intersect::{MAX_PASS_THROUGHS, Ray, culls_back_face, offset_ray_origin};
 use super::trace::{PreparedScene, shading_frame_normal};
 use super::traverse::intersect_scene;
 use crate::denoise::GuidePasses;
@@ -59,12 +59,16 @@ pub fn aov_albedo(material: &Material) -> DVec3 {
 /// colour, both texture-coordinate sets and its normal map, as the image's is.
 pub fn first_hit_aov(scene: &PreparedScene, ray: &Ray) -> Option<FirstHitAov> {
     let mut ray = *ray;
+    let mut passes = 0;
     let hit = loop {
         let hit = intersect_scene(&scene.geometry, &ray, f64::INFINITY)?;
         let record = &scene.materials[hit.material as usize];
-        if !culls_back_face(record.cull_back_faces, 0, ray.direction, hit.normal) {
+        if passes == MAX_PASS_THROUGHS
+            || !culls_back_face(record.cull_back_faces, 0, ray.direction, hit.normal)
+        {
             break hit;
         }
+        passes += 1;
         ray.origin = offset_ray_origin(hit.position, hit.normal, scene.geometry.offset_scale);
     };
     let record = &scene.materials[hit.material as usize];

@@ -250,6 +250,11 @@ pub fn culls_back_face(cull_back_faces: bool, depth: u32, direction: DVec3, norm
     cull_back_faces && depth == 0 && direction.dot(normal) > 0.0
 }
 
+/// The most back faces one camera ray passes through ([`culls_back_face`]); the next
+/// is shaded as a front. A mutated model made a camera ray pass through back faces
+/// without end (the fuzz test of model import never finished), so the CPU bounds it.
+pub const MAX_PASS_THROUGHS: u32 = 256;
+
 /// Fills a triangle hit's shading normal (its vertex normals interpolated at its
 /// barycentric coordinates), texture coordinates and vertex colour from its
 /// world-space `attributes`.

@@ -23,7 +23,9 @@ use super::bxdf::{
     pdf_ggx_visible_normal, reflect_direction, sample_beckmann_normal, sample_blinn_phong_half,
     sample_ggx_visible_normal, surface_response,
 };
-use super::intersect::{Hit, Ray, culls_back_face, offset_ray_origin, shadow_terminator_point};
+use super::intersect::{
+    Hit, MAX_PASS_THROUGHS, Ray, culls_back_face, offset_ray_origin, shadow_terminator_point,
+};
 use super::tabulated::{pdf_tabulated, sample_tabulated};
 use super::trace::{
     PreparedScene, add_contribution, direct_light, finite_radiance, keep_on_side,
@@ -193,6 +195,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
     let mut brdf_pdf: Option<f64> = None;
     let mut previous_point = ray.origin;
     let mut depth = 0u32;
+    let mut passes = 0u32;
     loop {
         let first_dimension = 2 + depth * DIMENSIONS_PER_BOUNCE;
         let random = move |k: u32| random_number(pixel, sample, first_dimension + k);
@@ -217,7 +220,10 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
             break;
         };
         let record = &scene.materials[hit.material as usize];
-        if culls_back_face(record.cull_back_faces, depth, ray.direction, hit.normal) {
+        if passes < MAX_PASS_THROUGHS
+            && culls_back_face(record.cull_back_faces, depth, ray.direction, hit.normal)
+        {
+            passes += 1;
             // Through the back face: the same camera ray from just beyond it.
             ray.origin = offset_ray_origin(hit.position, hit.normal, geometry.offset_scale);
             continue;

@@ -6,7 +6,9 @@
 use glam::DVec3;
 
 use super::bxdf::{eval_brdf, has_base_brdf, reflect_direction, surface_response};
-use super::intersect::{Hit, Ray, culls_back_face, offset_ray_origin, shadow_terminator_point};
+use super::intersect::{
+    Hit, MAX_PASS_THROUGHS, Ray, culls_back_face, offset_ray_origin, shadow_terminator_point,
+};
 use super::path::path_radiance;
 use super::traverse::{intersect_scene, occluded};
 use crate::accel::SceneGeometry;
@@ -217,6 +219,7 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
     });
     let mut radiance = DVec3::ZERO;
     let mut rays = 0u64;
+    let mut passes = 0u32;
     while let Some(entry) = stack.pop() {
         rays += 1;
         let Some(hit) = intersect_scene(&scene.geometry, &entry.ray, f64::INFINITY) else {
@@ -227,12 +230,15 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
             continue;
         };
         let material = &scene.materials[hit.material as usize];
-        if culls_back_face(
-            material.cull_back_faces,
-            entry.depth,
-            entry.ray.direction,
-            hit.normal,
-        ) {
+        if passes < MAX_PASS_THROUGHS
+            && culls_back_face(
+                material.cull_back_faces,
+                entry.depth,
+                entry.ray.direction,
+                hit.normal,
+            )
+        {
+            passes += 1;
             let origin = offset_ray_origin(hit.position, hit.normal, scene.geometry.offset_scale);
             stack.push(StackEntry {
                 ray: Ray {
