@@ -289,14 +289,9 @@ pub fn apply_triangle_attributes(hit: &mut Hit, attributes: &TriangleAttributes)
 pub fn triangle_barycentrics(point: DVec3, vertices: &[DVec3; 3]) -> DVec3 {
     // Scaled by a power of two as the GPU twin, whose f32 products of four coordinates
     // overflow for edges beyond about 4e9.
-    let scale = scale_to_unit(
-        (vertices[1] - vertices[0])
-            .abs()
-            .max_element()
-            .max((vertices[2] - vertices[0]).abs().max_element()),
-    );
-    let e1 = (vertices[1] - vertices[0]) * scale;
-    let e2 = (vertices[2] - vertices[0]) * scale;
+    let (e1, e2) = (vertices[1] - vertices[0], vertices[2] - vertices[0]);
+    let scale = scale_to_unit(e1.abs().max_element().max(e2.abs().max_element()));
+    let (e1, e2) = (e1 * scale, e2 * scale);
     let p = (point - vertices[0]) * scale;
     let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
     let (d20, d21) = (p.dot(e1), p.dot(e2));

@@ -104,10 +104,7 @@ pub fn light_beyond_the_gpu(scene: &Scene) -> Option<(usize, usize, f64)> {
 fn distance_to_shape(shape: &Shape, point: DVec3) -> f64 {
     match shape {
         Shape::Sphere { center, radius, .. } => {
-            let (anchor, normal) = super::sphere_anchor(*center, *radius);
-            let y = (point - anchor) / *radius;
-            super::sphere_level(point, anchor, normal, *radius).abs() * radius
-                / ((y + normal).length() + 1.0)
+            super::sphere_precision(*center, *radius, point).distance
         }
         Shape::Plane { normal, offset, .. } => (normal.dot(point) - offset).abs(),
         Shape::Polygon { vertices, .. } => distance_to_polygon(vertices, point),
@@ -130,17 +127,13 @@ pub struct FlatShapeBeyondTheGpu {
 /// triangle only where its world box does not already prove it fine.
 pub fn flat_shape_beyond_the_gpu(scene: &Scene) -> Option<FlatShapeBeyondTheGpu> {
     let eye = scene.camera.eye;
-    let beyond = |corners: &[DVec3]| {
-        let precision = flat_precision(corners, eye);
-        (precision.gpu_hopeless() && !precision.cpu_hopeless()).then_some(precision)
-    };
     for (i, shape) in scene.shapes.iter().enumerate() {
         let (corners, kind): (&[DVec3], _) = match shape {
             Shape::Triangle { vertices, .. } => (vertices, "triangle"),
             Shape::Polygon { vertices, .. } => (vertices, "polygon"),
             _ => continue,
         };
-        if let Some(precision) = beyond(corners) {
+        if let Some(precision) = only_the_cpu_places(corners, eye) {
             return Some(FlatShapeBeyondTheGpu {
                 what: format!("objects[{i}] ({kind})"),
                 precision,
@@ -154,10 +147,6 @@ pub fn flat_shape_beyond_the_gpu(scene: &Scene) -> Option<FlatShapeBeyondTheGpu>
 /// [`SPHERE_PRECISION_LIMIT`] seen from `eye` while the CPU reference can (see
 /// [`flat_shape_beyond_the_gpu`]).
 pub fn mesh_triangle_beyond_the_gpu(meshes: &[Mesh], eye: DVec3) -> Option<FlatShapeBeyondTheGpu> {
-    let beyond = |corners: &[DVec3]| {
-        let precision = flat_precision(corners, eye);
-        (precision.gpu_hopeless() && !precision.cpu_hopeless()).then_some(precision)
-    };
     for mesh in meshes {
         let Some((lo, hi)) = bounds(&mesh.positions) else {
             continue;
@@ -179,7 +168,7 @@ pub fn mesh_triangle_beyond_the_gpu(meshes: &[Mesh], eye: DVec3) -> Option<FlatS
             for triangle in &mesh.triangles {
                 let world =
                     triangle.map(|v| transform.transform_point3(mesh.positions[v as usize]));
-                if let Some(precision) = beyond(&world) {
+                if let Some(precision) = only_the_cpu_places(&world, eye) {
                     return Some(FlatShapeBeyondTheGpu {
                         what: format!("mesh {}", mesh.name),
                         precision,
@@ -189,6 +178,13 @@ pub fn mesh_triangle_beyond_the_gpu(meshes: &[Mesh], eye: DVec3) -> Option<FlatS
         }
     }
     None
+}
+
+/// The precision of the flat shape of `corners` seen from `eye` when the GPU cannot
+/// place it to [`SPHERE_PRECISION_LIMIT`] and the CPU reference can, else `None`.
+fn only_the_cpu_places(corners: &[DVec3], eye: DVec3) -> Option<SurfacePrecision> {
+    let precision = flat_precision(corners, eye);
+    (precision.gpu_hopeless() && !precision.cpu_hopeless()).then_some(precision)
 }
 
 /// The box of `points`, or `None` for none.
