@@ -70,8 +70,9 @@ fn clear_pixel_aov(pixel: u32) {
 
 // Adds the first hit of the camera ray from `origin` along `direction`, found by
 // `trace`, to region pixel `pixel`'s sums (an escaped ray adds nothing):
-// trace_pixel_aov's sum, one sample at a time, in sample order.
-fn add_first_hit_aov(pixel: u32, origin: vec3<f32>, direction: vec3<f32>, trace: TraceRay) {
+// trace_pixel_aov's sum, one sample at a time, in sample order. `pass_throughs` back
+// faces have been passed already.
+fn add_first_hit_aov(pixel: u32, origin: vec3<f32>, direction: vec3<f32>, trace: TraceRay, pass_throughs: u32) {
     let at = aov_index(pixel);
     if trace.best_prim == NO_PRIM {
         accumulation[at + 1u].w += 1.0;
@@ -80,7 +81,8 @@ fn add_first_hit_aov(pixel: u32, origin: vec3<f32>, direction: vec3<f32>, trace:
     // A single-sided back face the camera ray passes through: the ray traced again
     // from beyond it adds the sample (first_hit_aov's loop on the CPU).
     let passed = hit_record_keyed(trace.best_prim, trace.best_instance, Ray(origin, direction), trace.best_t);
-    if culls_back_face(materials[passed.material].cull_back_faces != 0u, 0u, direction, passed.normal) {
+    if pass_throughs < MAX_PASS_THROUGHS
+        && culls_back_face(materials[passed.material].cull_back_faces != 0u, 0u, direction, passed.normal) {
         return;
     }
     let first = first_hit_aov(Ray(origin, direction), trace);

@@ -147,7 +147,8 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
         return;
     }
     let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
-    if culls_back_face(materials[hit.material].cull_back_faces != 0u, (*path).depth, ray.direction, hit.normal) {
+    if (*path).pass_throughs < MAX_PASS_THROUGHS
+        && culls_back_face(materials[hit.material].cull_back_faces != 0u, (*path).depth, ray.direction, hit.normal) {
         (*path).origin = offset_ray_origin(hit.position, hit.normal, frame.offset_scale);
         (*path).phase = PHASE_PASS_THROUGH;
         return;

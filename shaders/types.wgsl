@@ -304,6 +304,10 @@ const PHASE_FETCH_PIXEL: u32 = 9u;
 // A camera ray met the back face of a single-sided material: it goes on from just
 // beyond it (culls_back_face).
 const PHASE_PASS_THROUGH: u32 = 10u;
+// The most back faces one camera ray passes through; the next is shaded as a front.
+// CPU twin: MAX_PASS_THROUGHS (a mutated model made a camera ray pass through back
+// faces without end).
+const MAX_PASS_THROUGHS: u32 = 256u;
 
 // The state of one slot's path tree between dispatches: its pixel and sample, the
 // sums, the ray being shaded (origin, direction, weight, depth, medium) and, while its
@@ -352,7 +356,9 @@ struct PathState {
     // llvmpipe divides integers one lane at a time.
     image_x: u32,
     image_y: u32,
-    _pad0: u32,
+    // Back faces the current sample's camera ray has passed through (PHASE_PASS_THROUGH,
+    // at most MAX_PASS_THROUGHS).
+    pass_throughs: u32,
 }
 
 // One pending reflected or refracted ray on a slot's bounce stack.

@@ -53,7 +53,7 @@ fn consume_closest_trace(slot: u32, path: ptr<function, PathState>, trace: Trace
     //#if AOV
     // Depth 0 is the camera ray: every branch and bounce is one deeper.
     if aov_mode() && (*path).depth == 0u {
-        add_first_hit_aov((*path).pixel, (*path).origin, (*path).direction, trace);
+        add_first_hit_aov((*path).pixel, (*path).origin, (*path).direction, trace, (*path).pass_throughs);
     }
     //#endif
     //#if PATH
@@ -142,6 +142,7 @@ fn start_sample(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) 
     (*path).medium_iors = frame.camera_medium_iors;
     (*path).stack_len = 0u;
     (*path).held_top = 0u;
+    (*path).pass_throughs = 0u;
     (*path).rays += 1u;
     start_trace(trace, origin, direction, bitcast<f32>(0x7f800000u), false);
     (*path).phase = PHASE_CLOSEST;
@@ -242,6 +243,7 @@ fn shade_step(slot: u32, path: ptr<function, PathState>, trace: ptr<function, Tr
     }
     if (*path).phase == PHASE_PASS_THROUGH {
         // The camera ray again, from beyond the back face it passed (culls_back_face).
+        (*path).pass_throughs += 1u;
         (*path).rays += 1u;
         start_trace(trace, (*path).origin, (*path).direction, bitcast<f32>(0x7f800000u), false);
         (*path).phase = PHASE_CLOSEST;

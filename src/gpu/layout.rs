@@ -232,8 +232,9 @@ pub struct GpuPathState {
     pub image_x: u32,
     /// Image row of `pixel`.
     pub image_y: u32,
-    /// Padding.
-    pub _pad0: u32,
+    /// Back faces the current sample's camera ray has passed through (at most
+    /// [`crate::cpu::intersect::MAX_PASS_THROUGHS`]).
+    pub pass_throughs: u32,
 }
 
 /// One pending ray on a slot's bounce stack (`StackEntry` in WGSL).

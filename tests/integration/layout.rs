@@ -252,7 +252,7 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 held_top,
                 image_x,
                 image_y,
-                _pad0
+                pass_throughs
             }),
         ),
         (
@@ -427,6 +427,10 @@ fn constants_match() {
         ("FLAG_SIMULATE_LOOP_CUT", FLAG_SIMULATE_LOOP_CUT),
         ("ERROR_LOOP_CUT", ERROR_LOOP_CUT),
         ("ERROR_TRAVERSAL_STACK", ERROR_TRAVERSAL_STACK),
+        (
+            "MAX_PASS_THROUGHS",
+            gpu_render::cpu::intersect::MAX_PASS_THROUGHS,
+        ),
         ("PRIM_KIND_SHIFT", PrimRef::INDEX_BITS),
         ("PRIM_INDEX_MASK", PrimRef::MAX_INDEX),
         ("PRIM_SPHERE", PrimKind::Sphere as u32),

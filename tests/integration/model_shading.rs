@@ -666,3 +666,57 @@ fn a_normal_mapped_quad_tilted_toward_a_grazing_light_is_brighter_than_its_mirro
     assert_eq!(colour(&cpu.image, pixel_at_uv(1.0, 0.5, 0.5)).x, 0.0);
     gpu_agrees("normal-map-instanced", &placed);
 }
+
+/// 300 red single-sided quads, each turned away from the camera, stacked in front of
+/// the green backdrop under an ambient light: a camera ray passes through the first
+/// `MAX_PASS_THROUGHS` back faces and shows the next as a front (a mutated model once
+/// made both tracers pass through back faces without end), on both backends alike.
+#[test]
+fn a_camera_ray_passes_through_at_most_max_pass_throughs_back_faces_on_both_backends() {
+    use gpu_render::cpu::intersect::MAX_PASS_THROUGHS;
+    const LAYERS: u32 = 300;
+    let red = DVec3::new(0.8, 0.1, 0.1);
+    let green = DVec3::new(0.1, 0.8, 0.1);
+    let layers = quad(
+        0,
+        (0..LAYERS)
+            .map(|i| {
+                DMat4::from_translation(DVec3::new(0.0, 0.0, -0.002 * f64::from(i)))
+                    * DMat4::from_rotation_y(std::f64::consts::PI)
+            })
+            .collect(),
+    );
+    let backdrop = Mesh {
+        positions: quad(1, vec![]).positions.iter().map(|p| *p * 2.0).collect(),
+        ..quad(1, vec![DMat4::from_translation(DVec3::new(0.0, 0.0, -1.0))])
+    };
+    let mut scene = scene(
+        vec![
+            Material {
+                cull_back_faces: true,
+                ..Material::lambert(red)
+            },
+            Material::lambert(green),
+        ],
+        vec![layers, backdrop],
+        vec![],
+    );
+    scene.environment.ambient = DVec3::ONE;
+    scene.lights.clear();
+    let centre = pixel_of(0.0, 0.0);
+    assert!(LAYERS > MAX_PASS_THROUGHS);
+    let cpu = gpu_render::cpu::render(&scene, None);
+    assert_colour_within("the layer after the bound", &cpu.image, centre, red, 1e-3);
+    assert_colour_within(
+        "the backdrop beside the layers",
+        &cpu.image,
+        pixel_of(1.5, 0.0),
+        green,
+        1e-3,
+    );
+    gpu_agrees("pass-through-bound-whitted", &scene);
+    let mut path = scene.clone();
+    path.render.integrator = gpu_render::scene::Integrator::Path;
+    path.render.samples_per_pixel = 2;
+    gpu_agrees("pass-through-bound-path", &path);
+}
