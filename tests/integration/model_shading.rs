@@ -704,7 +704,7 @@ fn a_camera_ray_passes_through_at_most_max_pass_throughs_back_faces_on_both_back
     scene.environment.ambient = DVec3::ONE;
     scene.lights.clear();
     let centre = pixel_of(0.0, 0.0);
-    assert!(LAYERS > MAX_PASS_THROUGHS);
+    const { assert!(LAYERS > MAX_PASS_THROUGHS) };
     let cpu = gpu_render::cpu::render(&scene, None);
     assert_colour_within("the layer after the bound", &cpu.image, centre, red, 1e-3);
     assert_colour_within(
