@@ -60,16 +60,26 @@ fn grid_angle_degrees(index: u32, size: u32) -> f64 {
     f64::from(index) / f64::from(size - 1) * 90.0
 }
 
+/// An image that cannot be a BRDF map: not square, or smaller than 2×2.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("a BRDF map must be square and at least 2x2 (θi across, θr down), got {width}x{height}")]
+pub struct NotABrdfMap {
+    /// The image's width.
+    pub width: u32,
+    /// The image's height.
+    pub height: u32,
+}
+
 /// Checks a square BRDF map (at least 2×2, texel `(x, y)` = `π·f` at
 /// `θi = x/(N-1)·90°`, `θr = y/(N-1)·90°`) against the three rules.
 ///
-/// Errors: a message when the map is not square or smaller than 2×2.
-pub fn check_brdf_map(map: &Image) -> Result<BrdfMapReport, String> {
+/// Errors: [`NotABrdfMap`] when the map is not square or smaller than 2×2.
+pub fn check_brdf_map(map: &Image) -> Result<BrdfMapReport, NotABrdfMap> {
     if map.width != map.height || map.width < 2 {
-        return Err(format!(
-            "a BRDF map must be square and at least 2x2 (θi across, θr down), got {}x{}",
-            map.width, map.height
-        ));
+        return Err(NotABrdfMap {
+            width: map.width,
+            height: map.height,
+        });
     }
     let n = map.width;
     let mut positivity = Worst {

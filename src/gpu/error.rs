@@ -57,7 +57,7 @@ pub enum RenderError {
     /// The scene's render settings are out of range
     /// ([`crate::scene::RenderSettings::check`]).
     #[error("invalid render settings: {0}")]
-    InvalidSettings(String),
+    InvalidSettings(#[source] crate::scene::SettingsError),
     /// A camera with an undefined view (eye on the look-at point, a zero or parallel
     /// up vector) or a field of view outside (0, 180) degrees.
     #[error("invalid camera {0:?}")]

@@ -1,14 +1,71 @@
 //! Reading image files for albedo textures and tabulated BRDF maps.
 
-use std::path::Path;
-
 use std::io::Cursor;
+use std::path::Path;
+use std::sync::Arc;
 
 use image::{DynamicImage, ImageFormat, ImageReader};
 
 use super::Image;
 use crate::color::srgb_decode;
-use crate::input::{read_confined, read_input};
+use crate::input::{InputError, read_confined, read_input};
+
+/// Why an image file was refused. The messages are the reason alone, without the
+/// image's path, which the caller names with the image's role ("the texture wood.png
+/// does not load: {reason}").
+#[derive(Debug, Clone, thiserror::Error)]
+#[non_exhaustive]
+pub enum ImageError {
+    /// The file could not be opened or read ([`crate::input`]'s rules).
+    #[error("cannot read the file: {0}")]
+    Read(#[source] Arc<InputError>),
+    /// The bytes are not an image the decoder reads (or its format cannot be told).
+    #[error("not a readable image: {0}")]
+    Decode(#[source] Arc<image::ImageError>),
+    /// The format of the bytes could not be guessed.
+    #[error("cannot read the file: {0}")]
+    Guess(#[source] Arc<std::io::Error>),
+    /// The image has no texels.
+    #[error("the image is empty ({width}x{height})")]
+    Empty {
+        /// Its width.
+        width: u32,
+        /// Its height.
+        height: u32,
+    },
+    /// A side is larger than [`MAX_IMAGE_SIDE`].
+    #[error(
+        "the image is {width}x{height}, larger than the {MAX_IMAGE_SIDE}x{MAX_IMAGE_SIDE} accepted"
+    )]
+    TooLarge {
+        /// Its width.
+        width: u32,
+        /// Its height.
+        height: u32,
+    },
+    /// The decoded texels do not match the size the header declares.
+    #[error(
+        "the image decodes to {decoded_width}x{decoded_height}, not the {width}x{height} its header declares"
+    )]
+    SizeMismatch {
+        /// The width the header declares.
+        width: u32,
+        /// The height the header declares.
+        height: u32,
+        /// The width decoded.
+        decoded_width: u32,
+        /// The height decoded.
+        decoded_height: u32,
+    },
+    /// A texel holds an infinite or NaN value.
+    #[error("texel ({x}, {y}) is not a finite number")]
+    NotFinite {
+        /// Its column.
+        x: u32,
+        /// Its row.
+        y: u32,
+    },
+}
 
 /// Largest accepted image width or height in texels. Every image of a scene shares one
 /// GPU texture array whose layers are as large as the largest image, so this bounds
@@ -27,9 +84,9 @@ pub const MAX_IMAGE_FILE_BYTES: u64 = 256 * 1024 * 1024;
 /// judged on the opened file, [`crate::input`]), not an image, empty or larger than
 /// [`MAX_IMAGE_SIDE`], or holds a non-finite value. Texels outside [0, 1] are kept as
 /// they are: a scene's materials check their range.
-pub fn load_image(path: &Path) -> Result<Image, String> {
+pub fn load_image(path: &Path) -> Result<Image, ImageError> {
     let bytes =
-        read_input(path, MAX_IMAGE_FILE_BYTES).map_err(|e| format!("cannot read the file: {e}"))?;
+        read_input(path, MAX_IMAGE_FILE_BYTES).map_err(|e| ImageError::Read(Arc::new(e)))?;
     decode_image(path, &bytes)
 }
 
@@ -37,51 +94,55 @@ pub fn load_image(path: &Path) -> Result<Image, String> {
 /// opened beneath `dir` so that no symbolic link, nor a swap of one while the file is
 /// opened, reaches outside it ([`crate::input::open_confined`]). The image's path is
 /// `dir/file`.
-pub fn load_confined_image(dir: &Path, file: &Path) -> Result<Image, String> {
+pub fn load_confined_image(dir: &Path, file: &Path) -> Result<Image, ImageError> {
     let bytes = read_confined(dir, file, MAX_IMAGE_FILE_BYTES)
-        .map_err(|e| format!("cannot read the file: {e}"))?;
+        .map_err(|e| ImageError::Read(Arc::new(e)))?;
     decode_image(&dir.join(file), &bytes)
 }
 
 /// The width and height the image file `bytes` (read from or named `path`) declares in
 /// its header, checked as [`load_image`] checks them, without decoding its texels: for
 /// callers that count the memory an image will take before it is decoded.
-pub fn image_dimensions(path: &Path, bytes: &[u8]) -> Result<(u32, u32), String> {
+pub fn image_dimensions(path: &Path, bytes: &[u8]) -> Result<(u32, u32), ImageError> {
     let bytes = radiance_header(bytes);
     let dimensions = image_reader(path, &bytes)?
         .into_dimensions()
-        .map_err(|e| format!("not a readable image: {e}"))?;
+        .map_err(|e| ImageError::Decode(Arc::new(e)))?;
     check_dimensions(dimensions)?;
     Ok(dimensions)
 }
 
 /// A reader of the image file `bytes`, its format from the bytes or else from `path`'s
 /// extension.
-fn image_reader<'b>(path: &Path, bytes: &'b [u8]) -> Result<ImageReader<Cursor<&'b [u8]>>, String> {
+fn image_reader<'b>(
+    path: &Path,
+    bytes: &'b [u8],
+) -> Result<ImageReader<Cursor<&'b [u8]>>, ImageError> {
     let mut reader = ImageReader::new(Cursor::new(bytes));
     if let Ok(format) = ImageFormat::from_path(path) {
         reader.set_format(format);
     }
     reader
         .with_guessed_format()
-        .map_err(|e| format!("cannot read the file: {e}"))
+        .map_err(|e| ImageError::Guess(Arc::new(e)))
 }
 
 /// Decodes the image file `bytes` (read from `path`, or embedded in a model and named
 /// `path`) as [`load_image`] does. The format comes from the bytes, or where they do
 /// not tell, from `path`'s extension.
-pub fn decode_image(path: &Path, bytes: &[u8]) -> Result<Image, String> {
+pub fn decode_image(path: &Path, bytes: &[u8]) -> Result<Image, ImageError> {
     let (width, height) = image_dimensions(path, bytes)?;
     let bytes = radiance_header(bytes);
     let decoded = image_reader(path, &bytes)?
         .decode()
-        .map_err(|e| format!("not a readable image: {e}"))?;
+        .map_err(|e| ImageError::Decode(Arc::new(e)))?;
     if (decoded.width(), decoded.height()) != (width, height) {
-        return Err(format!(
-            "the image decodes to {}x{}, not the {width}x{height} its header declares",
-            decoded.width(),
-            decoded.height()
-        ));
+        return Err(ImageError::SizeMismatch {
+            width,
+            height,
+            decoded_width: decoded.width(),
+            decoded_height: decoded.height(),
+        });
     }
     let (width, height) = (decoded.width(), decoded.height());
     let texels: Vec<[f32; 4]> = match &decoded {
@@ -115,7 +176,7 @@ pub fn decode_image(path: &Path, bytes: &[u8]) -> Result<Image, String> {
     };
     if let Some(index) = texels.iter().position(|t| t.iter().any(|c| !c.is_finite())) {
         let (x, y) = (index as u32 % width, index as u32 / width);
-        return Err(format!("texel ({x}, {y}) is not a finite number"));
+        return Err(ImageError::NotFinite { x, y });
     }
     Ok(Image {
         path: path.to_path_buf(),
@@ -141,14 +202,12 @@ fn radiance_header(bytes: &[u8]) -> std::borrow::Cow<'_, [u8]> {
     }
 }
 
-fn check_dimensions((width, height): (u32, u32)) -> Result<(), String> {
+fn check_dimensions((width, height): (u32, u32)) -> Result<(), ImageError> {
     if width == 0 || height == 0 {
-        return Err(format!("the image is empty ({width}x{height})"));
+        return Err(ImageError::Empty { width, height });
     }
     if width > MAX_IMAGE_SIDE || height > MAX_IMAGE_SIDE {
-        return Err(format!(
-            "the image is {width}x{height}, larger than the {MAX_IMAGE_SIDE}x{MAX_IMAGE_SIDE} accepted"
-        ));
+        return Err(ImageError::TooLarge { width, height });
     }
     Ok(())
 }

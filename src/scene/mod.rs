@@ -18,12 +18,13 @@ pub use environment::{EnvironmentMap, direction_to_uv, texel_at, uv_to_direction
 pub use error::{SceneError, SceneWarning};
 pub(crate) use file::view_problem;
 pub use file::{
-    CONDUCTOR_PRESETS, LoadOptions, LoadProgress, MAX_SCENE_FILE_BYTES, SceneFile, confined_path,
-    load_scene, load_scene_file, load_scene_with, parse_scene, parse_scene_file, parse_scene_with,
+    CONDUCTOR_PRESETS, LoadOptions, LoadProgress, MAX_SCENE_FILE_BYTES, SandboxError, SceneFile,
+    confined_path, load_scene, load_scene_file, load_scene_with, parse_scene, parse_scene_file,
+    parse_scene_with,
 };
 pub use image::{
-    MAX_IMAGE_FILE_BYTES, MAX_IMAGE_SIDE, decode_image, image_dimensions, load_confined_image,
-    load_image,
+    ImageError, MAX_IMAGE_FILE_BYTES, MAX_IMAGE_SIDE, decode_image, image_dimensions,
+    load_confined_image, load_image,
 };
 pub use medium::{MEDIUM_STACK_SIZE, MediumStack};
 pub use model::*;

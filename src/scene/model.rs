@@ -608,7 +608,7 @@ pub struct RenderOverrides {
 impl RenderSettings {
     /// Applies `overrides` and checks the result, returning a description of the first
     /// setting out of range.
-    pub fn with_overrides(mut self, overrides: &RenderOverrides) -> Result<Self, String> {
+    pub fn with_overrides(mut self, overrides: &RenderOverrides) -> Result<Self, SettingsError> {
         if let Some(width) = overrides.width {
             self.width = width;
         }
@@ -641,47 +641,70 @@ impl RenderSettings {
     }
 
     /// Checks every setting against the accepted ranges.
-    pub fn check(&self) -> Result<(), String> {
+    pub fn check(&self) -> Result<(), SettingsError> {
         for (name, value) in [("width", self.width), ("height", self.height)] {
             if value == 0 || value > MAX_IMAGE_DIMENSION {
-                return Err(format!(
-                    "{name} must be between 1 and {MAX_IMAGE_DIMENSION} pixels, got {value}"
-                ));
+                return Err(SettingsError::Dimension { name, value });
             }
         }
         let pixels = u64::from(self.width) * u64::from(self.height);
         if pixels > MAX_IMAGE_PIXELS {
-            return Err(format!(
-                "{}x{} is {pixels} pixels, more than the {MAX_IMAGE_PIXELS} accepted",
-                self.width, self.height
-            ));
+            return Err(SettingsError::Pixels {
+                width: self.width,
+                height: self.height,
+            });
         }
         if self.samples_per_pixel == 0 || self.samples_per_pixel > MAX_SAMPLES_PER_PIXEL {
-            return Err(format!(
-                "samples_per_pixel must be between 1 and {MAX_SAMPLES_PER_PIXEL}, got {}",
-                self.samples_per_pixel
-            ));
+            return Err(SettingsError::SamplesPerPixel(self.samples_per_pixel));
         }
         if self.max_depth > MAX_DEPTH_LIMIT {
-            return Err(format!(
-                "max_depth must be at most {MAX_DEPTH_LIMIT}, got {}",
-                self.max_depth
-            ));
+            return Err(SettingsError::MaxDepth(self.max_depth));
         }
         if !(0.0..=1.0).contains(&self.min_ray_weight) {
-            return Err(format!(
-                "min_ray_weight must be between 0 and 1, got {}",
-                crate::echo::short(self.min_ray_weight)
-            ));
+            return Err(SettingsError::MinRayWeight(self.min_ray_weight));
         }
         if self.stack_size == 0 || self.stack_size > MAX_STACK_SIZE {
-            return Err(format!(
-                "stack_size must be between 1 and {MAX_STACK_SIZE}, got {}",
-                self.stack_size
-            ));
+            return Err(SettingsError::StackSize(self.stack_size));
         }
         Ok(())
     }
+}
+
+/// A render setting out of its accepted range ([`RenderSettings::check`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SettingsError {
+    /// The width or height is 0 or above [`MAX_IMAGE_DIMENSION`].
+    #[error("{name} must be between 1 and {MAX_IMAGE_DIMENSION} pixels, got {value}")]
+    Dimension {
+        /// "width" or "height".
+        name: &'static str,
+        /// The value given.
+        value: u32,
+    },
+    /// The image has more than [`MAX_IMAGE_PIXELS`] pixels.
+    #[error(
+        "{width}x{height} is {} pixels, more than the {MAX_IMAGE_PIXELS} accepted",
+        u64::from(*.width) * u64::from(*.height)
+    )]
+    Pixels {
+        /// The width.
+        width: u32,
+        /// The height.
+        height: u32,
+    },
+    /// The samples per pixel are 0 or above [`MAX_SAMPLES_PER_PIXEL`].
+    #[error("samples_per_pixel must be between 1 and {MAX_SAMPLES_PER_PIXEL}, got {0}")]
+    SamplesPerPixel(u32),
+    /// The depth is above [`MAX_DEPTH_LIMIT`].
+    #[error("max_depth must be at most {MAX_DEPTH_LIMIT}, got {0}")]
+    MaxDepth(u32),
+    /// The ray-weight cutoff is outside [0, 1].
+    #[error("min_ray_weight must be between 0 and 1, got {}", crate::echo::short(*.0))]
+    MinRayWeight(f64),
+    /// The stack size is 0 or above [`MAX_STACK_SIZE`].
+    #[error("stack_size must be between 1 and {MAX_STACK_SIZE}, got {0}")]
+    StackSize(u32),
 }
 
 impl Scene {

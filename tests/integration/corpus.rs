@@ -130,7 +130,7 @@ fn outcome(path: &Path, verbose: bool) -> String {
             if verbose {
                 eprintln!("{e}");
             }
-            return format!("refused\t{}", refusal_reason(&e.message));
+            return format!("refused\t{}", refusal_reason(e.message()));
         }
     };
     if verbose {

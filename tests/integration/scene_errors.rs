@@ -37,13 +37,13 @@ fn syntax_error_has_line_and_column() {
         "[camera]\neye = [0, 1, 5]\nlook_at = oops\n",
         &["bad.toml:3:11:"],
     );
-    assert_eq!(err.location, Some((3, 11)));
+    assert_eq!(err.location(), Some((3, 11)));
 }
 
 #[test]
 fn unknown_top_level_table() {
     let err = error(&format!("{CAMERA}[lighting]\nx = 1\n"), &["lighting"]);
-    assert_eq!(err.location.map(|l| l.0), Some(4));
+    assert_eq!(err.location().map(|l| l.0), Some(4));
 }
 
 #[test]
@@ -52,7 +52,7 @@ fn unknown_field_is_named_and_located() {
         &scene("[[objects]]\ntype = \"sphere\"\ncentre = [0, 0, 0]\n"),
         &["unknown field `centre`", "objects"],
     );
-    assert_eq!(err.location, Some((9, 1)));
+    assert_eq!(err.location(), Some((9, 1)));
 }
 
 #[test]
@@ -67,7 +67,7 @@ fn field_of_another_type_is_rejected() {
             "center, radius, material",
         ],
     );
-    assert_eq!(err.location, Some((7, 1)));
+    assert_eq!(err.location(), Some((7, 1)));
 }
 
 #[test]
@@ -78,7 +78,7 @@ fn wrong_type_names_the_field() {
         ),
         &["`objects.radius`", "invalid type"],
     );
-    assert_eq!(err.location, Some((10, 10)));
+    assert_eq!(err.location(), Some((10, 10)));
 }
 
 #[test]
@@ -91,7 +91,7 @@ fn unknown_object_type() {
             "sphere, plane, polygon, triangle",
         ],
     );
-    assert_eq!(err.location, Some((7, 1)));
+    assert_eq!(err.location(), Some((7, 1)));
 }
 
 #[test]
@@ -105,7 +105,7 @@ fn missing_required_field() {
 #[test]
 fn missing_camera() {
     let err = error(LAMBERT, &["[camera]"]);
-    assert_eq!(err.location, None);
+    assert_eq!(err.location(), None);
 }
 
 #[test]
@@ -120,7 +120,7 @@ fn undefined_material_lists_defined_ones() {
             "`grey`",
         ],
     );
-    assert_eq!(err.location, Some((7, 1)));
+    assert_eq!(err.location(), Some((7, 1)));
 }
 
 #[test]
@@ -131,7 +131,7 @@ fn nan_component_is_named() {
         ),
         &["objects[0] (sphere): center.y is NaN"],
     );
-    assert_eq!(err.location, Some((7, 1)));
+    assert_eq!(err.location(), Some((7, 1)));
 }
 
 #[test]
@@ -178,7 +178,7 @@ fn eye_equals_look_at() {
         "\n[camera]\neye = [1, 1, 1]\nlook_at = [1, 1, 1]\n",
         &["camera", "eye", "look_at"],
     );
-    assert_eq!(err.location, Some((2, 1)));
+    assert_eq!(err.location(), Some((2, 1)));
 }
 
 #[test]
@@ -211,7 +211,7 @@ fn width_zero() {
         &format!("[render]\nwidth = 0\n{CAMERA}"),
         &["render: width must be between 1 and"],
     );
-    assert_eq!(err.location, Some((1, 1)));
+    assert_eq!(err.location(), Some((1, 1)));
 }
 
 #[test]
@@ -228,7 +228,7 @@ fn negative_width_is_a_type_error() {
         &format!("[render]\nwidth = -1\n{CAMERA}"),
         &["`render.width`"],
     );
-    assert_eq!(err.location, Some((2, 9)));
+    assert_eq!(err.location(), Some((2, 9)));
 }
 
 #[test]
@@ -251,7 +251,7 @@ fn non_planar_polygon_names_worst_vertex() {
         ),
         &["objects[1] (polygon)", "not planar", "vertex"],
     );
-    assert_eq!(err.location, Some((12, 1)));
+    assert_eq!(err.location(), Some((12, 1)));
 }
 
 #[test]
@@ -451,12 +451,12 @@ fn duplicate_key_names_the_key() {
         "[camera]\neye = [0, 1, 5]\neye = [1, 2, 3]\nlook_at = [0, 0.5, 0]\n",
         &["duplicate key `eye`"],
     );
-    assert_eq!(err.location, Some((3, 1)));
+    assert_eq!(err.location(), Some((3, 1)));
     let err = error(
         &format!("{CAMERA}{LAMBERT}[materials.grey]\ntype = \"mirror\"\n"),
         &["duplicate table `[materials.grey]`"],
     );
-    assert_eq!(err.location.map(|l| l.0), Some(7));
+    assert_eq!(err.location().map(|l| l.0), Some(7));
 }
 
 #[test]
@@ -467,11 +467,11 @@ fn recursion_limit_has_a_location() {
         &format!("{CAMERA}\n  {key} = 1\n"),
         &["recursion limit", "81 parts", "`a.a.a"],
     );
-    assert_eq!(err.location, Some((5, 3)));
+    assert_eq!(err.location(), Some((5, 3)));
     // Nesting too deep is located by the parser itself.
     let nested = format!("{CAMERA}x = {}{}\n", "[".repeat(100), "]".repeat(100));
     let err = error(&nested, &["recursion"]);
-    assert_eq!(err.location.map(|l| l.0), Some(4));
+    assert_eq!(err.location().map(|l| l.0), Some(4));
 }
 
 #[test]
@@ -486,7 +486,7 @@ fn a_file_of_tiny_values_is_refused_before_parsing() {
             "in memory",
         ],
     );
-    assert_eq!(err.location, None);
+    assert_eq!(err.location(), None);
     // Below the count a file of values is parsed (and fails for what it is).
     let small = format!("x = [{}]\n{CAMERA}", "[],".repeat(1000));
     error(&small, &["unknown field `x`"]);
@@ -677,4 +677,90 @@ fn radiance_that_the_gpu_cannot_sum_is_refused() {
          [[lights]]\ntype = \"point\"\nposition = [0, 4, 0]\nintensity = 1e30\n"
     );
     parse_scene(&accepted, Path::new(FILE)).expect("1e30 is accepted");
+}
+
+/// An embedder can tell the kinds of scene errors apart and reach the error beneath:
+/// a missing file is `Read` with the OS's error as its source, a TOML mistake `Syntax`
+/// at its place, a value out of range `Invalid`, a missing texture `Image` with the
+/// image's error as its source, glTF 1.0 `Unsupported`, and a model over the memory
+/// cap `TooLarge`; each shows the same located text as before.
+#[test]
+fn scene_errors_say_their_kind_and_keep_their_source() {
+    use gpu_render::low_level::input::InputError;
+    use gpu_render::scene::ImageError;
+    use gpu_render::scene::import::{ImportOptions, import_obj_with, parse_gltf};
+    use std::error::Error as _;
+
+    let missing = load_scene(Path::new("no/such/scene.toml")).expect_err("missing");
+    match &missing {
+        SceneError::Read { source, .. } => {
+            assert!(
+                matches!(&**source, InputError::Io(e) if e.kind() == std::io::ErrorKind::NotFound)
+            );
+        }
+        other => panic!("a missing scene file is a Read error, got {other:?}"),
+    }
+    assert!(
+        missing.source().is_some(),
+        "the I/O error is kept as the source"
+    );
+    assert_eq!(missing.path(), Path::new("no/such/scene.toml"));
+
+    let syntax = error(
+        "[camera]\neye = [0, 1, 5]\nlook_at = oops\n",
+        &["bad.toml:3:11:"],
+    );
+    assert!(
+        matches!(
+            syntax,
+            SceneError::Syntax {
+                location: Some((3, 11)),
+                ..
+            }
+        ),
+        "{syntax:?}"
+    );
+
+    let invalid = error(&scene("[render]\nwidth = 0\n"), &["width"]);
+    assert!(matches!(invalid, SceneError::Invalid { .. }), "{invalid:?}");
+
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene_path = dir.path().join("textured.toml");
+    std::fs::write(
+        &scene_path,
+        scene("[materials.wood]\ntype = \"lambert\"\nalbedo_texture = \"missing.png\"\n"),
+    )
+    .expect("write");
+    let image = load_scene(&scene_path).expect_err("missing texture");
+    match &image {
+        SceneError::Image {
+            source, location, ..
+        } => {
+            assert!(matches!(source, ImageError::Read(_)), "{source:?}");
+            assert!(location.is_some(), "the material is located");
+        }
+        other => panic!("a missing texture is an Image error, got {other:?}"),
+    }
+    assert!(image.to_string().contains("missing.png"), "{image}");
+    assert!(image.source().is_some());
+
+    let gltf1 = parse_gltf(
+        br#"{"asset": {"version": "1.0"}, "meshes": {"m": {}}}"#,
+        Path::new("old.gltf"),
+    )
+    .expect_err("glTF 1.0");
+    assert!(matches!(gltf1, SceneError::Unsupported { .. }), "{gltf1:?}");
+
+    let obj = dir.path().join("big.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".repeat(1000)).expect("write");
+    let capped = import_obj_with(
+        &obj,
+        &ImportOptions {
+            max_bytes: Some(1000),
+            progress: None,
+        },
+    )
+    .expect_err("over the cap");
+    assert!(matches!(capped, SceneError::TooLarge { .. }), "{capped:?}");
+    assert!(capped.to_string().contains("--max-memory"), "{capped}");
 }

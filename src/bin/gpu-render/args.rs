@@ -7,7 +7,7 @@ use gpu_render::low_level::quality::QualityPreset;
 use gpu_render::output::AuxPass;
 use gpu_render::scene::{
     Integrator, LightingSpace, MAX_DEPTH_LIMIT, MAX_IMAGE_DIMENSION, MAX_SAMPLES_PER_PIXEL,
-    RenderOverrides,
+    RenderOverrides, SettingsError,
 };
 use gpu_render::tiles::PixelWindow;
 
@@ -732,31 +732,23 @@ impl SettingsArgs {
         }
     }
 
-    /// The flag that sets the render setting a range-check message is about, with the
-    /// value given, if the user gave that flag (`"--width 0"`).
-    pub fn flag_for_setting_message(&self, message: &str) -> Option<String> {
+    /// The flag that sets the render setting `error` is about, with the value given,
+    /// if the user gave that flag (`"--width 0"`).
+    pub fn flag_for_setting(&self, error: &SettingsError) -> Option<String> {
         let text = |value: Option<u32>| value.map(|v| v.to_string());
-        let flags = [
-            ("width", "--width", text(self.width)),
-            ("height", "--height", text(self.height)),
-            ("samples_per_pixel", "--spp", text(self.spp)),
-            ("max_depth", "--max-depth", text(self.max_depth)),
-            ("stack_size", "--stack-size", text(self.stack_size)),
-            (
-                "min_ray_weight",
+        let (flag, value) = match error {
+            SettingsError::Dimension { name: "width", .. } => ("--width", text(self.width)),
+            SettingsError::Dimension { name: "height", .. } => ("--height", text(self.height)),
+            SettingsError::SamplesPerPixel(_) => ("--spp", text(self.spp)),
+            SettingsError::MaxDepth(_) => ("--max-depth", text(self.max_depth)),
+            SettingsError::StackSize(_) => ("--stack-size", text(self.stack_size)),
+            SettingsError::MinRayWeight(_) => (
                 "--min-ray-weight",
                 self.min_ray_weight.map(|w| w.to_string()),
             ),
-        ];
-        flags.into_iter().find_map(|(setting, flag, value)| {
-            let about_it = message
-                .strip_prefix(setting)
-                .is_some_and(|rest| rest.starts_with(' '));
-            match (about_it, value) {
-                (true, Some(value)) => Some(format!("{flag} {value}")),
-                _ => None,
-            }
-        })
+            _ => return None,
+        };
+        value.map(|value| format!("{flag} {value}"))
     }
 }
 
@@ -924,20 +916,18 @@ mod tests {
     fn names_the_flag_behind_a_settings_message() {
         let cli = Cli::try_parse_from(["gpu-render", "s.toml", "-o", "o.png", "--spp", "0"])
             .expect("parses");
-        let message = "samples_per_pixel must be between 1 and 65536, got 0";
+        let settings = &cli.render.settings;
         assert_eq!(
-            cli.render
-                .settings
-                .flag_for_setting_message(message)
+            settings
+                .flag_for_setting(&SettingsError::SamplesPerPixel(0))
                 .as_deref(),
             Some("--spp 0")
         );
-        assert_eq!(
-            cli.render
-                .settings
-                .flag_for_setting_message("width must be"),
-            None
-        );
+        let width = SettingsError::Dimension {
+            name: "width",
+            value: 0,
+        };
+        assert_eq!(settings.flag_for_setting(&width), None);
     }
 
     #[test]

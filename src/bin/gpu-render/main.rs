@@ -594,7 +594,7 @@ pub fn apply_overrides(
     scene_path: Option<&Path>,
 ) -> Result<RenderSettings> {
     base.with_overrides(&args.overrides())
-        .map_err(|message| match args.flag_for_setting_message(&message) {
+        .map_err(|message| match args.flag_for_setting(&message) {
             Some(flag) => anyhow!("invalid {flag}: {message}"),
             None => match scene_path {
                 Some(path) => anyhow!(

@@ -13,7 +13,7 @@ use glam::DVec3;
 
 use super::raw::{RawColor, RawVec3};
 use crate::echo::short;
-use crate::scene::{MAX_RADIANCE, SceneError, SceneWarning};
+use crate::scene::{ImageError, MAX_RADIANCE, SceneError, SceneWarning};
 
 /// The scene text and its path, for building located errors.
 pub struct Source<'a> {
@@ -47,11 +47,7 @@ impl<'a> Source<'a> {
         location: Option<(usize, usize)>,
         message: impl Into<String>,
     ) -> SceneError {
-        SceneError {
-            path: self.path.to_path_buf(),
-            location,
-            message: message.into(),
-        }
+        SceneError::invalid(self.path, location, message)
     }
 
     /// A named item whose text starts at `span` (or has no place in the file).
@@ -88,6 +84,17 @@ impl Item<'_> {
         let location = self.offset.map(|offset| self.source.location(offset));
         self.source
             .error(location, format!("{}: {message}", self.name))
+    }
+
+    /// The error `"{item}: {what}: {error}"` at the item's place, for an image the
+    /// item names that was refused ([`SceneError::Image`], `error` its source).
+    pub fn fail_image(&self, what: impl Display, error: ImageError) -> SceneError {
+        SceneError::Image {
+            path: self.source.path.to_path_buf(),
+            location: self.offset.map(|offset| self.source.location(offset)),
+            message: format!("{}: {what}: {error}", self.name),
+            source: error,
+        }
     }
 
     /// The warning `"{item}: {message}"` at the item's place.

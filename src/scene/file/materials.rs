@@ -171,7 +171,16 @@ impl<'a> ImageTable<'a> {
         } else {
             load_image(&path)
         }
-        .map_err(fail)?;
+        .map_err(|e| {
+            item.fail_image(
+                format_args!(
+                    "{field} `{}` ({})",
+                    echo_path(Path::new(file)),
+                    echo_path(&path)
+                ),
+                e,
+            )
+        })?;
         if let Some(((x, y), channel, value)) = negative_texel(&image) {
             let why = match role {
                 ImageRole::Albedo => "a reflectance cannot be negative",

@@ -21,11 +21,12 @@ use std::path::Path;
 use self::check::Source;
 pub use self::materials::CONDUCTOR_PRESETS;
 use self::objects::MaterialTable;
-pub use self::paths::confined_path;
+pub use self::paths::{SandboxError, confined_path};
 use self::raw::RawScene;
 pub(crate) use self::settings::view_problem;
 use super::{CameraPath, Scene, SceneError, SceneWarning};
 use crate::echo::{echo, short};
+use crate::input::InputError;
 
 /// Largest scene file accepted, in bytes (64 MiB).
 pub const MAX_SCENE_FILE_BYTES: u64 = 64 * 1024 * 1024;
@@ -190,35 +191,36 @@ pub fn parse_scene_file(
 }
 
 fn read_scene_file(path: &Path, options: &LoadOptions<'_>) -> Result<String, SceneError> {
-    let fail = |message: String| SceneError {
-        path: path.to_path_buf(),
-        location: None,
-        message,
-    };
+    const WHAT: &str = "cannot read the scene file";
+    let read = |e: InputError| SceneError::read(path, WHAT, e);
     // Opened, then judged on what was opened: a FIFO is refused without waiting for a
     // writer, and nothing can be swapped in between the check and the read.
-    let file = crate::input::open_input(path)
-        .map_err(|e| fail(format!("cannot read the scene file: {e}")))?;
-    let length = file
-        .metadata()
-        .map_err(|e| fail(format!("cannot read the scene file: {e}")))?
-        .len();
+    let file = crate::input::open_input(path).map_err(read)?;
+    let length = file.metadata().map_err(|e| read(InputError::Io(e)))?.len();
     if length > MAX_SCENE_FILE_BYTES {
-        return Err(fail(too_large_message(length)));
+        return Err(SceneError::too_large(path, None, too_large_message(length)));
     }
     options.report(LoadProgress::Reading { bytes: length });
     let mut bytes = Vec::new();
     file.take(MAX_SCENE_FILE_BYTES + 1)
         .read_to_end(&mut bytes)
-        .map_err(|e| fail(format!("cannot read the scene file: {e}")))?;
+        .map_err(|e| read(InputError::Io(e)))?;
     if bytes.len() as u64 > MAX_SCENE_FILE_BYTES {
-        return Err(fail(too_large_message(bytes.len() as u64)));
+        return Err(SceneError::too_large(
+            path,
+            None,
+            too_large_message(bytes.len() as u64),
+        ));
     }
     String::from_utf8(bytes).map_err(|e| {
-        fail(format!(
-            "cannot read the scene file: it is not valid UTF-8 (at byte {})",
-            e.utf8_error().valid_up_to()
-        ))
+        SceneError::syntax(
+            path,
+            None,
+            format!(
+                "{WHAT}: it is not valid UTF-8 (at byte {})",
+                e.utf8_error().valid_up_to()
+            ),
+        )
     })
 }
 
@@ -257,7 +259,7 @@ fn toml_error(
             source.text[start..].chars().take(24).collect::<String>()
         );
     }
-    source.error(location, message)
+    SceneError::syntax(source.path, location, message)
 }
 
 /// "duplicate key `eye`" or, for a table header, "duplicate table `[materials.a]`".
@@ -307,7 +309,8 @@ fn check_element_count(source: &Source<'_>, raw: &RawScene) -> Result<(), SceneE
         .sum();
     let total = raw.objects.len() + vertices;
     if total > MAX_SCENE_ELEMENTS {
-        return Err(source.error(
+        return Err(SceneError::too_large(
+            source.path,
             None,
             format!(
                 "the scene has {} objects and {vertices} polygon/triangle vertices, \

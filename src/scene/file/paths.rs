@@ -5,43 +5,63 @@ use std::path::{Component, Path, PathBuf};
 
 use crate::echo::echo_path;
 
+/// Why a sandboxed scene's file name was refused ([`confined_path`]). The messages name
+/// the file as the scene wrote it (without the scene's path, which the caller names).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SandboxError {
+    /// The name is an absolute path.
+    #[error("`{}` is an absolute path; a sandboxed scene may only name files inside its folder", echo_path(.0))]
+    Absolute(PathBuf),
+    /// The name contains `..`.
+    #[error("`{}` contains `..`; a sandboxed scene may only name files inside its folder", echo_path(.0))]
+    ParentDir(PathBuf),
+    /// The name has a drive prefix or root.
+    #[error("`{}` names a drive or root; a sandboxed scene may only name files inside its folder", echo_path(.0))]
+    Root(PathBuf),
+    /// A symbolic link inside the folder leads out of it.
+    #[error(
+        "`{}` leads out of the scene's folder (to {}) through a symbolic link; \
+         a sandboxed scene may only name files inside its folder",
+        echo_path(.file),
+        echo_path(.resolved)
+    )]
+    LinkOutside {
+        /// The name as the scene wrote it.
+        file: PathBuf,
+        /// Where the link leads.
+        resolved: PathBuf,
+    },
+}
+
 /// The path of `file`, as a scene file in folder `scene_dir` names it, confined to that
 /// folder: `file` must be relative, must not contain `..` (or a drive or root), and
 /// must not lead out of `scene_dir` through a symbolic link. Returns the joined path
-/// (`scene_dir/file`), or a message (without the scene's path, which the caller names)
-/// saying why the file is refused.
+/// (`scene_dir/file`), or why the file is refused.
 ///
 /// This is the `--sandbox` rule: without it a scene file is trusted input, like a
 /// program, and may name any file the user can read.
 ///
 /// ```
 /// use std::path::Path;
-/// use gpu_render::scene::confined_path;
+/// use gpu_render::scene::{SandboxError, confined_path};
 /// assert!(confined_path(Path::new("scenes"), "textures/wood.png").is_ok());
-/// assert!(confined_path(Path::new("scenes"), "../secret.png").is_err());
+/// assert!(matches!(
+///     confined_path(Path::new("scenes"), "../secret.png"),
+///     Err(SandboxError::ParentDir(_))
+/// ));
 /// assert!(confined_path(Path::new("scenes"), "/etc/passwd").is_err());
 /// ```
-pub fn confined_path(scene_dir: &Path, file: &str) -> Result<PathBuf, String> {
+pub fn confined_path(scene_dir: &Path, file: &str) -> Result<PathBuf, SandboxError> {
     let relative = Path::new(file);
     if relative.is_absolute() || relative.has_root() {
-        return Err(format!(
-            "`{}` is an absolute path; a sandboxed scene may only name files inside its folder",
-            echo_path(relative)
-        ));
+        return Err(SandboxError::Absolute(relative.to_path_buf()));
     }
     for component in relative.components() {
         match component {
-            Component::ParentDir => {
-                return Err(format!(
-                    "`{}` contains `..`; a sandboxed scene may only name files inside its folder",
-                    echo_path(relative)
-                ));
-            }
+            Component::ParentDir => return Err(SandboxError::ParentDir(relative.to_path_buf())),
             Component::Prefix(_) | Component::RootDir => {
-                return Err(format!(
-                    "`{}` names a drive or root; a sandboxed scene may only name files inside its folder",
-                    echo_path(relative)
-                ));
+                return Err(SandboxError::Root(relative.to_path_buf()));
             }
             Component::CurDir | Component::Normal(_) => {}
         }
@@ -57,12 +77,10 @@ pub fn confined_path(scene_dir: &Path, file: &str) -> Result<PathBuf, String> {
     if let (Ok(resolved), Ok(base)) = (joined.canonicalize(), base.canonicalize())
         && !resolved.starts_with(&base)
     {
-        return Err(format!(
-            "`{}` leads out of the scene's folder (to {}) through a symbolic link; \
-             a sandboxed scene may only name files inside its folder",
-            echo_path(relative),
-            echo_path(&resolved)
-        ));
+        return Err(SandboxError::LinkOutside {
+            file: relative.to_path_buf(),
+            resolved,
+        });
     }
     Ok(joined)
 }
@@ -92,7 +110,7 @@ mod tests {
             ("../secret.png", "`..`"),
             ("textures/../../secret.png", "`..`"),
         ] {
-            let err = confined_path(dir, file).expect_err(file);
+            let err = confined_path(dir, file).expect_err(file).to_string();
             assert!(err.contains(why) && err.contains(file), "{err}");
         }
     }
@@ -108,7 +126,8 @@ mod tests {
             .expect("symlink");
         std::fs::write(scene_dir.path().join("inside.png"), b"x").expect("write");
         let err = confined_path(scene_dir.path(), "innocent.png").expect_err("escapes");
-        assert!(err.contains("symbolic link"), "{err}");
+        assert!(matches!(err, SandboxError::LinkOutside { .. }), "{err}");
+        assert!(err.to_string().contains("symbolic link"), "{err}");
         assert!(confined_path(scene_dir.path(), "inside.png").is_ok());
     }
 }

@@ -198,7 +198,16 @@ fn environment_image(
     } else {
         load_image(&path)
     }
-    .map_err(fail)?;
+    .map_err(|e| {
+        item.fail_image(
+            format_args!(
+                "map `{}` ({})",
+                echo_path(Path::new(file)),
+                echo_path(&path)
+            ),
+            e,
+        )
+    })?;
     for (i, texel) in image.texels.iter().enumerate() {
         for (channel, value) in ["r", "g", "b"].into_iter().zip(texel.iter().copied()) {
             if value < 0.0 {

@@ -257,8 +257,9 @@ fn gltf1_json(bytes: &[u8]) -> Option<String> {
 
 /// The error for a glTF 1.0 file, `why` saying how it was recognised.
 fn gltf1_error(path: &Path, why: String) -> SceneError {
-    error(
+    SceneError::unsupported(
         path,
+        None,
         format!(
             "the file is glTF 1.0 ({why}); only glTF 2.0 is read: convert it first, e.g. with gltf-pipeline (`gltf-pipeline -i IN -o OUT`), which updates glTF 1.0 to 2.0"
         ),
@@ -273,20 +274,21 @@ fn parse_error(path: &Path, e: ::gltf::Error) -> SceneError {
             let (line, column) = (json.line(), json.column());
             let text = json.to_string();
             let suffix = format!(" at line {line} column {column}");
-            SceneError {
-                path: path.to_path_buf(),
-                location: Some((line, column.max(1))),
-                message: format!(
+            SceneError::syntax(
+                path,
+                Some((line, column.max(1))),
+                format!(
                     "not a valid glTF file: {}",
                     text.strip_suffix(&suffix).unwrap_or(&text)
                 ),
-            }
+            )
         }
-        ::gltf::Error::Binary(binary) => error(
+        ::gltf::Error::Binary(binary) => SceneError::syntax(
             path,
+            None,
             format!("not a valid GLB file (truncated or corrupt): {binary}"),
         ),
-        other => error(path, format!("not a valid glTF file: {other}")),
+        other => SceneError::syntax(path, None, format!("not a valid glTF file: {other}")),
     }
 }
 
@@ -472,7 +474,7 @@ fn load_buffers(
                     let bytes = decoded.map_err(fail)?;
                     budget
                         .charge_bytes(bytes.len() as u64, &name)
-                        .map_err(|e| error(path, e))?;
+                        .map_err(|e| e.at(path))?;
                     bytes
                 }
                 None => {
@@ -787,7 +789,7 @@ impl Importer<'_> {
                 .map_err(|e| self.fail(format!("{name}: {e}")))?;
             self.budget
                 .charge_instances(instances.len())
-                .map_err(|e| self.fail(e))?;
+                .map_err(|e| e.at(self.path))?;
             if let Some(imported) =
                 finish_mesh(name, self.path, raw, material, &mut self.model.warnings)
                     .map_err(|e| self.fail(e))?
@@ -832,7 +834,9 @@ impl Importer<'_> {
                 "{triangle_count} triangles, more than the {MAX_MODEL_TRIANGLES} accepted"
             ));
         }
-        self.budget.charge_mesh(count, triangle_count)?;
+        self.budget
+            .charge_mesh(count, triangle_count)
+            .map_err(String::from)?;
         let vec3 = |values: Vec<f64>| -> Vec<DVec3> {
             values
                 .chunks_exact(3)

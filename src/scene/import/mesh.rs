@@ -1,7 +1,11 @@
 //! Checks shared by the importers: finite vertices, triangle indices in range, degenerate
 //! triangles, unit normals, and the model-wide size limits.
 
+use std::path::Path;
+
 use glam::{DVec2, DVec3};
+
+use crate::scene::SceneError;
 
 use super::{
     ImportedMesh, MAX_MODEL_INSTANCES, MAX_MODEL_TEXELS, MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES,
@@ -254,6 +258,25 @@ pub(super) struct Budget {
     max_bytes: Option<u64>,
 }
 
+/// A model beyond the import's limits: a fixed count limit or the memory cap
+/// (`--max-memory`); the message says which, and by how much.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub(super) struct LimitExceeded(pub String);
+
+impl LimitExceeded {
+    /// The [`SceneError::TooLarge`] of the model `path`.
+    pub fn at(self, path: &Path) -> SceneError {
+        SceneError::too_large(path, None, self.0)
+    }
+}
+
+impl From<LimitExceeded> for String {
+    fn from(limit: LimitExceeded) -> Self {
+        limit.0
+    }
+}
+
 impl Budget {
     /// A budget capped at `max_bytes` (none: the fixed count limits only).
     pub fn new(max_bytes: Option<u64>) -> Self {
@@ -270,17 +293,19 @@ impl Budget {
 
     /// Counts `bytes` more held by the import (`what` names them in the message), before
     /// they are allocated where the caller can.
-    pub fn charge_bytes(&mut self, bytes: u64, what: &str) -> Result<(), String> {
+    pub fn charge_bytes(&mut self, bytes: u64, what: &str) -> Result<(), LimitExceeded> {
         self.bytes = self.bytes.saturating_add(bytes);
         match self.max_bytes {
-            Some(max) if self.bytes > max => Err(memory_cap_message(self.bytes, max, what)),
+            Some(max) if self.bytes > max => {
+                Err(LimitExceeded(memory_cap_message(self.bytes, max, what)))
+            }
             _ => Ok(()),
         }
     }
 
     /// Counts a mesh of `vertices` vertices and `triangles` triangles (before it is read,
     /// so that an absurd count is refused without allocating).
-    pub fn charge_mesh(&mut self, vertices: usize, triangles: usize) -> Result<(), String> {
+    pub fn charge_mesh(&mut self, vertices: usize, triangles: usize) -> Result<(), LimitExceeded> {
         self.charge_bytes(
             (vertices as u64).saturating_mul(BYTES_PER_VERTEX)
                 + (triangles as u64).saturating_mul(BYTES_PER_TRIANGLE),
@@ -289,40 +314,40 @@ impl Budget {
         self.vertices = self.vertices.saturating_add(vertices);
         self.triangles = self.triangles.saturating_add(triangles);
         if self.vertices > MAX_MODEL_VERTICES {
-            return Err(format!(
+            return Err(LimitExceeded(format!(
                 "the model has more than {MAX_MODEL_VERTICES} vertices, more than accepted"
-            ));
+            )));
         }
         if self.triangles > MAX_MODEL_TRIANGLES {
-            return Err(format!(
+            return Err(LimitExceeded(format!(
                 "the model has more than {MAX_MODEL_TRIANGLES} triangles, more than accepted"
-            ));
+            )));
         }
         Ok(())
     }
 
     /// Counts `count` more placements of meshes.
-    pub fn charge_instances(&mut self, count: usize) -> Result<(), String> {
+    pub fn charge_instances(&mut self, count: usize) -> Result<(), LimitExceeded> {
         self.instances = self.instances.saturating_add(count);
         if self.instances > MAX_MODEL_INSTANCES {
-            return Err(format!(
+            return Err(LimitExceeded(format!(
                 "the model places meshes more than {MAX_MODEL_INSTANCES} times, more than accepted"
-            ));
+            )));
         }
         Ok(())
     }
 
     /// Counts a texture of `width × height` texels.
-    pub fn charge_texels(&mut self, width: u32, height: u32) -> Result<(), String> {
+    pub fn charge_texels(&mut self, width: u32, height: u32) -> Result<(), LimitExceeded> {
         let texels = u64::from(width) * u64::from(height);
         self.charge_bytes(texels.saturating_mul(BYTES_PER_TEXEL), "its textures")?;
         self.texels = self
             .texels
             .saturating_add(u64::from(width) * u64::from(height));
         if self.texels > MAX_MODEL_TEXELS {
-            return Err(format!(
+            return Err(LimitExceeded(format!(
                 "the model's textures hold more than {MAX_MODEL_TEXELS} texels, more than accepted"
-            ));
+            )));
         }
         Ok(())
     }

@@ -356,8 +356,9 @@ pub fn import_model_with(
     match extension.as_deref() {
         Some("obj") => import_obj_with(path, options),
         Some("gltf" | "glb") => import_gltf_with(path, options),
-        _ => Err(error(
+        _ => Err(SceneError::unsupported(
             path,
+            None,
             "not a model file this program reads: the name must end in .obj, .gltf or .glb",
         )),
     }
@@ -365,11 +366,7 @@ pub fn import_model_with(
 
 /// An error about `path` with no line.
 fn error(path: &Path, message: impl Into<String>) -> SceneError {
-    SceneError {
-        path: path.to_path_buf(),
-        location: None,
-        message: message.into(),
-    }
+    SceneError::invalid(path, None, message)
 }
 
 /// Reads a whole file (a model, a material library or a buffer), refusing anything
@@ -392,6 +389,6 @@ fn read_file(
         .len();
     budget
         .charge_bytes(length, &format!("{what} ({length} bytes)"))
-        .map_err(|e| error(report, e))?;
+        .map_err(|e| e.at(report))?;
     crate::input::read_opened(file, MAX_MODEL_FILE_BYTES).map_err(fail)
 }

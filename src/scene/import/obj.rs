@@ -99,7 +99,7 @@ fn parse_obj_within(
     if let Cow::Owned(decoded) = &text {
         budget
             .charge_bytes(decoded.len() as u64, "its text decoded")
-            .map_err(|e| error(path, e))?;
+            .map_err(|e| e.at(path))?;
     }
     let mut notes = Notes::default();
     let reader = ObjReader::new(path, budget.bytes_left(), progress);
@@ -141,7 +141,7 @@ fn parse_obj_within(
         );
         budget
             .charge_mesh(group.vertices.len(), group.triangles.len())
-            .map_err(|e| error(path, e))?;
+            .map_err(|e| e.at(path))?;
         let raw = group.into_raw_mesh(&file);
         if let Some(mesh) = finish_mesh(name, path, raw, material, &mut model.warnings)
             .map_err(|e| error(path, e))?
@@ -616,8 +616,9 @@ impl<'p> ObjReader<'p> {
             + groups.0 * 48
             + groups.1 * 12;
         if held > max {
-            return Err(error(
+            return Err(SceneError::too_large(
                 self.path,
+                None,
                 format!(
                     "by line {n}: {}",
                     memory_cap_message(held, max, "the arrays read so far")
@@ -970,11 +971,7 @@ fn words(line: &str) -> Vec<(usize, &str)> {
 
 /// An error at `line`:`column` of `path`.
 fn at(path: &Path, line: usize, column: usize, message: impl Into<String>) -> SceneError {
-    SceneError {
-        path: path.to_path_buf(),
-        location: Some((line, column)),
-        message: message.into(),
-    }
+    SceneError::invalid(path, Some((line, column)), message)
 }
 
 /// Parses `word` as a number, failing with a message that names `what`. A word that

@@ -74,11 +74,13 @@ impl Textures {
         encoding: Encoding,
         budget: &mut Budget,
     ) -> Result<u32, TextureFailure> {
-        let (width, height) = image_dimensions(path, bytes).map_err(TextureFailure::Decode)?;
+        let (width, height) =
+            image_dimensions(path, bytes).map_err(|e| TextureFailure::Decode(e.to_string()))?;
         budget
             .charge_texels(width, height)
-            .map_err(TextureFailure::Budget)?;
-        let mut image = decode_image(path, bytes).map_err(TextureFailure::Decode)?;
+            .map_err(|e| TextureFailure::Budget(e.into()))?;
+        let mut image =
+            decode_image(path, bytes).map_err(|e| TextureFailure::Decode(e.to_string()))?;
         if encoding == Encoding::Data {
             // `load_image` linearised the 8/16-bit values as sRGB; glTF images are PNG or
             // JPEG (glTF 2.0 §3.8.3), never float, so encoding again restores the

@@ -148,7 +148,10 @@ fn scene_with(scene: &Scene, width: u32, spp: u32) -> Result<Scene, String> {
         ..RenderOverrides::default()
     };
     Ok(Scene {
-        render: scene.render.with_overrides(&overrides)?,
+        render: scene
+            .render
+            .with_overrides(&overrides)
+            .map_err(|e| e.to_string())?,
         ..scene.clone()
     })
 }
