@@ -162,6 +162,10 @@ pub enum LightingSpace {
     NaiveGamma,
 }
 
+/// Largest half view height of an orthographic camera accepted, in scene units
+/// ([`Camera::orthographic_half_height`]).
+pub const MAX_ORTHOGRAPHIC_HALF_HEIGHT: f64 = 1e15;
+
 /// A pinhole camera, or an orthographic one.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
@@ -175,7 +179,8 @@ pub struct Camera {
     /// orthographic camera).
     pub fov_y_degrees: f64,
     /// For an orthographic camera (glTF's `orthographic` projection), half the height
-    /// of the view in scene units (finite, > 0; glTF's `ymag`): its rays are parallel,
+    /// of the view in scene units (finite, > 0, at most
+    /// [`MAX_ORTHOGRAPHIC_HALF_HEIGHT`]; glTF's `ymag`): its rays are parallel,
     /// along the view direction, from points of the plane through `eye` facing it,
     /// `half_height` above and below `eye` and the image's aspect times that either
     /// side. `None`: a pinhole camera of `fov_y_degrees`.

@@ -720,3 +720,112 @@ fn a_camera_ray_passes_through_at_most_max_pass_throughs_back_faces_on_both_back
     path.render.samples_per_pixel = 2;
     gpu_agrees("pass-through-bound-path", &path);
 }
+
+/// Scene files have spot lights and orthographic cameras too: `type = "spot"` with
+/// cone half-angles in degrees (glTF's defaults 0 and 45 when left out) loads as the
+/// model's spot light, and `orthographic_half_height` as an orthographic camera; a
+/// scene written so renders the same image as the model built by hand
+/// (`spot_scene`). Cones out of order, a camera with both a field of view and a half
+/// height, and a half height of 0 are located errors.
+#[test]
+fn scene_files_write_spot_lights_and_orthographic_cameras() {
+    use gpu_render::scene::{SceneError, parse_scene};
+    let text = |light: &str, camera: &str| {
+        format!(
+            "[render]\nwidth = {WIDTH}\nheight = {HEIGHT}\nsamples_per_pixel = 1\n\
+             [camera]\neye = [0, 0, {EYE_Z}]\nlook_at = [0, 0, 0]\n{camera}\n\
+             [materials.white]\ntype = \"lambert\"\nalbedo = 1\n\
+             [[lights]]\n{light}\n\
+             [[objects]]\ntype = \"polygon\"\nmaterial = \"white\"\n\
+             vertices = [[-3.6, -3.6, 0], [3.6, -3.6, 0], [3.6, 3.6, 0], [-3.6, 3.6, 0]]\n"
+        )
+    };
+    let spot = format!(
+        "type = \"spot\"\nposition = [0, 0, {SPOT_HEIGHT}]\ndirection = [0, 0, -3]\n\
+         intensity = {}\ninner_cone_degrees = {}\nouter_cone_degrees = {}",
+        std::f64::consts::PI,
+        INNER.to_degrees(),
+        OUTER.to_degrees()
+    );
+    let written = parse_scene(
+        &text(&spot, &format!("fov_y_degrees = {FOV_Y_DEGREES}")),
+        "spot.toml".as_ref(),
+    )
+    .expect("the spot scene loads");
+    let Light::Spot {
+        direction,
+        cos_inner,
+        cos_outer,
+        ..
+    } = written.lights[0]
+    else {
+        panic!("a spot light, got {:?}", written.lights[0]);
+    };
+    assert_eq!(direction, DVec3::NEG_Z);
+    assert!((cos_inner - INNER.cos()).abs() < 1e-12 && (cos_outer - OUTER.cos()).abs() < 1e-12);
+    let by_hand = gpu_render::cpu::render(&spot_scene(), None);
+    let from_file = gpu_render::cpu::render(&written, None);
+    let centre = pixel_of(0.0, 0.0);
+    let edge = pixel_of(SPOT_HEIGHT * ((INNER + OUTER) / 2.0).tan(), 0.0);
+    for pixel in [centre, edge] {
+        assert_colour_within(
+            "the file's spot light",
+            &from_file.image,
+            pixel,
+            colour(&by_hand.image, pixel),
+            1e-6,
+        );
+    }
+
+    let defaults = parse_scene(
+        &text(
+            "type = \"spot\"\nposition = [0, 0, 2]\ndirection = [0, 0, -1]\nintensity = 1",
+            "",
+        ),
+        "spot.toml".as_ref(),
+    )
+    .expect("defaults");
+    assert!(matches!(
+        defaults.lights[0],
+        Light::Spot { cos_inner, cos_outer, .. }
+            if cos_inner == 1.0 && (cos_outer - std::f64::consts::FRAC_PI_4.cos()).abs() < 1e-12
+    ));
+
+    let orthographic = parse_scene(
+        &text(&spot, "orthographic_half_height = 1.5"),
+        "ortho.toml".as_ref(),
+    )
+    .expect("the orthographic scene loads");
+    assert_eq!(orthographic.camera.orthographic_half_height, Some(1.5));
+
+    let refused = |light: &str, camera: &str, needle: &str| {
+        let err = parse_scene(&text(light, camera), "bad.toml".as_ref()).expect_err(needle);
+        assert!(
+            matches!(
+                err,
+                SceneError::Invalid {
+                    location: Some(_),
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+        assert!(err.to_string().contains(needle), "{needle:?} not in {err}");
+    };
+    refused(
+        "type = \"spot\"\nposition = [0, 0, 2]\ndirection = [0, 0, -1]\nintensity = 1\n\
+         inner_cone_degrees = 30\nouter_cone_degrees = 20",
+        "",
+        "0 <= inner < outer <= 90",
+    );
+    refused(
+        &spot,
+        "fov_y_degrees = 30\northographic_half_height = 1",
+        "exclude each other",
+    );
+    refused(
+        &spot,
+        "orthographic_half_height = 0",
+        "orthographic_half_height must be in",
+    );
+}

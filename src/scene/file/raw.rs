@@ -96,6 +96,7 @@ pub struct RawCamera {
     pub look_at: Option<RawVec3>,
     pub up: Option<RawVec3>,
     pub fov_y_degrees: Option<f64>,
+    pub orthographic_half_height: Option<f64>,
 }
 
 /// `[environment]`.
@@ -183,6 +184,8 @@ pub struct RawLight {
     pub direction: Option<RawVec3>,
     pub irradiance: Option<f64>,
     pub color: Option<RawColor>,
+    pub inner_cone_degrees: Option<f64>,
+    pub outer_cone_degrees: Option<f64>,
 }
 
 impl RawLight {
@@ -194,6 +197,8 @@ impl RawLight {
             ("direction", self.direction.is_some()),
             ("irradiance", self.irradiance.is_some()),
             ("color", self.color.is_some()),
+            ("inner_cone_degrees", self.inner_cone_degrees.is_some()),
+            ("outer_cone_degrees", self.outer_cone_degrees.is_some()),
         ])
     }
 }

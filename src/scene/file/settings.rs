@@ -12,8 +12,9 @@ use super::paths::confined_path;
 use super::raw::{RawCamera, RawEnvironment, RawIntegrator, RawLighting, RawRender};
 use crate::echo::{echo_path, short};
 use crate::scene::{
-    Camera, Environment, EnvironmentMap, Image, Integrator, LightingSpace, MAX_RADIANCE,
-    RenderSettings, SceneError, load_confined_image, load_image,
+    Camera, Environment, EnvironmentMap, Image, Integrator, LightingSpace,
+    MAX_ORTHOGRAPHIC_HALF_HEIGHT, MAX_RADIANCE, RenderSettings, SceneError, load_confined_image,
+    load_image,
 };
 
 /// Default image width in pixels.
@@ -81,12 +82,32 @@ pub fn camera(source: &Source<'_>, raw: Option<Spanned<RawCamera>>) -> Result<Ca
     if let Some(problem) = view_problem(eye, look_at, up) {
         return Err(item.fail(problem));
     }
+    let orthographic_half_height = match raw.orthographic_half_height {
+        None => None,
+        Some(_) if raw.fov_y_degrees.is_some() => {
+            return Err(item.fail(
+                "fov_y_degrees and orthographic_half_height exclude each other: \
+                 a camera is either a pinhole (fov_y_degrees) or orthographic",
+            ));
+        }
+        Some(half_height) => {
+            let half_height = item.number("orthographic_half_height", half_height)?;
+            if !(half_height > 0.0 && half_height <= MAX_ORTHOGRAPHIC_HALF_HEIGHT) {
+                return Err(item.fail(format_args!(
+                    "orthographic_half_height must be in (0, {}], got {}",
+                    short(MAX_ORTHOGRAPHIC_HALF_HEIGHT),
+                    short(half_height)
+                )));
+            }
+            Some(half_height)
+        }
+    };
     Ok(Camera {
         eye,
         look_at,
         up,
         fov_y_degrees,
-        orthographic_half_height: None,
+        orthographic_half_height,
     })
 }
 

@@ -25,7 +25,8 @@ use super::{
 };
 use crate::echo::short;
 use crate::scene::{
-    Camera, Light, MAX_RADIANCE, Material, MaterialKind, SceneError, TextureTransform,
+    Camera, Light, MAX_ORTHOGRAPHIC_HALF_HEIGHT, MAX_RADIANCE, Material, MaterialKind, SceneError,
+    TextureTransform,
 };
 
 /// Luminous efficacy used to turn `KHR_lights_punctual`'s photometric intensities into
@@ -73,8 +74,6 @@ const TEXCOORD_TYPES: &[DataType] = &[
 /// Largest offset or scale (in size) of a `KHR_texture_transform` accepted: beyond it
 /// an `f32` texture coordinate keeps less than 1/16 of a repeat.
 const MAX_TEXTURE_TRANSFORM: f64 = 1e6;
-/// Largest half view height of an orthographic camera accepted, in scene units.
-const MAX_ORTHOGRAPHIC_SIZE: f64 = 1e15;
 /// Component types of `COLOR_0`: `FLOAT` and normalized unsigned bytes and shorts
 /// (glTF 2.0 §3.7.2.1).
 const COLOR_TYPES: &[DataType] = &[DataType::F32, DataType::U8, DataType::U16];
@@ -1512,13 +1511,13 @@ impl Importer<'_> {
                     f64::from(orthographic.ymag()).abs(),
                 );
                 let half_height = ymag * world.transform_vector3(DVec3::Y).length();
-                let usable = |v: f64| v.is_finite() && v > 0.0 && v <= MAX_ORTHOGRAPHIC_SIZE;
+                let usable = |v: f64| v.is_finite() && v > 0.0 && v <= MAX_ORTHOGRAPHIC_HALF_HEIGHT;
                 if !(usable(xmag) && usable(half_height)) {
                     return Err(self.fail(format!(
                         "{name} on {node}: orthographic xmag {} and ymag {} (times the node's scale) must be positive, finite and at most {}",
                         short(orthographic.xmag()),
                         short(orthographic.ymag()),
-                        short(MAX_ORTHOGRAPHIC_SIZE)
+                        short(MAX_ORTHOGRAPHIC_HALF_HEIGHT)
                     )));
                 }
                 (
