@@ -1,12 +1,14 @@
-// The pinhole camera and the pixel sample pattern. CPU twin: src/camera.rs
-// (strata_grid, jitter_seed, sample_offset, CameraFrame::ray_direction ->
-// camera_ray_direction); the hash is sample.wgsl's. The lattice generator of the
+// The pinhole camera (with an optional thin lens) and the pixel sample pattern. CPU
+// twin: src/camera.rs (strata_grid, jitter_seed, sample_offset, lens_sample,
+// CameraFrame::camera_ray, CameraFrame::ray_direction -> camera_ray_direction); the
+// hash is sample.wgsl's. The lattice generator of the
 // sample count is computed once on the host (camera::lattice_generator) and arrives in
 // frame.lattice_generator.
 
 #import types
 #import bindings
 #import sample
+#import intersect
 
 // n columns and n rows of elementary strata for n samples; sample_offset puts exactly
 // one sample in every column and every row.
@@ -46,6 +48,36 @@ fn sample_offset(px: u32, py: u32, index: u32) -> vec2<f32> {
     let jitter = vec2<f32>(unit_from_hash(seed), unit_from_hash(pcg_hash(seed)));
     let cell = vec2<f32>(f32(column), f32(row));
     return (cell + jitter) / vec2<f32>(grid);
+}
+
+// The 32-bit golden ratio, XORed into a sample's jitter seed for its lens point.
+// CPU twin: LENS_SALT.
+const LENS_SALT: u32 = 0x9e3779b9u;
+
+// The point of the unit square that picks the lens point of sample `index` of pixel
+// `pixel_index`: a hash of its jitter seed salted apart from the jitter.
+fn lens_sample(pixel_index: u32, spp: u32, index: u32) -> vec2<f32> {
+    let seed = pcg_hash(jitter_seed(pixel_index, max(spp, 1u), index) ^ LENS_SALT);
+    return vec2<f32>(unit_from_hash(seed), unit_from_hash(pcg_hash(seed)));
+}
+
+// The camera ray of sample `index` of pixel (px, py) at `offset` inside it: the
+// pinhole's (camera_ray_origin, camera_ray_direction), or through a thin lens
+// (frame.lens_radius > 0; pbrt-v4 §5.2.3) from the lens point lens_sample picks
+// towards where the pinhole ray meets the plane in focus.
+fn camera_ray(px: u32, py: u32, index: u32, offset: vec2<f32>) -> Ray {
+    let x = f32(px) + offset.x;
+    let y = f32(py) + offset.y;
+    let direction = camera_ray_direction(x, y);
+    let origin = camera_ray_origin(x, y);
+    if frame.lens_radius <= 0.0 {
+        return Ray(origin, direction);
+    }
+    let focus = frame.eye + direction * (frame.focus_distance / dot(direction, frame.forward));
+    let lens = lens_sample(py * frame.width + px, frame.samples_per_pixel, index);
+    let disk = sample_concentric_disk(lens) * frame.lens_radius;
+    let lens_point = frame.eye + frame.right * disk.x + frame.up * disk.y;
+    return Ray(lens_point, normalize(focus - lens_point));
 }
 
 // Unit direction through image position (x, y) in pixels from the top-left corner: the

@@ -36,6 +36,12 @@ struct FrameUniforms {
     min_ray_weight: f32,
     lattice_generator: u32,
     static_pixels: u32,
+    // The camera's thin lens (camera_ray): its radius, 0 for a pinhole, and the
+    // distance of the plane in focus along `forward`.
+    lens_radius: f32,
+    focus_distance: f32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 // FrameUniforms.flags: also store each finished pixel's sample sum and luminance m2 in

@@ -131,8 +131,9 @@ fn pop_ray(slot: u32, path: ptr<function, PathState>, trace: ptr<function, Trace
 fn start_sample(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) {
     let xy = image_position(path);
     let offset = sample_offset(xy.x, xy.y, (*path).sample);
-    let direction = camera_ray_direction(f32(xy.x) + offset.x, f32(xy.y) + offset.y);
-    let origin = camera_ray_origin(f32(xy.x) + offset.x, f32(xy.y) + offset.y);
+    let camera = camera_ray(xy.x, xy.y, (*path).sample, offset);
+    let direction = camera.direction;
+    let origin = camera.origin;
     (*path).radiance = vec3<f32>(0.0);
     (*path).origin = origin;
     (*path).direction = direction;

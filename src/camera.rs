@@ -1,10 +1,11 @@
-//! The pinhole camera and the pixel sample pattern, shared by both backends.
-//! The GPU twin is `shaders/camera.wgsl` (`sample_offset`, `ray_direction` as
-//! `camera_ray_direction`); the hash is [`crate::sample::pcg_hash`].
+//! The pinhole camera (with an optional thin lens) and the pixel sample pattern, shared
+//! by both backends. The GPU twin is `shaders/camera.wgsl` (`sample_offset`,
+//! `lens_sample`, `camera_ray`, `ray_direction` as `camera_ray_direction`); the hash is
+//! [`crate::sample::pcg_hash`].
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
-use crate::sample::{pcg_hash, unit_from_hash};
+use crate::sample::{pcg_hash, sample_concentric_disk, unit_from_hash};
 use crate::scene::{Camera, RenderSettings};
 
 /// An orthonormal camera basis with the projection constants, ready to generate rays.
@@ -25,6 +26,11 @@ pub struct CameraFrame {
     /// An orthographic camera's half view height in scene units
     /// ([`Camera::orthographic_half_height`]); `None` for a pinhole camera.
     pub orthographic_half_height: Option<f64>,
+    /// Radius of the thin lens ([`crate::scene::ThinLens`]); 0 for a pinhole.
+    pub lens_radius: f64,
+    /// Distance from the eye to the plane in focus along `forward` (unused without a
+    /// lens).
+    pub focus_distance: f64,
 }
 
 impl CameraFrame {
@@ -41,7 +47,39 @@ impl CameraFrame {
             tan_half_fov_y: (camera.fov_y_degrees.to_radians() * 0.5).tan(),
             aspect: f64::from(width) / f64::from(height),
             orthographic_half_height: camera.orthographic_half_height,
+            lens_radius: camera.lens.map_or(0.0, |lens| lens.aperture_radius),
+            focus_distance: camera.lens.map_or(0.0, |lens| {
+                lens.focus_distance_for(camera.eye, camera.look_at)
+            }),
         }
+    }
+
+    /// The origin and unit direction of camera ray through image position (`x`, `y`)
+    /// (as [`CameraFrame::ray_direction`] measures it), the lens point chosen by
+    /// `lens` in [0, 1)² ([`lens_sample`]). A pinhole's ray is
+    /// ([`CameraFrame::ray_origin`], [`CameraFrame::ray_direction`]). Through a thin
+    /// lens (pbrt-v4 §5.2.3) the ray starts at the lens point
+    /// `eye + r·(right·d.x + up·d.y)`, `d` the concentric disk map of `lens`
+    /// ([`sample_concentric_disk`]), and passes through the point where the pinhole
+    /// ray meets the plane in focus, `eye + p·focus / (p·forward)` for the pinhole
+    /// direction `p`.
+    pub fn camera_ray(
+        &self,
+        x: f64,
+        y: f64,
+        width: u32,
+        height: u32,
+        lens: DVec2,
+    ) -> (DVec3, DVec3) {
+        let direction = self.ray_direction(x, y, width, height);
+        let origin = self.ray_origin(x, y, width, height);
+        if self.lens_radius <= 0.0 {
+            return (origin, direction);
+        }
+        let focus = self.eye + direction * (self.focus_distance / direction.dot(self.forward));
+        let disk = sample_concentric_disk(lens) * self.lens_radius;
+        let origin = self.eye + self.right * disk.x + self.up * disk.y;
+        (origin, (focus - origin).normalize())
     }
 
     /// The unit direction of the ray through image position (`x`, `y`) in pixels,
@@ -193,6 +231,19 @@ pub fn jitter_seed(pixel_index: u32, spp: u32, index: u32) -> u32 {
     }
 }
 
+/// The point of the unit square that picks the lens point of sample `index` of pixel
+/// `pixel_index` ([`CameraFrame::camera_ray`]): a hash of the sample's jitter seed
+/// ([`jitter_seed`]) salted apart from the jitter itself, so that the lens point and
+/// the image position vary independently. Both backends pick the same points.
+pub fn lens_sample(pixel_index: u32, spp: u32, index: u32) -> DVec2 {
+    let seed = pcg_hash(jitter_seed(pixel_index, spp.max(1), index) ^ LENS_SALT);
+    DVec2::new(unit_from_hash(seed), unit_from_hash(pcg_hash(seed)))
+}
+
+/// XORed into a sample's jitter seed for its lens point ([`lens_sample`]): the
+/// 32-bit golden ratio, any constant that separates the two streams would do.
+pub const LENS_SALT: u32 = 0x9e37_79b9;
+
 /// The offset inside pixel (`px`, `py`) of sample `index`, in [0, 1)². One sample goes
 /// through the pixel centre (as in the lecture). With `n > 1` samples, sample `i` lies
 /// in column `i` and row `(i·g + s) mod n` of the `n × n` [`strata_grid`], where `g` is
@@ -303,6 +354,7 @@ mod tests {
             up: DVec3::Y,
             fov_y_degrees: 90.0,
             orthographic_half_height: None,
+            lens: None,
         };
         let frame = CameraFrame::new(&camera, 200, 100);
         let d = frame.ray_direction(100.0, 50.0, 200, 100);

@@ -115,16 +115,7 @@ pub fn trace_pixel_aov(scene: &PreparedScene, x: u32, y: u32) -> FirstHitAov {
     };
     for index in 0..settings.samples_per_pixel {
         let (dx, dy) = scene.samples.offset(x, y, index);
-        let direction = scene.camera.ray_direction(
-            f64::from(x) + dx,
-            f64::from(y) + dy,
-            settings.width,
-            settings.height,
-        );
-        let ray = Ray {
-            origin: scene.camera.eye,
-            direction,
-        };
+        let ray = scene.camera_ray(x, y, index, (dx, dy));
         if let Some(hit) = first_hit_aov(scene, &ray) {
             sum.albedo += hit.albedo;
             sum.normal += hit.normal;

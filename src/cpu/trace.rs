@@ -13,7 +13,7 @@ use super::path::path_radiance;
 use super::traverse::{intersect_scene, occluded};
 use crate::accel::SceneGeometry;
 use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight};
-use crate::camera::{CameraFrame, SamplePattern};
+use crate::camera::{CameraFrame, SamplePattern, lens_sample};
 use crate::noise::luminance_m2_step;
 pub use crate::scene::MediumStack;
 use crate::scene::{Image, Integrator, Light, Material, RenderSettings, Scene};
@@ -90,6 +90,26 @@ impl PreparedScene {
             brdf_map_cdfs,
         }
     }
+
+    /// The camera ray of sample `index` of pixel (`x`, `y`), at `offset` inside the
+    /// pixel ([`SamplePattern::offset`]), through the lens point [`lens_sample`]
+    /// picks for it ([`CameraFrame::camera_ray`]).
+    pub fn camera_ray(&self, x: u32, y: u32, index: u32, offset: (f64, f64)) -> Ray {
+        let (width, height) = (self.settings.width, self.settings.height);
+        let lens = lens_sample(
+            y.wrapping_mul(width).wrapping_add(x),
+            self.settings.samples_per_pixel,
+            index,
+        );
+        let (origin, direction) = self.camera.camera_ray(
+            f64::from(x) + offset.0,
+            f64::from(y) + offset.1,
+            width,
+            height,
+            lens,
+        );
+        Ray { origin, direction }
+    }
 }
 
 /// Squared distances to a point light below this (the smallest normal `f32`, 2^-126)
@@ -165,14 +185,7 @@ pub fn trace_pixel(scene: &PreparedScene, x: u32, y: u32) -> PixelResult {
     let mut rays = 0;
     for index in 0..settings.samples_per_pixel {
         let (dx, dy) = scene.samples.offset(x, y, index);
-        let (px, py) = (f64::from(x) + dx, f64::from(y) + dy);
-        let direction = scene
-            .camera
-            .ray_direction(px, py, settings.width, settings.height);
-        let origin = scene
-            .camera
-            .ray_origin(px, py, settings.width, settings.height);
-        let primary = Ray { origin, direction };
+        let primary = scene.camera_ray(x, y, index, (dx, dy));
         let (radiance, sample_rays) = match settings.integrator {
             Integrator::Whitted => trace_radiance(scene, primary),
             Integrator::Path => path_radiance(scene, primary, y * settings.width + x, index),

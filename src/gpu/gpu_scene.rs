@@ -25,7 +25,7 @@ static NEXT_SCENE_ID: AtomicU64 = AtomicU64::new(1);
 ///
 /// The camera is not in any GPU buffer of the scene: [`super::Renderer::set_camera`]
 /// changes it on the host, and the next trace pass of each film writes it with the
-/// pass's other constants (one [`FrameUniforms`] record, 192 bytes).
+/// pass's other constants (one [`FrameUniforms`] record, 208 bytes).
 #[derive(Debug)]
 pub struct GpuScene {
     pub(crate) id: u64,
@@ -176,6 +176,8 @@ impl GpuScene {
             region_height: height,
             target_x: 0,
             target_y: 0,
+            lens_radius: camera.lens_radius as f32,
+            focus_distance: camera.focus_distance as f32,
             ..self.prepared.frame
         }
     }

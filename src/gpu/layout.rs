@@ -83,6 +83,15 @@ pub struct FrameUniforms {
     /// Region pixels below this go to slots in a fixed order, the rest from the shared
     /// counter ([`static_pixels_for`]; set where a trace starts).
     pub static_pixels: u32,
+    /// Radius of the camera's thin lens ([`crate::camera::CameraFrame::lens_radius`]);
+    /// 0 for a pinhole.
+    pub lens_radius: f32,
+    /// Distance from the eye to the plane in focus along `forward` (with a lens).
+    pub focus_distance: f32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
 }
 
 /// Most rounds of pixels handed out in a fixed order ([`static_pixels_for`]).

@@ -337,15 +337,20 @@ impl Renderer {
 
     /// Moves `scene`'s camera. Writes nothing to the device: the next trace pass of
     /// each film (or the next blocking trace) writes the camera with the pass's other
-    /// constants (one 192-byte uniform record), and a film accumulating the old camera
+    /// constants (one 208-byte uniform record), and a film accumulating the old camera
     /// restarts at sample 0 in its next [`Renderer::encode_samples`]. No scene buffer
     /// is touched.
     ///
-    /// Errors: [`RenderError::InvalidCamera`] for an undefined view or a field of view
-    /// outside (0, 180) degrees (the scene keeps its camera).
+    /// Errors: [`RenderError::InvalidCamera`] for an undefined view, a field of view
+    /// outside (0, 180) degrees, or a thin lens with an aperture or focus distance that
+    /// is not finite and positive or on an orthographic camera (the scene keeps its
+    /// camera).
     pub fn set_camera(&self, scene: &mut GpuScene, camera: &Camera) -> Result<(), RenderError> {
         let fov_ok = camera.fov_y_degrees > 0.0 && camera.fov_y_degrees < 180.0;
-        if !fov_ok || view_problem(camera.eye, camera.look_at, camera.up).is_some() {
+        let lens_ok = camera.lens.is_none_or(|lens| {
+            lens.problem().is_none() && camera.orthographic_half_height.is_none()
+        });
+        if !fov_ok || !lens_ok || view_problem(camera.eye, camera.look_at, camera.up).is_some() {
             return Err(RenderError::InvalidCamera(*camera));
         }
         if scene.camera != *camera {

@@ -642,6 +642,10 @@ pub fn frame_uniforms(scene: &Scene, geometry: &SceneGeometry) -> FrameUniforms 
         min_ray_weight: settings.min_ray_weight as f32,
         lattice_generator: crate::camera::lattice_generator(settings.samples_per_pixel),
         static_pixels: 0,
+        lens_radius: camera.lens_radius as f32,
+        focus_distance: camera.focus_distance as f32,
+        _pad0: 0,
+        _pad1: 0,
     }
 }
 
@@ -670,6 +674,7 @@ mod tests {
                 up: DVec3::Y,
                 fov_y_degrees: 60.0,
                 orthographic_half_height: None,
+                lens: None,
             },
             environment: Environment {
                 background: DVec3::new(0.1, 0.2, 0.3),

@@ -211,6 +211,7 @@ mod tests {
             up: DVec3::X,
             fov_y_degrees: 30.0,
             orthographic_half_height: None,
+            lens: None,
         };
         let camera = path.frame_camera(&base, 12);
         assert_eq!(camera.eye.x, 12.0);

@@ -185,6 +185,46 @@ pub struct Camera {
     /// `half_height` above and below `eye` and the image's aspect times that either
     /// side. `None`: a pinhole camera of `fov_y_degrees`.
     pub orthographic_half_height: Option<f64>,
+    /// A thin lens at the eye of a pinhole camera, for depth of field; `None`: a
+    /// pinhole, everything in focus. Not with an orthographic camera.
+    pub lens: Option<ThinLens>,
+}
+
+/// A thin lens of radius `aperture_radius` centred on the eye, facing the view
+/// direction, focused on the plane `focus_distance` along it (pbrt-v4's
+/// `PerspectiveCamera` with `lensradius` and `focaldistance`, Pharr, Jakob and
+/// Humphreys, *Physically Based Rendering*, 4th ed., §5.2.3): each camera ray starts
+/// at a point of the lens, uniform in area, and passes through the point of the focal
+/// plane that the pinhole ray through its image position meets, so points on that
+/// plane are sharp and others blur with their distance from it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ThinLens {
+    /// Radius of the aperture in scene units (finite, > 0).
+    pub aperture_radius: f64,
+    /// Distance from the eye to the plane in focus, along the view direction (finite,
+    /// > 0); `None`: the distance to `look_at`, which a camera path moves with it.
+    pub focus_distance: Option<f64>,
+}
+
+impl ThinLens {
+    /// What makes the lens unusable, if anything: an aperture or focus distance that is
+    /// not finite and positive.
+    pub fn problem(&self) -> Option<&'static str> {
+        let usable = |v: f64| v.is_finite() && v > 0.0;
+        if !usable(self.aperture_radius) {
+            return Some("aperture_radius must be finite and > 0 (leave it out for a pinhole)");
+        }
+        if self.focus_distance.is_some_and(|d| !usable(d)) {
+            return Some("focus_distance must be finite and > 0");
+        }
+        None
+    }
+
+    /// The distance in focus for a camera at `eye` looking at `look_at`.
+    pub fn focus_distance_for(&self, eye: DVec3, look_at: DVec3) -> f64 {
+        self.focus_distance
+            .unwrap_or_else(|| (look_at - eye).length())
+    }
 }
 
 /// Light that does not come from a light source.

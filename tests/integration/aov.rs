@@ -44,6 +44,7 @@ fn plane_scene(material: Material, images: Vec<Image>, samples: u32) -> Scene {
             up: DVec3::Y,
             fov_y_degrees: FOV_Y_DEGREES,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment::default(),
         material_names: vec!["plane".into()],
@@ -378,4 +379,40 @@ fn recording_the_passes_leaves_the_image_bit_identical_and_a_film_keeps_them() {
         plain.read_aov(&gpu.device, &gpu.queue, &plain_scene, &mut plain_film),
         Err(gpu_render::gpu::RenderError::NoAov)
     ));
+}
+
+/// The passes follow the camera rays of every projection: an orthographic camera's
+/// rays start on its view plane and a thin lens's at its lens points, on both
+/// backends (the CPU's passes once started every ray at the eye, which an orthographic
+/// camera's GPU passes did not).
+#[test]
+fn the_gpu_passes_equal_the_cpu_passes_through_a_thin_lens_and_an_orthographic_camera() {
+    let Some(gpu) = crate::support::gpu::headless_gpu() else {
+        return;
+    };
+    let base = crate::support::scenes::reduced(
+        crate::support::scenes::shipped("showcase.toml"),
+        64,
+        RenderOverrides {
+            samples_per_pixel: Some(3),
+            ..RenderOverrides::default()
+        },
+    );
+    let mut orthographic = base.clone();
+    orthographic.camera.orthographic_half_height = Some(2.0);
+    let mut lens = base.clone();
+    lens.camera.lens = Some(gpu_render::scene::ThinLens {
+        aperture_radius: 0.3,
+        focus_distance: Some(3.0),
+    });
+    for (label, scene) in [("orthographic", orthographic), ("thin-lens", lens)] {
+        let cpu = gpu_render::cpu::aov::render_aovs(&scene);
+        // Through the eye the depth of the pinhole's rays: a different image.
+        let pinhole = gpu_render::cpu::aov::render_aovs(&base);
+        assert_ne!(
+            cpu.depth, pinhole.depth,
+            "{label}: the camera changed nothing"
+        );
+        assert_passes_match(label, &cpu, &gpu_passes(&gpu, &scene));
+    }
 }

@@ -97,6 +97,7 @@ fn scene_of(shapes: Vec<Shape>) -> Scene {
             up: DVec3::Y,
             fov_y_degrees: 40.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment::default(),
         materials: vec![Material::lambert(DVec3::splat(0.5))],

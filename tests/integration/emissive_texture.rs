@@ -166,6 +166,7 @@ fn the_camera_sees_the_emissive_texture() {
         up: DVec3::Z,
         fov_y_degrees: 40.0,
         orthographic_half_height: None,
+        lens: None,
     };
     for integrator in [Integrator::Whitted, Integrator::Path] {
         let mut s = scene(camera, None, integrator);
@@ -229,6 +230,7 @@ fn floor_camera() -> Camera {
         up: DVec3::Y,
         fov_y_degrees: 0.1,
         orthographic_half_height: None,
+        lens: None,
     }
 }
 
@@ -340,6 +342,7 @@ fn emissive_textures_render_alike_on_both_backends() {
         up: DVec3::Y,
         fov_y_degrees: 50.0,
         orthographic_half_height: None,
+        lens: None,
     };
     let mut whitted = scene(camera, Some(0.5), Integrator::Whitted);
     whitted.lights.push(Light::Directional {

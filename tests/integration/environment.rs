@@ -42,6 +42,7 @@ fn sphere_under(map: EnvironmentMap, rho: f64, integrator: Integrator, max_depth
             up: DVec3::Y,
             fov_y_degrees: 40.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment {
             map: Some(Arc::new(map)),

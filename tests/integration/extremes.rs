@@ -103,6 +103,7 @@ fn scaled_scene(s: f64) -> Scene {
             up: DVec3::Y,
             fov_y_degrees: 50.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment {
             background: DVec3::new(0.2, 0.3, 0.5),
@@ -253,6 +254,7 @@ fn floor_scene(sphere_radius: Option<f64>) -> Scene {
             up: DVec3::Y,
             fov_y_degrees: 50.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment::default(),
         materials: vec![
@@ -373,6 +375,7 @@ fn grazing_and_tangent_rays_are_finite_and_acne_free() {
             up: DVec3::Y,
             fov_y_degrees: 0.15,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment::default(),
         materials: vec![Material::lambert(DVec3::splat(0.7))],
@@ -397,6 +400,7 @@ fn grazing_and_tangent_rays_are_finite_and_acne_free() {
             up: DVec3::Y,
             fov_y_degrees: 30.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment {
             background: DVec3::splat(0.1),
@@ -567,6 +571,7 @@ fn mesh_scene(mesh: &[[DVec3; 3]], eye: DVec3, look_at: DVec3, fov_y_degrees: f6
             },
             fov_y_degrees,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment::default(),
         materials: vec![emissive(1.0)],
@@ -639,6 +644,7 @@ fn camera_inside_glass_sees_the_background() {
             up: DVec3::Y,
             fov_y_degrees: 70.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment {
             background: DVec3::new(0.5, 0.25, 1.0),
@@ -719,6 +725,7 @@ fn glass_scene(outer_ior: f64, inner_ior: Option<f64>) -> Scene {
             up: DVec3::Y,
             fov_y_degrees: 40.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment {
             background: DVec3::new(0.3, 0.35, 0.45),
@@ -856,6 +863,7 @@ fn degenerate_lights_never_produce_nan_or_infinity() {
         up: DVec3::Z,
         fov_y_degrees: 40.0,
         orthographic_half_height: None,
+        lens: None,
     };
     scene.render = settings(17, 17, 1);
     for position in [
@@ -1010,6 +1018,7 @@ fn camera_inside_nested_dielectrics_starts_in_the_innermost() {
             up: DVec3::Y,
             fov_y_degrees: 60.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment {
             background: DVec3::ONE,
@@ -1087,6 +1096,7 @@ fn triangle_floor(half: f64) -> Scene {
             up: DVec3::Y,
             fov_y_degrees: 60.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment {
             background: DVec3::new(0.2, 0.3, 0.5),

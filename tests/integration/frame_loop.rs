@@ -279,10 +279,16 @@ fn a_camera_move_uploads_only_the_trace_constants_and_equals_a_fresh_upload() {
         .render_to_image(&gpu.device, &gpu.queue, &gpu_scene, &mut film)
         .unwrap_or_else(|e| panic!("render_to_image: {e}"));
 
+    // The move also puts a thin lens on the camera: the lens travels in the trace
+    // constants like the rest of the camera.
     let moved = Camera {
         eye: scene.camera.eye + glam::DVec3::new(0.7, 0.4, -0.3),
         fov_y_degrees: scene.camera.fov_y_degrees * 0.9,
         orthographic_half_height: None,
+        lens: Some(gpu_render::scene::ThinLens {
+            aperture_radius: 0.15,
+            focus_distance: None,
+        }),
         ..scene.camera
     };
     renderer
@@ -323,12 +329,12 @@ fn a_camera_move_uploads_only_the_trace_constants_and_equals_a_fresh_upload() {
         .writes
         .into_inner()
         .unwrap_or_else(std::sync::PoisonError::into_inner);
-    // One pass: one write of the 192-byte trace constants into a uniform buffer, and
+    // One pass: one write of the 208-byte trace constants into a uniform buffer, and
     // nothing into any storage buffer (the scene's buffers are all storage buffers).
     assert_eq!(writes.len(), 1, "writes after the camera move: {writes:?}");
     let (buffer, offset, bytes) = &writes[0];
     assert_eq!((*offset, *bytes), (0, size_of::<FrameUniforms>()));
-    assert_eq!(size_of::<FrameUniforms>(), 192);
+    assert_eq!(size_of::<FrameUniforms>(), 208);
     assert!(buffer.usage().contains(wgpu::BufferUsages::UNIFORM));
     assert!(!buffer.usage().contains(wgpu::BufferUsages::STORAGE));
     assert_eq!(film.passes(), 1);
@@ -362,6 +368,24 @@ fn a_camera_move_uploads_only_the_trace_constants_and_equals_a_fresh_upload() {
         renderer.set_camera(&mut gpu_scene, &bad),
         Err(RenderError::InvalidCamera(_))
     ));
+    // So are a lens without an aperture and a lens on an orthographic camera.
+    let no_aperture = Camera {
+        lens: Some(gpu_render::scene::ThinLens {
+            aperture_radius: 0.0,
+            focus_distance: None,
+        }),
+        ..moved
+    };
+    let orthographic_lens = Camera {
+        orthographic_half_height: Some(1.0),
+        ..moved
+    };
+    for bad in [no_aperture, orthographic_lens] {
+        assert!(matches!(
+            renderer.set_camera(&mut gpu_scene, &bad),
+            Err(RenderError::InvalidCamera(_))
+        ));
+    }
     assert_eq!(gpu_scene.camera(), &moved);
 }
 

@@ -29,6 +29,7 @@ fn scene(samples_per_pixel: u32) -> Scene {
             up: DVec3::Y,
             fov_y_degrees: 50.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment::default(),
         materials: vec![Material::lambert(DVec3::splat(0.6))],

@@ -38,6 +38,7 @@ fn scene(samples_per_pixel: u32) -> Scene {
             up: DVec3::Y,
             fov_y_degrees: 50.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment {
             background: DVec3::new(0.2, 0.3, 0.5),

@@ -887,6 +887,7 @@ fn materials_map_with_their_textures_and_wrap_modes() {
             up: DVec3::Y,
             fov_y_degrees: 40.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Default::default(),
         materials: vec![],

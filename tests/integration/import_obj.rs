@@ -392,6 +392,7 @@ fn map_ke_loads_an_emission_texture_that_the_scene_keeps() {
             up: DVec3::Y,
             fov_y_degrees: 40.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Default::default(),
         materials: vec![],

@@ -110,6 +110,7 @@ fn base_scene(width: u32, meshes: Vec<Mesh>) -> Scene {
             up: DVec3::Y,
             fov_y_degrees: 45.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment {
             background: DVec3::new(0.1, 0.12, 0.15),

@@ -70,6 +70,10 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 min_ray_weight,
                 lattice_generator,
                 static_pixels,
+                lens_radius,
+                focus_distance,
+                _pad0,
+                _pad1,
             }),
         ),
         (

@@ -49,6 +49,7 @@ mod shader_modules;
 mod shading_normals;
 mod specialisation;
 mod stress_scenes;
+mod thin_lens;
 mod tiles;
 mod uniform_records;
 mod unrolled;

@@ -28,6 +28,7 @@ fn camera() -> Camera {
         up: DVec3::Y,
         fov_y_degrees: FOV_Y_DEGREES,
         orthographic_half_height: None,
+        lens: None,
     }
 }
 

@@ -60,6 +60,7 @@ fn furnace(material: Material, max_depth: u32) -> Scene {
             up: DVec3::Y,
             fov_y_degrees: 90.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment::default(),
         material_names: vec!["furnace".into()],
@@ -344,6 +345,7 @@ fn glossy_floor(material: Material) -> Scene {
             up: DVec3::Y,
             fov_y_degrees: 50.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment {
             background: DVec3::splat(0.4),

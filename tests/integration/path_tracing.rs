@@ -75,6 +75,7 @@ fn the_white_furnace_converges_to_the_geometric_series() {
         up: DVec3::Y,
         fov_y_degrees: 90.0,
         orthographic_half_height: None,
+        lens: None,
     };
     for (rho, depth) in [(0.0, 64), (0.5, 64), (0.8, 64), (0.8, 3)] {
         let furnace = Material {
@@ -113,6 +114,7 @@ fn floor_camera() -> Camera {
         up: DVec3::Y,
         fov_y_degrees: 0.1,
         orthographic_half_height: None,
+        lens: None,
     }
 }
 
@@ -265,6 +267,7 @@ fn with_point_lights_and_no_bounces_path_tracing_is_whitted() {
             up: DVec3::Y,
             fov_y_degrees: 40.0,
             orthographic_half_height: None,
+            lens: None,
         },
     );
     s.lights = vec![
@@ -326,6 +329,7 @@ fn the_white_furnace_of_a_ggx_conductor_loses_only_what_single_scattering_loses(
         up: DVec3::Y,
         fov_y_degrees: 90.0,
         orthographic_half_height: None,
+        lens: None,
     };
     for roughness in [0.3, 0.7, 1.0] {
         let conductor = Material {

@@ -26,6 +26,7 @@ fn furnace_scene(albedo: f64, radius: f64, intensity: f64) -> Scene {
             up: DVec3::Y,
             fov_y_degrees: 100.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment::default(),
         materials: vec![Material::lambert(DVec3::splat(albedo))],

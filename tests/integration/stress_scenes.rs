@@ -50,6 +50,7 @@ fn scene(
             up: DVec3::Y,
             fov_y_degrees: 50.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment {
             background: DVec3::new(0.2, 0.25, 0.35),

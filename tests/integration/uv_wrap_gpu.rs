@@ -97,6 +97,7 @@ fn scene() -> Scene {
             up: DVec3::Y,
             fov_y_degrees: 18.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment::default(),
         material_names: modes.iter().map(|m| format!("{m:?}")).collect(),

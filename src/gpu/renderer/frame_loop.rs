@@ -60,7 +60,7 @@ impl Renderer {
     /// host has seen it complete, calls record more rounds of it and queue their
     /// samples for the next pass ([`Film::samples`], [`Film::requested_samples`]).
     /// `samples = 0` only moves the pass in progress on. The only write through
-    /// `queue` is the film's 192-byte trace constants when a pass starts. Every
+    /// `queue` is the film's 208-byte trace constants when a pass starts. Every
     /// encoder given here must be submitted, in order.
     ///
     /// A film whose scene or camera changed since its last samples restarts at

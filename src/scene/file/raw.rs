@@ -97,6 +97,8 @@ pub struct RawCamera {
     pub up: Option<RawVec3>,
     pub fov_y_degrees: Option<f64>,
     pub orthographic_half_height: Option<f64>,
+    pub aperture_radius: Option<f64>,
+    pub focus_distance: Option<f64>,
 }
 
 /// `[environment]`.

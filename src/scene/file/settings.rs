@@ -13,8 +13,8 @@ use super::raw::{RawCamera, RawEnvironment, RawIntegrator, RawLighting, RawRende
 use crate::echo::{echo_path, short};
 use crate::scene::{
     Camera, Environment, EnvironmentMap, Image, Integrator, LightingSpace,
-    MAX_ORTHOGRAPHIC_HALF_HEIGHT, MAX_RADIANCE, RenderSettings, SceneError, load_confined_image,
-    load_image,
+    MAX_ORTHOGRAPHIC_HALF_HEIGHT, MAX_RADIANCE, RenderSettings, SceneError, ThinLens,
+    load_confined_image, load_image,
 };
 
 /// Default image width in pixels.
@@ -102,12 +102,38 @@ pub fn camera(source: &Source<'_>, raw: Option<Spanned<RawCamera>>) -> Result<Ca
             Some(half_height)
         }
     };
+    let lens = match (raw.aperture_radius, raw.focus_distance) {
+        (None, None) => None,
+        (None, Some(_)) => {
+            return Err(item.fail(
+                "focus_distance needs aperture_radius: a pinhole camera has everything in focus",
+            ));
+        }
+        (Some(_), _) if orthographic_half_height.is_some() => {
+            return Err(item.fail(
+                "aperture_radius (a thin lens) needs a pinhole camera, not an orthographic one",
+            ));
+        }
+        (Some(aperture_radius), focus_distance) => {
+            let lens = ThinLens {
+                aperture_radius: item.number("aperture_radius", aperture_radius)?,
+                focus_distance: focus_distance
+                    .map(|d| item.number("focus_distance", d))
+                    .transpose()?,
+            };
+            if let Some(problem) = lens.problem() {
+                return Err(item.fail(problem));
+            }
+            Some(lens)
+        }
+    };
     Ok(Camera {
         eye,
         look_at,
         up,
         fov_y_degrees,
         orthographic_half_height,
+        lens,
     })
 }
 

@@ -30,6 +30,7 @@ pub fn default_camera(bounds: Option<(DVec3, DVec3)>, aspect: f64) -> Camera {
             up: DVec3::Y,
             fov_y_degrees: DEFAULT_FOV_Y_DEGREES,
             orthographic_half_height: None,
+            lens: None,
         };
     };
     let aspect = if aspect.is_finite() && aspect > 0.0 {
@@ -57,6 +58,7 @@ pub fn default_camera(bounds: Option<(DVec3, DVec3)>, aspect: f64) -> Camera {
         up: DVec3::Y,
         fov_y_degrees: DEFAULT_FOV_Y_DEGREES,
         orthographic_half_height: None,
+        lens: None,
     }
 }
 

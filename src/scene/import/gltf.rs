@@ -1545,6 +1545,7 @@ impl Importer<'_> {
                 up,
                 fov_y_degrees,
                 orthographic_half_height: orthographic,
+                lens: None,
             },
             aspect_ratio,
         });

@@ -178,6 +178,7 @@ fn million_triangle_scene() -> gpu_render::scene::Scene {
             up: DVec3::Y,
             fov_y_degrees: 55.0,
             orthographic_half_height: None,
+            lens: None,
         },
         environment: Environment {
             background: DVec3::new(0.35, 0.45, 0.6),

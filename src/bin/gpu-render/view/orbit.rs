@@ -90,6 +90,7 @@ mod tests {
             up: DVec3::Y,
             fov_y_degrees: 45.0,
             orthographic_half_height: None,
+            lens: None,
         }
     }
 
