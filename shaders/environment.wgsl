@@ -74,11 +74,37 @@ fn environment_texel_radiance(texel: u32) -> vec3<f32> {
     return c * environment.header.scale;
 }
 
+// The radiance at map coordinates `uv`: the map interpolated bilinearly with Mitsuba
+// 3's envmap convention (column i's centre at u = (i + 1/2)/width, wrapping around;
+// row j at v = j/(height - 1)). Twin of EnvironmentMap::radiance_at and Bilinear::at.
+fn environment_radiance_at(uv: vec2<f32>) -> vec3<f32> {
+    let w = environment.header.width;
+    let h = environment.header.height;
+    let shifted = uv.x - 0.5 / f32(w);
+    let x = (shifted - floor(shifted)) * f32(w);
+    let x0 = min(u32(x), w - 1u);
+    let x1 = select(x0 + 1u, 0u, x0 + 1u == w);
+    let wx = clamp(x - f32(x0), 0.0, 1.0);
+    var y0 = 0u;
+    var y1 = 0u;
+    var wy = 0.0;
+    if h >= 2u {
+        let y = clamp(uv.y, 0.0, 1.0) * f32(h - 1u);
+        y0 = min(u32(y), h - 2u);
+        y1 = y0 + 1u;
+        wy = clamp(y - f32(y0), 0.0, 1.0);
+    }
+    let top = environment_texel_radiance(y0 * w + x0) * (1.0 - wx)
+        + environment_texel_radiance(y0 * w + x1) * wx;
+    let bottom = environment_texel_radiance(y1 * w + x0) * (1.0 - wx)
+        + environment_texel_radiance(y1 * w + x1) * wx;
+    return top * (1.0 - wy) + bottom * wy;
+}
+
 // The radiance seen looking along the unit world direction `d`. Twin of
 // EnvironmentMap::radiance.
 fn environment_radiance(d: vec3<f32>) -> vec3<f32> {
-    let uv = environment_direction_to_uv(environment_to_local(d));
-    return environment_texel_radiance(environment_texel_at(uv));
+    return environment_radiance_at(environment_direction_to_uv(environment_to_local(d)));
 }
 
 // Where the sampling function f, the conditional CDFs and the marginal CDF begin in
@@ -154,7 +180,7 @@ fn environment_sample(u: vec2<f32>) -> EnvironmentSample {
     }
     sample.wi = environment_to_world(environment_uv_to_direction(vec2<f32>(column.x, row.x)));
     sample.pdf = pdf_uv / (2.0 * PI * PI * sin_theta);
-    sample.radiance = environment_texel_radiance(texel);
+    sample.radiance = environment_radiance_at(vec2<f32>(column.x, row.x));
     sample.found = true;
     return sample;
 }

@@ -7,21 +7,17 @@ with `rotation` and `scale`, as Mitsuba's `envmap` emitter.
 Mapping (docs/path-tracing.md, "Environment maps"): our direction-to-(u, v)
 convention is Mitsuba's envmap's, u = atan2(x, -z) / 2pi, v = acos(y) / pi, and our
 `rotation` (degrees about +y, right-handed) is its `to_world` rotate([0, 1, 0],
-rotation). Our map is looked up per texel (nearest); Mitsuba's envmap interpolates
-bilinearly between texels. So that the two images agree, the map is given to
-Mitsuba enlarged 8 times by texel replication: Mitsuba's interpolation then blends
-only across a band about one enlarged texel wide (1/8 of one of ours) along each of
-our texel edges (smooth in our sky except at the sun's rim). The remaining
-difference on the directly seen sky, at most 0.15%, is measured and allowed for by
-tests/integration/environment_reference.rs. The larger map is a temporary file; only the render
-is committed.
+rotation). Both look the map up bilinearly with Mitsuba's texel convention (column i's
+centre at u = (i + 1/2)/width, wrapping; row j at v = j/(height - 1)), so the map is
+given to Mitsuba as it is. (Until gpu-render interpolated, the map went to Mitsuba
+enlarged 8 times by texel replication, to approximate a nearest lookup.)
 
 Run from the repository root (tested with mitsuba 3.6.4):
 
     python3 -m venv /tmp/mi-venv && /tmp/mi-venv/bin/pip install mitsuba==3.6.4 numpy
     /tmp/mi-venv/bin/python scripts/mitsuba/environment_reference.py \\
         tests/fixtures/mitsuba/env-lambert.toml tests/fixtures/mitsuba/env-lambert-48.exr \\
-        --size 48 --spp 32768
+        --size 48 --spp 65536
 """
 
 import argparse
@@ -36,21 +32,16 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import path_reference  # noqa: E402  (sets the scalar_rgb variant)
 
-# How many times the map is enlarged (texel replication) for Mitsuba.
-ENLARGE = 8
-
-
 def environment_emitter(scene_path, environment, work):
-    """The envmap emitter of `[environment]`, its map enlarged into `work`."""
+    """The envmap emitter of `[environment]`, its map (as RGB float) written into `work`."""
     unknown = set(environment) - {"map", "rotation", "scale", "ambient"}
     if unknown:
         path_reference.fail(f"[environment]: {sorted(unknown)} not supported")
     source = os.path.join(os.path.dirname(scene_path), environment["map"])
     texels = np.array(mi.Bitmap(source).convert(mi.Bitmap.PixelFormat.RGB,
                                                 mi.Struct.Type.Float32, False))
-    large = np.repeat(np.repeat(texels, ENLARGE, axis=0), ENLARGE, axis=1)
     path = os.path.join(work, "map.exr")
-    mi.Bitmap(large.astype(np.float32)).write(path)
+    mi.Bitmap(texels.astype(np.float32)).write(path)
     scale = environment.get("scale", 1.0)
     if isinstance(scale, list):
         if len(set(scale)) != 1:

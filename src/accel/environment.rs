@@ -9,9 +9,12 @@
 //! `PiecewiseConstant2D`, Pharr, Jakob and Humphreys, *Physically Based Rendering*, 4th
 //! ed., §A.5; pbrt-v3 §13.6.7 and §14.2.4 for its use on a latitude-longitude map): a
 //! marginal distribution over the rows and one conditional distribution per row over
-//! its texels, of the function `f(x, y) = luminance(texel · scale) · sin θ_y`, `θ_y =
-//! π (y + ½) / height` the row's polar angle. Weighting by `sin θ` makes the density
-//! proportional to the radiance per solid angle: a point `(u, v)` drawn with density
+//! its cells (`⌊u·width⌋`, `⌊v·height⌋`), of the function `f(x, y) = max luminance ·
+//! sin θ_y`, `θ_y = π (y + ½) / height` the row's polar angle, the maximum taken over
+//! the texels (times the scale) that the map's bilinear lookup blends anywhere in the
+//! cell ([`cell_texels`]): so the density is positive wherever the radiance is, and
+//! next-event estimation alone finds all the light. Weighting by `sin θ` makes the
+//! density follow the radiance per solid angle: a point `(u, v)` drawn with density
 //! `p(u, v) = f / ∫f` has the direction density `p(ω) = p(u, v) / (2π² sin θ)` (the
 //! Jacobian of `(u, v) ↦ ω`, `dω = 2π² sin θ du dv`).
 
@@ -117,14 +120,25 @@ impl EnvironmentLight {
     /// The light of `map`, in a scene with area lights or without.
     pub fn new(map: Arc<EnvironmentMap>, has_area_lights: bool) -> Self {
         let (w, h) = (map.image.width, map.image.height);
+        let texel_luminance: Vec<f64> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                let t = map.image.texel(x, y);
+                let c = DVec3::new(f64::from(t[0]), f64::from(t[1]), f64::from(t[2]));
+                luminance(c * map.scale)
+            })
+            .collect();
         let conditional: Vec<Distribution1D> = (0..h)
             .map(|y| {
                 let sin_theta = (PI * (f64::from(y) + 0.5) / f64::from(h)).sin();
                 let row = (0..w)
                     .map(|x| {
-                        let t = map.image.texel(x, y);
-                        let c = DVec3::new(f64::from(t[0]), f64::from(t[1]), f64::from(t[2]));
-                        let f = luminance(c * map.scale) * sin_theta;
+                        let (columns, rows) = cell_texels(x, y, w, h);
+                        let brightest = rows
+                            .flat_map(|r| columns.map(|c| (r * w + c) as usize))
+                            .map(|i| texel_luminance[i])
+                            .fold(0.0, f64::max);
+                        let f = brightest * sin_theta;
                         if f.is_finite() { f.max(0.0) } else { 0.0 }
                     })
                     .collect();
@@ -161,9 +175,7 @@ impl EnvironmentLight {
         if !(sin_theta > 0.0 && pdf_uv > 0.0) {
             return None;
         }
-        let t = self.map.image.texel(column as u32, row as u32);
-        let radiance =
-            DVec3::new(f64::from(t[0]), f64::from(t[1]), f64::from(t[2])) * self.map.scale;
+        let radiance = self.map.radiance_at(DVec2::new(u, v));
         Some(EnvironmentSample {
             wi: self.map.to_world(uv_to_direction(DVec2::new(u, v))),
             pdf: pdf_uv / (2.0 * PI * PI * sin_theta),
@@ -192,6 +204,27 @@ impl EnvironmentLight {
     }
 }
 
+/// The columns and rows of the texels that the map's bilinear lookup
+/// ([`crate::scene::Bilinear`]) blends somewhere in sampling cell (`x`, `y`) of a
+/// `width × height` map: columns `x − 1`, `x`, `x + 1` (wrapping around; the cell spans
+/// half a texel either side of column `x`'s centre), and the rows whose span
+/// `v·(height − 1)` over the cell's `v` reaches, a row either side included.
+pub fn cell_texels(
+    x: u32,
+    y: u32,
+    width: u32,
+    height: u32,
+) -> ([u32; 3], std::ops::RangeInclusive<u32>) {
+    let columns = [(x + width - 1) % width, x, (x + 1) % width];
+    if height < 2 {
+        return (columns, 0..=0);
+    }
+    let to_row = |v: f64| v * f64::from(height - 1);
+    let top = to_row(f64::from(y) / f64::from(height)).floor() as u32;
+    let bottom = to_row(f64::from(y + 1) / f64::from(height)).floor() as u32 + 1;
+    (columns, top.min(height - 2)..=bottom.min(height - 1))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -215,6 +248,42 @@ mod tests {
         assert_eq!(light.pdf(DVec3::X), 0.0);
         // Its tables are uniform, not NaN.
         assert!(light.marginal.cdf.iter().all(|c| c.is_finite()));
+    }
+
+    #[test]
+    fn the_density_is_positive_wherever_the_interpolated_radiance_is() {
+        // One lit texel in a dark map, at every position of a 5 × 4 and a 3 × 1 map:
+        // its bilinear footprint reaches into neighbouring cells, which must be
+        // sampled too.
+        for (w, h) in [(5u32, 4u32), (3, 1), (1, 3)] {
+            for lit in 0..w * h {
+                let mut texels = vec![[0.0, 0.0, 0.0, 1.0]; (w * h) as usize];
+                texels[lit as usize] = [1.0, 1.0, 1.0, 1.0];
+                let map = EnvironmentMap {
+                    image: Image {
+                        path: "dot.exr".into(),
+                        width: w,
+                        height: h,
+                        texels,
+                    },
+                    rotation_degrees: 0.0,
+                    scale: DVec3::ONE,
+                };
+                let light = EnvironmentLight::new(Arc::new(map), false);
+                for i in 0..97 {
+                    for j in 1..60 {
+                        let uv = DVec2::new(f64::from(i) / 97.0, f64::from(j) / 60.0);
+                        if light.map.radiance_at(uv).x > 0.0 {
+                            let wi = light.map.to_world(uv_to_direction(uv));
+                            assert!(
+                                light.pdf(wi) > 0.0,
+                                "{w}x{h}, texel {lit} lit: radiance at {uv} but density 0"
+                            );
+                        }
+                    }
+                }
+            }
+        }
     }
 
     #[test]

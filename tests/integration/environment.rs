@@ -143,16 +143,17 @@ fn a_lambert_sphere_under_a_uniform_sky_converges_to_rho_times_l() {
     }
 }
 
-/// Whitted's tracer sees the map as the background, texel by texel (here a map whose
-/// left and right halves differ, unrotated: the camera looks along −z, u = 0, so the
-/// image's left half sees u < 0 → the map's right edge). No light reaches the sphere
-/// but the ambient term, which stays as it is.
+/// Whitted's tracer sees the map as the background, interpolated bilinearly between
+/// texel centres as Mitsuba's `envmap` does (here a map whose column 0 differs from the
+/// rest, unrotated: the camera looks along −z, u = 0, between the last column's centre
+/// at u = 7/8 and the first's at u = 1/8). No light reaches the sphere but the ambient
+/// term, which stays as it is.
 #[test]
 fn whitted_sees_the_map_as_the_background() {
+    let columns = [2.0, 0.5, 0.5, 0.5];
     let mut image = uniform_map(4, 2, 0.0);
     for (i, texel) in image.texels.iter_mut().enumerate() {
-        // Columns 0 and 3 (u in [0, 1/4) and [3/4, 1), either side of −z).
-        let value = if i % 4 == 0 { 2.0 } else { 0.5 };
+        let value = columns[i % 4] as f32;
         *texel = [value, value, value, 1.0];
     }
     let map = EnvironmentMap {
@@ -161,13 +162,37 @@ fn whitted_sees_the_map_as_the_background() {
         scale: DVec3::ONE,
     };
     let mut scene = sphere_under(map, 0.5, Integrator::Whitted, 2);
+    // One sample: through each pixel's centre.
+    scene.render.samples_per_pixel = 1;
     scene.environment.ambient = DVec3::splat(0.2);
     let rendered = gpu_render::cpu::render(&scene, None).image;
     let pixel = |x: usize, y: usize| f64::from(rendered.pixels[y * 16 + x][1]);
-    // Top-left corner: left of −z (u just below 1, column 3); top-right: right of it
-    // (u just above 0, column 0).
-    assert!((pixel(0, 0) - 0.5).abs() < 1e-6, "{}", pixel(0, 0));
-    assert!((pixel(15, 0) - 2.0).abs() < 1e-6, "{}", pixel(15, 0));
+    // The map along each corner pixel's centre ray, interpolated here from the
+    // columns: x = frac(u − 1/8)·4 between columns ⌊x⌋ and ⌊x⌋ + 1 (wrapping).
+    let frame = gpu_render::low_level::camera::CameraFrame::new(&scene.camera, 16, 16);
+    let expected = |px: f64, py: f64| {
+        let d = frame.ray_direction(px, py, 16, 16);
+        let u = d.x.atan2(-d.z) / (2.0 * std::f64::consts::PI);
+        let shifted = u - 0.125;
+        let x = (shifted - shifted.floor()) * 4.0;
+        let (i, t) = (x.floor() as usize % 4, x - x.floor());
+        columns[i] * (1.0 - t) + columns[(i + 1) % 4] * t
+    };
+    // Top-left corner: left of −z (u just below 1); top-right: right of it (u just
+    // above 0); both between column 3 and column 0, nearer the middle than either.
+    for (x, y) in [(0usize, 0usize), (15, 0)] {
+        let want = expected(x as f64 + 0.5, y as f64 + 0.5);
+        assert!(want > 0.6 && want < 1.9, "corner ({x}, {y}) expects {want}");
+        assert!(
+            (pixel(x, y) - want).abs() < 1e-6,
+            "({x}, {y}): {} for {want}",
+            pixel(x, y)
+        );
+    }
+    assert!(
+        pixel(15, 0) > pixel(0, 0),
+        "the right corner is nearer column 0"
+    );
     // The sphere's centre: albedo × ambient only.
     assert!((pixel(8, 8) - 0.1).abs() < 1e-6, "{}", pixel(8, 8));
 }

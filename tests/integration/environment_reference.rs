@@ -6,16 +6,17 @@
 //! `tests/fixtures/mitsuba/env-lambert-48.exr`), and here with 1,024.
 //!
 //! The tolerance is that of `tests/integration/path_reference.rs`, per pixel and channel: `z =
-//! (ours − reference) / sqrt(s²/n + s²/n_ref + b²)` with `s²` our pixel's sample
-//! variance; at most 0.5% of the values may have |z| > 4, and each channel's image
-//! mean must agree within 4 of its standard error and within 0.5%. One model
-//! difference is known and bounded: Mitsuba interpolates its (8 times enlarged) map
-//! bilinearly where we look up texels, which shifts the sky seen directly by up to
-//! 0.15% (measured on the 840 sky values whose pixel lies inside one texel, where our
-//! estimate has no variance at all). So for pixels whose centre ray escapes, `b` is
-//! [`INTERPOLATION`] times the reference (0 elsewhere), and a background value without
-//! variance must agree within `b`. The measured figures are in docs/path-tracing.md
-//! and BENCHMARKS.md.
+//! (ours − reference) / sqrt(s²/n + s²/n_ref)` with `s²` our pixel's sample variance;
+//! at most 0.5% of the values may have |z| > 4, and each channel's image mean must
+//! agree within 4 of its standard error and within 0.5%. Both renderers look the map up
+//! bilinearly with Mitsuba's texel convention, so the map goes to Mitsuba as it is and
+//! no model difference is allowed for (until the lookups were bilinear here, the
+//! script enlarged the map 8 times and the sky seen directly needed a 0.2% allowance).
+//! The sky seen directly, smooth across a pixel, leaves our estimate almost no
+//! variance, so there `b =` [`ROUNDING`] times the reference is added to σ in
+//! quadrature (Mitsuba's `f32` film: measured at most 0.023% apart on the rows of pure
+//! sky), and a value without variance must agree within `b`. The measured figures are
+//! in docs/path-tracing.md and BENCHMARKS.md.
 
 use std::path::Path;
 
@@ -28,9 +29,10 @@ const WIDTH: u32 = 48;
 const HEIGHT: u32 = 27;
 const SAMPLES: u32 = 1024;
 const REFERENCE_SAMPLES: f64 = 65_536.0;
-/// The relative difference allowed, in quadrature, on the background seen directly
-/// for Mitsuba's bilinear lookup of the map (measured at most 0.154%).
-const INTERPOLATION: f64 = 0.002;
+/// The relative difference allowed, in quadrature, on the sky seen directly, which
+/// only rounding (Mitsuba's `f32` film) separates from the reference: measured at most
+/// 2.3e-4 on the rows of pure sky.
+const ROUNDING: f64 = 5e-4;
 
 #[test]
 fn an_environment_lit_scene_agrees_with_mitsuba_within_its_statistical_error() {
@@ -68,18 +70,12 @@ fn an_environment_lit_scene_agrees_with_mitsuba_within_its_statistical_error() {
             gathered.our_total[c] += mean[c];
             gathered.reference_total[c] += expected;
             gathered.total_variance[c] += statistical;
-            let b = if background {
-                INTERPOLATION * expected
-            } else {
-                0.0
-            };
+            let b = if background { ROUNDING * expected } else { 0.0 };
             if statistical > 0.0 {
                 gathered
                     .z_values
                     .push((mean[c] - expected) / (statistical + b * b).sqrt());
             } else {
-                // The sky seen inside one texel: no variance, so only the lookup
-                // differs.
                 assert!(
                     background && (mean[c] - expected).abs() <= b,
                     "pixel {i} channel {c}: {} against {expected} with no variance",
