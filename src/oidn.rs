@@ -63,7 +63,7 @@ pub enum OidnError {
         /// Each file tried, and why opening it failed.
         attempts: Vec<LoadAttempt>,
         /// What to do about it.
-        hint: &'static str,
+        hint: String,
     },
     /// A library was opened but lacks a function of the OIDN 2 C API (an OIDN 1 or
     /// another library of the same name).
@@ -230,8 +230,10 @@ impl Oidn {
             Some(dir) if !dir.is_empty() => Self::load_from_dir(Path::new(&dir)),
             _ => Self::load_candidates(
                 LIBRARY_NAMES.iter().map(PathBuf::from).collect(),
-                "install it (scripts/lib.sh's ensure_oidn installs the pyoidn wheel's copy) \
-                 and set OIDN_DIR to the folder whose lib/ holds it",
+                "OIDN_DIR is not set and the system's library path has none; install Open \
+                 Image Denoise 2 (scripts/lib.sh's ensure_oidn installs the pyoidn wheel's \
+                 copy) and set OIDN_DIR to the folder whose lib/ holds it"
+                    .to_owned(),
             ),
         }
     }
@@ -242,12 +244,15 @@ impl Oidn {
         let folder = dir.join(LIBRARY_FOLDER);
         Self::load_candidates(
             LIBRARY_NAMES.iter().map(|name| folder.join(name)).collect(),
-            "OIDN_DIR must name the folder whose lib/ holds the library \
-             (scripts/lib.sh's ensure_oidn installs the pyoidn wheel's copy)",
+            format!(
+                "{} must be the folder whose {LIBRARY_FOLDER}/ holds the library (as OIDN_DIR \
+                 names it; scripts/lib.sh's ensure_oidn installs the pyoidn wheel's copy)",
+                dir.display()
+            ),
         )
     }
 
-    fn load_candidates(candidates: Vec<PathBuf>, hint: &'static str) -> Result<Self, OidnError> {
+    fn load_candidates(candidates: Vec<PathBuf>, hint: String) -> Result<Self, OidnError> {
         let mut attempts = Vec::new();
         for path in candidates {
             // SAFETY: loading runs the library's initialisers; OIDN's are sound to
@@ -260,10 +265,13 @@ impl Oidn {
                     let api = Api::resolve(library, &path)?;
                     return Self::with_device(api, path);
                 }
-                Err(error) => attempts.push(LoadAttempt {
-                    path,
-                    error: error.to_string(),
-                }),
+                Err(error) => {
+                    // dlerror's message starts with the path; say it once.
+                    let message = error.to_string();
+                    let prefix = format!("{}: ", path.display());
+                    let error = message.strip_prefix(&prefix).unwrap_or(&message).to_owned();
+                    attempts.push(LoadAttempt { path, error })
+                }
             }
         }
         Err(OidnError::NotFound { attempts, hint })
