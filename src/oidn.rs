@@ -491,8 +491,8 @@ fn error_of(api: &Api, device: Handle, stage: &'static str) -> Option<OidnError>
 }
 
 /// Loads OIDN ([`Oidn::load`]) and denoises `radiance` with it ([`Oidn::denoise`]):
-/// for one image; keep an [`Oidn`] to denoise many (loading and committing the device
-/// cost tens of milliseconds).
+/// for one image; keep an [`Oidn`] to denoise many (it loads the library and commits
+/// its device once).
 pub fn denoise(
     radiance: &[[f32; 3]],
     guides: &GuidePasses,
