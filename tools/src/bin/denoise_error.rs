@@ -32,8 +32,8 @@ use gpu_render::cpu::PreparedScene;
 use gpu_render::cpu::intersect::Ray;
 use gpu_render::cpu::path::path_radiance;
 use gpu_render::gpu::{AdapterChoice, HeadlessGpu, Renderer, RendererOptions};
-use gpu_render::low_level::denoise::{DenoiseSettings, denoise};
 use gpu_render::low_level::denoise::GuidePasses;
+use gpu_render::low_level::denoise::{DenoiseSettings, denoise};
 use gpu_render::scene::{Integrator, RenderOverrides, RenderSettings, Scene, load_scene};
 
 /// Where the reference's sample indices start.
