@@ -36,7 +36,7 @@ use gpu_render::scene::{
 };
 use gpu_render::tiles::{Fingerprint, PixelWindow, Tile, TileInfo, tile_window};
 
-use crate::args::{AdapterArg, AovList, BackendArg, Cli, RenderArgs, SettingsArgs};
+use crate::args::{AdapterArg, AovList, BackendArg, Cli, DenoiserArg, RenderArgs, SettingsArgs};
 use crate::backend::{Backend, Denoiser, Frame, GpuOptions};
 use crate::memory::{BackendKind, Estimate};
 use crate::progress::Progress;
@@ -255,6 +255,7 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
         window.as_ref(),
         gpu_options.noise,
         gpu_options.aov,
+        args.denoise == Some(DenoiserArg::Oidn),
         args.max_memory,
     )?;
     let piece_name = window.as_ref().map(|window| match args.tile {
@@ -502,6 +503,7 @@ fn check_memory(
     window: Option<&PixelWindow>,
     noise: bool,
     aov: bool,
+    oidn: bool,
     max_memory_gib: f64,
 ) -> Result<()> {
     let kind = match backend {
@@ -517,6 +519,9 @@ fn check_memory(
     }
     if aov {
         estimate = estimate.with_aov();
+    }
+    if oidn {
+        estimate = estimate.with_oidn();
     }
     let cap = max_memory_gib * f64::from(1u32 << 30);
     if estimate.total as f64 > cap {
