@@ -10,8 +10,9 @@
 
 use crate::color::luminance;
 
-/// Intel Open Image Denoise, loaded at run time (feature `oidn`): the alternative
-/// to this module's filter, guided by the same albedo and normal passes.
+// Intel Open Image Denoise, loaded at run time (feature `oidn`): the alternative to
+// this module's filter, guided by the same albedo and normal passes. Documented by its
+// own `//!` (an outer doc here would make its links resolve from this module).
 #[cfg(feature = "oidn")]
 #[path = "oidn.rs"]
 pub mod oidn;
