@@ -342,6 +342,19 @@ mod with_the_feature {
         );
     }
 
+    #[test]
+    fn a_file_that_is_not_a_library_is_named_with_the_loaders_reason() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        std::fs::create_dir(dir.path().join("lib")).expect("lib/");
+        let file = dir.path().join("lib").join("libOpenImageDenoise.so.2");
+        std::fs::write(&file, "not a shared library\n".repeat(200)).expect("write");
+        let error = Oidn::load_from_dir(dir.path()).expect_err("not a library");
+        let message = error.to_string();
+        for needle in [file.to_string_lossy().as_ref(), "ELF"] {
+            assert!(message.contains(needle), "lacks {needle:?}: {message}");
+        }
+    }
+
     /// OIDN's buffers count toward --max-memory: a full-HD render that fits in 1 GiB
     /// with the built-in filter (0.42 GiB estimated) does not with OIDN (1.45 GiB; 1.29
     /// GiB measured), and is refused before rendering.
