@@ -5,6 +5,8 @@
 #   ensure_rust_components  rustfmt and clippy (rustup component add) if missing
 #   ensure_parallel   install GNU parallel (the recipe test runs it) if it is missing
 #   ensure_xvfb       install Xvfb (the viewer's window tests start it) if it is missing
+#   ensure_oidn       Intel Open Image Denoise (the pyoidn wheel's copy) in .oidn/, and
+#                     OIDN_DIR naming it, for the `oidn` feature (x86-64 Linux)
 #   setup_gpu_env     XDG_RUNTIME_DIR and WGPU_BACKEND defaults for headless wgpu
 #   section TITLE     print a section header
 
@@ -135,6 +137,55 @@ ensure_rust_components() {
             return 1
         fi
     fi
+}
+
+# Intel Open Image Denoise for the `oidn` feature (`--denoise oidn`), which opens the
+# library at run time from $OIDN_DIR/lib. OIDN's own release packages come from GitHub;
+# the pyoidn wheel on PyPI bundles the same library (2.5.1, with its TBB), so pip
+# installs it, pinned by hash, into the project's git-ignored .oidn/ and OIDN_DIR is
+# exported as its pyoidn/oidn folder. The wheel's GPU device modules (CUDA, HIP, SYCL and
+# their runtimes, 100 MB of 170) and programs are removed: the binding uses the CPU
+# device. LD_LIBRARY_PATH is left alone: the library is opened by path and finds its
+# own dependencies through its RPATH ($ORIGIN). Returns 1 (with a message) where pip or
+# the wheel is not available; the caller decides whether that is fatal.
+OIDN_WHEEL="pyoidn==2.5.1.0"
+OIDN_WHEEL_SHA256=32ad13368f8de1ef63001942ad05b02a00cd732d1206d97f352d3a3f606d823e
+ensure_oidn() {
+    local root dir
+    root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+    dir="$root/.oidn/pyoidn/oidn"
+    if [ ! -e "$dir/lib/libOpenImageDenoise.so.2" ]; then
+        if [ "$(uname -s)-$(uname -m)" != "Linux-x86_64" ]; then
+            echo "error: ensure_oidn installs the pyoidn wheel, built for x86-64 Linux only; install Open Image Denoise 2 and set OIDN_DIR" >&2
+            return 1
+        fi
+        if ! python3 -m pip --version >/dev/null 2>&1; then
+            echo "installing pip (python3-pip), to fetch the pyoidn wheel"
+            if ! { command -v apt-get >/dev/null 2>&1 &&
+                as_root apt-get update -qq &&
+                as_root env DEBIAN_FRONTEND=noninteractive \
+                    apt-get install -y -qq --no-install-recommends python3-pip; }; then
+                echo "error: ensure_oidn needs pip (python3 -m pip) to install the pyoidn wheel" >&2
+                return 1
+            fi
+        fi
+        echo "installing Intel Open Image Denoise ($OIDN_WHEEL) into $root/.oidn"
+        rm -rf "$root/.oidn"
+        local requirements
+        requirements="$(mktemp)"
+        printf '%s --hash=sha256:%s\n' "$OIDN_WHEEL" "$OIDN_WHEEL_SHA256" >"$requirements"
+        if ! python3 -m pip install --quiet --disable-pip-version-check --root-user-action=ignore --no-deps \
+            --only-binary=:all: --require-hashes --target "$root/.oidn" -r "$requirements"; then
+            rm -f "$requirements"
+            echo "error: could not install $OIDN_WHEEL with pip" >&2
+            return 1
+        fi
+        rm -f "$requirements"
+        rm -rf "$dir/bin" "$dir/lib/cmake" "$dir"/lib/libOpenImageDenoise_device_{cuda,hip,sycl}* \
+            "$dir"/lib/libsycl* "$dir"/lib/libur_* "$dir"/lib/libumf*
+    fi
+    export OIDN_DIR="$dir"
+    echo "OIDN_DIR=$OIDN_DIR"
 }
 
 # Headless wgpu wants a runtime directory and, by default here, Vulkan.

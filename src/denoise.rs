@@ -10,6 +10,13 @@
 
 use crate::color::luminance;
 
+// Intel Open Image Denoise, loaded at run time (feature `oidn`): the alternative to
+// this module's filter, guided by the same albedo and normal passes. Documented by its
+// own `//!` (an outer doc here would make its links resolve from this module).
+#[cfg(feature = "oidn")]
+#[path = "oidn.rs"]
+pub mod oidn;
+
 /// The auxiliary passes of a render that guide the filter, `width × height` each,
 /// row-major, top row first.
 #[derive(Debug, Clone, PartialEq)]

@@ -12,6 +12,7 @@ mod bxdf_plausibility;
 mod cli;
 mod corpus;
 mod denoise;
+mod denoise_oidn;
 mod display_pass;
 mod emissive_texture;
 mod environment;

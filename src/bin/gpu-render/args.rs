@@ -488,12 +488,21 @@ pub struct RenderArgs {
     )]
     pub aov: Option<AovList>,
 
-    /// Denoise the image with the built-in edge-avoiding à-trous filter, guided by the
-    /// first-hit albedo, normal and depth and by each pixel's noise estimate (on the
-    /// backend that renders). For the path integrator: Whitted images have no noise
-    /// to remove, and are refused.
-    #[arg(long, conflicts_with = "compare_gamma")]
-    pub denoise: bool,
+    /// Denoise the image: `builtin` (the default, plain `--denoise`) with the
+    /// edge-avoiding à-trous filter, guided by the first-hit albedo, normal and depth
+    /// and by each pixel's noise estimate (on the backend that renders); `oidn` with
+    /// Intel Open Image Denoise (a build with the `oidn` feature, and the library
+    /// where OIDN_DIR names it, README "Intel Open Image Denoise"), guided by the
+    /// albedo and normal, on the CPU. For the path integrator: Whitted images have no
+    /// noise to remove, and are refused.
+    #[arg(
+        long,
+        value_name = "DENOISER",
+        num_args = 0..=1,
+        default_missing_value = "builtin",
+        conflicts_with = "compare_gamma"
+    )]
+    pub denoise: Option<DenoiserArg>,
 
     /// Where and how to trace.
     #[command(flatten)]
@@ -807,6 +816,15 @@ impl From<LightingArg> for LightingSpace {
             LightingArg::NaiveGamma => LightingSpace::NaiveGamma,
         }
     }
+}
+
+/// `--denoise`: which denoiser.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DenoiserArg {
+    /// The built-in edge-avoiding à-trous filter (GPU, or its CPU twin).
+    Builtin,
+    /// Intel Open Image Denoise (feature `oidn`; the library loaded at run time).
+    Oidn,
 }
 
 /// `--backend` values.

@@ -12,8 +12,44 @@ use gpu_render::low_level::noise::NoiseEstimate;
 use gpu_render::scene::{Integrator, Scene};
 use gpu_render::tiles::PixelWindow;
 
-use crate::args::{AdapterArg, BackendArg};
+use crate::args::{AdapterArg, BackendArg, DenoiserArg};
 use crate::pipeline_cache::PipelineCacheFile;
+
+/// The denoiser `--denoise` chose, ready to run.
+pub enum Denoiser {
+    /// The built-in à-trous filter (GPU, or its CPU twin).
+    Builtin,
+    /// Intel Open Image Denoise, loaded.
+    #[cfg(feature = "oidn")]
+    Oidn(denoise::oidn::Oidn),
+}
+
+impl Denoiser {
+    /// Readies the denoiser `arg` names: loads OIDN (where `OIDN_DIR` says, see
+    /// `gpu_render::low_level::denoise::oidn`) for `oidn`, or says that this build
+    /// has no OIDN.
+    pub fn open(arg: DenoiserArg) -> Result<Self> {
+        match arg {
+            DenoiserArg::Builtin => Ok(Self::Builtin),
+            #[cfg(feature = "oidn")]
+            DenoiserArg::Oidn => Ok(Self::Oidn(
+                denoise::oidn::Oidn::load().context("--denoise oidn")?,
+            )),
+            #[cfg(not(feature = "oidn"))]
+            DenoiserArg::Oidn => bail!(
+                "--denoise oidn: this gpu-render was built without the `oidn` feature (Intel \
+                 Open Image Denoise); rebuild it with `cargo build --release --features oidn` \
+                 (README, \"Intel Open Image Denoise\"), or use --denoise builtin"
+            ),
+        }
+    }
+
+    /// Whether the render must estimate each pixel's noise for this denoiser (the
+    /// built-in filter weighs by it; OIDN does not use it).
+    pub fn needs_noise(&self) -> bool {
+        matches!(self, Self::Builtin)
+    }
+}
 
 /// A render as the command line needs it: both images and the statistics.
 pub struct Frame {
@@ -257,11 +293,38 @@ impl Backend {
         }
     }
 
-    /// The image of `frame` (rendered with noise estimate and auxiliary passes)
-    /// denoised by the built-in filter, on the GPU where `frame` was rendered there.
-    pub fn denoise(&self, frame: &Frame) -> Result<LinearImage> {
-        let (Some(noise), Some(guides)) = (&frame.noise, &frame.aov) else {
-            bail!("the backend returned no noise estimate or auxiliary passes to denoise with");
+    /// The image of `frame` (rendered with the auxiliary passes, and the noise
+    /// estimate for the built-in filter) denoised by `denoiser`: the built-in filter
+    /// on the GPU where `frame` was rendered there, OIDN on the CPU.
+    pub fn denoise(&self, frame: &Frame, denoiser: &Denoiser) -> Result<LinearImage> {
+        let Some(guides) = &frame.aov else {
+            bail!("the backend returned no auxiliary passes to denoise with");
+        };
+        let radiance = || -> Vec<[f32; 3]> {
+            frame
+                .image
+                .pixels
+                .iter()
+                .map(|p| [p[0], p[1], p[2]])
+                .collect()
+        };
+        let image = |denoised: Vec<[f32; 3]>| LinearImage {
+            width: frame.image.width,
+            height: frame.image.height,
+            pixels: denoised.iter().map(|p| [p[0], p[1], p[2], 1.0]).collect(),
+        };
+        match denoiser {
+            Denoiser::Builtin => {}
+            #[cfg(feature = "oidn")]
+            Denoiser::Oidn(oidn) => {
+                let denoised = oidn
+                    .denoise(&radiance(), guides, &denoise::oidn::OidnSettings::default())
+                    .context("--denoise oidn")?;
+                return Ok(image(denoised));
+            }
+        }
+        let Some(noise) = &frame.noise else {
+            bail!("the backend returned no noise estimate to denoise with");
         };
         let variance: Vec<f32> = noise.standard_error.iter().map(|se| se * se).collect();
         let settings = DenoiseSettings::default();
@@ -276,20 +339,12 @@ impl Backend {
                     &settings,
                 )
                 .context("GPU denoising failed"),
-            Backend::Cpu { .. } => {
-                let radiance: Vec<[f32; 3]> = frame
-                    .image
-                    .pixels
-                    .iter()
-                    .map(|p| [p[0], p[1], p[2]])
-                    .collect();
-                let denoised = denoise::denoise(&radiance, &variance, guides, &settings);
-                Ok(LinearImage {
-                    width: frame.image.width,
-                    height: frame.image.height,
-                    pixels: denoised.iter().map(|p| [p[0], p[1], p[2], 1.0]).collect(),
-                })
-            }
+            Backend::Cpu { .. } => Ok(image(denoise::denoise(
+                &radiance(),
+                &variance,
+                guides,
+                &settings,
+            ))),
         }
     }
 

@@ -36,8 +36,8 @@ use gpu_render::scene::{
 };
 use gpu_render::tiles::{Fingerprint, PixelWindow, Tile, TileInfo, tile_window};
 
-use crate::args::{AdapterArg, AovList, BackendArg, Cli, RenderArgs, SettingsArgs};
-use crate::backend::{Backend, Frame, GpuOptions};
+use crate::args::{AdapterArg, AovList, BackendArg, Cli, DenoiserArg, RenderArgs, SettingsArgs};
+use crate::backend::{Backend, Denoiser, Frame, GpuOptions};
 use crate::memory::{BackendKind, Estimate};
 use crate::progress::Progress;
 use crate::summary::Summary;
@@ -153,9 +153,12 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
             output_pattern.display()
         );
     }
-    if args.denoise && piece {
+    if args.denoise.is_some() && piece {
         bail!("--denoise filters a whole image; it cannot be used with --tile or --crop");
     }
+    // Before the scene is read: a build without OIDN, or a library that is not there,
+    // fails at once rather than after the render.
+    let denoiser = args.denoise.map(Denoiser::open).transpose()?;
     if args.aov.is_some() && piece {
         bail!(
             "--aov writes layers of a whole image's EXR; it cannot be used with --tile or --crop"
@@ -222,7 +225,7 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
         .map(|pattern| standard_error_path(pattern, frame, tile, &output_path, scene_path, &scene))
         .transpose()?;
     check_inputs_survive(&output_path, scene_path, &scene)?;
-    if args.denoise && scene.render.integrator == Integrator::Whitted {
+    if args.denoise.is_some() && scene.render.integrator == Integrator::Whitted {
         bail!(
             "{}: --denoise removes the noise of path tracing, and the scene uses the Whitted integrator, whose images have none; render with integrator = \"path\" (or --integrator path), or without --denoise",
             scene_path.display()
@@ -233,8 +236,9 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
     let gpu_options = GpuOptions {
         iteration_budget: args.device.iteration_budget,
         timeout: args.device.gpu_timeout,
-        noise: standard_error_path.is_some() || args.denoise,
-        aov: args.aov.is_some() || args.denoise,
+        noise: standard_error_path.is_some()
+            || denoiser.as_ref().is_some_and(Denoiser::needs_noise),
+        aov: args.aov.is_some() || denoiser.is_some(),
     };
     let backend = Backend::open(
         args.device.backend,
@@ -251,6 +255,7 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
         window.as_ref(),
         gpu_options.noise,
         gpu_options.aov,
+        args.denoise == Some(DenoiserArg::Oidn),
         args.max_memory,
     )?;
     let piece_name = window.as_ref().map(|window| match args.tile {
@@ -280,8 +285,8 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
         render_pass(&backend, &scene, None, args.quiet)?
     };
     let mut rendered = rendered;
-    if args.denoise {
-        let denoised = backend.denoise(&rendered)?;
+    if let Some(denoiser) = &denoiser {
+        let denoised = backend.denoise(&rendered, denoiser)?;
         rendered.display_rgba8 = denoised.to_display_rgba8(scene.display_encodes_srgb());
         rendered.image = denoised;
     }
@@ -498,6 +503,7 @@ fn check_memory(
     window: Option<&PixelWindow>,
     noise: bool,
     aov: bool,
+    oidn: bool,
     max_memory_gib: f64,
 ) -> Result<()> {
     let kind = match backend {
@@ -513,6 +519,9 @@ fn check_memory(
     }
     if aov {
         estimate = estimate.with_aov();
+    }
+    if oidn {
+        estimate = estimate.with_oidn();
     }
     let cap = max_memory_gib * f64::from(1u32 << 30);
     if estimate.total as f64 > cap {

@@ -70,6 +70,13 @@ fn noise_bytes_per_pixel(backend: BackendKind) -> u64 {
 /// encoder's copy of the channels with its compressed blocks (56).
 const AOV_BYTES_PER_PIXEL: u64 = 148;
 
+/// Bytes per pixel `--denoise oidn` adds: OIDN's own buffers for its network (its CPU
+/// device, no tiling below its memory limit) and the binding's copies of the colour,
+/// albedo, normal and output images (48). Measured (Cornell box, 1 spp, CPU backend,
+/// growth of the peak over an `--aov` render from 960x540 to 1920x1080, OIDN 2.5.1,
+/// 2026-12-04): 572; its fixed part (the library, its weights) about 8 MB.
+const OIDN_BYTES_PER_PIXEL: u64 = 576;
+
 /// An estimate of a render's peak memory, with its parts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Estimate {
@@ -124,6 +131,16 @@ impl Estimate {
         Self {
             per_pixel: self.per_pixel + AOV_BYTES_PER_PIXEL,
             total: self.total + self.pixels * AOV_BYTES_PER_PIXEL,
+            ..self
+        }
+    }
+
+    /// The estimate with Intel Open Image Denoise's bytes per pixel added
+    /// (`--denoise oidn`).
+    pub fn with_oidn(self) -> Self {
+        Self {
+            per_pixel: self.per_pixel + OIDN_BYTES_PER_PIXEL,
+            total: self.total + self.pixels * OIDN_BYTES_PER_PIXEL,
             ..self
         }
     }

@@ -1,21 +1,28 @@
-//! Measures the built-in denoiser (issue 29): relative MSE against a converged
-//! reference at 1, 4, 16 and 64 samples per pixel, raw and denoised, on the CPU
-//! reference (the GPU filter equals it per pixel: `tests/integration/denoise.rs`);
-//! and, where a GPU is present, the GPU filter's time per 1920x1080 frame.
+//! Measures the denoisers (issue 29): relative MSE against a converged reference at 1,
+//! 4, 16 and 64 samples per pixel, raw, built-in filter and (built with the `oidn`
+//! feature) Intel Open Image Denoise, on the CPU reference (the GPU filter equals the
+//! built-in one per pixel: `tests/integration/denoise.rs`); and each denoiser's time
+//! per 1920x1080 frame: the built-in GPU filter where a GPU is present, OIDN on the
+//! CPU.
 //!
 //! ```sh
 //! cargo run --release -p gpu-render-tools --bin denoise_error -- [SCENE] [WIDTH] [REFERENCE_SPP]
+//! cargo run --release -p gpu-render-tools --features oidn --bin denoise_error -- ...  # + OIDN (OIDN_DIR)
 //! ```
 //!
-//! Defaults: `scenes/cornell-box.toml` (path integrator), 128 pixels wide (same
-//! aspect), a 2,048-sample reference. The reference draws its path's random numbers
+//! SCENE is a scene file or a model file (.obj, .gltf, .glb, with its own camera and
+//! lights or the defaults, as `gpu-render MODEL` renders it), path traced whatever its
+//! integrator. Defaults: `scenes/cornell-box.toml`, 128 pixels wide (same aspect), a
+//! 2,048-sample reference. The reference draws its path's random numbers
 //! from sample index 2²⁰ on, so that they are not those of the images it judges; its
 //! own relative MSE against the exact image (from its estimated variance) is printed
 //! beside. Relative MSE: the mean over pixels and channels of `(x - r)² / (r² + 0.01)`
 //! (Rousselle, Knaus and Zwicker 2012, as SVGF's evaluation uses it), which keeps dark
 //! pixels from dominating. With `DENOISE_ERROR_WORST` set it also prints, for each spp,
 //! the eight pixels of largest denoised error with their guides (how the albedo edge
-//! stop's need was found).
+//! stop's need was found). OIDN's time per 1920x1080 frame is measured on the 1-spp
+//! image and its passes tiled to that size (its network's cost does not depend on the
+//! content), median of 3 after one warm-up run.
 
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::Instant;
@@ -25,8 +32,9 @@ use gpu_render::cpu::PreparedScene;
 use gpu_render::cpu::intersect::Ray;
 use gpu_render::cpu::path::path_radiance;
 use gpu_render::gpu::{AdapterChoice, HeadlessGpu, Renderer, RendererOptions};
+use gpu_render::low_level::denoise::GuidePasses;
 use gpu_render::low_level::denoise::{DenoiseSettings, denoise};
-use gpu_render::scene::{Integrator, RenderOverrides, Scene, load_scene};
+use gpu_render::scene::{Integrator, RenderOverrides, RenderSettings, Scene, load_scene};
 
 /// Where the reference's sample indices start.
 const REFERENCE_SAMPLE_OFFSET: u32 = 1 << 20;
@@ -127,6 +135,35 @@ fn at(scene: &Scene, width: u32, spp: u32) -> Scene {
     }
 }
 
+/// `radiance` and `guides` repeated to fill `width × height` (for timing only).
+#[cfg_attr(not(feature = "oidn"), allow(dead_code))]
+fn tiled(
+    radiance: &[[f32; 3]],
+    guides: &GuidePasses,
+    width: u32,
+    height: u32,
+) -> (Vec<[f32; 3]>, GuidePasses) {
+    let index = |x: u32, y: u32| ((y % guides.height) * guides.width + x % guides.width) as usize;
+    let mut out = GuidePasses {
+        width,
+        height,
+        albedo: Vec::new(),
+        normal: Vec::new(),
+        depth: Vec::new(),
+    };
+    let mut colour = Vec::new();
+    for y in 0..height {
+        for x in 0..width {
+            let i = index(x, y);
+            colour.push(radiance[i]);
+            out.albedo.push(guides.albedo[i]);
+            out.normal.push(guides.normal[i]);
+            out.depth.push(guides.depth[i]);
+        }
+    }
+    (colour, out)
+}
+
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let path = args
@@ -134,7 +171,18 @@ fn main() -> anyhow::Result<()> {
         .map_or("scenes/cornell-box.toml", String::as_str);
     let width: u32 = args.get(1).map_or(Ok(128), |a| a.parse())?;
     let reference_spp: u32 = args.get(2).map_or(Ok(2048), |a| a.parse())?;
-    let scene = load_scene(std::path::Path::new(path))?;
+    let scene_path = std::path::Path::new(path);
+    let scene = if gpu_render::scene::import::is_model_path(scene_path) {
+        gpu_render::scene::import::import_model(scene_path)?.into_scene(RenderSettings::default())
+    } else {
+        load_scene(scene_path)?
+    };
+    #[cfg(feature = "oidn")]
+    let oidn = gpu_render::low_level::denoise::oidn::Oidn::load()?;
+    #[cfg(feature = "oidn")]
+    let oidn_settings = gpu_render::low_level::denoise::oidn::OidnSettings::default();
+    #[cfg(feature = "oidn")]
+    println!("OIDN {} from {}", oidn.version(), oidn.path().display());
 
     let started = Instant::now();
     let reference_scene = at(&scene, width, reference_spp);
@@ -158,9 +206,14 @@ fn main() -> anyhow::Result<()> {
         reference_scene.render.height,
         started.elapsed().as_secs_f64()
     );
-    println!("| spp | raw relMSE | denoised relMSE | denoise time (CPU) |");
-    println!("|---|---|---|---|");
+    println!(
+        "| spp | raw relMSE | built-in relMSE | OIDN relMSE | built-in time (CPU, one thread) \
+         | OIDN time (CPU) |"
+    );
+    println!("|---|---|---|---|---|---|");
     let settings = DenoiseSettings::default();
+    // The 1-spp image and its passes, for OIDN's full-HD timing.
+    let mut one_spp: Option<(Vec<[f32; 3]>, GuidePasses)> = None;
     for spp in [1, 4, 16, 64] {
         let scene = at(&scene, width, spp);
         let rendered = gpu_render::cpu::render_with_noise(&scene, None);
@@ -203,13 +256,49 @@ fn main() -> anyhow::Result<()> {
                 );
             }
         }
+        #[cfg(feature = "oidn")]
+        let (oidn_error, oidn_time) = {
+            let timer = Instant::now();
+            let denoised = oidn.denoise(&raw, &guides, &oidn_settings)?;
+            let time = timer.elapsed();
+            (
+                format!("{:.4e}", relative_mse(&denoised, &reference)),
+                format!("{:.3} s", time.as_secs_f64()),
+            )
+        };
+        #[cfg(not(feature = "oidn"))]
+        let (oidn_error, oidn_time) = ("(no oidn feature)", "");
         println!(
-            "| {spp} | {:.4e} | {:.4e} | {:.3} s |",
+            "| {spp} | {:.4e} | {:.4e} | {oidn_error} | {:.3} s | {oidn_time} |",
             relative_mse(&raw, &reference),
             relative_mse(&denoised, &reference),
             time.as_secs_f64()
         );
+        if spp == 1 {
+            one_spp = Some((raw, guides));
+        }
     }
+
+    #[cfg(feature = "oidn")]
+    if let Some((raw, guides)) = &one_spp {
+        let (radiance, guides) = tiled(raw, guides, 1920, 1080);
+        let mut times = Vec::new();
+        for _ in 0..4 {
+            let timer = Instant::now();
+            oidn.denoise(&radiance, &guides, &oidn_settings)?;
+            times.push(timer.elapsed().as_secs_f64());
+        }
+        let mut steady = times[1..].to_vec();
+        steady.sort_by(f64::total_cmp);
+        println!(
+            "OIDN (CPU, {} threads), 1920x1080: median {:.3} s per frame (first {:.3} s)",
+            std::thread::available_parallelism().map_or(1, usize::from),
+            steady[steady.len() / 2],
+            times[0]
+        );
+    }
+    #[cfg(not(feature = "oidn"))]
+    let _ = one_spp;
 
     // The GPU filter's time per 1920x1080 frame: a film of one sample of the scene,
     // denoised five times (the filter only, no readback).
