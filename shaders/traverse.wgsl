@@ -33,6 +33,9 @@
 //#if UNROLLED
 #import unrolled_scene
 //#endif
+//#if ALPHA_MASK
+#import texture
+//#endif
 
 // Direction components smaller than this are replaced by it (with their sign; -0
 // counts as positive) before the slab test divides by them: a ray parallel to a slab
@@ -142,12 +145,35 @@ fn resumed_ray(trace: ptr<function, TraceRay>) -> TraversalRay {
     return traversal_ray(world_ray);
 }
 
+//#if ALPHA_MASK
+// Whether the hit of the surface (`prim`, `instance`) at parameter `t` along the
+// world-space `ray` lies where its material's alpha mask cuts the surface out: its
+// alpha (shading_alpha, at the hit record's point and texture coordinates) below the
+// material's alpha_cutoff (glTF 2.0 §3.9.4: opaque where alpha >= alphaCutoff; an
+// opaque material's cutoff is 0). Such a point does not exist for any ray: the
+// traversal looks on. Twin of alpha_cuts_out.
+fn alpha_cuts_out(prim: u32, instance: u32, ray: Ray, t: f32) -> bool {
+    let hit = hit_record_keyed(prim, instance, ray, t);
+    let material = materials[hit.material];
+    if !(material.alpha_cutoff > 0.0) {
+        return false;
+    }
+    return shading_alpha(material, hit.position, hit.normal, hit.uv, hit.uv1) < material.alpha_cutoff;
+}
+//#endif
+
 // Tests primitive `prim` of the tree being walked against the best hit so far with the
-// tie rule (limit_for), and keeps it if it is nearer. Twin of Query::consider.
+// tie rule (limit_for), and keeps it if it is nearer; a hit that its material's alpha
+// mask cuts out (alpha_cuts_out) is not one. Twin of Query::consider.
 fn consider(trace: ptr<function, TraceRay>, prim: u32, ray: TraversalRay) {
     let instance = (*trace).instance;
     let limit = limit_for(prim, instance, (*trace).best_t, (*trace).best_prim, (*trace).best_instance);
     let t = intersect_prim(prim, ray.ray, ray.sheared, limit);
+    //#if ALPHA_MASK
+    if t != NO_HIT && alpha_cuts_out(prim, instance, Ray((*trace).origin, (*trace).direction), t) {
+        return;
+    }
+    //#endif
     if t != NO_HIT {
         (*trace).best_t = t;
         (*trace).best_prim = prim;

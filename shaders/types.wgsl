@@ -212,6 +212,13 @@ struct Material {
     // Wrap modes as u in bits 0-7 and v in bits 8-15.
     normal_wrap: u32,
     normal_scale: f32,
+    // The alpha mask's cutoff (points whose alpha is below it do not exist for any
+    // ray), 0 for an opaque material; the alpha factor multiplying the albedo
+    // texture's texel alpha.
+    alpha_cutoff: f32,
+    alpha: f32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 const UV_SLOT_ALBEDO: u32 = 0u;

@@ -15,6 +15,7 @@ use super::intersect::{
 use crate::accel::{
     Bvh, BvhNode, HitKey, Instance, MAX_BVH_DEPTH, PrimKind, PrimRef, SceneGeometry,
 };
+use crate::texture::shading_alpha;
 
 /// Direction components smaller than this in magnitude are replaced by it (with their
 /// sign) before the slab test divides by them: an exactly parallel ray then gets huge
@@ -94,10 +95,13 @@ impl Query<'_> {
     }
 
     /// Tests the surface `key` with the query's tie rule, `hit` giving its distance
-    /// below a limit.
-    fn consider(&mut self, key: HitKey, hit: impl FnOnce(f64) -> Option<f64>) {
+    /// below a limit; a hit that its material's alpha mask cuts out
+    /// ([`alpha_cuts_out`], at the world ray `world_ray`) is not one.
+    fn consider(&mut self, key: HitKey, world_ray: &Ray, hit: impl FnOnce(f64) -> Option<f64>) {
         self.counts.primitives += 1;
-        if let Some(t) = hit(limit_for(key, self.best_t, self.best)) {
+        if let Some(t) = hit(limit_for(key, self.best_t, self.best))
+            && !alpha_cuts_out(self.geometry, key, world_ray, t)
+        {
             self.best_t = t;
             self.best = Some(key);
         }
@@ -109,7 +113,7 @@ impl Query<'_> {
             self.enter_instance(prim.index(), ray);
         } else {
             let geometry = self.geometry;
-            self.consider(HitKey::world(prim), |limit| {
+            self.consider(HitKey::world(prim), ray, |limit| {
                 intersect_prim(geometry, prim, ray, sheared, limit)
             });
         }
@@ -125,7 +129,7 @@ impl Query<'_> {
         let sheared = shear_ray(&local);
         let id = Some(index as u32);
         self.walk(&mesh.bvh, &local, |query, prim| {
-            query.consider(HitKey { prim, instance: id }, |limit| {
+            query.consider(HitKey { prim, instance: id }, ray, |limit| {
                 intersect_triangle(&sheared, &mesh.triangles[prim.index()].vertices, limit)
             });
         });
@@ -187,6 +191,34 @@ impl Query<'_> {
             };
         }
     }
+}
+
+/// Whether the hit of the surface `key` at parameter `t` along the world-space `ray`
+/// lies where its material's alpha mask cuts the surface out: its alpha
+/// ([`shading_alpha`], at the hit record's point and texture coordinates) below the
+/// mask's cutoff (glTF 2.0 §3.9.4: opaque where alpha >= alphaCutoff). Such a point
+/// does not exist for any ray: the traversal looks on. Twin of `alpha_cuts_out` in
+/// `shaders/traverse.wgsl`.
+pub fn alpha_cuts_out(geometry: &SceneGeometry, key: HitKey, ray: &Ray, t: f64) -> bool {
+    if geometry.alpha_masks.is_empty() {
+        return false;
+    }
+    let material = match key.instance {
+        Some(i) => geometry.instances[i as usize].material,
+        None => geometry.material(key.prim),
+    };
+    let Some(mask) = geometry.alpha_mask(material) else {
+        return false;
+    };
+    let hit = hit_record_keyed(geometry, key, ray, t);
+    let alpha = shading_alpha(
+        &mask.material,
+        mask.texture.as_ref(),
+        hit.position,
+        hit.normal,
+        [hit.uv, hit.uv1],
+    );
+    alpha < mask.cutoff
 }
 
 /// `ray` in the space of `instance`'s mesh: origin and direction through its
@@ -275,7 +307,9 @@ pub fn closest_hit_brute_force(
     let mut best_t = t_max;
     let mut best: Option<HitKey> = None;
     let mut consider = |key: HitKey, hit: &dyn Fn(f64) -> Option<f64>| {
-        if let Some(t) = hit(limit_for(key, best_t, best)) {
+        if let Some(t) = hit(limit_for(key, best_t, best))
+            && !alpha_cuts_out(geometry, key, ray, t)
+        {
             best_t = t;
             best = Some(key);
         }

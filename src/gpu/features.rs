@@ -50,6 +50,11 @@ pub struct ShaderFeatures {
     /// An environment map as the background and, for the path integrator, a light
     /// (`ENVIRONMENT_MAP`, `shaders/environment.wgsl`).
     pub environment_map: bool,
+    /// Alpha masks (`ALPHA_MASK`, glTF's `alphaMode` `MASK`): the traversal skips a
+    /// candidate hit whose alpha is below its material's cutoff (`alpha_cuts_out` in
+    /// `shaders/traverse.wgsl`). Scenes without a mask compile the traversal without
+    /// the test.
+    pub alpha_mask: bool,
     /// The auxiliary passes of the camera rays' first hits (`AOV`,
     /// `shaders/aov.wgsl`): chosen at upload ([`super::RendererOptions::aov`]), never
     /// by [`ShaderFeatures::for_scene`]; a module with it records them only when the
@@ -96,6 +101,7 @@ impl ShaderFeatures {
         instances: true,
         path: true,
         environment_map: true,
+        alpha_mask: true,
         aov: true,
         uniform_records: false,
         refill_lanes: false,
@@ -141,6 +147,9 @@ impl ShaderFeatures {
             instances: crate::accel::instance::has_instances(&scene.meshes),
             path: scene.render.integrator == crate::scene::Integrator::Path,
             environment_map: scene.environment.map.is_some(),
+            alpha_mask: scene.materials.iter().any(|m| {
+                matches!(m.alpha_mode, crate::scene::AlphaMode::Mask { cutoff } if cutoff > 0.0)
+            }),
             aov: false,
             uniform_records: false,
             refill_lanes: false,
@@ -178,7 +187,7 @@ impl ShaderFeatures {
 type FeatureFlag = fn(&ShaderFeatures) -> bool;
 
 /// The name of each feature in the WGSL directives, with the flag it reads.
-const FEATURE_NAMES: [(&str, FeatureFlag); 18] = [
+const FEATURE_NAMES: [(&str, FeatureFlag); 19] = [
     ("SPHERES", |f| f.spheres),
     ("PLANES", |f| f.planes),
     ("POLYGONS", |f| f.polygons),
@@ -194,6 +203,7 @@ const FEATURE_NAMES: [(&str, FeatureFlag); 18] = [
     ("INSTANCES", |f| f.instances),
     ("PATH", |f| f.path),
     ("ENVIRONMENT_MAP", |f| f.environment_map),
+    ("ALPHA_MASK", |f| f.alpha_mask),
     ("AOV", |f| f.aov),
     ("REFILL_LANES", |f| f.refill_lanes),
     ("UNROLLED", |f| f.unrolled.is_some()),

@@ -453,6 +453,17 @@ pub struct GpuMaterial {
     pub normal_wrap: u32,
     /// glTF's `normalTexture.scale`.
     pub normal_scale: f32,
+    /// The alpha mask's cutoff: points whose alpha is below it do not exist for any
+    /// ray ([`crate::scene::AlphaMode::Mask`]); 0 for an opaque material, which keeps
+    /// every point.
+    pub alpha_cutoff: f32,
+    /// The alpha factor ([`crate::scene::Material::alpha`]), multiplying the albedo
+    /// texture's texel alpha.
+    pub alpha: f32,
+    /// Padding to the record's 16-byte alignment.
+    pub _pad0: u32,
+    /// Padding to the record's 16-byte alignment.
+    pub _pad1: u32,
 }
 
 /// [`GpuMaterial::uv_rows`] and [`GpuMaterial::uv_sets`]: the albedo texture.

@@ -21,8 +21,8 @@ use crate::accel::{
 };
 use crate::camera::CameraFrame;
 use crate::scene::{
-    FresnelModel, Image, Light, Material, MaterialKind, MediumStack, MicrofacetDistribution, Scene,
-    TextureMapping, TextureWrap, project_to_plane,
+    AlphaMode, FresnelModel, Image, Light, Material, MaterialKind, MediumStack,
+    MicrofacetDistribution, Scene, TextureMapping, TextureWrap, project_to_plane,
 };
 
 /// Every record list of a scene, ready for upload. The lists hold exactly the scene's
@@ -415,6 +415,13 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
         normal_height,
         normal_wrap: wrap_code(material.normal_wrap[0]) | wrap_code(material.normal_wrap[1]) << 8,
         normal_scale: material.normal_scale as f32,
+        alpha_cutoff: match material.alpha_mode {
+            AlphaMode::Opaque => 0.0,
+            AlphaMode::Mask { cutoff } => cutoff as f32,
+        },
+        alpha: material.alpha as f32,
+        _pad0: 0,
+        _pad1: 0,
     }
 }
 

@@ -321,6 +321,26 @@ impl Default for TextureTransform {
     }
 }
 
+/// How a material's alpha (coverage) is used: glTF 2.0's `alphaMode` (§3.9.4, "Alpha
+/// Coverage"). The alpha of a surface point is [`Material::alpha`] times the albedo
+/// texture's texel alpha (the same lookup as the albedo's, bilinear on the image's own
+/// alpha channel).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum AlphaMode {
+    /// Alpha is ignored: the surface is fully opaque everywhere (glTF's `OPAQUE`).
+    #[default]
+    Opaque,
+    /// glTF's `MASK`: the surface is fully opaque where its alpha is greater than or
+    /// equal to `cutoff`, and does not exist for any ray (camera, reflected, refracted,
+    /// path and shadow rays, the AOV pass) where it is below: both tracers skip such
+    /// a candidate hit inside the traversal and look on for the next one.
+    Mask {
+        /// glTF's `alphaCutoff` (default 0.5), finite and not negative; 0 keeps
+        /// every point.
+        cutoff: f64,
+    },
+}
+
 /// A material. One flat record for all kinds (fields a kind does not use are zero),
 /// which is exactly what the GPU receives.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -414,11 +434,17 @@ pub struct Material {
     /// single-sided surface still reflects, refracts (a closed glass mesh) and casts
     /// shadows as a rasteriser's shadow map would. Default false: both faces show.
     pub cull_back_faces: bool,
+    /// How alpha is used: opaque, or glTF's alpha mask (see [`AlphaMode`]).
+    pub alpha_mode: AlphaMode,
+    /// The alpha factor in [0, 1] (glTF's `baseColorFactor`'s fourth component),
+    /// multiplying the albedo texture's texel alpha; used only by
+    /// [`AlphaMode::Mask`].
+    pub alpha: f64,
 }
 
 impl Material {
-    /// A material of `kind` with every parameter zero except transmittance, `eta` and
-    /// `texture_scale` (1), GGX and exact Fresnel, no images.
+    /// A material of `kind` with every parameter zero except transmittance, `eta`,
+    /// `texture_scale` and `alpha` (1), GGX and exact Fresnel, no images, opaque.
     pub fn blank(kind: MaterialKind) -> Self {
         Self {
             kind,
@@ -456,6 +482,8 @@ impl Material {
             normal_scale: 1.0,
             two_sided: false,
             cull_back_faces: false,
+            alpha_mode: AlphaMode::Opaque,
+            alpha: 1.0,
         }
     }
 

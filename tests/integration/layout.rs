@@ -160,6 +160,10 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 normal_height,
                 normal_wrap,
                 normal_scale,
+                alpha_cutoff,
+                alpha,
+                _pad0,
+                _pad1,
             }),
         ),
         (

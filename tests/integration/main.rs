@@ -33,6 +33,7 @@ mod layering;
 mod layout;
 mod load_time;
 mod material_errors;
+mod model_alpha;
 mod model_shading;
 mod noise;
 mod path_gpu;

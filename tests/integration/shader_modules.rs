@@ -117,13 +117,14 @@ fn feature_sets() -> Vec<ShaderFeatures> {
         instances: false,
         path: false,
         environment_map: false,
+        alpha_mask: false,
         aov: false,
         uniform_records: false,
         refill_lanes: false,
         unrolled: None,
     };
     type Toggle = fn(&mut ShaderFeatures, bool);
-    let toggles: [Toggle; 16] = [
+    let toggles: [Toggle; 17] = [
         |f, v| f.spheres = v,
         |f, v| f.planes = v,
         |f, v| f.polygons = v,
@@ -139,6 +140,7 @@ fn feature_sets() -> Vec<ShaderFeatures> {
         |f, v| f.instances = v,
         |f, v| f.path = v,
         |f, v| f.environment_map = v,
+        |f, v| f.alpha_mask = v,
         |f, v| f.aov = v,
     ];
     let unrolled = UnrolledPrimitives::for_scene(&[0], 1, &[]);

@@ -163,13 +163,14 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         instances: false,
         path: false,
         environment_map: false,
+        alpha_mask: false,
         aov: false,
         uniform_records: false,
         refill_lanes: false,
         unrolled: None,
     };
     type Toggle = fn(&mut ShaderFeatures, bool);
-    let toggles: [Toggle; 16] = [
+    let toggles: [Toggle; 17] = [
         |f, v| f.spheres = v,
         |f, v| f.planes = v,
         |f, v| f.polygons = v,
@@ -185,6 +186,7 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         |f, v| f.instances = v,
         |f, v| f.path = v,
         |f, v| f.environment_map = v,
+        |f, v| f.alpha_mask = v,
         |f, v| f.aov = v,
     ];
     let all = function_names(&ShaderFeatures::ALL).len();
