@@ -13,7 +13,7 @@ fn image_texel(layer: u32, x: u32, y: u32) -> vec3<f32> {
     return textureLoad(images, vec2<u32>(x, y), layer, 0).rgb;
 }
 
-//#if ALPHA_MASK
+//#if ALPHA
 // The alpha of texel (x, y) of layer `layer` (the image's own alpha channel).
 fn image_alpha(layer: u32, x: u32, y: u32) -> f32 {
     return textureLoad(images, vec2<u32>(x, y), layer, 0).a;
@@ -98,7 +98,7 @@ fn sample_texture(layer: u32, width: u32, height: u32, uv: vec2<f32>, wrap: vec2
 }
 //#endif
 
-//#if ALPHA_MASK
+//#if ALPHA
 //#if TEXTURES
 // sample_texture of the alpha channel: the same four texels and weights. Twin of
 // sample_texture_alpha.
@@ -115,7 +115,7 @@ fn sample_texture_alpha(layer: u32, width: u32, height: u32, uv: vec2<f32>, wrap
 //#endif
 //#endif
 
-//#if ALPHA_MASK
+//#if ALPHA
 // The alpha (coverage) at a hit: material.alpha times the albedo texture's alpha at
 // the albedo's coordinates (glTF 2.0 §3.9.4). Twin of shading_alpha (src/texture.rs).
 fn shading_alpha(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, uv1: vec2<f32>) -> f32 {

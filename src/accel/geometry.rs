@@ -166,15 +166,16 @@ impl TriangleAttributes {
     }
 }
 
-/// What the CPU traversal needs to test a material's alpha mask
-/// ([`AlphaMode::Mask`]): the material and its albedo texture, whose alpha channel is
-/// the texture's part of the surface's alpha.
+/// What the CPU traversal needs to find the coverage of a material whose alpha
+/// matters ([`AlphaMode::Mask`] with a positive cutoff, or [`AlphaMode::Blend`]): the
+/// material and its albedo texture, whose alpha channel is the texture's part of the
+/// surface's alpha.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AlphaMask {
     /// The material (its alpha factor, texture coordinates and wrap modes).
     pub material: Material,
-    /// Points whose alpha is below it do not exist for any ray (> 0).
-    pub cutoff: f64,
+    /// Its alpha mode: a mask whose cutoff is above 0, or blending.
+    pub mode: AlphaMode,
     /// The albedo texture, if any.
     pub texture: Option<Image>,
 }
@@ -185,15 +186,14 @@ pub struct AlphaMask {
 pub fn alpha_masks(materials: &[Material], images: &[Image]) -> Vec<Option<AlphaMask>> {
     materials
         .iter()
-        .map(|material| match material.alpha_mode {
-            AlphaMode::Mask { cutoff } if cutoff > 0.0 => Some(AlphaMask {
+        .map(|material| {
+            material.uses_alpha().then(|| AlphaMask {
                 material: *material,
-                cutoff,
+                mode: material.alpha_mode,
                 texture: material
                     .albedo_texture
                     .and_then(|i| images.get(i as usize).cloned()),
-            }),
-            _ => None,
+            })
         })
         .collect()
 }

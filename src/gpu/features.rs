@@ -11,7 +11,7 @@
 
 use super::cpu_device::unrolled::UnrolledPrimitives;
 use crate::accel::MAX_POLYGON_VERTICES;
-use crate::scene::{MaterialKind, Scene, Shape};
+use crate::scene::{Material, MaterialKind, Scene, Shape};
 
 /// Which optional parts of the trace shader a module contains.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -50,11 +50,12 @@ pub struct ShaderFeatures {
     /// An environment map as the background and, for the path integrator, a light
     /// (`ENVIRONMENT_MAP`, `shaders/environment.wgsl`).
     pub environment_map: bool,
-    /// Alpha masks (`ALPHA_MASK`, glTF's `alphaMode` `MASK`): the traversal skips a
-    /// candidate hit whose alpha is below its material's cutoff (`alpha_cuts_out` in
-    /// `shaders/traverse.wgsl`). Scenes without a mask compile the traversal without
-    /// the test.
-    pub alpha_mask: bool,
+    /// Alpha coverage (`ALPHA`, glTF's `alphaMode` `MASK` and `BLEND`): the
+    /// traversal finds each candidate hit's coverage (`hit_coverage` in
+    /// `shaders/traverse.wgsl`), skipping a mask's points below its cutoff and passing
+    /// blended surfaces as the trace's rule says; the integrators branch at blended
+    /// hits. Scenes whose materials are all opaque compile the kernels without it.
+    pub alpha: bool,
     /// The auxiliary passes of the camera rays' first hits (`AOV`,
     /// `shaders/aov.wgsl`): chosen at upload ([`super::RendererOptions::aov`]), never
     /// by [`ShaderFeatures::for_scene`]; a module with it records them only when the
@@ -101,7 +102,7 @@ impl ShaderFeatures {
         instances: true,
         path: true,
         environment_map: true,
-        alpha_mask: true,
+        alpha: true,
         aov: true,
         uniform_records: false,
         refill_lanes: false,
@@ -147,9 +148,7 @@ impl ShaderFeatures {
             instances: crate::accel::instance::has_instances(&scene.meshes),
             path: scene.render.integrator == crate::scene::Integrator::Path,
             environment_map: scene.environment.map.is_some(),
-            alpha_mask: scene.materials.iter().any(|m| {
-                matches!(m.alpha_mode, crate::scene::AlphaMode::Mask { cutoff } if cutoff > 0.0)
-            }),
+            alpha: scene.materials.iter().any(Material::uses_alpha),
             aov: false,
             uniform_records: false,
             refill_lanes: false,
@@ -203,7 +202,7 @@ const FEATURE_NAMES: [(&str, FeatureFlag); 19] = [
     ("INSTANCES", |f| f.instances),
     ("PATH", |f| f.path),
     ("ENVIRONMENT_MAP", |f| f.environment_map),
-    ("ALPHA_MASK", |f| f.alpha_mask),
+    ("ALPHA", |f| f.alpha),
     ("AOV", |f| f.aov),
     ("REFILL_LANES", |f| f.refill_lanes),
     ("UNROLLED", |f| f.unrolled.is_some()),

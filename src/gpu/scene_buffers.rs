@@ -281,8 +281,8 @@ pub(crate) fn upload_scene(
         && unrolled::preferred(&device.adapter_info())
         && geometry.instances.is_empty()
         && geometry.instanced_meshes.is_empty()
-        // The unrolled test has no alpha masks.
-        && !ShaderFeatures::for_scene(scene).alpha_mask
+        // The unrolled test has no alpha coverage.
+        && !ShaderFeatures::for_scene(scene).alpha
     {
         UnrolledPrimitives::for_scene(&records.bvh_prims, records.planes.len(), &records.polygons)
     } else {

@@ -339,6 +339,17 @@ pub enum AlphaMode {
         /// every point.
         cutoff: f64,
     },
+    /// glTF's `BLEND`: alpha is the fraction of light the surface stops (its
+    /// coverage), `1 − alpha` passes through it unchanged and unbent. The Whitted
+    /// integrator weights the hit's shading by alpha and continues the ray through
+    /// the surface with weight `1 − alpha` (a branch like a dielectric's transmitted
+    /// one, one bounce deeper); its shadow rays carry a transmittance of `1 − alpha`
+    /// per surface they cross. The path integrator makes the choice stochastically
+    /// (stochastic transparency, as Cycles and pbrt-v4 do): every ray, camera,
+    /// bounce or shadow, passes each crossing with probability `1 − alpha`, decided
+    /// inside the traversal by a hash of the ray's sample and the primitive (see
+    /// `docs/models.md`).
+    Blend,
 }
 
 /// A material. One flat record for all kinds (fields a kind does not use are zero),
@@ -434,11 +445,10 @@ pub struct Material {
     /// single-sided surface still reflects, refracts (a closed glass mesh) and casts
     /// shadows as a rasteriser's shadow map would. Default false: both faces show.
     pub cull_back_faces: bool,
-    /// How alpha is used: opaque, or glTF's alpha mask (see [`AlphaMode`]).
+    /// How alpha is used: opaque, masked or blended (see [`AlphaMode`]).
     pub alpha_mode: AlphaMode,
     /// The alpha factor in [0, 1] (glTF's `baseColorFactor`'s fourth component),
-    /// multiplying the albedo texture's texel alpha; used only by
-    /// [`AlphaMode::Mask`].
+    /// multiplying the albedo texture's texel alpha; unused by [`AlphaMode::Opaque`].
     pub alpha: f64,
 }
 
@@ -484,6 +494,16 @@ impl Material {
             cull_back_faces: false,
             alpha_mode: AlphaMode::Opaque,
             alpha: 1.0,
+        }
+    }
+
+    /// Whether the material's alpha matters to the tracers: a mask whose cutoff is
+    /// above 0 (a cutoff of 0 keeps every point), or blending.
+    pub fn uses_alpha(&self) -> bool {
+        match self.alpha_mode {
+            AlphaMode::Opaque => false,
+            AlphaMode::Mask { cutoff } => cutoff > 0.0,
+            AlphaMode::Blend => true,
         }
     }
 

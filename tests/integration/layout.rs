@@ -162,7 +162,7 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 normal_scale,
                 alpha_cutoff,
                 alpha,
-                _pad0,
+                alpha_blend,
                 _pad1,
             }),
         ),
@@ -221,7 +221,11 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 instance,
                 stack_base,
                 world_cursor,
-                world_leaf_end
+                world_leaf_end,
+                blend_seed,
+                transmittance,
+                _pad0,
+                _pad1
             }),
         ),
         (
@@ -424,6 +428,7 @@ fn constants_match() {
         ("WRAP_CLAMP_TO_EDGE", WRAP_CLAMP_TO_EDGE),
         ("NO_ATTRIBUTES", NO_ATTRIBUTES),
         ("NO_IMAGE", NO_IMAGE),
+        ("NO_BLEND_SEED", NO_BLEND_SEED),
         ("LIGHT_POINT", LIGHT_POINT),
         ("LIGHT_DIRECTIONAL", LIGHT_DIRECTIONAL),
         ("LIGHT_SPOT", LIGHT_SPOT),

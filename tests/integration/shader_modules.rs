@@ -117,7 +117,7 @@ fn feature_sets() -> Vec<ShaderFeatures> {
         instances: false,
         path: false,
         environment_map: false,
-        alpha_mask: false,
+        alpha: false,
         aov: false,
         uniform_records: false,
         refill_lanes: false,
@@ -140,7 +140,7 @@ fn feature_sets() -> Vec<ShaderFeatures> {
         |f, v| f.instances = v,
         |f, v| f.path = v,
         |f, v| f.environment_map = v,
-        |f, v| f.alpha_mask = v,
+        |f, v| f.alpha = v,
         |f, v| f.aov = v,
     ];
     let unrolled = UnrolledPrimitives::for_scene(&[0], 1, &[]);
@@ -371,6 +371,7 @@ const WITHOUT_RUST_TWIN: &[(&str, &[&str], &str)] = &[
             "path_consume_shadow_ray",
             "path_start_emitter",
             "path_consume_emitter",
+            "path_blend_seed",
         ],
         "path_radiance's loop body cut at each shadow ray into the wavefront's steps, \
          with the path's random numbers and state in its slot",

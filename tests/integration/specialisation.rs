@@ -163,7 +163,7 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         instances: false,
         path: false,
         environment_map: false,
-        alpha_mask: false,
+        alpha: false,
         aov: false,
         uniform_records: false,
         refill_lanes: false,
@@ -186,7 +186,7 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         |f, v| f.instances = v,
         |f, v| f.path = v,
         |f, v| f.environment_map = v,
-        |f, v| f.alpha_mask = v,
+        |f, v| f.alpha = v,
         |f, v| f.aov = v,
     ];
     let all = function_names(&ShaderFeatures::ALL).len();

@@ -1105,7 +1105,7 @@ impl Importer<'_> {
             self.warn_once(
                 "color alpha",
                 format!(
-                    "{name}: COLOR_0 has alpha below 1, which is ignored (only the base colour's alpha factor and texture are read): the surface is opaque"
+                    "{name}: COLOR_0 has alpha below 1, which is ignored (alpha modes read the base colour's alpha factor and texture only): the surface is opaque"
                 ),
             );
         }
@@ -1225,8 +1225,8 @@ impl Importer<'_> {
             )));
         }
         // glTF 2.0 §3.9.4 "Alpha Coverage": MASK makes the surface opaque where the base
-        // colour's alpha is >= alphaCutoff (default 0.5) and absent elsewhere; OPAQUE
-        // ignores alpha.
+        // colour's alpha is >= alphaCutoff (default 0.5) and absent elsewhere; BLEND
+        // makes alpha its coverage; OPAQUE ignores alpha.
         let alpha_mode = match material.alpha_mode() {
             ::gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
             ::gltf::material::AlphaMode::Mask => {
@@ -1241,12 +1241,7 @@ impl Importer<'_> {
                 };
                 AlphaMode::Mask { cutoff }
             }
-            ::gltf::material::AlphaMode::Blend => {
-                self.warn(format!(
-                    "{name}: alphaMode Blend is not supported (MASK is); the material is opaque"
-                ));
-                AlphaMode::Opaque
-            }
+            ::gltf::material::AlphaMode::Blend => AlphaMode::Blend,
         };
         // occlusionTexture is left out without a warning: baked ambient occlusion is a
         // rasteriser's stand-in for the shadowing of indirect light (glTF 2.0 §3.9.3),
