@@ -54,7 +54,8 @@ pub struct ShaderFeatures {
     /// traversal finds each candidate hit's coverage (`hit_coverage` in
     /// `shaders/traverse.wgsl`), skipping a mask's points below its cutoff and passing
     /// blended surfaces as the trace's rule says; the integrators branch at blended
-    /// hits. Scenes whose materials are all opaque compile the kernels without it.
+    /// hits. Scenes whose materials are all opaque compile the kernels without it, the
+    /// general module too ([`ShaderFeatures::ALL`] leaves it out).
     pub alpha: bool,
     /// The auxiliary passes of the camera rays' first hits (`AOV`,
     /// `shaders/aov.wgsl`): chosen at upload ([`super::RendererOptions::aov`]), never
@@ -84,8 +85,12 @@ pub struct ShaderFeatures {
 }
 
 impl ShaderFeatures {
-    /// Every feature: the general module that renders any scene (with storage buffers
-    /// for the records, which hold scenes of any size).
+    /// Every feature but [`ShaderFeatures::alpha`]: the general module that renders
+    /// any scene (with storage buffers for the records, which hold scenes of any
+    /// size), to which the upload adds `alpha` for a scene whose materials need it
+    /// (the alpha test inlined into every primitive test made lavapipe compile the
+    /// general module's kernels many times slower, and opaque scenes keep the
+    /// kernels they had).
     pub const ALL: Self = Self {
         spheres: true,
         planes: true,
@@ -102,7 +107,7 @@ impl ShaderFeatures {
         instances: true,
         path: true,
         environment_map: true,
-        alpha: true,
+        alpha: false,
         aov: true,
         uniform_records: false,
         refill_lanes: false,

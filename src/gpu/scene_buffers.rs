@@ -306,7 +306,11 @@ pub(crate) fn upload_scene(
             ..if specialise {
                 ShaderFeatures::for_scene(scene)
             } else {
-                ShaderFeatures::ALL
+                // The general module, with the alpha test only where it is needed.
+                ShaderFeatures {
+                    alpha: ShaderFeatures::for_scene(scene).alpha,
+                    ..ShaderFeatures::ALL
+                }
             }
         },
         encode_srgb: scene.display_encodes_srgb(),

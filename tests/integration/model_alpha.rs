@@ -529,3 +529,47 @@ fn the_corpus_clear_coat_test_s_partial_coating_renders_blended() {
         "{differing} pixels differ: more than the coated samples cover"
     );
 }
+
+/// The AOV pass sees what the image's camera ray stops at: on a mask, what lies behind
+/// the cut-out parts; on a blended surface, the surface for the Whitted integrator and
+/// the path integrator's stochastic choice for it, the same on both backends.
+#[test]
+fn the_aov_pass_sees_what_the_camera_ray_stops_at_on_both_backends() {
+    let Some(gpu) = crate::support::gpu::headless_gpu() else {
+        return;
+    };
+    let renderer = crate::support::gpu::renderer_with(
+        &gpu,
+        gpu_render::gpu::RendererOptions {
+            aov: true,
+            ..gpu_render::gpu::RendererOptions::default()
+        },
+    );
+    let blend = blend_scene(Material::lambert(DVec3::ONE), Material::lambert(GREEN));
+    for (label, scene) in [
+        ("mask", checker_scene(AlphaMode::Mask { cutoff: CUTOFF })),
+        ("blend-whitted", blend.clone()),
+        ("blend-path", path_traced(&blend, 4)),
+    ] {
+        let cpu = gpu_render::cpu::aov::render_aovs(&scene);
+        let gpu_aov = renderer
+            .render(&gpu.device, &gpu.queue, &scene, None)
+            .unwrap_or_else(|e| panic!("{label}: GPU render failed: {e}"))
+            .aov
+            .expect("asked for");
+        let outliers = cpu
+            .depth
+            .iter()
+            .zip(&gpu_aov.depth)
+            .filter(|(a, b)| (*a - *b).abs() > 1e-3 + 1e-4 * a.abs())
+            .count();
+        eprintln!(
+            "AOV {label}: {outliers} of {} depths differ",
+            cpu.depth.len()
+        );
+        assert!(
+            outliers <= cpu.depth.len() / 200,
+            "AOV {label}: {outliers} depths differ"
+        );
+    }
+}
