@@ -147,6 +147,11 @@ fn feature_sets() -> Vec<ShaderFeatures> {
     assert!(unrolled.is_some(), "a sphere and a plane are unrolled");
     let mut sets = vec![
         ShaderFeatures::ALL,
+        // Every feature: the general module of a scene with alpha coverage.
+        ShaderFeatures {
+            alpha: true,
+            ..ShaderFeatures::ALL
+        },
         none,
         ShaderFeatures {
             uniform_records: true,
@@ -206,6 +211,10 @@ fn imports_and_uses(
 
 #[test]
 fn each_module_imports_exactly_the_modules_whose_names_it_uses() {
+    let every = ShaderFeatures {
+        alpha: true,
+        ..ShaderFeatures::ALL
+    };
     let mut problems = Vec::new();
     for features in feature_sets() {
         for (name, (imported, used)) in imports_and_uses(&features) {
@@ -213,9 +222,10 @@ fn each_module_imports_exactly_the_modules_whose_names_it_uses() {
             if !missing.is_empty() {
                 problems.push(format!("{name} uses {missing:?} without importing them"));
             }
-            // Every import is used where every feature is on; with fewer, an import
-            // may serve only code the features leave out.
-            if features == ShaderFeatures::ALL {
+            // Every import is used where every feature is on (the general module
+            // with alpha coverage); with fewer, an import may serve only code the
+            // features leave out.
+            if features == every {
                 let unused: Vec<_> = imported.difference(&used).collect();
                 if !unused.is_empty() {
                     problems.push(format!("{name} imports {unused:?} but uses none of it"));
