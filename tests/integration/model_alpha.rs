@@ -2,9 +2,13 @@
 //! `MASK` mode is fully opaque where its alpha (the base colour factor's alpha times the
 //! base colour texture's texel alpha) is greater than or equal to its cutoff, and does
 //! not exist for any ray where it is below: camera rays see what lies behind, shadow
-//! rays pass, the AOV pass records what is behind. Each scene is checked against what
-//! the specification says lands where (probes of the CPU image), then rendered on the
-//! GPU and compared per pixel with the CPU reference, Whitted and path traced.
+//! rays pass, the AOV pass records what is behind. A material in `BLEND` mode stops the
+//! fraction alpha of the light (docs/models.md, "Alpha coverage"): Whitted shows
+//! `alpha·surface + (1 − alpha)·behind` and its shadow rays carry `1 − alpha`, the path
+//! tracer passes the surface with probability `1 − alpha` and converges to the same.
+//! Each scene is checked against what the specification says lands where (probes of
+//! the CPU image), then rendered on the GPU and compared per pixel with the CPU
+//! reference, Whitted and path traced.
 
 use glam::{DMat4, DVec2, DVec3};
 use gpu_render::film::LinearImage as Film;
