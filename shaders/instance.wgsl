@@ -8,8 +8,8 @@
 // A placement of an instanced mesh (twin of accel::Instance), unpacked from the four
 // bvh_nodes records the host stores it in (instance_records in src/gpu/upload.rs):
 // the columns of object_to_world and of world_to_object (the images of x, y and z,
-// then the translation), the root node of its mesh's tree, its material and whether
-// it mirrors.
+// then the translation), the root node of its mesh's tree, its material, whether it
+// mirrors, its index and its mesh's first triangle.
 struct Instance {
     o2w_x: vec3<f32>,
     o2w_y: vec3<f32>,
@@ -22,6 +22,10 @@ struct Instance {
     root: u32,
     material: u32,
     mirrored: bool,
+    // Its index among the scene's instances and its mesh's first triangle in
+    // `triangles`: a hit named as the CPU names it (HitKey).
+    index: u32,
+    first_triangle: u32,
 }
 
 fn load_instance(record: u32) -> Instance {
@@ -30,7 +34,7 @@ fn load_instance(record: u32) -> Instance {
     let c = bvh_nodes[record + 2u];
     let d = bvh_nodes[record + 3u];
     return Instance(a.min, a.max, b.min, b.max, c.min, c.max, d.min, d.max, a.first, a.count,
-                    b.first != 0u);
+                    b.first != 0u, c.first, c.count);
 }
 
 // A mesh-space point in world space.

@@ -35,6 +35,9 @@
 #import slot
 #import area_lights
 #import trace
+//#if ALPHA
+#import traverse
+//#endif
 //#if ENVIRONMENT_MAP
 #import environment
 //#endif
@@ -55,6 +58,21 @@ const DIMENSIONS_PER_BOUNCE: u32 = 8u;
 // PathState.brdf_pdf of a ray that no BRDF sample made (a camera ray, or one after a
 // perfectly specular event): its emission is not weighted.
 const NO_BRDF_PDF: f32 = -1.0;
+
+//#if ALPHA
+// The dimension of a bounce whose hash (blend_seed) seeds its rays' stochastic
+// transparency: roulette's, which uses its top bits directly, while the draws hash it
+// again with each surface (blend_number). Twin of BLEND_DIMENSION.
+const BLEND_DIMENSION: u32 = 7u;
+
+// The stochastic transparency seed of the rays of the path's current bounce. Twin of
+// the `blend` of path_radiance's loop.
+fn path_blend_seed(path: ptr<function, PathState>) -> u32 {
+    let xy = image_position(path);
+    let dimension = 2u + (*path).depth * DIMENSIONS_PER_BOUNCE + BLEND_DIMENSION;
+    return blend_seed(xy.y * frame.width + xy.x, (*path).sample, dimension);
+}
+//#endif
 
 // Random number `k` of the path's current bounce: dimension 2 + 8·depth + k of its
 // sample, for its image pixel (y·width + x).
@@ -471,6 +489,9 @@ fn path_start_emitter(path: ptr<function, PathState>, trace: ptr<function, Trace
     // The environment's sample is visible when its ray hits nothing: any hit will do.
     start_trace(trace, (*path).shadow_origin, sample.wi, bitcast<f32>(0x7f800000u),
                 sample.emitter == ENVIRONMENT_EMITTER);
+    //#if ALPHA
+    (*trace).blend_seed = path_blend_seed(path);
+    //#endif
     (*path).phase = PHASE_EMITTER;
     return true;
 }

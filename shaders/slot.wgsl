@@ -47,7 +47,8 @@ fn trace_in_flight(trace: TraceRay) -> bool {
 // whether anything lies there.
 fn start_trace(trace: ptr<function, TraceRay>, origin: vec3<f32>, direction: vec3<f32>, t_max: f32, any_hit: bool) {
     *trace = TraceRay(origin, t_max, direction, TRACE_PENDING, t_max, NO_PRIM, 0u, NO_NODE,
-                      0u, 0u, u32(any_hit), NO_INSTANCE, NO_INSTANCE, 0u, 0u, 0u);
+                      0u, 0u, u32(any_hit), NO_INSTANCE, NO_INSTANCE, 0u, 0u, 0u,
+                      NO_BLEND_SEED, 1.0, 0u, 0u);
 }
 
 // The image pixel of region pixel `pixel`.

@@ -13,6 +13,13 @@ fn image_texel(layer: u32, x: u32, y: u32) -> vec3<f32> {
     return textureLoad(images, vec2<u32>(x, y), layer, 0).rgb;
 }
 
+//#if ALPHA
+// The alpha of texel (x, y) of layer `layer` (the image's own alpha channel).
+fn image_alpha(layer: u32, x: u32, y: u32) -> f32 {
+    return textureLoad(images, vec2<u32>(x, y), layer, 0).a;
+}
+//#endif
+
 //#if TEXTURES
 struct TangentFrame {
     t: vec3<f32>,
@@ -88,6 +95,39 @@ fn sample_texture(layer: u32, width: u32, height: u32, uv: vec2<f32>, wrap: vec2
     let xs = vec2<u32>(wrap_index(p0.x, width, wrap.x), wrap_index(p0.x + 1.0, width, wrap.x));
     let ys = vec2<u32>(wrap_index(p0.y, height, wrap.y), wrap_index(p0.y + 1.0, height, wrap.y));
     return bilinear(layer, xs, ys, p - p0);
+}
+//#endif
+
+//#if ALPHA
+//#if TEXTURES
+// sample_texture of the alpha channel: the same four texels and weights. Twin of
+// sample_texture_alpha.
+fn sample_texture_alpha(layer: u32, width: u32, height: u32, uv: vec2<f32>, wrap: vec2<u32>) -> f32 {
+    let p = uv * vec2<f32>(f32(width), f32(height)) - 0.5;
+    let p0 = floor(p);
+    let xs = vec2<u32>(wrap_index(p0.x, width, wrap.x), wrap_index(p0.x + 1.0, width, wrap.x));
+    let ys = vec2<u32>(wrap_index(p0.y, height, wrap.y), wrap_index(p0.y + 1.0, height, wrap.y));
+    let f = p - p0;
+    let top = image_alpha(layer, xs.x, ys.x) * (1.0 - f.x) + image_alpha(layer, xs.y, ys.x) * f.x;
+    let bottom = image_alpha(layer, xs.x, ys.y) * (1.0 - f.x) + image_alpha(layer, xs.y, ys.y) * f.x;
+    return top * (1.0 - f.y) + bottom * f.y;
+}
+//#endif
+//#endif
+
+//#if ALPHA
+// The alpha (coverage) at a hit: material.alpha times the albedo texture's alpha at
+// the albedo's coordinates (glTF 2.0 §3.9.4). Twin of shading_alpha (src/texture.rs).
+fn shading_alpha(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, uv1: vec2<f32>) -> f32 {
+    //#if TEXTURES
+    if material.texture_layer != NO_IMAGE {
+        let st = texture_coordinates(material, UV_SLOT_ALBEDO, position, normal, uv, uv1);
+        let wrap = vec2<u32>(material.texture_wrap_u, material.texture_wrap_v);
+        return material.alpha * sample_texture_alpha(material.texture_layer, material.texture_width,
+                                                     material.texture_height, st, wrap);
+    }
+    //#endif
+    return material.alpha;
 }
 //#endif
 

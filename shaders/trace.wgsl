@@ -134,6 +134,14 @@ fn keep_on_side(d: vec3<f32>, side: vec3<f32>) -> vec3<f32> {
 }
 //#endif
 
+//#if ALPHA
+// The alpha of a blended `material` at `hit` (shading_alpha), clamped to [0, 1]: the
+// fraction of light the surface stops. CPU twin: blend_alpha.
+fn blend_alpha(material: Material, hit: Hit) -> f32 {
+    return clamp(shading_alpha(material, hit.position, hit.normal, hit.uv, hit.uv1), 0.0, 1.0);
+}
+//#endif
+
 // Shades the hit (or miss) of the path's current ray, as shade_hit and trace_radiance
 // do on the CPU: a miss adds the background (background_radiance: the environment map
 // or the constant); a hit pushes the refracted, then the
@@ -158,6 +166,21 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
     // Shading happens on the side the ray came from.
     let ng = select(-hit.normal, hit.normal, entering);
     let medium = MediumStack((*path).medium_iors, (*path).medium_depth);
+    //#if ALPHA
+    // A blended surface stops the fraction alpha of the light: its shading and
+    // branches are weighted by alpha, and the ray goes on through it, unbent, with
+    // weight 1 - alpha (one bounce deeper, pushed first so it is traced last).
+    if materials[hit.material].alpha_blend != 0u {
+        let alpha = blend_alpha(materials[hit.material], hit);
+        if alpha < 1.0 && (*path).depth < frame.max_depth {
+            let beyond = select(-hit.normal, hit.normal, dot(ray.direction, hit.normal) > 0.0);
+            push_branch(slot, path, StackEntry(
+                offset_ray_origin(hit.position, beyond, frame.offset_scale), (*path).depth + 1u,
+                ray.direction, medium.depth, (*path).weight * (1.0 - alpha), 0u, medium.iors));
+        }
+        (*path).weight *= alpha;
+    }
+    //#endif
     //#if REFRACTION
     let outside_ior = medium_outside_ior(medium, entering);
     //#else
@@ -213,14 +236,15 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
     }
 }
 
-// Adds the current light's f(wi, wo)·E·cos θi if its shadow ray was unblocked, and
-// moves on to the next light.
+// Adds the current light's f(wi, wo)·E·cos θi times its shadow ray's transmittance
+// if the ray was unblocked, and moves on to the next light.
 fn consume_shadow_ray(path: ptr<function, PathState>, trace: TraceRay) {
-    if trace.best_prim == NO_PRIM {
+    // Blended surfaces the shadow ray passed let through the fraction transmittance.
+    if trace.best_prim == NO_PRIM && trace.transmittance > 0.0 {
         let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal);
         let material = lit_material(path);
         (*path).direct += eval_brdf(material, (*path).normal, sample.wi, -(*path).direction)
-            * sample.irradiance * sample.cos_i;
+            * sample.irradiance * (sample.cos_i * trace.transmittance);
     }
     (*path).light += 1u;
     (*path).phase = PHASE_NEXT_LIGHT;

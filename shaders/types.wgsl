@@ -218,6 +218,14 @@ struct Material {
     // Wrap modes as u in bits 0-7 and v in bits 8-15.
     normal_wrap: u32,
     normal_scale: f32,
+    // The alpha mask's cutoff (points whose alpha is below it do not exist for any
+    // ray), 0 for an opaque material; the alpha factor multiplying the albedo
+    // texture's texel alpha.
+    alpha_cutoff: f32,
+    alpha: f32,
+    // 1 for a blended material, whose alpha is the fraction of light it stops.
+    alpha_blend: u32,
+    _pad1: u32,
 }
 
 const UV_SLOT_ALBEDO: u32 = 0u;
@@ -293,7 +301,17 @@ struct TraceRay {
     stack_base: u32,
     world_cursor: u32,
     world_leaf_end: u32,
+    // Stochastic transparency's seed (the path integrator's rays), or NO_BLEND_SEED:
+    // blended surfaces are then hit by a closest-hit trace and multiply an any-hit
+    // trace's transmittance by 1 - alpha.
+    blend_seed: u32,
+    transmittance: f32,
+    _pad0: u32,
+    _pad1: u32,
 }
+
+// TraceRay.blend_seed of a trace without stochastic transparency.
+const NO_BLEND_SEED: u32 = 0xffffffffu;
 
 // PathState.phase: what a path does next (see shaders/wavefront.wgsl).
 // A zeroed slot, before its first pixel.

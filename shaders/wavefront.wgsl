@@ -47,6 +47,18 @@ fn path_mode() -> bool {
 }
 //#endif
 
+// Gives a trace of the path integrator the stochastic transparency seed of the path's
+// current bounce (path_blend_seed); the Whitted integrator's traces keep none.
+fn seed_blend(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) {
+    //#if ALPHA
+    //#if PATH
+    if path_mode() {
+        (*trace).blend_seed = path_blend_seed(path);
+    }
+    //#endif
+    //#endif
+}
+
 // Shades the finished closest-hit trace of the path's current ray with the trace's
 // integrator.
 fn consume_closest_trace(slot: u32, path: ptr<function, PathState>, trace: TraceRay) {
@@ -97,6 +109,7 @@ fn next_light(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) ->
     }
     (*path).rays += 1u;
     start_trace(trace, (*path).shadow_origin, sample.wi, sample.distance, true);
+    seed_blend(path, trace);
     (*path).phase = PHASE_SHADOW;
     return true;
 }
@@ -122,6 +135,7 @@ fn pop_ray(slot: u32, path: ptr<function, PathState>, trace: ptr<function, Trace
     (*path).medium_iors = entry.medium_iors;
     (*path).rays += 1u;
     start_trace(trace, entry.origin, entry.direction, bitcast<f32>(0x7f800000u), false);
+    seed_blend(path, trace);
     (*path).phase = PHASE_CLOSEST;
     return true;
 }
@@ -146,6 +160,7 @@ fn start_sample(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) 
     (*path).pass_throughs = 0u;
     (*path).rays += 1u;
     start_trace(trace, origin, direction, bitcast<f32>(0x7f800000u), false);
+    seed_blend(path, trace);
     (*path).phase = PHASE_CLOSEST;
 }
 
@@ -247,6 +262,7 @@ fn shade_step(slot: u32, path: ptr<function, PathState>, trace: ptr<function, Tr
         (*path).pass_throughs += 1u;
         (*path).rays += 1u;
         start_trace(trace, (*path).origin, (*path).direction, bitcast<f32>(0x7f800000u), false);
+        seed_blend(path, trace);
         (*path).phase = PHASE_CLOSEST;
     }
     if (*path).phase == PHASE_NEXT_LIGHT {

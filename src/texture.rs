@@ -85,6 +85,26 @@ pub fn wrap_index(i: f64, n: u32, wrap: TextureWrap) -> u32 {
 /// Bilinear lookup at texture coordinates `(u, v)` with the wrap modes `wrap` of the
 /// two axes.
 pub fn sample_texture(image: &Image, u: f64, v: f64, wrap: [TextureWrap; 2]) -> DVec3 {
+    let (xs, ys, fx, fy) = footprint(image, u, v, wrap);
+    bilinear(image, xs, ys, fx, fy)
+}
+
+/// [`sample_texture`] of the alpha channel: the same four texels and weights.
+pub fn sample_texture_alpha(image: &Image, u: f64, v: f64, wrap: [TextureWrap; 2]) -> f64 {
+    let ([xa, xb], [ya, yb], fx, fy) = footprint(image, u, v, wrap);
+    let top = image_alpha(image, xa, ya) * (1.0 - fx) + image_alpha(image, xb, ya) * fx;
+    let bottom = image_alpha(image, xa, yb) * (1.0 - fx) + image_alpha(image, xb, yb) * fx;
+    top * (1.0 - fy) + bottom * fy
+}
+
+/// The four texels a bilinear lookup at `(u, v)` reads (columns, rows) and the
+/// weights `(fx, fy)` of the second of each.
+fn footprint(
+    image: &Image,
+    u: f64,
+    v: f64,
+    wrap: [TextureWrap; 2],
+) -> ([u32; 2], [u32; 2], f64, f64) {
     let (w, h) = (f64::from(image.width), f64::from(image.height));
     let x = u * w - 0.5;
     let y = v * h - 0.5;
@@ -98,7 +118,7 @@ pub fn sample_texture(image: &Image, u: f64, v: f64, wrap: [TextureWrap; 2]) -> 
         wrap_index(y0, image.height, wrap[1]),
         wrap_index(y0 + 1.0, image.height, wrap[1]),
     );
-    bilinear(image, [xa, xb], [ya, yb], fx, fy)
+    ([xa, xb], [ya, yb], fx, fy)
 }
 
 /// The tabulated BRDF `f(θi, θr)` (per channel, in 1/sr) from a square map whose
@@ -119,6 +139,12 @@ pub fn sample_brdf_map(image: &Image, theta_i: f64, theta_r: f64) -> DVec3 {
 pub fn image_texel(image: &Image, x: u32, y: u32) -> DVec3 {
     let t = image.texel(x, y);
     DVec3::new(f64::from(t[0]), f64::from(t[1]), f64::from(t[2]))
+}
+
+/// The alpha of texel (`x`, `y`) of `image` (its own alpha channel: 1 for images
+/// without one).
+pub fn image_alpha(image: &Image, x: u32, y: u32) -> f64 {
+    f64::from(image.texel(x, y)[3])
 }
 
 fn bilinear(image: &Image, xs: [u32; 2], ys: [u32; 2], fx: f64, fy: f64) -> DVec3 {
@@ -283,5 +309,27 @@ pub fn shading_albedo(
             albedo * sample_texture(image, u, v, material.texture_wrap)
         }
         None => albedo,
+    }
+}
+
+/// The alpha (coverage) at a hit at `position` with geometric normal `normal` and mesh
+/// texture coordinates `uvs` (sets 0 and 1): `material.alpha` times the alpha of the
+/// albedo texture `texture` (the material's `albedo_texture`, if any) at the albedo's
+/// coordinates (glTF 2.0 §3.9.4: the base colour's alpha). Vertex colours do not
+/// contribute (their alpha is not kept).
+pub fn shading_alpha(
+    material: &Material,
+    texture: Option<&Image>,
+    position: DVec3,
+    normal: DVec3,
+    uvs: [DVec2; 2],
+) -> f64 {
+    match texture {
+        Some(image) => {
+            let transform = &material.texture_transform;
+            let (u, v) = texture_coordinates(material, transform, position, normal, uvs);
+            material.alpha * sample_texture_alpha(image, u, v, material.texture_wrap)
+        }
+        None => material.alpha,
     }
 }

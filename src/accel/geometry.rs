@@ -5,7 +5,9 @@ use glam::{DVec2, DVec3, DVec4};
 
 use super::bvh::{Aabb32, BuildMethod, Bvh};
 use super::instance::{Instance, InstancedMesh, mesh_groups};
-use crate::scene::{Mesh, PolygonPlane, Scene, Shape, polygon_plane, project_to_plane};
+use crate::scene::{
+    AlphaMode, Image, Material, Mesh, PolygonPlane, Scene, Shape, polygon_plane, project_to_plane,
+};
 
 pub use crate::scene::outline::MAX_POLYGON_VERTICES;
 
@@ -164,6 +166,38 @@ impl TriangleAttributes {
     }
 }
 
+/// What the CPU traversal needs to find the coverage of a material whose alpha
+/// matters ([`AlphaMode::Mask`] with a positive cutoff, or [`AlphaMode::Blend`]): the
+/// material and its albedo texture, whose alpha channel is the texture's part of the
+/// surface's alpha.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AlphaMask {
+    /// The material (its alpha factor, texture coordinates and wrap modes).
+    pub material: Material,
+    /// Its alpha mode: a mask whose cutoff is above 0, or blending.
+    pub mode: AlphaMode,
+    /// The albedo texture, if any.
+    pub texture: Option<Image>,
+}
+
+/// The alpha masks of `materials` (indexed alike; `None` for an opaque material and
+/// for a mask whose cutoff is 0, which keeps every point), their textures from
+/// `images`.
+pub fn alpha_masks(materials: &[Material], images: &[Image]) -> Vec<Option<AlphaMask>> {
+    materials
+        .iter()
+        .map(|material| {
+            material.uses_alpha().then(|| AlphaMask {
+                material: *material,
+                mode: material.alpha_mode,
+                texture: material
+                    .albedo_texture
+                    .and_then(|i| images.get(i as usize).cloned()),
+            })
+        })
+        .collect()
+}
+
 /// A scene's primitives by kind and the BVH over the bounded ones: what both tracers
 /// intersect.
 #[derive(Debug, Clone)]
@@ -196,6 +230,10 @@ pub struct SceneGeometry {
     pub offset_scale: f64,
     /// The hierarchy over spheres, polygons and triangles.
     pub bvh: Bvh,
+    /// The alpha mask of each material, indexed by material (empty: none masks; see
+    /// [`alpha_masks`]): the traversal skips a candidate hit whose alpha is below its
+    /// material's cutoff.
+    pub alpha_masks: Vec<Option<AlphaMask>>,
 }
 
 impl SceneGeometry {
@@ -208,7 +246,12 @@ impl SceneGeometry {
     /// than once is instanced, emissive or not (next-event estimation samples each
     /// instance's triangles, [`super::AreaLights`]).
     pub fn with_method(scene: &Scene, method: BuildMethod) -> Self {
-        Self::from_parts(&scene.shapes, &scene.meshes, method)
+        let mut geometry = Self::from_parts(&scene.shapes, &scene.meshes, method);
+        let masks = alpha_masks(&scene.materials, &scene.images);
+        if masks.iter().any(Option::is_some) {
+            geometry.alpha_masks = masks;
+        }
+        geometry
     }
 
     /// The geometry of `shapes` (validated, as in a [`Scene`]) with a BVH built by
@@ -232,6 +275,7 @@ impl SceneGeometry {
             triangulated_polygons: 0,
             offset_scale: 1.0,
             bvh: Bvh::default(),
+            alpha_masks: Vec::new(),
         };
         let mut large_polygons = Vec::new();
         for shape in shapes {
@@ -448,6 +492,11 @@ impl SceneGeometry {
             PrimKind::Plane => self.planes[prim.index()].material,
             PrimKind::Instance => self.instances[prim.index()].material,
         }
+    }
+
+    /// The alpha mask of material `material`, if it has one.
+    pub fn alpha_mask(&self, material: u32) -> Option<&AlphaMask> {
+        self.alpha_masks.get(material as usize)?.as_ref()
     }
 
     /// The number of bounded primitives (those in the BVH, instances counted once).

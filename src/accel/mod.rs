@@ -35,7 +35,7 @@ pub use brdf_map_cdf::{BrdfMapCdf, BrdfMapCdfs};
 pub use bvh::{BuildMethod, Bvh, BvhNode, BvhStats, MAX_BVH_DEPTH, MAX_LEAF_PRIMITIVES};
 pub use environment::{Distribution1D, ENVIRONMENT_SELECTION, EnvironmentLight, EnvironmentSample};
 pub use geometry::{
-    MAX_PLANES, MAX_POLYGON_VERTICES, PlaneShape, PolygonShape, PrimKind, PrimRef, SceneGeometry,
-    SphereShape, TriangleAttributes, TriangleShape, ray_offset_scale,
+    AlphaMask, MAX_PLANES, MAX_POLYGON_VERTICES, PlaneShape, PolygonShape, PrimKind, PrimRef,
+    SceneGeometry, SphereShape, TriangleAttributes, TriangleShape, alpha_masks, ray_offset_scale,
 };
 pub use instance::{HitKey, Instance, InstanceId, InstancedMesh};

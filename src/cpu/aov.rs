@@ -23,10 +23,11 @@
 use glam::DVec3;
 
 use super::intersect::{MAX_PASS_THROUGHS, Ray, culls_back_face, offset_ray_origin};
+use super::path::bounce_blend;
 use super::trace::{PreparedScene, shading_frame_normal};
-use super::traverse::intersect_scene;
+use super::traverse::{BlendRule, intersect_scene_with};
 use crate::denoise::GuidePasses;
-use crate::scene::{Material, MaterialKind, Scene};
+use crate::scene::{Integrator, Material, MaterialKind, Scene};
 use crate::texture::{mapped_normal, shading_material};
 
 /// What a camera ray's first hit contributes to the auxiliary passes.
@@ -57,11 +58,12 @@ pub fn aov_albedo(material: &Material) -> DVec3 {
 /// A camera ray passes through the back faces of single-sided materials
 /// ([`culls_back_face`]), as the image's does, and the hit is shaded with its vertex
 /// colour, both texture-coordinate sets and its normal map, as the image's is.
-pub fn first_hit_aov(scene: &PreparedScene, ray: &Ray) -> Option<FirstHitAov> {
+/// Blended surfaces stop it as `blend` says: as they stop the image's camera ray.
+pub fn first_hit_aov(scene: &PreparedScene, ray: &Ray, blend: BlendRule) -> Option<FirstHitAov> {
     let mut ray = *ray;
     let mut passes = 0;
     let hit = loop {
-        let hit = intersect_scene(&scene.geometry, &ray, f64::INFINITY)?;
+        let hit = intersect_scene_with(&scene.geometry, &ray, f64::INFINITY, blend)?;
         let record = &scene.materials[hit.material as usize];
         if passes == MAX_PASS_THROUGHS
             || !culls_back_face(record.cull_back_faces, 0, ray.direction, hit.normal)
@@ -116,7 +118,12 @@ pub fn trace_pixel_aov(scene: &PreparedScene, x: u32, y: u32) -> FirstHitAov {
     for index in 0..settings.samples_per_pixel {
         let (dx, dy) = scene.samples.offset(x, y, index);
         let ray = scene.camera_ray(x, y, index, (dx, dy));
-        if let Some(hit) = first_hit_aov(scene, &ray) {
+        // The path integrator's camera ray passes blended surfaces stochastically.
+        let blend = match settings.integrator {
+            Integrator::Path => bounce_blend(y * settings.width + x, index, 0),
+            Integrator::Whitted => BlendRule::Hit,
+        };
+        if let Some(hit) = first_hit_aov(scene, &ray, blend) {
             sum.albedo += hit.albedo;
             sum.normal += hit.normal;
             sum.depth += hit.depth;

@@ -31,7 +31,7 @@ use super::trace::{
     PreparedScene, add_contribution, direct_light, finite_radiance, keep_on_side,
     shading_frame_normal,
 };
-use super::traverse::{intersect_scene, occluded};
+use super::traverse::{BlendRule, blend_seed, intersect_scene_with, transmittance};
 use crate::accel::area_lights::{Emitter, EmitterShape};
 use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight, PrimKind};
 use crate::color::luminance;
@@ -55,6 +55,12 @@ pub const MIN_SURVIVAL: f64 = 0.05;
 /// on the emitter or the map's direction (5, 6) and roulette (7).
 /// Dimensions 0 and 1 of a pixel's sample are its position in the pixel.
 const DIMENSIONS_PER_BOUNCE: u32 = 8;
+
+/// The dimension of a bounce (after its first) whose hash seeds the stochastic
+/// transparency of its rays ([`blend_seed`]): roulette's, which uses the hash's top
+/// bits directly, while each draw hashes it again with the surface
+/// ([`super::traverse::blend_number`]).
+const BLEND_DIMENSION: u32 = 7;
 
 /// The probability that next-event estimation picks the environment map rather than
 /// an area light (0 without a map; [`EnvironmentLight::selection`]).
@@ -180,6 +186,14 @@ fn pdf_brdf(material: &Material, cdfs: &BrdfMapCdfs, n: DVec3, wo: DVec3, wi: DV
     pdf
 }
 
+/// The stochastic transparency ([`BlendRule::Stochastic`]) of the rays of bounce
+/// `depth` (0: the camera ray) of sample `sample` of image pixel `pixel`: seeded by
+/// the hash of the bounce's dimension [`BLEND_DIMENSION`] ([`blend_seed`]).
+pub fn bounce_blend(pixel: u32, sample: u32, depth: u32) -> BlendRule {
+    let dimension = 2 + depth * DIMENSIONS_PER_BOUNCE + BLEND_DIMENSION;
+    BlendRule::Stochastic(blend_seed(pixel, sample, dimension))
+}
+
 /// Radiance along `primary` for sample `sample` of pixel `pixel`, by path tracing.
 /// Returns it and the number of rays traced.
 pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u32) -> (DVec3, u64) {
@@ -199,8 +213,11 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
     loop {
         let first_dimension = 2 + depth * DIMENSIONS_PER_BOUNCE;
         let random = move |k: u32| random_number(pixel, sample, first_dimension + k);
+        // Stochastic transparency: every ray of this bounce passes a blended surface
+        // as the hash of this seed and the surface says.
+        let blend = bounce_blend(pixel, sample, depth);
         rays += 1;
-        let Some(hit) = intersect_scene(geometry, &ray, f64::INFINITY) else {
+        let Some(hit) = intersect_scene_with(geometry, &ray, f64::INFINITY, blend) else {
             // The environment, weighted against next-event estimation where that
             // could have found it.
             let background = match &scene.environment {
@@ -292,7 +309,8 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
             let shadow_origin = offset_ray_origin(lifted, ng, geometry.offset_scale);
             // Point and directional lights: one shadow ray each (delta lights, no MIS).
             for light in &scene.lights {
-                let (lit, traced) = direct_light(scene, light, &material, shadow_origin, n, wo);
+                let (lit, traced) =
+                    direct_light(scene, light, &material, shadow_origin, n, wo, blend);
                 rays += traced;
                 add_contribution(&mut radiance, event_weight * lit);
             }
@@ -312,6 +330,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
                     wo,
                     DVec2::new(random(5), random(6)),
                     continues,
+                    blend,
                 );
                 rays += traced;
                 add_contribution(&mut radiance, event_weight * lit);
@@ -329,6 +348,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
                     wo,
                     DVec2::new(random(5), random(6)),
                     continues,
+                    blend,
                 );
                 rays += traced;
                 add_contribution(&mut radiance, event_weight * lit);
@@ -421,6 +441,7 @@ fn sample_emitter(
     wo: DVec3,
     u: DVec2,
     mis: bool,
+    blend: BlendRule,
 ) -> (DVec3, u64) {
     let (wi, pdf) = match emitter.shape {
         EmitterShape::Sphere { center, radius } => {
@@ -457,10 +478,12 @@ fn sample_emitter(
     };
     // Visible when the first thing the ray meets is the emitter itself, on its
     // emitting side.
-    let Some(light_hit) = intersect_scene(&scene.geometry, &shadow, f64::INFINITY).filter(|hit| {
-        hit.key() == emitter.key
-            && emits_towards(hit, wi, scene.materials[hit.material as usize].two_sided)
-    }) else {
+    let Some(light_hit) = intersect_scene_with(&scene.geometry, &shadow, f64::INFINITY, blend)
+        .filter(|hit| {
+            hit.key() == emitter.key
+                && emits_towards(hit, wi, scene.materials[hit.material as usize].two_sided)
+        })
+    else {
         return (DVec3::ZERO, 1);
     };
     // The radiance of the sampled point: the emitter's own, times its emission texture
@@ -493,6 +516,7 @@ fn sample_environment(
     wo: DVec3,
     u: DVec2,
     mis: bool,
+    blend: BlendRule,
 ) -> (DVec3, u64) {
     let Some(sample) = environment.sample(u) else {
         return (DVec3::ZERO, 0);
@@ -507,7 +531,7 @@ fn sample_environment(
         origin,
         direction: wi,
     };
-    if occluded(&scene.geometry, &shadow, f64::INFINITY) {
+    if transmittance(&scene.geometry, &shadow, f64::INFINITY, blend) <= 0.0 {
         return (DVec3::ZERO, 1);
     }
     (

@@ -10,14 +10,14 @@ use super::intersect::{
     Hit, MAX_PASS_THROUGHS, Ray, culls_back_face, offset_ray_origin, shadow_terminator_point,
 };
 use super::path::path_radiance;
-use super::traverse::{intersect_scene, occluded};
+use super::traverse::{BlendRule, intersect_scene, transmittance};
 use crate::accel::SceneGeometry;
 use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight};
 use crate::camera::{CameraFrame, SamplePattern, lens_sample};
 use crate::noise::luminance_m2_step;
 pub use crate::scene::MediumStack;
-use crate::scene::{Image, Integrator, Light, Material, RenderSettings, Scene};
-use crate::texture::{mapped_normal, shading_material};
+use crate::scene::{AlphaMode, Image, Integrator, Light, Material, RenderSettings, Scene};
+use crate::texture::{mapped_normal, shading_alpha, shading_material};
 
 /// The scene in the form the tracer reads: colours in the lighting space, the geometry
 /// with its BVH, the camera basis.
@@ -262,6 +262,36 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
             });
             continue;
         }
+        // A blended surface stops the fraction alpha of the light: its shading and
+        // branches are weighted by alpha, and the ray goes on through it, unbent,
+        // with weight 1 − alpha (one bounce deeper, pushed first so it is traced
+        // last).
+        let mut entry = entry;
+        if material.alpha_mode == AlphaMode::Blend {
+            let alpha = blend_alpha(scene, material, &hit);
+            if alpha < 1.0 && entry.depth < scene.settings.max_depth {
+                let weight = entry.weight * (1.0 - alpha);
+                if weight.max_element() > cutoff && stack.len() < capacity {
+                    let beyond = if entry.ray.direction.dot(hit.normal) > 0.0 {
+                        hit.normal
+                    } else {
+                        -hit.normal
+                    };
+                    let origin =
+                        offset_ray_origin(hit.position, beyond, scene.geometry.offset_scale);
+                    stack.push(StackEntry {
+                        ray: Ray {
+                            origin,
+                            ..entry.ray
+                        },
+                        weight,
+                        depth: entry.depth + 1,
+                        medium: entry.medium,
+                    });
+                }
+            }
+            entry.weight *= alpha;
+        }
         let shaded = shade_hit(scene, &entry.ray, &hit, &entry.medium);
         add_contribution(&mut radiance, entry.weight * shaded.radiance);
         rays += shaded.shadow_rays;
@@ -288,6 +318,23 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
         }
     }
     (radiance, rays)
+}
+
+/// The alpha of a blended `material` at `hit` ([`shading_alpha`]), clamped to [0, 1]:
+/// the fraction of light the surface stops. Twin of `blend_alpha` in
+/// `shaders/trace.wgsl`.
+pub fn blend_alpha(scene: &PreparedScene, material: &Material, hit: &Hit) -> f64 {
+    let texture = material
+        .albedo_texture
+        .and_then(|i| scene.images.get(i as usize));
+    shading_alpha(
+        material,
+        texture,
+        hit.position,
+        hit.normal,
+        [hit.uv, hit.uv1],
+    )
+    .clamp(0.0, 1.0)
 }
 
 /// What shading one hit produced.
@@ -393,7 +440,15 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumSta
         let lifted = shadow_terminator_point(&scene.geometry, hit, ng);
         let shadow_origin = offset_ray_origin(lifted, ng, scene.geometry.offset_scale);
         for light in &scene.lights {
-            let (lit, traced) = direct_light(scene, light, material, shadow_origin, n, wo);
+            let (lit, traced) = direct_light(
+                scene,
+                light,
+                material,
+                shadow_origin,
+                n,
+                wo,
+                BlendRule::Transmit,
+            );
             direct += lit;
             shadow_rays += traced;
         }
@@ -418,8 +473,9 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumSta
 }
 
 /// Reflected radiance due to one light: `f(wi, wo) · E · cos θ_i` (the BRDF and the
-/// cosine taken about the shading normal `n`) when the shadow ray from `origin` towards
-/// the light is unblocked. Returns it and the number of shadow rays traced (0 when the
+/// cosine taken about the shading normal `n`) times the transmittance of the shadow
+/// ray from `origin` towards the light, whose blended surfaces `blend` treats
+/// ([`transmittance`]: 0 when an opaque surface blocks it). Returns it and the number of shadow rays traced (0 when the
 /// light is below the shading normal). A light below a smooth mesh's flat triangle but
 /// above its shading normal (`ng·wi < 0 < n·wi`, near the shadow terminator) is lit
 /// when its shadow ray, which starts at the lifted point of [`shadow_terminator_point`],
@@ -433,6 +489,7 @@ pub fn direct_light(
     origin: DVec3,
     n: DVec3,
     wo: DVec3,
+    blend: BlendRule,
 ) -> (DVec3, u64) {
     let Some(sample) = sample_light(light, origin, n) else {
         return (DVec3::ZERO, 0);
@@ -441,11 +498,14 @@ pub fn direct_light(
         origin,
         direction: sample.wi,
     };
-    if occluded(&scene.geometry, &shadow, sample.distance) {
+    let passed = transmittance(&scene.geometry, &shadow, sample.distance, blend);
+    if passed <= 0.0 {
         return (DVec3::ZERO, 1);
     }
     (
-        eval_brdf(material, &scene.images, n, sample.wi, wo) * sample.irradiance * sample.cos_i,
+        eval_brdf(material, &scene.images, n, sample.wi, wo)
+            * sample.irradiance
+            * (sample.cos_i * passed),
         1,
     )
 }

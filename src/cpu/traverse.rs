@@ -15,6 +15,9 @@ use super::intersect::{
 use crate::accel::{
     Bvh, BvhNode, HitKey, Instance, MAX_BVH_DEPTH, PrimKind, PrimRef, SceneGeometry,
 };
+use crate::sample::{pcg_hash, unit_from_hash};
+use crate::scene::AlphaMode;
+use crate::texture::shading_alpha;
 
 /// Direction components smaller than this in magnitude are replaced by it (with their
 /// sign) before the slab test divides by them: an exactly parallel ray then gets huge
@@ -83,6 +86,10 @@ impl SlabRay {
 struct Query<'a> {
     geometry: &'a SceneGeometry,
     any_hit: bool,
+    blend: BlendRule,
+    /// The product of `1 − alpha` of the blended surfaces a [`BlendRule::Transmit`]
+    /// query crossed.
+    transmittance: f64,
     best_t: f64,
     best: Option<HitKey>,
     counts: &'a mut TraversalCounts,
@@ -94,10 +101,19 @@ impl Query<'_> {
     }
 
     /// Tests the surface `key` with the query's tie rule, `hit` giving its distance
-    /// below a limit.
-    fn consider(&mut self, key: HitKey, hit: impl FnOnce(f64) -> Option<f64>) {
+    /// below a limit; a hit is kept as [`stops_ray`] says of its coverage
+    /// ([`hit_coverage`], at the world ray `world_ray`).
+    fn consider(&mut self, key: HitKey, world_ray: &Ray, hit: impl FnOnce(f64) -> Option<f64>) {
         self.counts.primitives += 1;
-        if let Some(t) = hit(limit_for(key, self.best_t, self.best)) {
+        if let Some(t) = hit(limit_for(key, self.best_t, self.best))
+            && stops_ray(
+                self.blend,
+                self.any_hit,
+                &mut self.transmittance,
+                key,
+                hit_coverage(self.geometry, key, world_ray, t),
+            )
+        {
             self.best_t = t;
             self.best = Some(key);
         }
@@ -109,7 +125,7 @@ impl Query<'_> {
             self.enter_instance(prim.index(), ray);
         } else {
             let geometry = self.geometry;
-            self.consider(HitKey::world(prim), |limit| {
+            self.consider(HitKey::world(prim), ray, |limit| {
                 intersect_prim(geometry, prim, ray, sheared, limit)
             });
         }
@@ -125,7 +141,7 @@ impl Query<'_> {
         let sheared = shear_ray(&local);
         let id = Some(index as u32);
         self.walk(&mesh.bvh, &local, |query, prim| {
-            query.consider(HitKey { prim, instance: id }, |limit| {
+            query.consider(HitKey { prim, instance: id }, ray, |limit| {
                 intersect_triangle(&sheared, &mesh.triangles[prim.index()].vertices, limit)
             });
         });
@@ -189,6 +205,111 @@ impl Query<'_> {
     }
 }
 
+/// How a query treats the surfaces of [`AlphaMode::Blend`] materials whose alpha lies
+/// strictly between 0 and 1 (alpha 0 is never hit, alpha 1 always).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BlendRule {
+    /// Such a surface is hit like an opaque one: the Whitted integrator's camera and
+    /// secondary rays, which branch there (weight alpha shaded, `1 − alpha` on
+    /// through it), and the AOV pass.
+    Hit,
+    /// An any-hit query passes it, multiplying its transmittance by `1 − alpha`: the
+    /// Whitted integrator's shadow rays.
+    Transmit,
+    /// Stochastic transparency: the ray is stopped with probability alpha, by
+    /// [`blend_number`] of this seed and the surface: every ray of the path
+    /// integrator, whose seed comes from its path's sample ([`blend_seed`]).
+    Stochastic(u32),
+}
+
+/// The fraction of light the hit of the surface `key` at parameter `t` along the
+/// world-space `ray` stops (its coverage): 1 for an opaque material; for a mask
+/// (glTF 2.0 §3.9.4: opaque where alpha >= alphaCutoff) 1 where its alpha
+/// ([`shading_alpha`], at the hit record's point and texture coordinates) reaches the
+/// cutoff and 0 where it is below, so the point does not exist for any ray and the
+/// traversal looks on; for a blended material its alpha. Twin of `hit_coverage` in
+/// `shaders/traverse.wgsl`.
+pub fn hit_coverage(geometry: &SceneGeometry, key: HitKey, ray: &Ray, t: f64) -> f64 {
+    if geometry.alpha_masks.is_empty() {
+        return 1.0;
+    }
+    let material = match key.instance {
+        Some(i) => geometry.instances[i as usize].material,
+        None => geometry.material(key.prim),
+    };
+    let Some(mask) = geometry.alpha_mask(material) else {
+        return 1.0;
+    };
+    let hit = hit_record_keyed(geometry, key, ray, t);
+    let alpha = shading_alpha(
+        &mask.material,
+        mask.texture.as_ref(),
+        hit.position,
+        hit.normal,
+        [hit.uv, hit.uv1],
+    );
+    match mask.mode {
+        AlphaMode::Mask { cutoff } => {
+            if alpha < cutoff {
+                0.0
+            } else {
+                1.0
+            }
+        }
+        _ => alpha,
+    }
+}
+
+/// Whether a candidate hit of the surface `key` whose coverage is `coverage`
+/// ([`hit_coverage`]) stops a query of rule `blend` (an any-hit query if `any_hit`):
+/// never at coverage 0 (or NaN), always at 1; between, per [`BlendRule`], a
+/// transmitting any-hit query multiplying `transmittance` by `1 − coverage`. Twin of
+/// `stops_ray` in `shaders/traverse.wgsl`.
+pub fn stops_ray(
+    blend: BlendRule,
+    any_hit: bool,
+    transmittance: &mut f64,
+    key: HitKey,
+    coverage: f64,
+) -> bool {
+    // NaN stops nothing.
+    if coverage.is_nan() || coverage <= 0.0 {
+        return false;
+    }
+    if coverage >= 1.0 {
+        return true;
+    }
+    match blend {
+        BlendRule::Hit => true,
+        BlendRule::Transmit => {
+            if !any_hit {
+                return true;
+            }
+            *transmittance *= 1.0 - coverage;
+            false
+        }
+        BlendRule::Stochastic(seed) => blend_number(seed, key) < coverage,
+    }
+}
+
+/// The uniform number in [0, 1) that decides whether a stochastic ray of seed `seed`
+/// passes the blended surface `key`: its primitive and instance (`u32::MAX` for the
+/// scene's own) hashed with the seed by [`pcg_hash`]. Twin of `blend_number`.
+pub fn blend_number(seed: u32, key: HitKey) -> f64 {
+    let instance = key.instance.unwrap_or(u32::MAX);
+    unit_from_hash(pcg_hash(seed ^ pcg_hash(key.prim.0 ^ pcg_hash(instance))))
+}
+
+/// The seed of the stochastic transparency of the rays of sample `sample` of image
+/// pixel `pixel` at the path's bounce whose random numbers start at dimension
+/// `dimension`: [`crate::sample::random_number`]'s hash, unreduced (`u32::MAX`, which
+/// the GPU reads as no seed, made 0). Twin of `blend_seed`.
+pub fn blend_seed(pixel: u32, sample: u32, dimension: u32) -> u32 {
+    let seed = pcg_hash(pcg_hash(pcg_hash(pixel) ^ sample) ^ dimension);
+    // u32::MAX means "none" on the GPU (NO_BLEND_SEED).
+    if seed == u32::MAX { 0 } else { seed }
+}
+
 /// `ray` in the space of `instance`'s mesh: origin and direction through its
 /// world-to-object transform, the direction not renormalised, so that a point keeps
 /// its ray parameter (twin: `object_ray` in `shaders/traverse.wgsl`).
@@ -204,18 +325,23 @@ pub fn object_ray(instance: &Instance, ray: &Ray) -> Ray {
 /// the planes, then the tree nearest child first, each leaf's primitives in order
 /// (an instance's mesh traversed in its own space where the leaf names it), each
 /// popped node re-tested against the best hit so far. With `any_hit` the first hit
-/// ends it. Returns the best hit, counting the work into `counts`.
+/// ends it; `blend` says how blended surfaces stop the ray. Returns the best hit and
+/// the transmittance of the blended surfaces passed ([`BlendRule::Transmit`]),
+/// counting the work into `counts`.
 fn traverse(
     geometry: &SceneGeometry,
     ray: &Ray,
     t_max: f64,
     any_hit: bool,
+    blend: BlendRule,
     counts: &mut TraversalCounts,
-) -> Option<(f64, HitKey)> {
+) -> (Option<(f64, HitKey)>, f64) {
     let sheared = shear_ray(ray);
     let mut query = Query {
         geometry,
         any_hit,
+        blend,
+        transmittance: 1.0,
         best_t: t_max,
         best: None,
         counts,
@@ -226,30 +352,45 @@ fn traverse(
     query.walk(&geometry.bvh, ray, |query, prim| {
         query.world_prim(prim, ray, &sheared);
     });
-    query.best.map(|key| (query.best_t, key))
+    (
+        query.best.map(|key| (query.best_t, key)),
+        query.transmittance,
+    )
 }
 
 /// The nearest surface along `ray` in (0, `t_max`) and its distance, counting the
-/// work into `counts`.
+/// work into `counts` (blended surfaces hit, [`BlendRule::Hit`]).
 pub fn closest_hit_counted(
     geometry: &SceneGeometry,
     ray: &Ray,
     t_max: f64,
     counts: &mut TraversalCounts,
 ) -> Option<(f64, HitKey)> {
-    traverse(geometry, ray, t_max, false, counts)
+    traverse(geometry, ray, t_max, false, BlendRule::Hit, counts).0
 }
 
 /// The nearest hit along `ray` in (0, `t_max`), its point re-projected onto the
-/// primitive ([`super::intersect::hit_record_keyed`]).
+/// primitive ([`super::intersect::hit_record_keyed`]); blended surfaces are hit
+/// ([`BlendRule::Hit`]).
 pub fn intersect_scene(geometry: &SceneGeometry, ray: &Ray, t_max: f64) -> Option<Hit> {
+    intersect_scene_with(geometry, ray, t_max, BlendRule::Hit)
+}
+
+/// [`intersect_scene`] with blended surfaces treated by `blend`.
+pub fn intersect_scene_with(
+    geometry: &SceneGeometry,
+    ray: &Ray,
+    t_max: f64,
+    blend: BlendRule,
+) -> Option<Hit> {
     let mut counts = TraversalCounts::default();
-    closest_hit_counted(geometry, ray, t_max, &mut counts)
+    traverse(geometry, ray, t_max, false, blend, &mut counts)
+        .0
         .map(|(t, key)| hit_record_keyed(geometry, key, ray, t))
 }
 
 /// Whether anything lies along `ray` in (0, `t_max`): the shadow-ray query, which
-/// stops at the first hit it finds.
+/// stops at the first hit it finds (blended surfaces included).
 pub fn occluded(geometry: &SceneGeometry, ray: &Ray, t_max: f64) -> bool {
     let mut counts = TraversalCounts::default();
     occluded_counted(geometry, ray, t_max, &mut counts)
@@ -262,7 +403,21 @@ pub fn occluded_counted(
     t_max: f64,
     counts: &mut TraversalCounts,
 ) -> bool {
-    traverse(geometry, ray, t_max, true, counts).is_some()
+    traverse(geometry, ray, t_max, true, BlendRule::Hit, counts)
+        .0
+        .is_some()
+}
+
+/// The fraction of light that passes along `ray` in (0, `t_max`): 0 if an opaque
+/// surface (or, for [`BlendRule::Stochastic`], a blended one that the draw says
+/// stops it) lies there, else the product of `1 − alpha` of the blended surfaces
+/// crossed ([`BlendRule::Transmit`]; 1 for the other rules). The shadow-ray query.
+pub fn transmittance(geometry: &SceneGeometry, ray: &Ray, t_max: f64, blend: BlendRule) -> f64 {
+    let mut counts = TraversalCounts::default();
+    match traverse(geometry, ray, t_max, true, blend, &mut counts) {
+        (Some(_), _) => 0.0,
+        (None, transmittance) => transmittance,
+    }
 }
 
 /// The nearest hit by testing every primitive (every instance's every triangle in its
@@ -275,7 +430,9 @@ pub fn closest_hit_brute_force(
     let mut best_t = t_max;
     let mut best: Option<HitKey> = None;
     let mut consider = |key: HitKey, hit: &dyn Fn(f64) -> Option<f64>| {
-        if let Some(t) = hit(limit_for(key, best_t, best)) {
+        if let Some(t) = hit(limit_for(key, best_t, best))
+            && hit_coverage(geometry, key, ray, t) > 0.0
+        {
             best_t = t;
             best = Some(key);
         }

@@ -11,7 +11,7 @@
 
 use super::cpu_device::unrolled::UnrolledPrimitives;
 use crate::accel::MAX_POLYGON_VERTICES;
-use crate::scene::{MaterialKind, Scene, Shape};
+use crate::scene::{Material, MaterialKind, Scene, Shape};
 
 /// Which optional parts of the trace shader a module contains.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -50,6 +50,13 @@ pub struct ShaderFeatures {
     /// An environment map as the background and, for the path integrator, a light
     /// (`ENVIRONMENT_MAP`, `shaders/environment.wgsl`).
     pub environment_map: bool,
+    /// Alpha coverage (`ALPHA`, glTF's `alphaMode` `MASK` and `BLEND`): the
+    /// traversal finds each candidate hit's coverage (`hit_coverage` in
+    /// `shaders/traverse.wgsl`), skipping a mask's points below its cutoff and passing
+    /// blended surfaces as the trace's rule says; the integrators branch at blended
+    /// hits. Scenes whose materials are all opaque compile the kernels without it, the
+    /// general module too ([`ShaderFeatures::ALL`] leaves it out).
+    pub alpha: bool,
     /// The auxiliary passes of the camera rays' first hits (`AOV`,
     /// `shaders/aov.wgsl`): chosen at upload ([`super::RendererOptions::aov`]), never
     /// by [`ShaderFeatures::for_scene`]; a module with it records them only when the
@@ -78,8 +85,12 @@ pub struct ShaderFeatures {
 }
 
 impl ShaderFeatures {
-    /// Every feature: the general module that renders any scene (with storage buffers
-    /// for the records, which hold scenes of any size).
+    /// Every feature but [`ShaderFeatures::alpha`]: the general module that renders
+    /// any scene (with storage buffers for the records, which hold scenes of any
+    /// size), to which the upload adds `alpha` for a scene whose materials need it
+    /// (the alpha test inlined into every primitive test made lavapipe compile the
+    /// general module's kernels many times slower, and opaque scenes keep the
+    /// kernels they had).
     pub const ALL: Self = Self {
         spheres: true,
         planes: true,
@@ -96,6 +107,7 @@ impl ShaderFeatures {
         instances: true,
         path: true,
         environment_map: true,
+        alpha: false,
         aov: true,
         uniform_records: false,
         refill_lanes: false,
@@ -141,6 +153,7 @@ impl ShaderFeatures {
             instances: crate::accel::instance::has_instances(&scene.meshes),
             path: scene.render.integrator == crate::scene::Integrator::Path,
             environment_map: scene.environment.map.is_some(),
+            alpha: scene.materials.iter().any(Material::uses_alpha),
             aov: false,
             uniform_records: false,
             refill_lanes: false,
@@ -178,7 +191,7 @@ impl ShaderFeatures {
 type FeatureFlag = fn(&ShaderFeatures) -> bool;
 
 /// The name of each feature in the WGSL directives, with the flag it reads.
-const FEATURE_NAMES: [(&str, FeatureFlag); 18] = [
+const FEATURE_NAMES: [(&str, FeatureFlag); 19] = [
     ("SPHERES", |f| f.spheres),
     ("PLANES", |f| f.planes),
     ("POLYGONS", |f| f.polygons),
@@ -194,6 +207,7 @@ const FEATURE_NAMES: [(&str, FeatureFlag); 18] = [
     ("INSTANCES", |f| f.instances),
     ("PATH", |f| f.path),
     ("ENVIRONMENT_MAP", |f| f.environment_map),
+    ("ALPHA", |f| f.alpha),
     ("AOV", |f| f.aov),
     ("REFILL_LANES", |f| f.refill_lanes),
     ("UNROLLED", |f| f.unrolled.is_some()),

@@ -171,7 +171,25 @@ pub struct GpuTraceRay {
     pub world_cursor: u32,
     /// Inside an instance: one past that leaf's last primitive.
     pub world_leaf_end: u32,
+    /// The seed of stochastic transparency (the path integrator's rays,
+    /// [`crate::cpu::traverse::BlendRule::Stochastic`]), or [`NO_BLEND_SEED`]:
+    /// blended surfaces are then hit by a closest-hit trace and transmit light
+    /// through an any-hit one.
+    pub blend_seed: u32,
+    /// With [`NO_BLEND_SEED`], the product of `1 − alpha` of the blended surfaces an
+    /// any-hit trace passed.
+    pub transmittance: f32,
+    /// Padding to the record's 16-byte alignment.
+    pub _pad0: u32,
+    /// Padding to the record's 16-byte alignment.
+    pub _pad1: u32,
 }
+
+/// [`GpuTraceRay::blend_seed`] of a trace without stochastic transparency. A seed
+/// that happens to equal it is taken as none; the path integrator's seeds are hashes
+/// ([`crate::cpu::traverse::blend_seed`]), so its traces avoid it by changing it to 0
+/// (`blend_seed` in `shaders/path.wgsl` and `src/cpu/traverse.rs`).
+pub const NO_BLEND_SEED: u32 = u32::MAX;
 
 /// The state of one slot's path tree between dispatches (`PathState` in WGSL). Only
 /// the shaders read and write it; the host zeroes it (`PHASE_FIRST_PIXEL`).
@@ -462,6 +480,17 @@ pub struct GpuMaterial {
     pub normal_wrap: u32,
     /// glTF's `normalTexture.scale`.
     pub normal_scale: f32,
+    /// The alpha mask's cutoff: points whose alpha is below it do not exist for any
+    /// ray ([`crate::scene::AlphaMode::Mask`]); 0 for an opaque or blended material.
+    pub alpha_cutoff: f32,
+    /// The alpha factor ([`crate::scene::Material::alpha`]), multiplying the albedo
+    /// texture's texel alpha.
+    pub alpha: f32,
+    /// 1 for a blended material ([`crate::scene::AlphaMode::Blend`]), whose alpha is
+    /// the fraction of light it stops.
+    pub alpha_blend: u32,
+    /// Padding to the record's 16-byte alignment.
+    pub _pad1: u32,
 }
 
 /// [`GpuMaterial::uv_rows`] and [`GpuMaterial::uv_sets`]: the albedo texture.

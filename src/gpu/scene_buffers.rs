@@ -281,6 +281,8 @@ pub(crate) fn upload_scene(
         && unrolled::preferred(&device.adapter_info())
         && geometry.instances.is_empty()
         && geometry.instanced_meshes.is_empty()
+        // The unrolled test has no alpha coverage.
+        && !ShaderFeatures::for_scene(scene).alpha
     {
         UnrolledPrimitives::for_scene(&records.bvh_prims, records.planes.len(), &records.polygons)
     } else {
@@ -304,7 +306,11 @@ pub(crate) fn upload_scene(
             ..if specialise {
                 ShaderFeatures::for_scene(scene)
             } else {
-                ShaderFeatures::ALL
+                // The general module, with the alpha test only where it is needed.
+                ShaderFeatures {
+                    alpha: ShaderFeatures::for_scene(scene).alpha,
+                    ..ShaderFeatures::ALL
+                }
             }
         },
         encode_srgb: scene.display_encodes_srgb(),

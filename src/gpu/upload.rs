@@ -21,8 +21,8 @@ use crate::accel::{
 };
 use crate::camera::CameraFrame;
 use crate::scene::{
-    FresnelModel, Image, Light, Material, MaterialKind, MediumStack, MicrofacetDistribution, Scene,
-    TextureMapping, TextureWrap, project_to_plane,
+    AlphaMode, FresnelModel, Image, Light, Material, MaterialKind, MediumStack,
+    MicrofacetDistribution, Scene, TextureMapping, TextureWrap, project_to_plane,
 };
 
 /// Every record list of a scene, ready for upload. The lists hold exactly the scene's
@@ -146,7 +146,7 @@ impl SceneRecords {
             );
             let first_node = index(self.bvh_nodes.len());
             let first_prim = index(self.bvh_prims.len());
-            roots.push(first_node);
+            roots.push((first_node, first_triangle));
             self.bvh_nodes
                 .extend(mesh.bvh.nodes.iter().map(|n| BvhNode {
                     first: n.first + if n.is_leaf() { first_prim } else { first_node },
@@ -160,9 +160,10 @@ impl SceneRecords {
             );
         }
         let first_record = self.bvh_nodes.len();
-        for instance in &geometry.instances {
-            let root = roots[instance.mesh as usize];
-            self.bvh_nodes.extend(instance_records(instance, root));
+        for (i, instance) in geometry.instances.iter().enumerate() {
+            let (root, first_triangle) = roots[instance.mesh as usize];
+            self.bvh_nodes
+                .extend(instance_records(instance, root, index(i), first_triangle));
         }
         let record = |i: usize| index(first_record + INSTANCE_RECORD_NODES * i);
         for prim in &mut self.bvh_prims[..geometry.bvh.prims.len()] {
@@ -241,9 +242,17 @@ pub const INSTANCE_RECORD_NODES: usize = 4;
 /// node `root`: the columns of `object_to_world` (the images of x, y and z, then the
 /// translation) in the first two records' corners, those of `world_to_object` in the
 /// last two; the first record's `first` and `count` hold the root and the material,
-/// the second's `first` whether the transform mirrors. The normal matrix is the
-/// transpose of `world_to_object`'s linear part and is not stored.
-pub fn instance_records(instance: &Instance, root: u32) -> [BvhNode; INSTANCE_RECORD_NODES] {
+/// the second's `first` whether the transform mirrors, the third's `first` and
+/// `count` the instance's index in [`SceneGeometry::instances`] and its mesh's first
+/// triangle in the triangle buffer (which name a hit as the CPU does, for stochastic
+/// transparency's hash). The normal matrix is the transpose of `world_to_object`'s
+/// linear part and is not stored.
+pub fn instance_records(
+    instance: &Instance,
+    root: u32,
+    index: u32,
+    first_triangle: u32,
+) -> [BvhNode; INSTANCE_RECORD_NODES] {
     let o2w = &instance.object_to_world;
     let w2o = &instance.world_to_object;
     let node = |min: DVec3, first: u32, max: DVec3, count: u32| BvhNode {
@@ -265,7 +274,12 @@ pub fn instance_records(instance: &Instance, root: u32) -> [BvhNode; INSTANCE_RE
             o2w.translation,
             0,
         ),
-        node(w2o.matrix3.x_axis, 0, w2o.matrix3.y_axis, 0),
+        node(
+            w2o.matrix3.x_axis,
+            index,
+            w2o.matrix3.y_axis,
+            first_triangle,
+        ),
         node(w2o.matrix3.z_axis, 0, w2o.translation, 0),
     ]
 }
@@ -415,6 +429,13 @@ pub fn material_record(material: &Material, images: &[Image]) -> GpuMaterial {
         normal_height,
         normal_wrap: wrap_code(material.normal_wrap[0]) | wrap_code(material.normal_wrap[1]) << 8,
         normal_scale: material.normal_scale as f32,
+        alpha_cutoff: match material.alpha_mode {
+            AlphaMode::Mask { cutoff } => cutoff as f32,
+            AlphaMode::Opaque | AlphaMode::Blend => 0.0,
+        },
+        alpha: material.alpha as f32,
+        alpha_blend: u32::from(material.alpha_mode == AlphaMode::Blend),
+        _pad1: 0,
     }
 }
 
@@ -531,7 +552,8 @@ pub fn triangle_attributes_record(
 /// shaders only read texels inside the image's own width and height), the rest zero.
 /// The alpha channel of a BRDF map's layer holds its inverse-CDF table from `cdfs`
 /// (texel `(x, y)` = [`crate::accel::BrdfMapCdf::value`]`(x, y)`), which the path
-/// integrator samples the map by; no material reads an image's alpha otherwise.
+/// integrator samples the map by; otherwise only an albedo texture's alpha coverage
+/// reads an image's alpha ([`crate::scene::AlphaMode`]).
 /// Returns `(width, height, layers, texels)` with texels layer by layer, row-major; a
 /// scene without images gets one 1×1 zero layer (WGSL needs a bound texture).
 pub fn image_layers(images: &[Image], cdfs: &BrdfMapCdfs) -> (u32, u32, u32, Vec<[f32; 4]>) {

@@ -366,6 +366,37 @@ impl Default for TextureTransform {
     }
 }
 
+/// How a material's alpha (coverage) is used: glTF 2.0's `alphaMode` (§3.9.4, "Alpha
+/// Coverage"). The alpha of a surface point is [`Material::alpha`] times the albedo
+/// texture's texel alpha (the same lookup as the albedo's, bilinear on the image's own
+/// alpha channel).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum AlphaMode {
+    /// Alpha is ignored: the surface is fully opaque everywhere (glTF's `OPAQUE`).
+    #[default]
+    Opaque,
+    /// glTF's `MASK`: the surface is fully opaque where its alpha is greater than or
+    /// equal to `cutoff`, and does not exist for any ray (camera, reflected, refracted,
+    /// path and shadow rays, the AOV pass) where it is below: both tracers skip such
+    /// a candidate hit inside the traversal and look on for the next one.
+    Mask {
+        /// glTF's `alphaCutoff` (default 0.5), finite and not negative; 0 keeps
+        /// every point.
+        cutoff: f64,
+    },
+    /// glTF's `BLEND`: alpha is the fraction of light the surface stops (its
+    /// coverage), `1 − alpha` passes through it unchanged and unbent. The Whitted
+    /// integrator weights the hit's shading by alpha and continues the ray through
+    /// the surface with weight `1 − alpha` (a branch like a dielectric's transmitted
+    /// one, one bounce deeper); its shadow rays carry a transmittance of `1 − alpha`
+    /// per surface they cross. The path integrator makes the choice stochastically
+    /// (stochastic transparency, as Cycles and pbrt-v4 do): every ray, camera,
+    /// bounce or shadow, passes each crossing with probability `1 − alpha`, decided
+    /// inside the traversal by a hash of the ray's sample and the primitive (see
+    /// `docs/models.md`).
+    Blend,
+}
+
 /// A material. One flat record for all kinds (fields a kind does not use are zero),
 /// which is exactly what the GPU receives.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -459,11 +490,16 @@ pub struct Material {
     /// single-sided surface still reflects, refracts (a closed glass mesh) and casts
     /// shadows as a rasteriser's shadow map would. Default false: both faces show.
     pub cull_back_faces: bool,
+    /// How alpha is used: opaque, masked or blended (see [`AlphaMode`]).
+    pub alpha_mode: AlphaMode,
+    /// The alpha factor in [0, 1] (glTF's `baseColorFactor`'s fourth component),
+    /// multiplying the albedo texture's texel alpha; unused by [`AlphaMode::Opaque`].
+    pub alpha: f64,
 }
 
 impl Material {
-    /// A material of `kind` with every parameter zero except transmittance, `eta` and
-    /// `texture_scale` (1), GGX and exact Fresnel, no images.
+    /// A material of `kind` with every parameter zero except transmittance, `eta`,
+    /// `texture_scale` and `alpha` (1), GGX and exact Fresnel, no images, opaque.
     pub fn blank(kind: MaterialKind) -> Self {
         Self {
             kind,
@@ -501,6 +537,18 @@ impl Material {
             normal_scale: 1.0,
             two_sided: false,
             cull_back_faces: false,
+            alpha_mode: AlphaMode::Opaque,
+            alpha: 1.0,
+        }
+    }
+
+    /// Whether the material's alpha matters to the tracers: a mask whose cutoff is
+    /// above 0 (a cutoff of 0 keeps every point), or blending.
+    pub fn uses_alpha(&self) -> bool {
+        match self.alpha_mode {
+            AlphaMode::Opaque => false,
+            AlphaMode::Mask { cutoff } => cutoff > 0.0,
+            AlphaMode::Blend => true,
         }
     }
 

@@ -13,7 +13,7 @@ use gpu_render::low_level::color::srgb_decode;
 use gpu_render::scene::import::{
     ImportedModel, LUMENS_PER_WATT, WrapMode, import_gltf, import_model, parse_gltf,
 };
-use gpu_render::scene::{Light, MaterialKind};
+use gpu_render::scene::{AlphaMode, Light, MaterialKind};
 
 /// A glTF document under construction: one binary buffer and its views and accessors.
 #[derive(Default)]
@@ -592,7 +592,7 @@ fn float_and_short_vertex_colours_read_with_alpha_and_range_warned_about() {
     assert_eq!(model.warnings.len(), 2, "{:?}", model.warnings);
     assert!(
         model.warnings.iter().any(|w| w.ends_with(
-            "rgba.gltf: mesh 0, primitive 0: COLOR_0 has alpha below 1, which is ignored (alpha modes are not supported): the surface is opaque"
+            "rgba.gltf: mesh 0, primitive 0: COLOR_0 has alpha below 1, which is ignored (alpha modes read the base colour's alpha factor and texture only): the surface is opaque"
         )),
         "{:?}",
         model.warnings
@@ -795,6 +795,61 @@ fn png(width: u32, height: u32, texels: &[[u8; 4]]) -> Vec<u8> {
         .write_to(&mut bytes, image::ImageFormat::Png)
         .expect("encode png");
     bytes.into_inner()
+}
+
+/// glTF 2.0 §3.9.4: alphaMode MASK with its alphaCutoff (default 0.5), BLEND and the
+/// base colour factor's alpha are read, without warnings; OPAQUE ignores alpha; the
+/// base colour texture keeps its own (linear) alpha channel.
+#[test]
+fn alpha_modes_cutoffs_and_the_base_colour_s_alpha_are_read() {
+    let (mut doc, _) = triangle_doc();
+    let checker = png(2, 1, &[[255, 255, 255, 255], [255, 255, 255, 64]]);
+    let view = doc.view(&checker);
+    let primitive =
+        |m: usize| format!(r#"{{"attributes":{{"POSITION":0}},"indices":1,"material":{m}}}"#);
+    let body = format!(
+        r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+           "meshes":[{{"primitives":[{},{},{},{}]}}],
+           "materials":[
+              {{"name":"leaf","alphaMode":"MASK","pbrMetallicRoughness":{{"baseColorFactor":[1,1,1,0.8],"baseColorTexture":{{"index":0}}}}}},
+              {{"name":"fence","alphaMode":"MASK","alphaCutoff":0.25}},
+              {{"name":"glass","alphaMode":"BLEND","pbrMetallicRoughness":{{"baseColorFactor":[1,1,1,0.5]}}}},
+              {{"name":"wall","alphaMode":"OPAQUE","pbrMetallicRoughness":{{"baseColorFactor":[1,1,1,0.5]}}}}],
+           "textures":[{{"source":0}}],
+           "images":[{{"bufferView":{view},"mimeType":"image/png"}}]"#,
+        primitive(0),
+        primitive(1),
+        primitive(2),
+        primitive(3)
+    );
+    let model = imported("alpha.gltf", doc.embedded(&body).as_bytes());
+    let material = |name: &str| {
+        model
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .unwrap_or_else(|| panic!("material {name}"))
+    };
+    let leaf = material("leaf");
+    assert_eq!(leaf.material.alpha_mode, AlphaMode::Mask { cutoff: 0.5 });
+    assert!((leaf.material.alpha - 0.8).abs() < 1e-7);
+    let texture = leaf.base_color_texture.expect("base colour texture");
+    let image = &model.images[texture.image as usize];
+    assert_eq!(image.texel(0, 0)[3], 1.0);
+    assert_eq!(
+        image.texel(1, 0)[3],
+        64.0 / 255.0,
+        "alpha is linear, not decoded"
+    );
+    assert_eq!(
+        material("fence").material.alpha_mode,
+        AlphaMode::Mask { cutoff: 0.25 }
+    );
+    let glass = material("glass").material;
+    assert_eq!(glass.alpha_mode, AlphaMode::Blend);
+    assert_eq!(glass.alpha, 0.5);
+    assert_eq!(material("wall").material.alpha_mode, AlphaMode::Opaque);
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
 }
 
 #[test]

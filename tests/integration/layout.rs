@@ -164,6 +164,10 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 normal_height,
                 normal_wrap,
                 normal_scale,
+                alpha_cutoff,
+                alpha,
+                alpha_blend,
+                _pad1,
             }),
         ),
         (
@@ -221,7 +225,11 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 instance,
                 stack_base,
                 world_cursor,
-                world_leaf_end
+                world_leaf_end,
+                blend_seed,
+                transmittance,
+                _pad0,
+                _pad1
             }),
         ),
         (
@@ -424,6 +432,7 @@ fn constants_match() {
         ("WRAP_CLAMP_TO_EDGE", WRAP_CLAMP_TO_EDGE),
         ("NO_ATTRIBUTES", NO_ATTRIBUTES),
         ("NO_IMAGE", NO_IMAGE),
+        ("NO_BLEND_SEED", NO_BLEND_SEED),
         ("LIGHT_POINT", LIGHT_POINT),
         ("LIGHT_DIRECTIONAL", LIGHT_DIRECTIONAL),
         ("LIGHT_SPOT", LIGHT_SPOT),

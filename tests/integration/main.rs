@@ -34,6 +34,7 @@ mod layering;
 mod layout;
 mod load_time;
 mod material_errors;
+mod model_alpha;
 mod model_shading;
 mod noise;
 mod path_gpu;

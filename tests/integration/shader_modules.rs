@@ -117,13 +117,14 @@ fn feature_sets() -> Vec<ShaderFeatures> {
         instances: false,
         path: false,
         environment_map: false,
+        alpha: false,
         aov: false,
         uniform_records: false,
         refill_lanes: false,
         unrolled: None,
     };
     type Toggle = fn(&mut ShaderFeatures, bool);
-    let toggles: [Toggle; 16] = [
+    let toggles: [Toggle; 17] = [
         |f, v| f.spheres = v,
         |f, v| f.planes = v,
         |f, v| f.polygons = v,
@@ -139,12 +140,18 @@ fn feature_sets() -> Vec<ShaderFeatures> {
         |f, v| f.instances = v,
         |f, v| f.path = v,
         |f, v| f.environment_map = v,
+        |f, v| f.alpha = v,
         |f, v| f.aov = v,
     ];
     let unrolled = UnrolledPrimitives::for_scene(&[0], 1, &[]);
     assert!(unrolled.is_some(), "a sphere and a plane are unrolled");
     let mut sets = vec![
         ShaderFeatures::ALL,
+        // Every feature: the general module of a scene with alpha coverage.
+        ShaderFeatures {
+            alpha: true,
+            ..ShaderFeatures::ALL
+        },
         none,
         ShaderFeatures {
             uniform_records: true,
@@ -204,6 +211,10 @@ fn imports_and_uses(
 
 #[test]
 fn each_module_imports_exactly_the_modules_whose_names_it_uses() {
+    let every = ShaderFeatures {
+        alpha: true,
+        ..ShaderFeatures::ALL
+    };
     let mut problems = Vec::new();
     for features in feature_sets() {
         for (name, (imported, used)) in imports_and_uses(&features) {
@@ -211,9 +222,10 @@ fn each_module_imports_exactly_the_modules_whose_names_it_uses() {
             if !missing.is_empty() {
                 problems.push(format!("{name} uses {missing:?} without importing them"));
             }
-            // Every import is used where every feature is on; with fewer, an import
-            // may serve only code the features leave out.
-            if features == ShaderFeatures::ALL {
+            // Every import is used where every feature is on (the general module
+            // with alpha coverage); with fewer, an import may serve only code the
+            // features leave out.
+            if features == every {
                 let unused: Vec<_> = imported.difference(&used).collect();
                 if !unused.is_empty() {
                     problems.push(format!("{name} imports {unused:?} but uses none of it"));
@@ -369,6 +381,7 @@ const WITHOUT_RUST_TWIN: &[(&str, &[&str], &str)] = &[
             "path_consume_shadow_ray",
             "path_start_emitter",
             "path_consume_emitter",
+            "path_blend_seed",
         ],
         "path_radiance's loop body cut at each shadow ray into the wavefront's steps, \
          with the path's random numbers and state in its slot",

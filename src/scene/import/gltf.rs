@@ -25,8 +25,8 @@ use super::{
 };
 use crate::echo::short;
 use crate::scene::{
-    Camera, Light, MAX_ORTHOGRAPHIC_HALF_HEIGHT, MAX_RADIANCE, Material, MaterialKind, SceneError,
-    TextureTransform,
+    AlphaMode, Camera, Light, MAX_ORTHOGRAPHIC_HALF_HEIGHT, MAX_RADIANCE, Material, MaterialKind,
+    SceneError, TextureTransform,
 };
 
 /// Luminous efficacy used to turn `KHR_lights_punctual`'s photometric intensities into
@@ -79,6 +79,8 @@ const MAX_TEXTURE_TRANSFORM: f64 = 1e6;
 const COLOR_TYPES: &[DataType] = &[DataType::F32, DataType::U8, DataType::U16];
 /// Index of refraction of `KHR_materials_ior`'s default (and of glass without it).
 const DEFAULT_IOR: f64 = 1.5;
+/// glTF's `alphaCutoff` where a `MASK` material gives none (glTF 2.0 §3.9.4).
+const DEFAULT_ALPHA_CUTOFF: f32 = 0.5;
 /// Most validation problems quoted in one error message.
 const QUOTED_PROBLEMS: usize = 5;
 
@@ -1059,8 +1061,8 @@ impl Importer<'_> {
 
     /// Reads `COLOR_0` of `primitive` (of `count` vertices), if it has it: `VEC3` or
     /// `VEC4` of floats or normalized unsigned bytes or shorts (glTF 2.0 §3.7.2.1), the
-    /// alpha of `VEC4` left out (alpha modes are not supported; a warning says so when
-    /// it is not 1). An accessor that breaks these rules is left out with a warning:
+    /// alpha of `VEC4` left out (alpha masks read the base colour's alpha factor and
+    /// texture only; a warning says so when it is not 1). An accessor that breaks these rules is left out with a warning:
     /// the model still renders, in its materials' colours.
     fn colors(
         &mut self,
@@ -1106,7 +1108,7 @@ impl Importer<'_> {
             self.warn_once(
                 "color alpha",
                 format!(
-                    "{name}: COLOR_0 has alpha below 1, which is ignored (alpha modes are not supported): the surface is opaque"
+                    "{name}: COLOR_0 has alpha below 1, which is ignored (alpha modes read the base colour's alpha factor and texture only): the surface is opaque"
                 ),
             );
         }
@@ -1201,16 +1203,20 @@ impl Importer<'_> {
     ) -> Result<(ImportedMaterial, bool, Option<u32>), SceneError> {
         let name = describe("material", material.index().unwrap_or(0), material.name());
         let pbr = material.pbr_metallic_roughness();
-        let [r, g, b, _alpha] = pbr.base_color_factor().map(f64::from);
+        let [r, g, b, alpha] = pbr.base_color_factor().map(f64::from);
         let base = DVec3::new(r, g, b);
         let metallic = f64::from(pbr.metallic_factor());
         let roughness = f64::from(pbr.roughness_factor());
         let strength = f64::from(material.emissive_strength().unwrap_or(1.0));
         let emissive = DVec3::from_array(material.emissive_factor().map(f64::from));
         let in_unit = |v: f64| (0.0..=1.0).contains(&v);
-        if !base.to_array().into_iter().all(in_unit) || !in_unit(metallic) || !in_unit(roughness) {
+        if !base.to_array().into_iter().all(in_unit)
+            || !in_unit(alpha)
+            || !in_unit(metallic)
+            || !in_unit(roughness)
+        {
             return Err(self.fail(format!(
-                "{name}: baseColorFactor {base}, metallicFactor {metallic} and roughnessFactor {roughness} must lie in [0, 1]"
+                "{name}: baseColorFactor {base} (alpha {alpha}), metallicFactor {metallic} and roughnessFactor {roughness} must lie in [0, 1]"
             )));
         }
         if !(emissive.to_array().into_iter().all(in_unit)
@@ -1221,12 +1227,25 @@ impl Importer<'_> {
                 "{name}: emissiveFactor {emissive} must lie in [0, 1] and emissiveStrength {strength} be finite and not negative"
             )));
         }
-        if material.alpha_mode() != ::gltf::material::AlphaMode::Opaque {
-            self.warn(format!(
-                "{name}: alphaMode {:?} is not supported; the material is opaque",
-                material.alpha_mode()
-            ));
-        }
+        // glTF 2.0 §3.9.4 "Alpha Coverage": MASK makes the surface opaque where the base
+        // colour's alpha is >= alphaCutoff (default 0.5) and absent elsewhere; BLEND
+        // makes alpha its coverage; OPAQUE ignores alpha.
+        let alpha_mode = match material.alpha_mode() {
+            ::gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            ::gltf::material::AlphaMode::Mask => {
+                let cutoff = f64::from(material.alpha_cutoff().unwrap_or(DEFAULT_ALPHA_CUTOFF));
+                let cutoff = if cutoff.is_finite() && cutoff >= 0.0 {
+                    cutoff
+                } else {
+                    self.warn(format!(
+                        "{name}: alphaCutoff {cutoff} must be finite and not negative; {DEFAULT_ALPHA_CUTOFF} is used"
+                    ));
+                    f64::from(DEFAULT_ALPHA_CUTOFF)
+                };
+                AlphaMode::Mask { cutoff }
+            }
+            ::gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+        };
         // occlusionTexture is left out without a warning: baked ambient occlusion is a
         // rasteriser's stand-in for the shadowing of indirect light (glTF 2.0 §3.9.3),
         // which a path tracer computes; applying it too would darken creases twice.
@@ -1292,6 +1311,8 @@ impl Importer<'_> {
         let ours = Material {
             two_sided: material.double_sided() && ours.emission != DVec3::ZERO,
             cull_back_faces: !material.double_sided(),
+            alpha_mode,
+            alpha,
             ..ours
         };
         let base_color_texture = match pbr.base_color_texture() {
