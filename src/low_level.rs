@@ -35,6 +35,40 @@ pub mod texture;
 #[path = "tradeoff.rs"]
 pub mod tradeoff;
 
+/// The CPU reference tracer's internals: its ray and hit records and intersection
+/// tests, the BVH queries, the BxDFs, the two integrators' steps and the auxiliary
+/// passes. Whole renders are [`crate::cpu`].
+pub mod cpu {
+    /// The first-hit albedo, normal and depth passes.
+    pub mod aov {
+        pub use crate::cpu::aov::*;
+    }
+    /// The BxDFs: evaluation, sampling and densities.
+    pub mod bxdf {
+        pub use crate::cpu::bxdf::*;
+    }
+    /// Rays, hits and the intersection tests of each primitive.
+    pub mod intersect {
+        pub use crate::cpu::intersect::*;
+    }
+    /// The path integrator.
+    pub mod path {
+        pub use crate::cpu::path::*;
+    }
+    /// Tabulated BRDF maps.
+    pub mod tabulated {
+        pub use crate::cpu::tabulated::*;
+    }
+    /// The Whitted integrator and the prepared scene.
+    pub mod trace {
+        pub use crate::cpu::trace::*;
+    }
+    /// The scene queries over the BVH.
+    pub mod traverse {
+        pub use crate::cpu::traverse::*;
+    }
+}
+
 /// The GPU backend's internals: the `#[repr(C)]` records and their upload, the WGSL
 /// composition and specialisation, the emitter and environment records, and the
 /// strategies for CPU devices. The frame-loop API is [`crate::gpu`].

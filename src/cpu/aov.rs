@@ -148,7 +148,7 @@ pub fn trace_pixel_aov(scene: &PreparedScene, x: u32, y: u32) -> FirstHitAov {
 ///      [[objects]]\ntype = \"plane\"\nnormal = [0, 0, 1]\npoint = [0, 0, 0]\nmaterial = \"grey\"\n",
 ///     std::path::Path::new("<inline>"),
 /// )?;
-/// let passes = gpu_render::cpu::aov::render_aovs(&scene);
+/// let passes = gpu_render::low_level::cpu::aov::render_aovs(&scene);
 /// assert!((passes.depth[0] - 3.0).abs() < 0.5);
 /// assert_eq!(passes.normal[5], [0.0, 0.0, 1.0]);
 /// # Ok(())

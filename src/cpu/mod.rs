@@ -4,14 +4,18 @@
 //! It is the oracle of the GPU tests and the fallback when no GPU adapter exists. It
 //! computes in `f64` so that its own rounding error is negligible next to the GPU's
 //! `f32`: the difference between the two images is then the GPU's error budget.
+//!
+//! Whole renders are here; the internals (ray and hit records, the BVH queries, the
+//! BxDFs, the integrators' steps) are public under [`crate::low_level::cpu`], for tests
+//! and tools.
 
-pub mod aov;
-pub mod bxdf;
-pub mod intersect;
-pub mod path;
-pub mod tabulated;
-pub mod trace;
-pub mod traverse;
+pub(crate) mod aov;
+pub(crate) mod bxdf;
+pub(crate) mod intersect;
+pub(crate) mod path;
+pub(crate) mod tabulated;
+pub(crate) mod trace;
+pub(crate) mod traverse;
 
 use std::ops::Range;
 use std::sync::Mutex;
@@ -21,6 +25,7 @@ use std::time::Instant;
 use crate::film::{LinearImage, ProgressFn, RenderStats, Rendered};
 use crate::noise::{NoiseEstimate, standard_error};
 use crate::scene::Scene;
+pub use aov::render_aovs;
 pub use trace::{PreparedScene, trace_pixel};
 
 /// Renders `scene` on all CPU cores, rows handed out one at a time. `progress` is told

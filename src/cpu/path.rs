@@ -60,7 +60,7 @@ const DIMENSIONS_PER_BOUNCE: u32 = 8;
 /// transparency of its rays ([`blend_seed`]): roulette's, which uses the hash's top
 /// bits directly, while each draw hashes it again with the surface
 /// ([`super::traverse::blend_number`]).
-const BLEND_DIMENSION: u32 = 7;
+pub const BLEND_DIMENSION: u32 = 7;
 
 /// The probability that next-event estimation picks the environment map rather than
 /// an area light (0 without a map; [`EnvironmentLight::selection`]).

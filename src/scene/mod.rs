@@ -14,7 +14,7 @@ mod precision;
 mod sphere;
 
 pub use animation::{CameraKey, CameraPath, Interpolation, MAX_FRAMES};
-pub use environment::{EnvironmentMap, direction_to_uv, texel_at, uv_to_direction};
+pub use environment::{Bilinear, EnvironmentMap, direction_to_uv, texel_at, uv_to_direction};
 pub use error::{SceneError, SceneWarning};
 pub(crate) use file::view_problem;
 pub use file::{

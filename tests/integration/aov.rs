@@ -161,7 +161,7 @@ fn a_lambert_planes_passes_are_its_albedo_its_normal_and_the_ray_distance() {
     let albedo = DVec3::new(0.2, 0.5, 0.8);
     // One sample: the pixel centre's ray, whose depth has a closed form.
     let scene = plane_scene(Material::lambert(albedo), vec![], 1);
-    let cpu = gpu_render::cpu::aov::render_aovs(&scene);
+    let cpu = gpu_render::low_level::cpu::aov::render_aovs(&scene);
     let expected = albedo.as_vec3().to_array();
     let depth = |x, y| centre_ray_depth(&scene, x, y);
     assert_plane_passes("CPU", &cpu, expected, Some(&depth));
@@ -169,7 +169,7 @@ fn a_lambert_planes_passes_are_its_albedo_its_normal_and_the_ray_distance() {
     let jittered = plane_scene(Material::lambert(albedo), vec![], 5);
     assert_plane_passes(
         "CPU 5 spp",
-        &gpu_render::cpu::aov::render_aovs(&jittered),
+        &gpu_render::low_level::cpu::aov::render_aovs(&jittered),
         expected,
         None,
     );
@@ -181,7 +181,7 @@ fn a_lambert_planes_passes_are_its_albedo_its_normal_and_the_ray_distance() {
     assert_passes_match("plane", &cpu, &gpu_aov);
     assert_passes_match(
         "plane 5 spp",
-        &gpu_render::cpu::aov::render_aovs(&jittered),
+        &gpu_render::low_level::cpu::aov::render_aovs(&jittered),
         &gpu_passes(&gpu, &jittered),
     );
 }
@@ -209,7 +209,7 @@ fn a_textured_albedo_pass_is_the_texel() {
         ..Material::lambert(diffuse)
     };
     let scene = plane_scene(material, vec![texture.clone()], 1);
-    let cpu = gpu_render::cpu::aov::render_aovs(&scene);
+    let cpu = gpu_render::low_level::cpu::aov::render_aovs(&scene);
     // Pixels whose lookup lies inside a block (between its four texel centres, with a
     // margin) show that block's texel times the diffuse factor.
     let mut checked = 0;
@@ -290,7 +290,7 @@ fn the_gpu_passes_equal_the_cpu_passes_on_shipped_scenes() {
                 ..RenderOverrides::default()
             },
         );
-        let cpu = gpu_render::cpu::aov::render_aovs(&scene);
+        let cpu = gpu_render::low_level::cpu::aov::render_aovs(&scene);
         assert!(
             cpu.depth.iter().any(|&d| d > 0.0),
             "{name}: the camera sees something"
@@ -406,9 +406,9 @@ fn the_gpu_passes_equal_the_cpu_passes_through_a_thin_lens_and_an_orthographic_c
         focus_distance: Some(3.0),
     });
     for (label, scene) in [("orthographic", orthographic), ("thin-lens", lens)] {
-        let cpu = gpu_render::cpu::aov::render_aovs(&scene);
+        let cpu = gpu_render::low_level::cpu::aov::render_aovs(&scene);
         // Through the eye the depth of the pinhole's rays: a different image.
-        let pinhole = gpu_render::cpu::aov::render_aovs(&base);
+        let pinhole = gpu_render::low_level::cpu::aov::render_aovs(&base);
         assert_ne!(
             cpu.depth, pinhole.depth,
             "{label}: the camera changed nothing"

@@ -3,10 +3,10 @@
 //! aimed at the shared edges and vertices of closed meshes, with both builders.
 
 use crate::support::geometry::{mixed_shapes, random_rays, rays_through_mesh_edges};
-use gpu_render::cpu::traverse::{
+use gpu_render::low_level::accel::{BuildMethod, SceneGeometry};
+use gpu_render::low_level::cpu::traverse::{
     TraversalCounts, closest_hit_brute_force, closest_hit_counted, occluded,
 };
-use gpu_render::low_level::accel::{BuildMethod, SceneGeometry};
 
 #[test]
 fn traversal_equals_brute_force_for_random_rays() {

@@ -8,10 +8,10 @@ use crate::support::geometry::{
     blob, mixed_shapes, random_rays, rays_through_mesh_edges, small_polygons,
 };
 use glam::{DMat4, DQuat, DVec3};
-use gpu_render::cpu::intersect::Ray;
-use gpu_render::cpu::traverse::closest_hit_brute_force;
 use gpu_render::gpu::ShaderFeatures;
 use gpu_render::low_level::accel::{BuildMethod, SceneGeometry};
+use gpu_render::low_level::cpu::intersect::Ray;
+use gpu_render::low_level::cpu::traverse::closest_hit_brute_force;
 use gpu_render::low_level::gpu::layout::{FrameUniforms, GpuCounters};
 use gpu_render::low_level::gpu::shaders::compose_source;
 use gpu_render::low_level::gpu::upload::{SceneRecords, frame_uniforms};

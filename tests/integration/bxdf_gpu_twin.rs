@@ -10,8 +10,8 @@ use std::path::Path;
 
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
-use gpu_render::cpu::bxdf::eval_brdf;
 use gpu_render::low_level::accel::BrdfMapCdfs;
+use gpu_render::low_level::cpu::bxdf::eval_brdf;
 use gpu_render::low_level::gpu::shaders::{BXDF_EVAL_ENTRY_POINT, bxdf_eval_shader_source};
 use gpu_render::low_level::gpu::upload::{image_layers, material_record};
 use gpu_render::scene::{

@@ -13,7 +13,7 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 use glam::DVec3;
-use gpu_render::cpu::bxdf::{
+use gpu_render::low_level::cpu::bxdf::{
     eval_brdf, fresnel_conductor, fresnel_dielectric, fresnel_schlick, oren_nayar_coefficients,
 };
 use gpu_render::scene::{

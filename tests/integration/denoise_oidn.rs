@@ -119,8 +119,8 @@ fn plain_denoise_is_the_builtin_filter_and_unknown_names_are_refused() {
 mod with_the_feature {
     use glam::DVec3;
     use gpu_render::cpu::PreparedScene;
-    use gpu_render::cpu::intersect::Ray;
-    use gpu_render::cpu::path::path_radiance;
+    use gpu_render::low_level::cpu::intersect::Ray;
+    use gpu_render::low_level::cpu::path::path_radiance;
     use gpu_render::low_level::denoise::GuidePasses;
     use gpu_render::low_level::denoise::oidn::{Oidn, OidnError, OidnSettings};
     use gpu_render::scene::{Integrator, RenderOverrides};
@@ -212,7 +212,7 @@ mod with_the_feature {
             .iter()
             .map(|p| [p[0], p[1], p[2]])
             .collect();
-        let guides = gpu_render::cpu::aov::render_aovs(&scene);
+        let guides = gpu_render::low_level::cpu::aov::render_aovs(&scene);
         let denoised = oidn()
             .denoise(&raw, &guides, &OidnSettings::default())
             .expect("OIDN denoises");

@@ -20,9 +20,9 @@
 
 use std::path::Path;
 
-use gpu_render::cpu::intersect::Ray;
-use gpu_render::cpu::trace::PreparedScene;
-use gpu_render::cpu::traverse::intersect_scene;
+use gpu_render::low_level::cpu::intersect::Ray;
+use gpu_render::low_level::cpu::trace::PreparedScene;
+use gpu_render::low_level::cpu::traverse::intersect_scene;
 use gpu_render::scene::load_scene;
 
 const WIDTH: u32 = 48;

@@ -18,11 +18,11 @@
 use crate::support::compare::{Tolerance, assert_images_match};
 use crate::support::geometry::{SplitMix, blob};
 use glam::{DMat3, DMat4, DVec3};
-use gpu_render::cpu::intersect::Ray;
-use gpu_render::cpu::traverse::{
+use gpu_render::low_level::accel::SceneGeometry;
+use gpu_render::low_level::cpu::intersect::Ray;
+use gpu_render::low_level::cpu::traverse::{
     TraversalCounts, closest_hit_brute_force, closest_hit_counted, occluded,
 };
-use gpu_render::low_level::accel::SceneGeometry;
 use gpu_render::low_level::gpu::upload::SceneRecords;
 use gpu_render::scene::import::ModelPlacement;
 use gpu_render::scene::{
@@ -317,7 +317,8 @@ fn hits_on_mirrored_and_scaled_instances_face_out() {
     let geometry = SceneGeometry::new(&scene);
     let mut checked = [0usize; 4];
     for ray in rays(4000, 3) {
-        let Some(hit) = gpu_render::cpu::traverse::intersect_scene(&geometry, &ray, f64::INFINITY)
+        let Some(hit) =
+            gpu_render::low_level::cpu::traverse::intersect_scene(&geometry, &ray, f64::INFINITY)
         else {
             continue;
         };

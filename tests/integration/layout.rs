@@ -442,7 +442,7 @@ fn constants_match() {
         ("ERROR_TRAVERSAL_STACK", ERROR_TRAVERSAL_STACK),
         (
             "MAX_PASS_THROUGHS",
-            gpu_render::cpu::intersect::MAX_PASS_THROUGHS,
+            gpu_render::low_level::cpu::intersect::MAX_PASS_THROUGHS,
         ),
         ("PRIM_KIND_SHIFT", PrimRef::INDEX_BITS),
         ("PRIM_INDEX_MASK", PrimRef::MAX_INDEX),
@@ -549,11 +549,11 @@ fn wgsl_constants_equal_their_rust_twins() {
     for (name, rust) in [
         (
             "MIN_LIGHT_DISTANCE_SQUARED",
-            gpu_render::cpu::trace::MIN_LIGHT_DISTANCE_SQUARED,
+            gpu_render::low_level::cpu::trace::MIN_LIGHT_DISTANCE_SQUARED,
         ),
         (
             "MIN_SECONDARY_COSINE",
-            gpu_render::cpu::trace::MIN_SECONDARY_COSINE,
+            gpu_render::low_level::cpu::trace::MIN_SECONDARY_COSINE,
         ),
     ] {
         assert_eq!(wgsl_f32_const(trace, name), rust as f32, "{name}");
@@ -561,15 +561,15 @@ fn wgsl_constants_equal_their_rust_twins() {
     let path = module("path");
     assert_eq!(
         wgsl_f32_const(path, "MIN_SURVIVAL"),
-        gpu_render::cpu::path::MIN_SURVIVAL as f32
+        gpu_render::low_level::cpu::path::MIN_SURVIVAL as f32
     );
     assert_eq!(
         wgsl_f32_const(module("tabulated"), "TABULATED_COSINE_PROBABILITY"),
-        gpu_render::cpu::tabulated::TABULATED_COSINE_PROBABILITY as f32
+        gpu_render::low_level::cpu::tabulated::TABULATED_COSINE_PROBABILITY as f32
     );
     let roulette = format!(
         "const ROULETTE_DEPTH: u32 = {}u;",
-        gpu_render::cpu::path::ROULETTE_DEPTH
+        gpu_render::low_level::cpu::path::ROULETTE_DEPTH
     );
     assert!(path.lines().any(|l| l == roulette), "{roulette}");
     let [r, g, b] = gpu_render::low_level::color::LUMINANCE_WEIGHTS.map(|w| w as f32);

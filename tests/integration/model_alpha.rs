@@ -226,7 +226,7 @@ fn a_masked_checker_shows_the_backdrop_exactly_where_alpha_is_below_the_cutoff()
                 if opaque { DVec3::ONE } else { GREEN },
             );
             // The AOV pass's first hit is the quad, or the backdrop behind it.
-            let aov = gpu_render::cpu::aov::trace_pixel_aov(&prepared, pixel.0, pixel.1);
+            let aov = gpu_render::low_level::cpu::aov::trace_pixel_aov(&prepared, pixel.0, pixel.1);
             let on_quad = DVec3::new(centre - 0.9 + 1.8 * u, 0.9 - 1.8 * v, 0.0);
             let depth_beyond_quad = aov.depth > on_quad.distance(camera().eye) + 0.5;
             assert_eq!(
@@ -556,7 +556,7 @@ fn the_aov_pass_sees_what_the_camera_ray_stops_at_on_both_backends() {
         ("blend-whitted", blend.clone()),
         ("blend-path", path_traced(&blend, 4)),
     ] {
-        let cpu = gpu_render::cpu::aov::render_aovs(&scene);
+        let cpu = gpu_render::low_level::cpu::aov::render_aovs(&scene);
         let gpu_aov = renderer
             .render(&gpu.device, &gpu.queue, &scene, None)
             .unwrap_or_else(|e| panic!("{label}: GPU render failed: {e}"))

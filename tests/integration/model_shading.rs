@@ -674,7 +674,7 @@ fn a_normal_mapped_quad_tilted_toward_a_grazing_light_is_brighter_than_its_mirro
 /// made both tracers pass through back faces without end), on both backends alike.
 #[test]
 fn a_camera_ray_passes_through_at_most_max_pass_throughs_back_faces_on_both_backends() {
-    use gpu_render::cpu::intersect::MAX_PASS_THROUGHS;
+    use gpu_render::low_level::cpu::intersect::MAX_PASS_THROUGHS;
     const LAYERS: u32 = 300;
     let red = DVec3::new(0.8, 0.1, 0.1);
     let green = DVec3::new(0.1, 0.8, 0.1);

@@ -13,7 +13,7 @@
 
 use std::path::Path;
 
-use gpu_render::cpu::trace::PreparedScene;
+use gpu_render::low_level::cpu::trace::PreparedScene;
 use gpu_render::scene::load_scene;
 
 const SIZE: u32 = 32;

@@ -309,7 +309,8 @@ fn normal_incidence_albedo(material: &Material) -> f64 {
                 theta.sin() * phi.sin(),
                 theta.cos(),
             );
-            let f = gpu_render::cpu::bxdf::eval_brdf(material, &[], DVec3::Z, wi, DVec3::Z);
+            let f =
+                gpu_render::low_level::cpu::bxdf::eval_brdf(material, &[], DVec3::Z, wi, DVec3::Z);
             sum += f.y * wi.z * theta.sin() * dt * dp;
         }
     }

@@ -13,14 +13,14 @@
 use std::cell::Cell;
 
 use glam::{DVec2, DVec3};
-use gpu_render::cpu::bxdf::{
+use gpu_render::low_level::accel::BrdfMapCdf;
+use gpu_render::low_level::cpu::bxdf::{
     pdf_beckmann_normal, pdf_blinn_phong_half, pdf_ggx_visible_normal, sample_beckmann_normal,
     sample_blinn_phong_half, sample_ggx_visible_normal,
 };
-use gpu_render::cpu::tabulated::{
+use gpu_render::low_level::cpu::tabulated::{
     TABULATED_COSINE_PROBABILITY, pdf_brdf_map_direction, pdf_tabulated, sample_tabulated,
 };
-use gpu_render::low_level::accel::BrdfMapCdf;
 use gpu_render::low_level::sample::*;
 use gpu_render::scene::Image;
 

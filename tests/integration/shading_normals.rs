@@ -5,7 +5,7 @@
 //! geometric one.
 
 use glam::DVec3;
-use gpu_render::cpu::trace::{MIN_SECONDARY_COSINE, keep_on_side, shading_frame_normal};
+use gpu_render::low_level::cpu::trace::{MIN_SECONDARY_COSINE, keep_on_side, shading_frame_normal};
 
 /// Unit directions over the sphere (a Fibonacci lattice).
 fn directions(count: usize) -> impl Iterator<Item = DVec3> {

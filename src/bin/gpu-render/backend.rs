@@ -375,7 +375,7 @@ impl Backend {
                     cpu::render(scene, Some(progress))
                 };
                 let mut frame = Frame::from_cpu(rendered, scene);
-                frame.aov = aov.then(|| cpu::aov::render_aovs(scene));
+                frame.aov = aov.then(|| cpu::render_aovs(scene));
                 Ok(frame)
             }
         }

@@ -2,7 +2,7 @@
 //! the rays that test them.
 
 use glam::{DVec2, DVec3};
-use gpu_render::cpu::intersect::Ray;
+use gpu_render::low_level::cpu::intersect::Ray;
 use gpu_render::scene::{Mesh, Shape};
 
 /// A small deterministic generator (SplitMix64), so the tests need no crate.

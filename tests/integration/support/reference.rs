@@ -2,9 +2,9 @@
 //! renderer's reference image (tests/integration/path_reference.rs, tests/integration/environment_reference.rs).
 
 use glam::DVec3;
-use gpu_render::cpu::intersect::Ray;
-use gpu_render::cpu::path::path_radiance;
-use gpu_render::cpu::trace::PreparedScene;
+use gpu_render::low_level::cpu::intersect::Ray;
+use gpu_render::low_level::cpu::path::path_radiance;
+use gpu_render::low_level::cpu::trace::PreparedScene;
 
 /// Per pixel (row-major): the mean and the sample variance of `samples` path-traced
 /// samples of `scene` (`width × height` pixels), on every core.

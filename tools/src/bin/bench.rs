@@ -636,9 +636,11 @@ fn compare_schedules(
 /// work of one camera ray per pixel (through the pixel centre) and of one shadow ray
 /// from each hit to the scene's first light.
 fn traversal_figures(scene: &gpu_render::scene::Scene) {
-    use gpu_render::cpu::intersect::{Ray, hit_record_keyed};
-    use gpu_render::cpu::traverse::{TraversalCounts, closest_hit_counted, occluded_counted};
     use gpu_render::low_level::accel::{BuildMethod, SceneGeometry};
+    use gpu_render::low_level::cpu::intersect::{Ray, hit_record_keyed};
+    use gpu_render::low_level::cpu::traverse::{
+        TraversalCounts, closest_hit_counted, occluded_counted,
+    };
     for method in [BuildMethod::Sah, BuildMethod::MedianSplit] {
         let geometry = SceneGeometry::with_method(scene, method);
         let stats = geometry.bvh.stats;
@@ -674,7 +676,7 @@ fn traversal_figures(scene: &gpu_render::scene::Scene) {
                 } else {
                     -hit.normal
                 };
-                let origin = gpu_render::cpu::intersect::offset_ray_origin(
+                let origin = gpu_render::low_level::cpu::intersect::offset_ray_origin(
                     hit.position,
                     n,
                     geometry.offset_scale,

@@ -21,10 +21,10 @@ use std::sync::atomic::{AtomicU32, Ordering};
 
 use glam::DVec3;
 use gpu_render::cpu::PreparedScene;
-use gpu_render::cpu::intersect::Ray;
-use gpu_render::cpu::path::path_radiance;
-use gpu_render::cpu::traverse::intersect_scene;
 use gpu_render::low_level::accel::BrdfMapCdfs;
+use gpu_render::low_level::cpu::intersect::Ray;
+use gpu_render::low_level::cpu::path::path_radiance;
+use gpu_render::low_level::cpu::traverse::intersect_scene;
 use gpu_render::scene::{Integrator, MaterialKind, RenderOverrides, Scene, load_scene};
 
 /// Where the reference's sample indices start.

@@ -29,9 +29,9 @@ use std::time::Instant;
 
 use glam::DVec3;
 use gpu_render::cpu::PreparedScene;
-use gpu_render::cpu::intersect::Ray;
-use gpu_render::cpu::path::path_radiance;
 use gpu_render::gpu::{AdapterChoice, HeadlessGpu, Renderer, RendererOptions};
+use gpu_render::low_level::cpu::intersect::Ray;
+use gpu_render::low_level::cpu::path::path_radiance;
 use gpu_render::low_level::denoise::GuidePasses;
 use gpu_render::low_level::denoise::{DenoiseSettings, denoise};
 use gpu_render::scene::{Integrator, RenderOverrides, RenderSettings, Scene, load_scene};
@@ -217,7 +217,7 @@ fn main() -> anyhow::Result<()> {
     for spp in [1, 4, 16, 64] {
         let scene = at(&scene, width, spp);
         let rendered = gpu_render::cpu::render_with_noise(&scene, None);
-        let guides = gpu_render::cpu::aov::render_aovs(&scene);
+        let guides = gpu_render::low_level::cpu::aov::render_aovs(&scene);
         let noise = rendered.noise.expect("asked for");
         let variance: Vec<f32> = noise.standard_error.iter().map(|se| se * se).collect();
         let raw: Vec<[f32; 3]> = rendered

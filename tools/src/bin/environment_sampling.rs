@@ -13,10 +13,10 @@
 use std::time::Instant;
 
 use glam::DVec3;
-use gpu_render::cpu::intersect::Ray;
-use gpu_render::cpu::path::path_radiance;
-use gpu_render::cpu::trace::PreparedScene;
 use gpu_render::low_level::color::luminance;
+use gpu_render::low_level::cpu::intersect::Ray;
+use gpu_render::low_level::cpu::path::path_radiance;
+use gpu_render::low_level::cpu::trace::PreparedScene;
 
 /// Mean over the pixels of the sample variance of the luminance, and the seconds taken.
 fn mean_variance(scene: &PreparedScene, samples: u32) -> (f64, f64) {

@@ -12,11 +12,11 @@
 
 use glam::DVec3;
 use gpu_render::cpu::PreparedScene;
-use gpu_render::cpu::intersect::Ray;
-use gpu_render::cpu::trace::shade_hit;
-use gpu_render::cpu::traverse::intersect_scene;
 use gpu_render::gpu::RendererOptions;
 use gpu_render::gpu::{AdapterChoice, HeadlessGpu, Renderer};
+use gpu_render::low_level::cpu::intersect::Ray;
+use gpu_render::low_level::cpu::trace::shade_hit;
+use gpu_render::low_level::cpu::traverse::intersect_scene;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
