@@ -36,7 +36,7 @@ fn test_trace(slot: u32) -> TraceRay {
     let a = test_rays[2u * slot];
     let b = test_rays[2u * slot + 1u];
     return TraceRay(a.xyz, a.w, b.xyz, TRACE_PENDING, a.w, NO_PRIM, 0u, NO_NODE, 0u, 0u,
-                    u32(b.w), NO_INSTANCE, NO_INSTANCE, 0u, 0u, 0u);
+                    u32(b.w), NO_INSTANCE, NO_INSTANCE, 0u, 0u, 0u, NO_BLEND_SEED, 1.0, 0u, 0u);
 }
 
 @compute @workgroup_size(64)

@@ -27,10 +27,7 @@ radius = 1.0
 material = "white"
 "#;
 
-/// Bytes that must survive a failed run untouched.
-const OLD_OUTPUT: &[u8] = b"an older image that a failed run must not touch";
-
-use crate::support::process::{Run, gpu_render};
+use crate::support::process::{OLD_OUTPUT, assert_fails_with, gpu_render};
 
 /// A temporary directory holding `scene.toml` with `text` and an existing `out.png`.
 struct Workspace {
@@ -71,25 +68,6 @@ impl Workspace {
         expected.sort_unstable();
         assert_eq!(names, expected, "stray files left behind");
     }
-}
-
-/// Asserts a failed run: status 1 and every `needle` in stderr.
-fn assert_fails_with(run: &Run, needles: &[&str]) {
-    assert_eq!(
-        run.status,
-        Some(1),
-        "expected exit 1, stderr:\n{}",
-        run.stderr
-    );
-    assert!(run.stderr.starts_with("error: "), "stderr:\n{}", run.stderr);
-    for needle in needles {
-        assert!(
-            run.stderr.contains(needle),
-            "stderr lacks {needle:?}:\n{}",
-            run.stderr
-        );
-    }
-    assert!(run.stdout.is_empty(), "stdout: {}", run.stdout);
 }
 
 fn read_png_size(path: &Path) -> (u32, u32) {

@@ -8,7 +8,7 @@
 //! `ensure_oidn`; scripts/test.sh runs them): `cargo test --features oidn --test
 //! integration -- denoise_oidn::`.
 
-use crate::support::process::{Run, gpu_render};
+use crate::support::process::{OLD_OUTPUT, assert_fails_with, gpu_render};
 
 /// A small path-traced scene the program renders in a moment.
 const TINY_PATH_SCENE: &str = r#"
@@ -34,32 +34,12 @@ radius = 1.0
 material = "white"
 "#;
 
-/// Bytes that must survive a failed run untouched.
-const OLD_OUTPUT: &[u8] = b"an older image that a failed run must not touch";
-
 /// A folder with the tiny scene and an existing `out.png`.
 fn workspace() -> tempfile::TempDir {
     let dir = tempfile::tempdir().expect("tempdir");
     std::fs::write(dir.path().join("scene.toml"), TINY_PATH_SCENE).expect("write scene");
     std::fs::write(dir.path().join("out.png"), OLD_OUTPUT).expect("write old output");
     dir
-}
-
-fn assert_fails_with(run: &Run, needles: &[&str]) {
-    assert_eq!(
-        run.status,
-        Some(1),
-        "expected exit 1, stderr:\n{}",
-        run.stderr
-    );
-    assert!(run.stderr.starts_with("error: "), "stderr:\n{}", run.stderr);
-    for needle in needles {
-        assert!(
-            run.stderr.contains(needle),
-            "stderr lacks {needle:?}:\n{}",
-            run.stderr
-        );
-    }
 }
 
 fn render_args(dir: &std::path::Path, denoise: &str) -> Vec<String> {

@@ -10,21 +10,19 @@
 //! the CPU image), then rendered on the GPU and compared per pixel with the CPU
 //! reference, Whitted and path traced.
 
-use glam::{DMat4, DVec2, DVec3};
+use glam::{DMat4, DVec3};
 use gpu_render::film::LinearImage as Film;
 use gpu_render::scene::{
-    AlphaMode, Camera, Environment, Image, Integrator, Light, Material, Mesh, RenderSettings,
-    Scene, TextureMapping, TextureWrap,
+    AlphaMode, Environment, Image, Integrator, Light, Material, Mesh, RenderSettings, Scene,
+    TextureMapping, TextureWrap,
 };
 
+use crate::support::quads::{
+    EYE_Z, HEIGHT, WIDTH, assert_colour, at, camera, colour, pixel_at_uv, pixel_of, quad,
+};
 use crate::support::twins::{TWIN_TOLERANCE, assert_backends_agree};
 
-/// Image size and camera: quads of side 1.8 in the plane z = 0, centred at x = -3, -1,
-/// 1, 3, seen head on from z = 7.5; a backdrop at z = -1.
-const WIDTH: u32 = 160;
-const HEIGHT: u32 = 48;
-const EYE_Z: f64 = 7.5;
-const FOV_Y_DEGREES: f64 = 18.0;
+/// The backdrop's plane, behind the quads (`crate::support::quads`).
 const BACKDROP_Z: f64 = -1.0;
 
 /// The backdrop's albedo, and the masked surfaces' (white).
@@ -33,80 +31,10 @@ const GREEN: DVec3 = DVec3::new(0.1, 0.8, 0.1);
 /// The glTF default cutoff.
 const CUTOFF: f64 = 0.5;
 
-fn camera() -> Camera {
-    Camera {
-        eye: DVec3::new(0.0, 0.0, EYE_Z),
-        look_at: DVec3::ZERO,
-        up: DVec3::Y,
-        fov_y_degrees: FOV_Y_DEGREES,
-        orthographic_half_height: None,
-        lens: None,
-    }
-}
-
-/// The pixel (column, row) that sees the point `(x, y, 0)`.
-fn pixel_of(x: f64, y: f64) -> (u32, u32) {
-    let half_height = EYE_Z * (FOV_Y_DEGREES.to_radians() / 2.0).tan();
-    let half_width = half_height * f64::from(WIDTH) / f64::from(HEIGHT);
-    let column = (x / half_width + 1.0) / 2.0 * f64::from(WIDTH);
-    let row = (1.0 - y / half_height) / 2.0 * f64::from(HEIGHT);
-    (column as u32, row as u32)
-}
-
 /// The pixel that sees the backdrop's point `(x, y, BACKDROP_Z)` (past z = 0).
 fn pixel_of_backdrop(x: f64, y: f64) -> (u32, u32) {
     let scale = EYE_Z / (EYE_Z - BACKDROP_Z);
     pixel_of(x * scale, y * scale)
-}
-
-/// The pixel that sees the point of the quad centred at `(centre, 0, 0)` at its
-/// texture coordinates `(u, v)` (`v` down).
-fn pixel_at_uv(centre: f64, u: f64, v: f64) -> (u32, u32) {
-    pixel_of(centre - 0.9 + 1.8 * u, 0.9 - 1.8 * v)
-}
-
-fn colour(film: &Film, (x, y): (u32, u32)) -> DVec3 {
-    let p = film.pixels[(y * film.width + x) as usize];
-    DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
-}
-
-fn assert_colour(label: &str, film: &Film, pixel: (u32, u32), expected: DVec3) {
-    let got = colour(film, pixel);
-    assert!(
-        (got - expected).abs().max_element() < 2e-3,
-        "{label}: pixel {pixel:?} is {got}, expected {expected}"
-    );
-}
-
-/// A quad of side 1.8 in the plane z = 0 facing +z, texture coordinates from (0, 0)
-/// at its top-left corner to (1, 1) at its bottom-right.
-fn quad(material: u32, instances: Vec<DMat4>) -> Mesh {
-    Mesh {
-        name: "quad".into(),
-        positions: vec![
-            DVec3::new(-0.9, -0.9, 0.0),
-            DVec3::new(0.9, -0.9, 0.0),
-            DVec3::new(0.9, 0.9, 0.0),
-            DVec3::new(-0.9, 0.9, 0.0),
-        ],
-        normals: None,
-        uvs: Some(vec![
-            DVec2::new(0.0, 1.0),
-            DVec2::new(1.0, 1.0),
-            DVec2::new(1.0, 0.0),
-            DVec2::new(0.0, 0.0),
-        ]),
-        uvs1: None,
-        colors: None,
-        tangents: None,
-        triangles: vec![[0, 1, 2], [0, 2, 3]],
-        material,
-        instances,
-    }
-}
-
-fn at(x: f64) -> DMat4 {
-    DMat4::from_translation(DVec3::new(x, 0.0, 0.0))
 }
 
 /// A green backdrop at z = BACKDROP_Z filling the view.

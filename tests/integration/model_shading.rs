@@ -8,92 +8,15 @@
 use glam::{DMat4, DVec2, DVec3};
 use gpu_render::film::LinearImage as Film;
 use gpu_render::scene::{
-    Camera, Environment, Image, Light, Material, Mesh, RenderSettings, Scene, TextureMapping,
+    Environment, Image, Light, Material, Mesh, RenderSettings, Scene, TextureMapping,
     TextureTransform,
 };
 
+use crate::support::quads::{
+    EYE_Z, FOV_Y_DEGREES, HEIGHT, WIDTH, assert_colour, assert_colour_within, at, camera, colour,
+    pixel_at_uv, pixel_of, quad,
+};
 use crate::support::twins::{TWIN_TOLERANCE, assert_backends_agree};
-
-/// Image size and camera of the scenes: four quads side by side at x = -3, -1, 1, 3,
-/// each 1.8 wide, seen head on.
-const WIDTH: u32 = 160;
-const HEIGHT: u32 = 48;
-const EYE_Z: f64 = 7.5;
-const FOV_Y_DEGREES: f64 = 18.0;
-
-fn camera() -> Camera {
-    Camera {
-        eye: DVec3::new(0.0, 0.0, EYE_Z),
-        look_at: DVec3::ZERO,
-        up: DVec3::Y,
-        fov_y_degrees: FOV_Y_DEGREES,
-        orthographic_half_height: None,
-        lens: None,
-    }
-}
-
-/// The pixel (column, row) that sees the point `(x, y, 0)`.
-fn pixel_of(x: f64, y: f64) -> (u32, u32) {
-    let half_height = EYE_Z * (FOV_Y_DEGREES.to_radians() / 2.0).tan();
-    let half_width = half_height * f64::from(WIDTH) / f64::from(HEIGHT);
-    let column = (x / half_width + 1.0) / 2.0 * f64::from(WIDTH);
-    let row = (1.0 - y / half_height) / 2.0 * f64::from(HEIGHT);
-    (column as u32, row as u32)
-}
-
-/// The point of the quad centred at `(centre, 0, 0)` at its texture coordinates
-/// `(u, v)` (`v` down): the pixel that sees it.
-fn pixel_at_uv(centre: f64, u: f64, v: f64) -> (u32, u32) {
-    pixel_of(centre - 0.9 + 1.8 * u, 0.9 - 1.8 * v)
-}
-
-fn colour(film: &Film, (x, y): (u32, u32)) -> DVec3 {
-    let p = film.pixels[(y * film.width + x) as usize];
-    DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))
-}
-
-fn assert_colour(label: &str, film: &Film, pixel: (u32, u32), expected: DVec3) {
-    assert_colour_within(label, film, pixel, expected, 2e-3);
-}
-
-fn assert_colour_within(label: &str, film: &Film, pixel: (u32, u32), expected: DVec3, within: f64) {
-    let got = colour(film, pixel);
-    assert!(
-        (got - expected).abs().max_element() < within,
-        "{label}: pixel {pixel:?} is {got}, expected {expected}"
-    );
-}
-
-/// A quad of side 1.8 in the plane z = 0 facing +z, texture coordinates running from
-/// (0, 0) at its top-left corner to (1, 1) at its bottom-right.
-fn quad(material: u32, instances: Vec<DMat4>) -> Mesh {
-    Mesh {
-        name: "quad".into(),
-        positions: vec![
-            DVec3::new(-0.9, -0.9, 0.0),
-            DVec3::new(0.9, -0.9, 0.0),
-            DVec3::new(0.9, 0.9, 0.0),
-            DVec3::new(-0.9, 0.9, 0.0),
-        ],
-        normals: None,
-        uvs: Some(vec![
-            DVec2::new(0.0, 1.0),
-            DVec2::new(1.0, 1.0),
-            DVec2::new(1.0, 0.0),
-            DVec2::new(0.0, 0.0),
-        ]),
-        uvs1: None,
-        colors: None,
-        tangents: None,
-        triangles: vec![[0, 1, 2], [0, 2, 3]],
-        material,
-        instances,
-    }
-}
-
-fn at(x: f64) -> DMat4 {
-    DMat4::from_translation(DVec3::new(x, 0.0, 0.0))
-}
 
 /// A scene of `meshes` under a light along −z of irradiance π: a white Lambert surface
 /// facing it has radiance 1, so a pixel shows its albedo.

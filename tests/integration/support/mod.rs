@@ -5,6 +5,7 @@ pub mod geometry;
 pub mod gpu;
 pub mod pipeline;
 pub mod process;
+pub mod quads;
 pub mod reference;
 pub mod scenes;
 pub mod twins;

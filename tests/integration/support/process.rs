@@ -46,3 +46,27 @@ pub fn gpu_render<S: AsRef<OsStr>>(args: &[S]) -> Run {
     );
     run
 }
+
+/// Bytes a test writes where a run's output goes, which a failed run must leave
+/// untouched.
+pub const OLD_OUTPUT: &[u8] = b"an older image that a failed run must not touch";
+
+/// Asserts a failed run: status 1, an `error: ` message holding every `needle`, and
+/// nothing on standard output.
+pub fn assert_fails_with(run: &Run, needles: &[&str]) {
+    assert_eq!(
+        run.status,
+        Some(1),
+        "expected exit 1, stderr:\n{}",
+        run.stderr
+    );
+    assert!(run.stderr.starts_with("error: "), "stderr:\n{}", run.stderr);
+    for needle in needles {
+        assert!(
+            run.stderr.contains(needle),
+            "stderr lacks {needle:?}:\n{}",
+            run.stderr
+        );
+    }
+    assert!(run.stdout.is_empty(), "stdout: {}", run.stdout);
+}
