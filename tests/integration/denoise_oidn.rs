@@ -302,7 +302,7 @@ mod with_the_feature {
             .env("OIDN_DIR", empty.path())
             .output()
             .expect("run gpu-render");
-        let run = super::Run {
+        let run = crate::support::process::Run {
             status: run.status.code(),
             stdout: String::from_utf8_lossy(&run.stdout).into_owned(),
             stderr: String::from_utf8_lossy(&run.stderr).into_owned(),
