@@ -10,28 +10,11 @@ use std::process::Command;
 /// The showcase (polygons, triangles, glass, a mirror, three lights) made small.
 const SHOWCASE_ARGS: [&str; 6] = ["--width", "96", "--height", "54", "--spp", "2"];
 
-use crate::support::process::{Run, gpu_render};
+use crate::support::process::{Run, assert_failed, gpu_render};
 
 fn succeeds(run: Run) -> Run {
     assert_eq!(run.status, Some(0), "stderr:\n{}", run.stderr);
     run
-}
-
-fn fails_with(run: &Run, needles: &[&str]) {
-    assert_eq!(
-        run.status,
-        Some(1),
-        "expected exit 1, stderr:\n{}",
-        run.stderr
-    );
-    assert!(run.stderr.starts_with("error: "), "stderr:\n{}", run.stderr);
-    for needle in needles {
-        assert!(
-            run.stderr.contains(needle),
-            "stderr lacks {needle:?}:\n{}",
-            run.stderr
-        );
-    }
 }
 
 fn shipped(name: &str) -> String {
@@ -229,7 +212,7 @@ fn merge_refuses_a_missing_tile_naming_it_and_its_pixels() {
         &out,
         &[tiles[0].clone(), tiles[1].clone(), tiles[3].clone()],
     );
-    fails_with(
+    assert_failed(
         &run,
         &[
             "the tiles leave 80 of the 20x16 pixels uncovered",
@@ -259,7 +242,7 @@ fn merge_refuses_an_overlapping_tile_naming_both_files_and_the_pixels() {
     let mut with_crop = tiles.clone();
     with_crop.push(arg(&crop));
     let run = merge_into(&dir.path().join("out.png"), &with_crop);
-    fails_with(
+    assert_failed(
         &run,
         &[
             "s-0.exr and ",
@@ -287,7 +270,7 @@ fn merge_refuses_a_tile_of_another_scene_or_settings() {
             tiles[3].clone(),
         ],
     );
-    fails_with(
+    assert_failed(
         &run,
         &[
             "other-2.exr: not the same scene as ",
@@ -310,7 +293,7 @@ fn merge_refuses_a_tile_of_another_scene_or_settings() {
             tiles[3].clone(),
         ],
     );
-    fails_with(
+    assert_failed(
         &run,
         &[
             "more-1.exr: not the same render settings as ",
@@ -329,7 +312,7 @@ fn merge_refuses_a_tile_of_another_scene_or_settings() {
         "-q".into(),
     ]));
     let run = merge_into(&dir.path().join("out.png"), &[arg(&plain)]);
-    fails_with(
+    assert_failed(
         &run,
         &["plain.exr: not a gpu-render tile: attribute `gpuRender.tileFormat`"],
     );
@@ -392,7 +375,7 @@ fn tile_and_crop_arguments_are_checked_before_rendering() {
     for (extra, needles) in cases {
         let mut args = vec![scene.as_str(), "--backend", "cpu"];
         args.extend(extra);
-        fails_with(&gpu_render(&args), needles);
+        assert_failed(&gpu_render(&args), needles);
     }
     let entries = std::fs::read_dir(dir.path()).expect("list").count();
     assert_eq!(entries, 1, "only the scene is there");
@@ -451,7 +434,7 @@ fn a_frame_at_a_keyframe_is_the_still_of_that_camera() {
 
     let mut args = vec![orbit.as_str(), "--frame", "49", "-o", pattern.as_str()];
     args.extend(small);
-    fails_with(
+    assert_failed(
         &gpu_render(&args),
         &["--frame 49: the animation has 49 frames (0 to 48)"],
     );
@@ -484,7 +467,7 @@ fn tiles_of_two_frames_do_not_merge() {
         arg(&out)
     };
     let run = merge_into(&dir.path().join("out.png"), &[tile("3", 0), tile("4", 1)]);
-    fails_with(
+    assert_failed(
         &run,
         &["f4-1.exr: not the same frame as ", "4 here, 3 there"],
     );
