@@ -28,7 +28,8 @@
 // Each slot's bounce stack of frame.stack_size entries (interleaved across slots).
 @group(0) @binding(15) var<storage, read_write> ray_stack: array<StackEntry>;
 @group(0) @binding(16) var<storage, read_write> traces: array<TraceRay>;
-// Each slot's traversal stack of MAX_BVH_DEPTH entries (interleaved across slots).
+// Each slot's traversal stack of MAX_TRAVERSAL_STACK entries of two words, a child
+// word and its entry distance's bits (interleaved across slots: traverse.wgsl).
 @group(0) @binding(17) var<storage, read_write> traversal_stack: array<u32>;
 // Vertex normals and texture coordinates of mesh triangles (Triangle.attributes).
 @group(0) @binding(18) var<storage, read> triangle_attributes: array<TriangleAttributes>;

@@ -5,7 +5,7 @@
 #import records
 
 //#if INSTANCES
-// A placement of an instanced mesh (twin of accel::Instance), unpacked from the four
+// A placement of an instanced mesh (twin of accel::Instance), unpacked from the two
 // bvh_nodes records the host stores it in (instance_records in src/gpu/upload.rs):
 // the columns of object_to_world and of world_to_object (the images of x, y and z,
 // then the translation), the root node of its mesh's tree, its material, whether it
@@ -31,10 +31,11 @@ struct Instance {
 fn load_instance(record: u32) -> Instance {
     let a = bvh_nodes[record];
     let b = bvh_nodes[record + 1u];
-    let c = bvh_nodes[record + 2u];
-    let d = bvh_nodes[record + 3u];
-    return Instance(a.min, a.max, b.min, b.max, c.min, c.max, d.min, d.max, a.first, a.count,
-                    b.first != 0u, c.first, c.count);
+    return Instance(a.origin, bitcast<vec3<f32>>(a.low), bitcast<vec3<f32>>(a.high),
+                    bitcast<vec3<f32>>(a.children.xyz),
+                    b.origin, bitcast<vec3<f32>>(b.low), bitcast<vec3<f32>>(b.high),
+                    bitcast<vec3<f32>>(b.children.xyz),
+                    a.exponents, a.spare_low, a.spare_high != 0u, a.children.w, b.exponents);
 }
 
 // A mesh-space point in world space.

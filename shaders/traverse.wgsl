@@ -2,7 +2,7 @@
 // same rules: planes first, then the tree nearest child first; at equal distance the
 // smaller primitive reference wins, so the result does not depend on the visit order).
 //
-// MAX_BVH_DEPTH and MAX_POLYGON_VERTICES come from the Rust constants (the module
+// MAX_TRAVERSAL_STACK, the child word constants and MAX_POLYGON_VERTICES come from the Rust constants (the module
 // `limits`, src/gpu/shaders.rs). Every step is charged to the invocation's budget
 // (budget.wgsl).
 //
@@ -47,6 +47,10 @@ const MIN_DIRECTION_COMPONENT: f32 = 1e-20;
 // slab distance is enlarged by it so that rounding never loses a box the ray enters
 // (Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013).
 const FAR_SLAB_SCALE: f32 = 1.0000003576;
+
+// The entry distance child_entries gives a child the ray misses: larger than any it
+// enters, so that sorting puts the missed last.
+const MISSED_CHILD: f32 = 3.40282347e38;
 
 // What `traverse` did: finished the traversal, stopped because the budget is
 // spent (or the loop was cut), or gave way to lanes whose rays have finished.
@@ -96,18 +100,39 @@ fn slab_ray(ray: Ray) -> SlabRay {
     return SlabRay(ray.origin, inverse_direction(ray.direction));
 }
 
-// The distance at which the ray enters node `index`'s box, if it does so in
-// [0, t_max], else NO_HIT (the slab test of Kay and Kajiya, with Ize's far distance).
-// Twin of SlabRay::enter.
-fn slab_ray_enter(slab: SlabRay, index: u32, t_max: f32) -> f32 {
-    let node = bvh_nodes[index];
-    let lo = (node.min - slab.origin) * slab.inverse_direction;
-    let hi = (node.max - slab.origin) * slab.inverse_direction;
-    let near_axes = min(lo, hi);
-    let far_axes = max(lo, hi);
-    let near = max(max(max(near_axes.x, near_axes.y), near_axes.z), 0.0);
-    let far = min(min(min(far_axes.x, far_axes.y), far_axes.z), t_max) * FAR_SLAB_SCALE;
-    return select(NO_HIT, near, near <= far);
+// The four bytes of `word`, byte i in component i.
+fn unpack_bytes(word: u32) -> vec4<u32> {
+    return (vec4<u32>(word) >> vec4<u32>(0u, 8u, 16u, 24u)) & vec4<u32>(0xffu);
+}
+
+// The four children's bounds on one axis: origin + q * 2^e, whose product is exact in
+// f32, so that the sum rounds once, fused or not (accel::wide). Twin of dequantize.
+fn dequantize(origin: f32, biased_exponent: u32, quantized: u32) -> vec4<f32> {
+    let step = bitcast<f32>(biased_exponent << 23u);
+    return vec4<f32>(origin) + vec4<f32>(unpack_bytes(quantized)) * step;
+}
+
+// The four slab distances of one axis (the slab test of Kay and Kajiya).
+fn slab_axis(origin: f32, inverse_direction: f32, bound: vec4<f32>) -> vec4<f32> {
+    return (bound - vec4<f32>(origin)) * inverse_direction;
+}
+
+// The distances at which the ray enters node `index`'s four children's boxes, for each
+// that it enters in [0, t_max] (with Ize's far distance) and is not empty, else
+// MISSED_CHILD. Twin of SlabRay::enter on WideNode::child_box.
+fn child_entries(slab: SlabRay, node: WideNode, t_max: f32) -> vec4<f32> {
+    let e = unpack_bytes(node.exponents);
+    let lo_x = slab_axis(slab.origin.x, slab.inverse_direction.x, dequantize(node.origin.x, e.x, node.low.x));
+    let hi_x = slab_axis(slab.origin.x, slab.inverse_direction.x, dequantize(node.origin.x, e.x, node.high.x));
+    let lo_y = slab_axis(slab.origin.y, slab.inverse_direction.y, dequantize(node.origin.y, e.y, node.low.y));
+    let hi_y = slab_axis(slab.origin.y, slab.inverse_direction.y, dequantize(node.origin.y, e.y, node.high.y));
+    let lo_z = slab_axis(slab.origin.z, slab.inverse_direction.z, dequantize(node.origin.z, e.z, node.low.z));
+    let hi_z = slab_axis(slab.origin.z, slab.inverse_direction.z, dequantize(node.origin.z, e.z, node.high.z));
+    let near = max(max(max(min(lo_x, hi_x), min(lo_y, hi_y)), min(lo_z, hi_z)), vec4<f32>(0.0));
+    let far = min(min(min(max(lo_x, hi_x), max(lo_y, hi_y)), max(lo_z, hi_z)), vec4<f32>(t_max))
+        * FAR_SLAB_SCALE;
+    let entered = (near <= far) & (node.children != vec4<u32>(EMPTY_CHILD));
+    return select(vec4<f32>(MISSED_CHILD), near, entered);
 }
 
 // The ray a traversal walks with, in the space of the tree it is in (the scene's, or
@@ -234,16 +259,17 @@ fn consider(trace: ptr<function, TraceRay>, prim: u32, ray: TraversalRay) {
     }
 }
 
-// Opens the current node if it is a leaf: its primitives become the range [cursor,
-// leaf_end) and the node becomes NO_NODE (the traversal descends only through inner
-// nodes). Called on every node a traversal reaches, in the step that reaches it, so
-// that the node on the saved state is never a leaf.
-fn open_if_leaf(trace: ptr<function, TraceRay>) {
-    let count = bvh_nodes[(*trace).node].count;
+// Goes to the child a child word names: an inner node becomes the current node; a
+// leaf's primitives become the range [cursor, leaf_end) (the node stays NO_NODE), so
+// that the node on the saved state is never a leaf. Twin of WideChild::from_word.
+fn enter_child(trace: ptr<function, TraceRay>, word: u32) {
+    let count = word >> CHILD_COUNT_SHIFT;
     if count > 0u {
-        (*trace).cursor = bvh_nodes[(*trace).node].first;
+        (*trace).cursor = word & CHILD_INDEX_MASK;
         (*trace).leaf_end = (*trace).cursor + count;
         (*trace).node = NO_NODE;
+    } else {
+        (*trace).node = word & CHILD_INDEX_MASK;
     }
 }
 
@@ -291,9 +317,9 @@ fn start_traversal(trace: ptr<function, TraceRay>, ray: TraversalRay) -> u32 {
     //#if PLANES
     test_planes(trace, ray);
     //#endif
-    if frame.node_count > 0u && slab_ray_enter(ray.slab, 0u, (*trace).best_t) != NO_HIT {
+    // The root is visited as any node (its children's boxes are tested there).
+    if frame.node_count > 0u {
         (*trace).node = 0u;
-        open_if_leaf(trace);
     }
     return 0u;
     //#endif
@@ -321,13 +347,8 @@ fn enter_instance(trace: ptr<function, TraceRay>, record: u32, world_ray: Ray) -
     (*trace).leaf_end = 0u;
     (*trace).instance = record;
     (*trace).stack_base = (*trace).stack_len;
-    let ray = traversal_ray(object_ray(placed, world_ray));
-    (*trace).node = NO_NODE;
-    if slab_ray_enter(ray.slab, placed.root, (*trace).best_t) != NO_HIT {
-        (*trace).node = placed.root;
-        open_if_leaf(trace);
-    }
-    return ray;
+    (*trace).node = placed.root;
+    return traversal_ray(object_ray(placed, world_ray));
 }
 
 // Leaves the instance whose tree is done: back to the scene's ray and leaf.
@@ -353,73 +374,106 @@ fn next_leaf_prim(trace: ptr<function, TraceRay>, ray: ptr<function, TraversalRa
     consider(trace, prim, *ray);
 }
 
-// Where level `level` of slot `slot`'s traversal stack lives: levels are interleaved
-// across slots, so the lanes of one vector touch neighbouring words.
-fn traversal_stack_index(slot: u32, level: u32) -> u32 {
-    return level * frame.slot_count + slot;
+// Where word `word` (0: the child word, 1: its entry distance's bits) of level
+// `level` of slot `slot`'s traversal stack lives: levels are interleaved across slots,
+// so the lanes of one vector touch neighbouring words.
+fn traversal_stack_index(slot: u32, level: u32, word: u32) -> u32 {
+    return (2u * level + word) * frame.slot_count + slot;
 }
 
-// The stack's top node is kept in `held` while it is not in traversal_stack (NO_NODE
-// when level stack_len - 1, if any, is in memory): a node pushed and popped with no push
-// between never goes through memory.
+// A child waiting on the traversal stack: its word and the distance at which the ray
+// enters its box.
+struct StackedChild {
+    word: u32,
+    entry: f32,
+}
 
-// Pops the stack's top node and makes it current if the ray still enters its box: a
-// node pushed earlier may lie beyond a hit found since.
-fn pop_node(slot: u32, trace: ptr<function, TraceRay>, held: ptr<function, u32>, slab: SlabRay) {
+// The stack's top child is kept in `held` while it is not in traversal_stack
+// (held.word == EMPTY_CHILD when level stack_len - 1, if any, is in memory): a child
+// pushed and popped with no push between never goes through memory.
+
+// Writes `child` to level `level` of slot `slot`'s stack.
+fn store_stacked(slot: u32, level: u32, child: StackedChild) {
+    traversal_stack[traversal_stack_index(slot, level, 0u)] = child.word;
+    traversal_stack[traversal_stack_index(slot, level, 1u)] = bitcast<u32>(child.entry);
+}
+
+// Pushes `child`: the held child goes to memory and `child` is held.
+fn push_child(slot: u32, trace: ptr<function, TraceRay>, held: ptr<function, StackedChild>, child: StackedChild) {
+    if (*trace).stack_len >= MAX_TRAVERSAL_STACK {
+        atomicOr(&counters.errors, ERROR_TRAVERSAL_STACK);
+        return;
+    }
+    if (*held).word != EMPTY_CHILD {
+        store_stacked(slot, (*trace).stack_len - 1u, *held);
+    }
+    *held = child;
+    (*trace).stack_len += 1u;
+}
+
+// Pops the stack's top child and goes to it if the ray enters its box no farther
+// than the best hit (times Ize's factor, as the slab test's far distance): a child
+// pushed earlier may lie beyond a hit found since. Twin of the pop in Query::walk.
+fn pop_child(slot: u32, trace: ptr<function, TraceRay>, held: ptr<function, StackedChild>) {
     (*trace).stack_len -= 1u;
-    var candidate = *held;
-    if *held == NO_NODE {
-        candidate = traversal_stack[traversal_stack_index(slot, (*trace).stack_len)];
+    var child = *held;
+    if child.word == EMPTY_CHILD {
+        child = StackedChild(
+            traversal_stack[traversal_stack_index(slot, (*trace).stack_len, 0u)],
+            bitcast<f32>(traversal_stack[traversal_stack_index(slot, (*trace).stack_len, 1u)]));
     }
-    *held = NO_NODE;
-    if slab_ray_enter(slab, candidate, (*trace).best_t) != NO_HIT {
-        (*trace).node = candidate;
-    }
-}
-
-// Visits the current inner node: descends into the child the ray enters nearer, the
-// other waiting on the stack, or into the only child it enters, or nowhere.
-fn visit_inner_node(slot: u32, trace: ptr<function, TraceRay>, held: ptr<function, u32>, slab: SlabRay) {
-    let a = bvh_nodes[(*trace).node].first;
-    let b = a + 1u;
-    let enter_a = slab_ray_enter(slab, a, (*trace).best_t);
-    let enter_b = slab_ray_enter(slab, b, (*trace).best_t);
-    if enter_a != NO_HIT && enter_b != NO_HIT {
-        var near = a;
-        var far = b;
-        if enter_b < enter_a {
-            near = b;
-            far = a;
-        }
-        if (*trace).stack_len < MAX_BVH_DEPTH {
-            if *held != NO_NODE {
-                traversal_stack[traversal_stack_index(slot, (*trace).stack_len - 1u)] = *held;
-            }
-            *held = far;
-            (*trace).stack_len += 1u;
-        } else {
-            atomicOr(&counters.errors, ERROR_TRAVERSAL_STACK);
-        }
-        (*trace).node = near;
-    } else if enter_a != NO_HIT {
-        (*trace).node = a;
-    } else if enter_b != NO_HIT {
-        (*trace).node = b;
-    } else {
-        (*trace).node = NO_NODE;
+    (*held).word = EMPTY_CHILD;
+    if child.entry <= (*trace).best_t * FAR_SLAB_SCALE {
+        enter_child(trace, child.word);
     }
 }
 
-// One node step: a pop when no node is current, else a visit of the current inner
-// node; a leaf it reaches is opened in the same step.
-fn node_step(slot: u32, trace: ptr<function, TraceRay>, held: ptr<function, u32>, slab: SlabRay) {
+// Orders two (entry, word) pairs of the sort in visit_wide_node.
+fn sort_pair(entries: ptr<function, vec4<f32>>, words: ptr<function, vec4<u32>>, i: u32, j: u32) {
+    let swap = (*entries)[j] < (*entries)[i];
+    let ti = (*entries)[i];
+    let wi = (*words)[i];
+    (*entries)[i] = select(ti, (*entries)[j], swap);
+    (*entries)[j] = select((*entries)[j], ti, swap);
+    (*words)[i] = select(wi, (*words)[j], swap);
+    (*words)[j] = select((*words)[j], wi, swap);
+}
+
+// Visits the current wide node: tests its four children's boxes, goes to the child the
+// ray enters nearest, and stacks the others it enters, the farthest deepest. Twin of
+// the node visit in Query::walk.
+fn visit_wide_node(slot: u32, trace: ptr<function, TraceRay>, held: ptr<function, StackedChild>, slab: SlabRay) {
+    let node = bvh_nodes[(*trace).node];
+    var entries = child_entries(slab, node, (*trace).best_t);
+    var words = select(node.children, vec4<u32>(EMPTY_CHILD), entries == vec4<f32>(MISSED_CHILD));
+    // A sorting network of four (Knuth, TAOCP vol. 3, §5.3.4): the nearest first.
+    sort_pair(&entries, &words, 0u, 1u);
+    sort_pair(&entries, &words, 2u, 3u);
+    sort_pair(&entries, &words, 0u, 2u);
+    sort_pair(&entries, &words, 1u, 3u);
+    sort_pair(&entries, &words, 1u, 2u);
+    if words[3] != EMPTY_CHILD {
+        push_child(slot, trace, held, StackedChild(words[3], entries[3]));
+    }
+    if words[2] != EMPTY_CHILD {
+        push_child(slot, trace, held, StackedChild(words[2], entries[2]));
+    }
+    if words[1] != EMPTY_CHILD {
+        push_child(slot, trace, held, StackedChild(words[1], entries[1]));
+    }
+    (*trace).node = NO_NODE;
+    if words[0] != EMPTY_CHILD {
+        enter_child(trace, words[0]);
+    }
+}
+
+// One node step: a pop when no node is current, else a visit of the current node; a
+// leaf it reaches is opened in the same step.
+fn node_step(slot: u32, trace: ptr<function, TraceRay>, held: ptr<function, StackedChild>, slab: SlabRay) {
     if (*trace).node == NO_NODE {
-        pop_node(slot, trace, held, slab);
+        pop_child(slot, trace, held);
     } else {
-        visit_inner_node(slot, trace, held, slab);
-    }
-    if (*trace).node != NO_NODE {
-        open_if_leaf(trace);
+        visit_wide_node(slot, trace, held, slab);
     }
 }
 
@@ -457,8 +511,9 @@ fn traverse(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) -> u32 {
     }
     var finished = false;
     var exited = false;
-    // The stack's top (see pop_node), written back before a suspended call returns.
-    var held = NO_NODE;
+    // The stack's top (see StackedChild), written back before a suspended call
+    // returns.
+    var held = StackedChild(EMPTY_CHILD, 0.0);
     loop {
         // The test switch: a driver that cuts the loop after its first step (even
         // one that would have ended it).
@@ -502,8 +557,8 @@ fn traverse(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) -> u32 {
     if !exited {
         atomicOr(&counters.errors, ERROR_LOOP_CUT);
     }
-    if !finished && held != NO_NODE {
-        traversal_stack[traversal_stack_index(slot, (*trace).stack_len - 1u)] = held;
+    if !finished && held.word != EMPTY_CHILD {
+        store_stacked(slot, (*trace).stack_len - 1u, held);
     }
     if finished {
         return TRAVERSAL_FINISHED;

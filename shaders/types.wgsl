@@ -248,13 +248,19 @@ struct Light {
     cos_outer: f32,
 }
 
-// One node of the BVH (twin of `accel::BvhNode`): an inner node's children are
-// `first` and `first + 1`; a leaf (count > 0) holds bvh_prims[first .. first + count].
-struct BvhNode {
-    min: vec3<f32>,
-    first: u32,
-    max: vec3<f32>,
-    count: u32,
+// One node of the compressed 4-wide BVH (twin of `accel::WideNode`, which explains
+// the quantization): byte i of low[a] and high[a] holds child i's quantized bounds on
+// axis a, decoded as origin[a] + q * 2^e with byte a of `exponents` the biased e;
+// children holds the children's words: EMPTY_CHILD, an inner node's index (count 0),
+// or a leaf's first primitive in bvh_prims with its count above CHILD_COUNT_SHIFT.
+struct WideNode {
+    origin: vec3<f32>,
+    exponents: u32,
+    low: vec3<u32>,
+    spare_low: u32,
+    high: vec3<u32>,
+    spare_high: u32,
+    children: vec4<u32>,
 }
 
 // A primitive reference (twin of `accel::PrimRef`): kind << 29 | index in its list;
@@ -399,7 +405,7 @@ struct StackEntry {
 // Counters.errors bits.
 // A loop ended without reaching its exit: the driver cut it (llvmpipe's loop limit).
 const ERROR_LOOP_CUT: u32 = 1u;
-// A traversal needed more than MAX_BVH_DEPTH stack entries.
+// A traversal needed more than MAX_TRAVERSAL_STACK stack entries.
 const ERROR_TRAVERSAL_STACK: u32 = 2u;
 
 // Shared counters of one trace: pixels handed out and finished, rays traced (64 bits

@@ -25,6 +25,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Vec3A};
 
 use super::geometry::PrimRef;
+use super::wide::{WideNode, collapse};
 
 /// Deepest tree either tracer traverses: the GPU's traversal stack has this many
 /// entries, and both builders stay within it (see [`MEDIAN_SPLIT_DEPTH`]).
@@ -133,12 +134,14 @@ pub enum BuildMethod {
 pub struct BvhStats {
     /// The builder that made the tree.
     pub method: BuildMethod,
-    /// Wall time of the build, flattening included.
+    /// Wall time of the build, flattening and the collapse to wide nodes included.
     pub build_time: Duration,
-    /// Depth of the tree (a lone leaf has depth 1; an empty tree 0).
+    /// Depth of the binary tree (a lone leaf has depth 1; an empty tree 0).
     pub depth: u32,
-    /// Number of nodes.
+    /// Number of binary nodes.
     pub nodes: usize,
+    /// Number of wide nodes ([`Bvh::wide`]).
+    pub wide_nodes: usize,
     /// Number of leaves.
     pub leaves: usize,
     /// The tree's SAH cost relative to its root box: `Σ inner area / root area +
@@ -146,11 +149,16 @@ pub struct BvhStats {
     pub sah_cost: f64,
 }
 
-/// The hierarchy: depth-first nodes and the primitive references of the leaves.
+/// The hierarchy: depth-first binary nodes, the wide nodes the tracers walk, and the
+/// primitive references of the leaves (which both share).
 #[derive(Debug, Clone, Default)]
 pub struct Bvh {
-    /// Nodes; node 0 is the root. Empty when there is no bounded primitive.
+    /// The binary tree as built; node 0 is the root. Empty when there is no bounded
+    /// primitive.
     pub nodes: Vec<BvhNode>,
+    /// The same tree collapsed into compressed 4-wide nodes ([`super::wide`]), which
+    /// both tracers traverse; node 0 is the root.
+    pub wide: Vec<WideNode>,
     /// Primitive references, leaf by leaf.
     pub prims: Vec<PrimRef>,
     /// How it was built.
@@ -177,6 +185,8 @@ impl Bvh {
     pub fn build(primitives: &[(PrimRef, Aabb32)], method: BuildMethod) -> Self {
         let start = Instant::now();
         let mut bvh = build_tree(primitives, method);
+        bvh.wide = collapse(&bvh.nodes);
+        bvh.stats.wide_nodes = bvh.wide.len();
         bvh.stats.build_time = start.elapsed();
         bvh
     }

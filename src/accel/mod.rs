@@ -16,6 +16,8 @@
 //!
 //! - [`geometry`]: the primitive lists and [`SceneGeometry`];
 //! - [`bvh`]: the tree, its `f32` node records and its two builders;
+//! - [`wide`]: the same tree collapsed into the compressed 4-wide nodes both tracers
+//!   walk;
 //! - [`instance`]: meshes placed more than once, stored once with a BVH of their own
 //!   and entered through their placements' transforms (a two-level BVH).
 //!
@@ -29,6 +31,7 @@ pub mod bvh;
 pub mod environment;
 pub mod geometry;
 pub mod instance;
+pub mod wide;
 
 pub use area_lights::{AreaLights, EmitterEntry, EmitterEntryShape};
 pub use brdf_map_cdf::{BrdfMapCdf, BrdfMapCdfs};
@@ -39,3 +42,7 @@ pub use geometry::{
     SceneGeometry, SphereShape, TriangleAttributes, TriangleShape, alpha_masks, ray_offset_scale,
 };
 pub use instance::{HitKey, Instance, InstanceId, InstancedMesh};
+pub use wide::{
+    CHILD_COUNT_SHIFT, CHILD_INDEX_MASK, EMPTY_CHILD, MAX_TRAVERSAL_STACK, MAX_WIDE_DEPTH,
+    WIDTH, WideChild, WideNode,
+};

@@ -1,8 +1,9 @@
 //! The scene queries over the BVH: the CPU twin of `shaders/traverse.wgsl` (same
 //! function names, the same nodes, the same rules, in `f64`).
 //!
-//! Both queries test the planes first, then descend the tree nearest child first with
-//! a stack of [`MAX_BVH_DEPTH`] entries, one function for both as in WGSL. Of two hits at exactly the same distance the
+//! Both queries test the planes first, then descend the wide tree ([`crate::accel::wide`])
+//! nearest child first with a stack of [`MAX_TRAVERSAL_STACK`] entries, one function
+//! for both as in WGSL. Of two hits at exactly the same distance the
 //! smaller [`PrimRef`] wins, so the nearest hit does not depend on the visiting order
 //! and equals [`closest_hit_brute_force`], which tests every primitive.
 
@@ -12,8 +13,10 @@ use super::intersect::{
     Hit, Ray, ShearedRay, hit_record_keyed, intersect_prim, intersect_triangle, limit_for,
     shear_ray,
 };
+use crate::accel::bvh::Aabb32;
 use crate::accel::{
-    Bvh, BvhNode, HitKey, Instance, MAX_BVH_DEPTH, PrimKind, PrimRef, SceneGeometry,
+    Bvh, EMPTY_CHILD, HitKey, Instance, MAX_TRAVERSAL_STACK, PrimKind, PrimRef, SceneGeometry,
+    WIDTH, WideChild, WideNode,
 };
 use crate::sample::{pcg_hash, unit_from_hash};
 use crate::scene::AlphaMode;
@@ -33,7 +36,7 @@ pub const FAR_SLAB_SCALE: f64 =
 /// Work one query did: nodes visited and primitives tested.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct TraversalCounts {
-    /// BVH nodes visited (inner and leaf).
+    /// Wide BVH nodes visited (each tests its children's boxes).
     pub nodes: u64,
     /// Primitive intersection tests (planes included).
     pub primitives: u64,
@@ -69,17 +72,35 @@ impl SlabRay {
         }
     }
 
-    /// The distance at which the ray enters `node`'s box, if it does so in
-    /// [0, `t_max`] (the slab test of Kay and Kajiya, with Ize's robust far distance).
-    fn enter(&self, node: &BvhNode, t_max: f64) -> Option<f64> {
+    /// The distance at which the ray enters `aabb`, if it does so in [0, `t_max`] (the
+    /// slab test of Kay and Kajiya, with Ize's robust far distance).
+    fn enter(&self, aabb: &Aabb32, t_max: f64) -> Option<f64> {
         let lo =
-            (DVec3::from_array(node.min.map(f64::from)) - self.origin) * self.inverse_direction;
+            (DVec3::from_array(aabb.min.map(f64::from)) - self.origin) * self.inverse_direction;
         let hi =
-            (DVec3::from_array(node.max.map(f64::from)) - self.origin) * self.inverse_direction;
+            (DVec3::from_array(aabb.max.map(f64::from)) - self.origin) * self.inverse_direction;
         let near = lo.min(hi).max_element().max(0.0);
         let far = lo.max(hi).min_element().min(t_max) * FAR_SLAB_SCALE;
         (near <= far).then_some(near)
     }
+}
+
+/// The children of `node` the ray enters in [0, `t_max`], with their child words
+/// and entry distances, in slot order, and their number (twin of `child_entries` in
+/// `shaders/traverse.wgsl`, which marks the others missed instead).
+fn child_entries(slab: &SlabRay, node: &WideNode, t_max: f64) -> ([(u32, f64); WIDTH], usize) {
+    let mut entered = [(EMPTY_CHILD, f64::INFINITY); WIDTH];
+    let mut count = 0;
+    for (slot, &word) in node.children.iter().enumerate() {
+        if word == EMPTY_CHILD {
+            continue;
+        }
+        if let Some(t) = slab.enter(&node.child_box(slot), t_max) {
+            entered[count] = (word, t);
+            count += 1;
+        }
+    }
+    (entered, count)
 }
 
 /// One query's state: the best hit so far and the work done.
@@ -147,60 +168,61 @@ impl Query<'_> {
         });
     }
 
-    /// Descends `bvh` nearest child first, each popped node re-tested against the best
-    /// hit so far, handing each leaf's primitives in order to `leaf_prim`.
+    /// Descends `bvh`'s wide nodes nearest child first, each node testing its four
+    /// children's boxes and stacking the farther ones it enters with their entry
+    /// distance; a popped child is skipped where it begins beyond the best hit found
+    /// since. Hands each leaf's primitives in order to `leaf_prim`.
     fn walk(&mut self, bvh: &Bvh, ray: &Ray, mut leaf_prim: impl FnMut(&mut Self, PrimRef)) {
-        let nodes = &bvh.nodes;
+        let nodes = &bvh.wide;
+        if nodes.is_empty() {
+            return;
+        }
         let slab = SlabRay::new(ray);
-        let mut stack = [0u32; MAX_BVH_DEPTH as usize];
+        let mut stack = [(EMPTY_CHILD, 0.0f64); MAX_TRAVERSAL_STACK as usize];
         let mut stack_len = 0usize;
-        let mut current = match nodes.first() {
-            Some(root) if slab.enter(root, self.best_t).is_some() => Some(0u32),
-            _ => None,
-        };
+        let mut current = WideChild::Node(0);
         loop {
             if self.done() {
                 break;
             }
-            let Some(index) = current else {
-                // Pop; a node pushed earlier may lie beyond a hit found since.
-                if stack_len == 0 {
-                    break;
-                }
-                stack_len -= 1;
-                let candidate = stack[stack_len];
-                current = slab
-                    .enter(&nodes[candidate as usize], self.best_t)
-                    .map(|_| candidate);
-                continue;
-            };
-            self.counts.nodes += 1;
-            let node = &nodes[index as usize];
-            current = None;
-            if node.is_leaf() {
-                for &prim in &bvh.prims[node.first as usize..(node.first + node.count) as usize] {
-                    leaf_prim(self, prim);
-                    if self.done() {
+            match current {
+                WideChild::Empty => {
+                    // Pop; a child stacked earlier may begin beyond a hit found since.
+                    if stack_len == 0 {
                         break;
                     }
+                    stack_len -= 1;
+                    let (word, entry) = stack[stack_len];
+                    if entry <= self.best_t * FAR_SLAB_SCALE {
+                        current = WideChild::from_word(word);
+                    }
                 }
-                continue;
+                WideChild::Leaf { first, count } => {
+                    current = WideChild::Empty;
+                    for &prim in &bvh.prims[first as usize..(first + count) as usize] {
+                        leaf_prim(self, prim);
+                        if self.done() {
+                            break;
+                        }
+                    }
+                }
+                WideChild::Node(index) => {
+                    self.counts.nodes += 1;
+                    let (mut entered, count) =
+                        child_entries(&slab, &nodes[index as usize], self.best_t);
+                    let entered = &mut entered[..count];
+                    entered.sort_by(|a, b| a.1.total_cmp(&b.1));
+                    // Nearest child first; the others wait on the stack, the
+                    // farthest deepest.
+                    for &waiting in entered.iter().skip(1).rev() {
+                        stack[stack_len] = waiting;
+                        stack_len += 1;
+                    }
+                    current = entered
+                        .first()
+                        .map_or(WideChild::Empty, |&(word, _)| WideChild::from_word(word));
+                }
             }
-            let (a, b) = (node.first, node.first + 1);
-            let enter_a = slab.enter(&nodes[a as usize], self.best_t);
-            let enter_b = slab.enter(&nodes[b as usize], self.best_t);
-            current = match (enter_a, enter_b) {
-                (Some(ta), Some(tb)) => {
-                    // Nearest child first; the other waits on the stack.
-                    let (near, far) = if tb < ta { (b, a) } else { (a, b) };
-                    stack[stack_len] = far;
-                    stack_len += 1;
-                    Some(near)
-                }
-                (Some(_), None) => Some(a),
-                (None, Some(_)) => Some(b),
-                (None, None) => None,
-            };
         }
     }
 }

@@ -313,7 +313,7 @@ impl GpuCounters {
 
 /// `Counters.errors` bit: a loop ended without reaching its exit (the driver cut it).
 pub const ERROR_LOOP_CUT: u32 = 1;
-/// `Counters.errors` bit: a traversal needed more stack than `MAX_BVH_DEPTH`.
+/// `Counters.errors` bit: a traversal needed more stack than `MAX_TRAVERSAL_STACK`.
 pub const ERROR_TRAVERSAL_STACK: u32 = 2;
 
 /// A sphere (`Sphere` in WGSL).

@@ -90,9 +90,15 @@ pub fn shader_module(name: &str) -> Option<&'static str> {
 pub fn host_module(name: &str, features: &ShaderFeatures) -> Option<String> {
     match name {
         "limits" => Some(format!(
-            "const MAX_BVH_DEPTH: u32 = {}u;\nconst MAX_POLYGON_VERTICES: u32 = {}u;\n",
+            "const MAX_BVH_DEPTH: u32 = {}u;\nconst MAX_POLYGON_VERTICES: u32 = {}u;\n\
+             const MAX_TRAVERSAL_STACK: u32 = {}u;\nconst EMPTY_CHILD: u32 = {}u;\n\
+             const CHILD_COUNT_SHIFT: u32 = {}u;\nconst CHILD_INDEX_MASK: u32 = {}u;\n",
             crate::accel::MAX_BVH_DEPTH,
-            crate::accel::MAX_POLYGON_VERTICES
+            crate::accel::MAX_POLYGON_VERTICES,
+            crate::accel::MAX_TRAVERSAL_STACK,
+            crate::accel::EMPTY_CHILD,
+            crate::accel::CHILD_COUNT_SHIFT,
+            crate::accel::CHILD_INDEX_MASK,
         )),
         "records" => Some(format!(
             "#import types\n{}",

@@ -16,7 +16,7 @@ use super::layout::{
     WRAP_REPEAT,
 };
 use crate::accel::{
-    BrdfMapCdfs, BvhNode, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry,
+    BrdfMapCdfs, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry, WideNode,
     TriangleAttributes, TriangleShape,
 };
 use crate::camera::CameraFrame;
@@ -50,10 +50,10 @@ pub struct SceneRecords {
     pub materials: Vec<GpuMaterial>,
     /// Lights, in scene order.
     pub lights: Vec<GpuLight>,
-    /// The BVH nodes, as both tracers read them (the scene's tree from node 0), then
-    /// each instanced mesh's tree, then four records per instance
-    /// ([`instance_records`]).
-    pub bvh_nodes: Vec<BvhNode>,
+    /// The wide BVH nodes, as both tracers read them (the scene's tree from node 0),
+    /// then each instanced mesh's tree, then [`INSTANCE_RECORD_NODES`] records per
+    /// instance ([`instance_records`]).
+    pub bvh_nodes: Vec<WideNode>,
     /// The BVH's primitive references (`PrimRef` values), leaf by leaf: the scene's
     /// tree's (an instance named by the node index of its records), then each
     /// instanced mesh's (its triangles by their index in `triangles`).
@@ -98,7 +98,7 @@ impl SceneRecords {
                 .iter()
                 .map(|a| triangle_attributes_record(a, shift_uvs))
                 .collect(),
-            bvh_nodes: geometry.bvh.nodes.clone(),
+            bvh_nodes: geometry.bvh.wide.clone(),
             bvh_prims: geometry.bvh.prims.iter().map(|p| p.0).collect(),
             ..Self::default()
         };
@@ -147,11 +147,12 @@ impl SceneRecords {
             let first_node = index(self.bvh_nodes.len());
             let first_prim = index(self.bvh_prims.len());
             roots.push((first_node, first_triangle));
-            self.bvh_nodes
-                .extend(mesh.bvh.nodes.iter().map(|n| BvhNode {
-                    first: n.first + if n.is_leaf() { first_prim } else { first_node },
-                    ..*n
-                }));
+            self.bvh_nodes.extend(
+                mesh.bvh
+                    .wide
+                    .iter()
+                    .map(|n| n.shifted(first_node, first_prim)),
+            );
             self.bvh_prims.extend(
                 mesh.bvh
                     .prims
@@ -210,12 +211,12 @@ impl InstanceLayout {
     pub fn new(geometry: &SceneGeometry) -> Self {
         let index = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
         let mut triangles = geometry.triangles.len();
-        let mut nodes = geometry.bvh.nodes.len();
+        let mut nodes = geometry.bvh.wide.len();
         let mut first_triangle = Vec::with_capacity(geometry.instanced_meshes.len());
         for mesh in &geometry.instanced_meshes {
             first_triangle.push(index(triangles));
             triangles += mesh.triangles.len();
-            nodes += mesh.bvh.nodes.len();
+            nodes += mesh.bvh.wide.len();
         }
         Self {
             first_triangle,
@@ -235,52 +236,59 @@ impl InstanceLayout {
 }
 
 /// Node records per instance in [`SceneRecords::bvh_nodes`].
-pub const INSTANCE_RECORD_NODES: usize = 4;
+pub const INSTANCE_RECORD_NODES: usize = 2;
 
 /// The [`INSTANCE_RECORD_NODES`] node records that hold `instance` for the shaders
-/// (`load_instance` in `shaders/intersect.wgsl`), whose mesh's tree has its root at
+/// (`load_instance` in `shaders/instance.wgsl`), whose mesh's tree has its root at
 /// node `root`: the columns of `object_to_world` (the images of x, y and z, then the
-/// translation) in the first two records' corners, those of `world_to_object` in the
-/// last two; the first record's `first` and `count` hold the root and the material,
-/// the second's `first` whether the transform mirrors, the third's `first` and
-/// `count` the instance's index in [`SceneGeometry::instances`] and its mesh's first
-/// triangle in the triangle buffer (which name a hit as the CPU does, for stochastic
-/// transparency's hash). The normal matrix is the transpose of `world_to_object`'s
-/// linear part and is not stored.
+/// translation) in the first record's `origin`, `low`, `high` and `children[0..3]`
+/// (as `f32` bits), those of `world_to_object` in the second's; the first record's
+/// `exponents`, `spare_low`, `spare_high` and `children[3]` hold the root, the
+/// material, whether the transform mirrors and the instance's index in
+/// [`SceneGeometry::instances`], the second's `exponents` its mesh's first triangle in
+/// the triangle buffer (the index and first triangle name a hit as the CPU does, for
+/// stochastic transparency's hash). The normal matrix is the transpose of
+/// `world_to_object`'s linear part and is not stored.
 pub fn instance_records(
     instance: &Instance,
     root: u32,
     index: u32,
     first_triangle: u32,
-) -> [BvhNode; INSTANCE_RECORD_NODES] {
+) -> [WideNode; INSTANCE_RECORD_NODES] {
+    let bits = |v: DVec3| vec3(v).map(f32::to_bits);
+    let record = |columns: [DVec3; 4], words: [u32; 4]| {
+        let t = bits(columns[3]);
+        WideNode {
+            origin: vec3(columns[0]),
+            exponents: words[0],
+            low: bits(columns[1]),
+            spare_low: words[1],
+            high: bits(columns[2]),
+            spare_high: words[2],
+            children: [t[0], t[1], t[2], words[3]],
+        }
+    };
     let o2w = &instance.object_to_world;
     let w2o = &instance.world_to_object;
-    let node = |min: DVec3, first: u32, max: DVec3, count: u32| BvhNode {
-        min: vec3(min),
-        first,
-        max: vec3(max),
-        count,
-    };
     [
-        node(
-            o2w.matrix3.x_axis,
-            root,
-            o2w.matrix3.y_axis,
-            instance.material,
+        record(
+            [
+                o2w.matrix3.x_axis,
+                o2w.matrix3.y_axis,
+                o2w.matrix3.z_axis,
+                o2w.translation,
+            ],
+            [root, instance.material, u32::from(instance.mirrored), index],
         ),
-        node(
-            o2w.matrix3.z_axis,
-            u32::from(instance.mirrored),
-            o2w.translation,
-            0,
+        record(
+            [
+                w2o.matrix3.x_axis,
+                w2o.matrix3.y_axis,
+                w2o.matrix3.z_axis,
+                w2o.translation,
+            ],
+            [first_triangle, 0, 0, 0],
         ),
-        node(
-            w2o.matrix3.x_axis,
-            index,
-            w2o.matrix3.y_axis,
-            first_triangle,
-        ),
-        node(w2o.matrix3.z_axis, 0, w2o.translation, 0),
     ]
 }
 
@@ -646,7 +654,7 @@ pub fn frame_uniforms(scene: &Scene, geometry: &SceneGeometry) -> FrameUniforms 
         camera_medium_iors: camera_medium.iors.map(|ior| ior as f32),
         camera_medium_depth: camera_medium.depth,
         plane_count: count(geometry.planes.len()),
-        node_count: count(geometry.bvh.nodes.len()),
+        node_count: count(geometry.bvh.wide.len()),
         light_count: count(scene.lights.len()),
         region_x: 0,
         region_y: 0,
@@ -676,6 +684,7 @@ mod tests {
     use bytemuck::Zeroable;
 
     use super::*;
+    use crate::accel::WideChild;
     use crate::scene::{Camera, Environment, LightingSpace, RenderSettings, Shape};
 
     fn scene(shapes: Vec<Shape>, lights: Vec<Light>) -> Scene {
@@ -886,14 +895,14 @@ mod tests {
         let mut referenced = r.bvh_prims.clone();
         referenced.sort_unstable();
         assert_eq!(referenced.len(), 4);
-        assert_eq!(r.bvh_nodes.len(), geometry.bvh.nodes.len());
+        assert_eq!(r.bvh_nodes.len(), geometry.bvh.wide.len());
         let f = frame_uniforms(&s, &geometry);
         assert_eq!(
             (f.width, f.height, f.samples_per_pixel, f.max_depth),
             (40, 20, 4, 3)
         );
         assert_eq!((f.plane_count, f.light_count), (1, 2));
-        assert_eq!(f.node_count as usize, geometry.bvh.nodes.len());
+        assert_eq!(f.node_count as usize, geometry.bvh.wide.len());
         assert_eq!((f.region_width, f.region_height, f.end_sample), (40, 20, 4));
         assert_eq!(f.aspect, 2.0);
         assert_eq!(f.forward, [0.0, 0.0, -1.0]);
@@ -980,16 +989,17 @@ mod tests {
         // The mesh's one triangle and its attributes, once.
         assert_eq!((r.triangles.len(), r.triangle_attributes.len()), (1, 1));
         assert_eq!(r.triangles[0].attributes, 0);
-        let world_nodes = geometry.bvh.nodes.len();
-        let mesh_nodes = geometry.instanced_meshes[0].bvh.nodes.len();
+        let world_nodes = geometry.bvh.wide.len();
+        let mesh_nodes = geometry.instanced_meshes[0].bvh.wide.len();
         assert_eq!(
             r.bvh_nodes.len(),
             world_nodes + mesh_nodes + 2 * INSTANCE_RECORD_NODES
         );
         // The mesh's leaf names the triangle at its place in the triangle list.
-        let leaf = r.bvh_nodes[world_nodes];
-        assert!(leaf.is_leaf());
-        let prim = PrimRef(r.bvh_prims[leaf.first as usize]);
+        let WideChild::Leaf { first, .. } = r.bvh_nodes[world_nodes].child(0) else {
+            panic!("the mesh's root holds its leaf");
+        };
+        let prim = PrimRef(r.bvh_prims[first as usize]);
         assert_eq!((prim.kind(), prim.index()), (PrimKind::Triangle, 0));
         // The scene's tree names each instance by its records' node index.
         let mut records: Vec<usize> = r.bvh_prims[..geometry.bvh.prims.len()]
@@ -1003,17 +1013,21 @@ mod tests {
         assert_eq!(records, [first, first + INSTANCE_RECORD_NODES]);
         let second = &r.bvh_nodes[first + INSTANCE_RECORD_NODES..];
         assert_eq!(
-            second[0].first as usize, world_nodes,
+            second[0].exponents as usize, world_nodes,
             "the mesh tree's root"
         );
-        assert_eq!(second[0].count, 1, "the material");
-        assert_eq!(second[1].first, 1, "mirrored");
+        assert_eq!(second[0].spare_low, 1, "the material");
+        assert_eq!(second[0].spare_high, 1, "mirrored");
         assert_eq!(
-            second[0].min,
+            second[0].origin,
             [-1.0, 0.0, 0.0],
             "object_to_world's x column"
         );
-        assert_eq!(second[2].max, [0.0, 0.5, 0.0], "world_to_object's y column");
+        assert_eq!(
+            second[1].low.map(f32::from_bits),
+            [0.0, 0.5, 0.0],
+            "world_to_object's y column"
+        );
     }
 
     #[test]

@@ -22,7 +22,7 @@ use super::pipelines::{TracePipelines, binding};
 use super::readback::{Caught, capture, create_texture, map_read, read_buffer, submit_and_wait};
 use super::scene_buffers::DeviceScene;
 use super::shaders::SLOT_WORKGROUP_SIZE;
-use crate::accel::MAX_BVH_DEPTH;
+use crate::accel::MAX_TRAVERSAL_STACK;
 use crate::denoise::GuidePasses;
 use crate::noise::NoiseEstimate;
 
@@ -80,6 +80,10 @@ pub fn iteration_budget_for(adapter: &wgpu::AdapterInfo) -> u32 {
         None => 1 << 20,
     }
 }
+
+/// Bytes of one slot's traversal stack: [`MAX_TRAVERSAL_STACK`] entries of a child
+/// word and an entry distance (`traversal_stack` in `shaders/bindings.wgsl`).
+pub const TRAVERSAL_STACK_BYTES_PER_SLOT: u64 = MAX_TRAVERSAL_STACK as u64 * 2 * 4;
 
 /// The number of path slots a trace uses on `adapter` when the caller does not choose:
 /// 16,384 on CPU devices (enough for every SIMD lane of every core, small enough for
@@ -164,7 +168,7 @@ impl SlotBuffers {
             .min(limits.max_buffer_size);
         let largest_per_slot = (u64::from(stack_size.max(1)) * size_of::<GpuStackEntry>() as u64)
             .max(size_of::<GpuPathState>() as u64)
-            .max(u64::from(MAX_BVH_DEPTH) * 4);
+            .max(TRAVERSAL_STACK_BYTES_PER_SLOT);
         let fits = binding / largest_per_slot;
         let workgroups =
             u64::from(limits.max_compute_workgroups_per_dimension) * u64::from(SLOT_WORKGROUP_SIZE);
@@ -220,7 +224,7 @@ impl SlotBuffers {
             ),
             traversal_stack: storage(
                 "gpu-render traversal stacks",
-                slots * u64::from(MAX_BVH_DEPTH) * 4,
+                slots * TRAVERSAL_STACK_BYTES_PER_SLOT,
                 wgpu::BufferUsages::empty(),
             ),
             counters: storage(
@@ -576,7 +580,7 @@ pub(crate) fn check_errors(errors: u32) -> Result<(), RenderError> {
     }
     if errors & ERROR_TRAVERSAL_STACK != 0 {
         return Err(RenderError::TraceIncomplete(TraceFailure::TraversalStack {
-            max_depth: MAX_BVH_DEPTH,
+            max_depth: MAX_TRAVERSAL_STACK,
         }));
     }
     Ok(())

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use std::mem::{offset_of, size_of};
 
 use gpu_render::gpu::ShaderFeatures;
-use gpu_render::low_level::accel::{BvhNode, PrimKind, PrimRef};
+use gpu_render::low_level::accel::{PrimKind, PrimRef, WideNode};
 use gpu_render::low_level::gpu::area_lights::{
     EMITTER_NONE, EMITTER_SPHERE, EMITTER_TRIANGLE, EMITTER_TWO_SIDED_TRIANGLE, FLAG_PATH,
     GpuEmitter, PHASE_EMITTER,
@@ -199,12 +199,15 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
             }),
         ),
         (
-            "BvhNode",
-            twin!(BvhNode {
-                min,
-                first,
-                max,
-                count
+            "WideNode",
+            twin!(WideNode {
+                origin,
+                exponents,
+                low,
+                spare_low,
+                high,
+                spare_high,
+                children
             }),
         ),
         (

@@ -356,15 +356,24 @@ const WITHOUT_RUST_TWIN: &[(&str, &[&str], &str)] = &[
             "traversal_done",
             "next_leaf_prim",
             "leave_instance",
-            "open_if_leaf",
+            "enter_child",
             "traversal_stack_index",
-            "pop_node",
-            "visit_inner_node",
+            "store_stacked",
+            "push_child",
+            "pop_child",
+            "visit_wide_node",
             "node_step",
         ],
         "the steps of the resumable, budgeted traversal, whose state lives in a TraceRay \
          and the slot's stack: the CPU walks a tree in one call (Query::walk) and \
          recurses into instances",
+    ),
+    (
+        "traverse",
+        &["unpack_bytes", "dequantize", "slab_axis", "sort_pair"],
+        "the vector arithmetic of child_entries and the sort of visit_wide_node: the CPU \
+         decodes a child's box in WideNode::child_box (src/accel/wide.rs, whose dequantize \
+         is the same f32 sum) and sorts a slice in Query::walk",
     ),
     (
         "trace",

@@ -140,7 +140,7 @@ fn modules_with_uniform_records_validate_and_differ_only_in_their_bindings() {
         };
         assert_eq!(function_names(&uniform), function_names(&features));
         let source = trace_shader_source(&uniform).expect("well-formed directives");
-        assert!(source.contains("var<uniform> bvh_nodes: array<BvhNode, 2048>;"));
+        assert!(source.contains("var<uniform> bvh_nodes: array<WideNode, 1024>;"));
         assert!(!source.contains("var<storage, read> bvh_nodes"));
     }
 }

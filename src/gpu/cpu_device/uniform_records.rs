@@ -21,7 +21,7 @@
 
 use std::mem::size_of;
 
-use crate::accel::BvhNode;
+use crate::accel::WideNode;
 use crate::gpu::layout::{GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle};
 use crate::gpu::pipelines::binding;
 use crate::gpu::upload::SceneRecords;
@@ -91,8 +91,8 @@ const RECORDS: [RecordBinding; 7] = [
     RecordBinding {
         binding: binding::BVH_NODES,
         name: "bvh_nodes",
-        wgsl_type: "BvhNode",
-        stride: size_of::<BvhNode>(),
+        wgsl_type: "WideNode",
+        stride: size_of::<WideNode>(),
         length: |r| r.bvh_nodes.len(),
     },
 ];
@@ -263,11 +263,11 @@ mod tests {
     fn declarations_give_the_address_space_and_the_capacity() {
         assert!(
             declarations(false)
-                .contains("@group(0) @binding(12) var<storage, read> bvh_nodes: array<BvhNode>;\n")
+                .contains("@group(0) @binding(12) var<storage, read> bvh_nodes: array<WideNode>;\n")
         );
         assert!(
             declarations(true)
-                .contains("@group(0) @binding(12) var<uniform> bvh_nodes: array<BvhNode, 2048>;\n")
+                .contains("@group(0) @binding(12) var<uniform> bvh_nodes: array<WideNode, 1024>;\n")
         );
     }
 

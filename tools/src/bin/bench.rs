@@ -357,8 +357,8 @@ fn instancing_figures(scene: &gpu_render::scene::Scene) {
                         * std::mem::size_of::<
                             gpu_render::low_level::gpu::layout::GpuTriangleAttributes,
                         >()
-                    + m.bvh.nodes.len()
-                        * std::mem::size_of::<gpu_render::low_level::accel::BvhNode>()
+                    + m.bvh.wide.len()
+                        * std::mem::size_of::<gpu_render::low_level::accel::WideNode>()
                     + m.bvh.prims.len() * 4
             })
             .sum();
