@@ -43,6 +43,6 @@ pub use geometry::{
 };
 pub use instance::{HitKey, Instance, InstanceId, InstancedMesh};
 pub use wide::{
-    CHILD_COUNT_SHIFT, CHILD_INDEX_MASK, EMPTY_CHILD, MAX_TRAVERSAL_STACK, MAX_WIDE_DEPTH,
-    WIDTH, WideChild, WideNode,
+    CHILD_COUNT_SHIFT, CHILD_INDEX_MASK, EMPTY_CHILD, MAX_TRAVERSAL_STACK, MAX_WIDE_DEPTH, WIDTH,
+    WideChild, WideNode,
 };

@@ -188,7 +188,10 @@ impl WideNode {
     /// The node with box `bounds` and `children` (each with its box), at most
     /// [`WIDTH`]; the other slots are empty.
     pub fn new(bounds: Aabb32, children: &[(WideChild, Aabb32)]) -> Self {
-        assert!(children.len() <= WIDTH, "a wide node has at most {WIDTH} children");
+        assert!(
+            children.len() <= WIDTH,
+            "a wide node has at most {WIDTH} children"
+        );
         let origin = bounds.min.map(normal_or_zero_below);
         let mut node = Self {
             origin,
@@ -199,13 +202,13 @@ impl WideNode {
             spare_high: 0,
             children: [EMPTY_CHILD; WIDTH],
         };
-        for axis in 0..3 {
-            let biased = axis_exponent(origin[axis], bounds.max[axis]);
+        for (axis, &start) in origin.iter().enumerate() {
+            let biased = axis_exponent(start, bounds.max[axis]);
             node.exponents |= biased << (8 * axis);
             let step = step_of(biased);
             for (slot, (_, aabb)) in children.iter().enumerate() {
-                let lo = quantize_down(origin[axis], step, aabb.min[axis]);
-                let hi = quantize_up(origin[axis], step, aabb.max[axis]);
+                let lo = quantize_down(start, step, aabb.min[axis]);
+                let hi = quantize_up(start, step, aabb.max[axis]);
                 node.low[axis] |= lo << (8 * slot);
                 node.high[axis] |= hi << (8 * slot);
             }
@@ -353,7 +356,10 @@ mod tests {
                             min: inner.origin,
                             max: inner.origin,
                         };
-                        assert!(contains(&b, &inner_box), "node {child} starts outside its box");
+                        assert!(
+                            contains(&b, &inner_box),
+                            "node {child} starts outside its box"
+                        );
                         pending.push((child, depth + 1));
                     }
                     WideChild::Leaf { first, count } => {
@@ -420,7 +426,11 @@ mod tests {
         let bvh = Bvh::build(&prims, BuildMethod::Sah);
         let wide = collapse(&bvh.nodes);
         let inner = bvh.nodes.len() - bvh.stats.leaves;
-        assert!(2 * wide.len() <= inner, "{} wide for {inner} inner", wide.len());
+        assert!(
+            2 * wide.len() <= inner,
+            "{} wide for {inner} inner",
+            wide.len()
+        );
     }
 
     #[test]

@@ -86,7 +86,7 @@ impl SlabRay {
 }
 
 /// The children of `node` the ray enters in [0, `t_max`], with their child words
-/// and entry distances, in slot order, and their number (twin of `child_entries` in
+/// and entry distances, nearest first, and their number (twin of `child_entries` in
 /// `shaders/traverse.wgsl`, which marks the others missed instead).
 fn child_entries(slab: &SlabRay, node: &WideNode, t_max: f64) -> ([(u32, f64); WIDTH], usize) {
     let mut entered = [(EMPTY_CHILD, f64::INFINITY); WIDTH];
@@ -96,7 +96,13 @@ fn child_entries(slab: &SlabRay, node: &WideNode, t_max: f64) -> ([(u32, f64); W
             continue;
         }
         if let Some(t) = slab.enter(&node.child_box(slot), t_max) {
-            entered[count] = (word, t);
+            // Insertion by entry distance: the nearest first.
+            let mut at = count;
+            while at > 0 && t < entered[at - 1].1 {
+                entered[at] = entered[at - 1];
+                at -= 1;
+            }
+            entered[at] = (word, t);
             count += 1;
         }
     }
@@ -208,10 +214,9 @@ impl Query<'_> {
                 }
                 WideChild::Node(index) => {
                     self.counts.nodes += 1;
-                    let (mut entered, count) =
+                    let (entered, count) =
                         child_entries(&slab, &nodes[index as usize], self.best_t);
-                    let entered = &mut entered[..count];
-                    entered.sort_by(|a, b| a.1.total_cmp(&b.1));
+                    let entered = &entered[..count];
                     // Nearest child first; the others wait on the stack, the
                     // farthest deepest.
                     for &waiting in entered.iter().skip(1).rev() {

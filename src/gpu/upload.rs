@@ -16,8 +16,8 @@ use super::layout::{
     WRAP_REPEAT,
 };
 use crate::accel::{
-    BrdfMapCdfs, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry, WideNode,
-    TriangleAttributes, TriangleShape,
+    BrdfMapCdfs, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry, TriangleAttributes,
+    TriangleShape, WideNode,
 };
 use crate::camera::CameraFrame;
 use crate::scene::{

@@ -186,7 +186,10 @@ fn run_kernel(
         (
             17,
             storage(
-                &vec![0u8; rays.len() * gpu_render::low_level::accel::MAX_TRAVERSAL_STACK as usize * 8],
+                &vec![
+                    0u8;
+                    rays.len() * gpu_render::low_level::accel::MAX_TRAVERSAL_STACK as usize * 8
+                ],
                 none,
             ),
         ),

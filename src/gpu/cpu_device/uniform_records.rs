@@ -262,12 +262,14 @@ mod tests {
     #[test]
     fn declarations_give_the_address_space_and_the_capacity() {
         assert!(
-            declarations(false)
-                .contains("@group(0) @binding(12) var<storage, read> bvh_nodes: array<WideNode>;\n")
+            declarations(false).contains(
+                "@group(0) @binding(12) var<storage, read> bvh_nodes: array<WideNode>;\n"
+            )
         );
         assert!(
-            declarations(true)
-                .contains("@group(0) @binding(12) var<uniform> bvh_nodes: array<WideNode, 1024>;\n")
+            declarations(true).contains(
+                "@group(0) @binding(12) var<uniform> bvh_nodes: array<WideNode, 1024>;\n"
+            )
         );
     }
 
