@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use glam::{DVec2, DVec3};
 use gpu_render::low_level::color::srgb_decode;
 use gpu_render::scene::import::{ImportedModel, WrapMode, import_model, import_obj, parse_obj};
-use gpu_render::scene::{MaterialKind, SceneError};
+use gpu_render::scene::{AlphaMode, MaterialKind, SceneError};
 
 /// Writes `files` (name, contents) into a fresh directory and imports the first.
 fn import(files: &[(&str, &str)]) -> (tempfile::TempDir, Result<ImportedModel, SceneError>) {
@@ -1170,5 +1170,39 @@ fn placements_with_many_material_overrides_are_added_in_linear_time() {
     assert!(
         ratio < 8.0,
         "adding {large} placements took {ratio:.1}x as long as {small} ({large_time:?} against {small_time:?}); expected about 4x"
+    );
+}
+
+/// `d` and `Tr` are coverage, as tinyobjloader and assimp read them: a blended material
+/// of that alpha; glass ignores them, and `d 1` stays opaque.
+#[test]
+fn dissolve_makes_a_blended_material_of_that_alpha() {
+    let mtl = "newmtl quarter\nKd 1 1 1\nd 0.25\n\
+               newmtl tr\nKd 1 1 1\nTr 0.75\n\
+               newmtl whole\nKd 1 1 1\nd 1\n\
+               newmtl glass\nillum 7\nNi 1.5\nd 0.5\n";
+    let mut obj = String::from("mtllib d.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    for name in ["quarter", "tr", "whole", "glass"] {
+        obj.push_str(&format!("usemtl {name}\nf 1 2 3\n"));
+    }
+    let model = imported(&[("d.obj", &obj), ("d.mtl", mtl)]);
+    let material = |name: &str| {
+        &model
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .unwrap_or_else(|| panic!("no material {name}"))
+            .material
+    };
+    for name in ["quarter", "tr"] {
+        assert_eq!(material(name).alpha_mode, AlphaMode::Blend, "{name}");
+        assert_eq!(material(name).alpha, 0.25, "{name}");
+    }
+    assert_eq!(material("whole").alpha_mode, AlphaMode::Opaque);
+    assert_eq!(material("glass").alpha_mode, AlphaMode::Opaque);
+    assert!(
+        !model.warnings.iter().any(|w| w.contains("transparency")),
+        "{:?}",
+        model.warnings
     );
 }

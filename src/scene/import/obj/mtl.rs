@@ -14,7 +14,7 @@ use crate::input::{InputError, read_input};
 use crate::scene::import::mesh::Budget;
 use crate::scene::import::texture::{Encoding, Textures};
 use crate::scene::import::{ImportedMaterial, MAX_MODEL_FILE_BYTES, TextureRef, WrapMode, error};
-use crate::scene::{MAX_RADIANCE, Material, MaterialKind, SceneError};
+use crate::scene::{AlphaMode, MAX_RADIANCE, Material, MaterialKind, SceneError};
 
 /// Index of refraction assumed for glass (`illum` 4, 6, 7, 9) and coats (`illum` 3, 5, 8)
 /// whose material gives no usable `Ni`.
@@ -506,7 +506,7 @@ pub(super) fn map_material(
         None => DEFAULT_IOR,
     };
 
-    let material = if matches!(illum, 4 | 6 | 7 | 9) {
+    let mut material = if matches!(illum, 4 | 6 | 7 | 9) {
         let ior = ior_or_default(&mut warn, "the glass");
         let transmittance = unit("Tf", tf.unwrap_or(DVec3::ONE), &mut warn);
         Material {
@@ -591,11 +591,15 @@ pub(super) fn map_material(
             }
         }
     };
+    // `d` (or `1 − Tr`) as coverage, as tinyobjloader (`dissolve`) and assimp
+    // (`AI_MATKEY_OPACITY`) read it and viewers blend by it: glTF's BLEND with that
+    // alpha. Glass needs none: it transmits by its own model.
     if dissolve < 1.0 && material.kind != MaterialKind::Dielectric {
-        warn(format!(
-            "d {} (partial transparency) is not supported; the material is opaque",
-            short(dissolve)
-        ));
+        if dissolve < 0.0 {
+            warn(format!("d {} is below 0; read as 0", short(dissolve)));
+        }
+        material.alpha_mode = AlphaMode::Blend;
+        material.alpha = dissolve.max(0.0);
     }
     Ok(ImportedMaterial {
         name: m.name.clone(),
