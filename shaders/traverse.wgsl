@@ -2,12 +2,12 @@
 // same rules: planes first, then the tree nearest child first; at equal distance the
 // smaller primitive reference wins, so the result does not depend on the visit order).
 //
-// MAX_TRAVERSAL_STACK, the child word constants and MAX_POLYGON_VERTICES come from the Rust constants (the module
-// `limits`, src/gpu/shaders.rs). Every step is charged to the invocation's budget
-// (budget.wgsl).
+// MAX_TRAVERSAL_STACK, the child word constants and MAX_POLYGON_VERTICES come from
+// the Rust constants (the module `limits`, src/gpu/shaders.rs). Every step is charged
+// to the invocation's budget (budget.wgsl).
 //
 // The traversal runs in steps (`traverse`): a primitive test while a leaf is open,
-// else a node step (pop, or visit an inner node and descend into the child it enters
+// else a node step (pop, or visit a wide node and descend into the child it enters
 // first), so that a lane never waits for the others to finish a phase of their own.
 // Its state between steps and between dispatches is its TraceRay.
 

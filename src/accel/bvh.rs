@@ -27,8 +27,9 @@ use glam::{DVec3, Vec3A};
 use super::geometry::PrimRef;
 use super::wide::{WideNode, collapse};
 
-/// Deepest tree either tracer traverses: the GPU's traversal stack has this many
-/// entries, and both builders stay within it (see [`MEDIAN_SPLIT_DEPTH`]).
+/// Deepest binary tree the builders make (see [`MEDIAN_SPLIT_DEPTH`]): its collapse
+/// into wide nodes is half as deep, which sizes the tracers' traversal stacks
+/// ([`super::wide::MAX_TRAVERSAL_STACK`]).
 pub const MAX_BVH_DEPTH: u32 = 64;
 
 /// Most primitives in one leaf.
@@ -140,8 +141,6 @@ pub struct BvhStats {
     pub depth: u32,
     /// Number of binary nodes.
     pub nodes: usize,
-    /// Number of wide nodes ([`Bvh::wide`]).
-    pub wide_nodes: usize,
     /// Number of leaves.
     pub leaves: usize,
     /// The tree's SAH cost relative to its root box: `Σ inner area / root area +
@@ -186,7 +185,6 @@ impl Bvh {
         let start = Instant::now();
         let mut bvh = build_tree(primitives, method);
         bvh.wide = collapse(&bvh.nodes);
-        bvh.stats.wide_nodes = bvh.wide.len();
         bvh.stats.build_time = start.elapsed();
         bvh
     }

@@ -136,7 +136,8 @@ fn axis_exponent(lo: f32, hi: f32) -> u32 {
     } else {
         1
     };
-    // The estimate may be one short where the decoder's sum rounds down.
+    // The estimate may be one too large or, where the decoder's sum rounds down, one
+    // too small.
     while biased > 1 && dequantize(lo, step_of(biased - 1), 255) >= hi {
         biased -= 1;
     }

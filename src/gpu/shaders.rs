@@ -6,7 +6,8 @@
 //! import inside an `//#if` block is followed only where the block is kept.
 //!
 //! Besides the files, three modules are written by the host: `limits` (the Rust
-//! constants `MAX_BVH_DEPTH` and `MAX_POLYGON_VERTICES`), `records` (the bindings of
+//! constants `MAX_POLYGON_VERTICES`, `MAX_TRAVERSAL_STACK` and the wide tree's
+//! child-word constants), `records` (the bindings of
 //! the scene records, storage or uniform arrays: `super::cpu_device::uniform_records`) and, for
 //! an unrolled scene, `unrolled_scene` (its `unrolled_closest_hit`: [`super::cpu_device::unrolled`]).
 //!
@@ -90,10 +91,9 @@ pub fn shader_module(name: &str) -> Option<&'static str> {
 pub fn host_module(name: &str, features: &ShaderFeatures) -> Option<String> {
     match name {
         "limits" => Some(format!(
-            "const MAX_BVH_DEPTH: u32 = {}u;\nconst MAX_POLYGON_VERTICES: u32 = {}u;\n\
+            "const MAX_POLYGON_VERTICES: u32 = {}u;\n\
              const MAX_TRAVERSAL_STACK: u32 = {}u;\nconst EMPTY_CHILD: u32 = {}u;\n\
              const CHILD_COUNT_SHIFT: u32 = {}u;\nconst CHILD_INDEX_MASK: u32 = {}u;\n",
-            crate::accel::MAX_BVH_DEPTH,
             crate::accel::MAX_POLYGON_VERTICES,
             crate::accel::MAX_TRAVERSAL_STACK,
             crate::accel::EMPTY_CHILD,
@@ -184,7 +184,7 @@ pub const WORKGROUP_SIZE: u32 = 8;
 /// ```
 /// use gpu_render::gpu::ShaderFeatures;
 /// let src = gpu_render::low_level::gpu::shaders::trace_shader_source(&ShaderFeatures::ALL).unwrap();
-/// assert!(src.contains("const MAX_BVH_DEPTH: u32 = 64u;\n"));
+/// assert!(src.contains("const MAX_TRAVERSAL_STACK: u32 = 96u;\n"));
 /// assert!(src.contains("fn refract_direction"));
 /// assert!(src.contains("fn shade_paths") && src.contains("fn trace_rays"));
 /// ```
