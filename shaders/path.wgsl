@@ -36,7 +36,7 @@
 #import area_lights
 #import trace
 //#if ALPHA
-#import traverse
+#import coverage
 //#endif
 //#if ENVIRONMENT_MAP
 #import environment

@@ -43,6 +43,10 @@ pub mod cpu {
     pub mod aov {
         pub use crate::cpu::aov::*;
     }
+    /// Alpha coverage: what a candidate hit stops, and whether it stops a query.
+    pub mod coverage {
+        pub use crate::cpu::coverage::*;
+    }
     /// The BxDFs: evaluation, sampling and densities.
     pub mod bxdf {
         pub use crate::cpu::bxdf::*;

@@ -339,6 +339,18 @@ impl SceneGeometry {
         geometry
     }
 
+    /// A hierarchy over the analytic shapes alone (spheres and polygons), built by
+    /// `method`: what the software walk traverses where the device's ray queries find
+    /// the triangles and instances (the GPU's hardware traversal).
+    pub fn analytic_bvh(&self, method: BuildMethod) -> Bvh {
+        let analytic: Vec<_> = self
+            .bounded_primitives()
+            .into_iter()
+            .filter(|(prim, _)| matches!(prim.kind(), PrimKind::Sphere | PrimKind::Polygon))
+            .collect();
+        Bvh::build(&analytic, method)
+    }
+
     /// Every bounded primitive with its conservative `f32` box, spheres first, then
     /// polygons, then triangles.
     fn bounded_primitives(&self) -> Vec<(PrimRef, Aabb32)> {

@@ -22,10 +22,11 @@
 
 use glam::DVec3;
 
+use super::coverage::BlendRule;
 use super::intersect::{MAX_PASS_THROUGHS, Ray, culls_back_face, offset_ray_origin};
 use super::path::bounce_blend;
 use super::trace::{PreparedScene, shading_frame_normal};
-use super::traverse::{BlendRule, intersect_scene_with};
+use super::traverse::intersect_scene_with;
 use crate::denoise::GuidePasses;
 use crate::scene::{Integrator, Material, MaterialKind, Scene};
 use crate::texture::{mapped_normal, shading_material};

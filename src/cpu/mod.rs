@@ -11,6 +11,7 @@
 
 pub(crate) mod aov;
 pub(crate) mod bxdf;
+pub(crate) mod coverage;
 pub(crate) mod intersect;
 pub(crate) mod path;
 pub(crate) mod tabulated;

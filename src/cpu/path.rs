@@ -23,6 +23,7 @@ use super::bxdf::{
     pdf_ggx_visible_normal, reflect_direction, sample_beckmann_normal, sample_blinn_phong_half,
     sample_ggx_visible_normal, surface_response,
 };
+use super::coverage::{BlendRule, blend_seed};
 use super::intersect::{
     Hit, MAX_PASS_THROUGHS, Ray, culls_back_face, offset_ray_origin, shadow_terminator_point,
 };
@@ -31,7 +32,7 @@ use super::trace::{
     PreparedScene, add_contribution, direct_light, finite_radiance, keep_on_side,
     shading_frame_normal,
 };
-use super::traverse::{BlendRule, blend_seed, intersect_scene_with, transmittance};
+use super::traverse::{intersect_scene_with, transmittance};
 use crate::accel::area_lights::{Emitter, EmitterShape};
 use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight, PrimKind};
 use crate::color::luminance;
@@ -59,7 +60,7 @@ const DIMENSIONS_PER_BOUNCE: u32 = 8;
 /// The dimension of a bounce (after its first) whose hash seeds the stochastic
 /// transparency of its rays ([`blend_seed`]): roulette's, which uses the hash's top
 /// bits directly, while each draw hashes it again with the surface
-/// ([`super::traverse::blend_number`]).
+/// ([`super::coverage::blend_number`]).
 pub const BLEND_DIMENSION: u32 = 7;
 
 /// The probability that next-event estimation picks the environment map rather than

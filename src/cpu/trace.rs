@@ -6,11 +6,12 @@
 use glam::DVec3;
 
 use super::bxdf::{eval_brdf, has_base_brdf, reflect_direction, surface_response};
+use super::coverage::BlendRule;
 use super::intersect::{
     Hit, MAX_PASS_THROUGHS, Ray, culls_back_face, offset_ray_origin, shadow_terminator_point,
 };
 use super::path::path_radiance;
-use super::traverse::{BlendRule, intersect_scene, transmittance};
+use super::traverse::{intersect_scene, transmittance};
 use crate::accel::SceneGeometry;
 use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight};
 use crate::camera::{CameraFrame, SamplePattern, lens_sample};

@@ -54,6 +54,19 @@ pub enum RenderError {
         /// The device's limit.
         limit: u64,
     },
+    /// A traversal was asked of a device that cannot run it:
+    /// [`super::Traversal::Hardware`] on a device without
+    /// [`wgpu::Features::EXPERIMENTAL_RAY_QUERY`] (or without room to bind an
+    /// acceleration structure).
+    #[error("{what} needs the device feature {feature}, which this device does not have{hint}")]
+    MissingFeature {
+        /// What needed it ("hardware traversal").
+        what: &'static str,
+        /// The `wgpu::Features` flag or limit.
+        feature: &'static str,
+        /// What to do about it (empty, or a sentence beginning with "; ").
+        hint: &'static str,
+    },
     /// The scene's render settings are out of range
     /// ([`crate::scene::RenderSettings::check`]).
     #[error("invalid render settings: {0}")]

@@ -82,6 +82,15 @@ pub struct ShaderFeatures {
     /// upload for small scenes on CPU devices, never by [`ShaderFeatures::for_scene`],
     /// and [`ShaderFeatures::ALL`] leaves it out. The image does not depend on it.
     pub unrolled: Option<UnrolledPrimitives>,
+    /// The scene's triangles are found by the device's ray queries in hardware
+    /// acceleration structures, the analytic shapes by the software walk
+    /// (`HARDWARE_TRAVERSAL`, `shaders/ray_query.wgsl`; see `super::ray_query`). Needs
+    /// [`wgpu::Features::EXPERIMENTAL_RAY_QUERY`], so it is chosen at upload from the
+    /// device and [`super::Traversal`], never by [`ShaderFeatures::for_scene`], and
+    /// [`ShaderFeatures::ALL`] leaves it out. The image depends on it only where the
+    /// hardware's triangle test and ours differ (an edge-grazing ray, a tie between
+    /// two triangles: `docs/model.md`, "Hardware traversal").
+    pub hardware_traversal: bool,
 }
 
 impl ShaderFeatures {
@@ -112,6 +121,7 @@ impl ShaderFeatures {
         uniform_records: false,
         refill_lanes: false,
         unrolled: None,
+        hardware_traversal: false,
     };
 
     /// Exactly the features `scene` uses.
@@ -158,6 +168,7 @@ impl ShaderFeatures {
             uniform_records: false,
             refill_lanes: false,
             unrolled: None,
+            hardware_traversal: false,
         }
     }
 
@@ -191,7 +202,7 @@ impl ShaderFeatures {
 type FeatureFlag = fn(&ShaderFeatures) -> bool;
 
 /// The name of each feature in the WGSL directives, with the flag it reads.
-const FEATURE_NAMES: [(&str, FeatureFlag); 19] = [
+const FEATURE_NAMES: [(&str, FeatureFlag); 20] = [
     ("SPHERES", |f| f.spheres),
     ("PLANES", |f| f.planes),
     ("POLYGONS", |f| f.polygons),
@@ -211,6 +222,7 @@ const FEATURE_NAMES: [(&str, FeatureFlag); 19] = [
     ("AOV", |f| f.aov),
     ("REFILL_LANES", |f| f.refill_lanes),
     ("UNROLLED", |f| f.unrolled.is_some()),
+    ("HARDWARE_TRAVERSAL", |f| f.hardware_traversal),
 ];
 
 /// A malformed feature directive in a WGSL source: a bug in our own shaders, which the

@@ -172,7 +172,7 @@ pub struct GpuTraceRay {
     /// Inside an instance: one past that leaf's last primitive.
     pub world_leaf_end: u32,
     /// The seed of stochastic transparency (the path integrator's rays,
-    /// [`crate::cpu::traverse::BlendRule::Stochastic`]), or [`NO_BLEND_SEED`]:
+    /// [`crate::cpu::coverage::BlendRule::Stochastic`]), or [`NO_BLEND_SEED`]:
     /// blended surfaces are then hit by a closest-hit trace and transmit light
     /// through an any-hit one.
     pub blend_seed: u32,
@@ -187,7 +187,7 @@ pub struct GpuTraceRay {
 
 /// [`GpuTraceRay::blend_seed`] of a trace without stochastic transparency. A seed
 /// that happens to equal it is taken as none; the path integrator's seeds are hashes
-/// ([`crate::cpu::traverse::blend_seed`]), so its traces avoid it by changing it to 0
+/// ([`crate::cpu::coverage::blend_seed`]), so its traces avoid it by changing it to 0
 /// (`blend_seed` in `shaders/path.wgsl` and `src/cpu/traverse.rs`).
 pub const NO_BLEND_SEED: u32 = u32::MAX;
 

@@ -9,7 +9,8 @@
 //!   and tests that do not bring their own device.
 //! - The stages: `scene_buffers` (a scene uploaded to the device), `wavefront` (the
 //!   path slots and the schedule of the trace kernels), `pipelines`, `display`,
-//!   `draw`, and `limits` (what the renderer needs of a device).
+//!   `draw`, `limits` (what the renderer needs of a device) and `ray_query` (the
+//!   hardware traversal's acceleration structures, [`Traversal`]).
 //! - `shaders`: composition of the WGSL sources, specialised by `features`;
 //!   `upload`: pure conversion of a [`crate::scene::Scene`] into the GPU records,
 //!   `layout` their `#[repr(C)]` twins of `shaders/types.wgsl` (these four public as
@@ -43,6 +44,7 @@ mod gpu_scene;
 pub(crate) mod layout;
 mod limits;
 mod pipelines;
+mod ray_query;
 mod readback;
 mod renderer;
 mod scene_buffers;
@@ -63,6 +65,7 @@ pub use features::ShaderFeatures;
 pub use film::Film;
 pub use gpu_scene::GpuScene;
 pub use pipelines::{DISPLAY_FORMAT, LINEAR_FORMAT, TRACE_STORAGE_BUFFERS, TracePipelines};
+pub use ray_query::{Traversal, hardware_traversal_available};
 pub use readback::read_texture;
 pub use renderer::{
     BufferWrites, FilmImage, RenderedImage, Renderer, RendererOptions, TraceRegion, image_tiles,

@@ -7,6 +7,7 @@ use std::sync::{Mutex, PoisonError};
 use super::RenderError;
 use super::cpu_device::uniform_records::{UNIFORM_BUFFERS, device_allows, is_uniform_record};
 use super::features::ShaderFeatures;
+use super::ray_query::hardware_traversal_available;
 use super::readback::{Caught, capture};
 use super::shaders::{
     DISPLAY_ENTRY_POINT, FUSED_ENTRY_POINT, SHADE_ENTRY_POINT, TRACE_ENTRY_POINT,
@@ -25,7 +26,8 @@ pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// output; 9 counters; 10 accumulation; 11 images; 12–13 BVH nodes and primitives;
 /// 14–17 path states, bounce stacks, traces, traversal stacks; 18 mesh triangles'
 /// vertex normals and texture coordinates; 19 the path integrator's emitters; 20 the
-/// environment map and its sampling tables.
+/// environment map and its sampling tables; 21 the hardware traversal's top-level
+/// acceleration structure (only in its layout).
 pub(crate) mod binding {
     pub const FRAME: u32 = 0;
     pub const SPHERES: u32 = 1;
@@ -48,6 +50,7 @@ pub(crate) mod binding {
     pub const TRIANGLE_ATTRIBUTES: u32 = 18;
     pub const EMITTERS: u32 = 19;
     pub const ENVIRONMENT: u32 = 20;
+    pub const SCENE_TLAS: u32 = 21;
 }
 
 /// Storage buffers the trace kernels bind in one stage.
@@ -89,7 +92,8 @@ impl TracePipelines {
 }
 
 /// The bind group and pipeline layout of the trace modules of one kind of record
-/// binding (see [`ShaderFeatures::uniform_records`]).
+/// binding (see [`ShaderFeatures::uniform_records`]), with or without the hardware
+/// traversal's acceleration structure ([`ShaderFeatures::hardware_traversal`]).
 #[derive(Debug)]
 struct TraceLayout {
     bind_group: wgpu::BindGroupLayout,
@@ -97,7 +101,11 @@ struct TraceLayout {
 }
 
 impl TraceLayout {
-    fn new(device: &wgpu::Device, uniform_records: bool) -> Result<Self, RenderError> {
+    fn new(
+        device: &wgpu::Device,
+        uniform_records: bool,
+        acceleration_structure: bool,
+    ) -> Result<Self, RenderError> {
         use binding::*;
         // The records every traversal step reads: storage or uniform arrays.
         let record = |binding: u32| {
@@ -109,36 +117,45 @@ impl TraceLayout {
         };
         // Explicit layouts: an automatic layout would drop bindings a shader leaves
         // unused, and the bind groups would no longer match it.
+        let mut entries = vec![
+            uniform_entry(FRAME),
+            record(SPHERES),
+            record(PLANES),
+            record(POLYGONS),
+            record(POLYGON_POINTS),
+            record(TRIANGLES),
+            record(MATERIALS),
+            record(LIGHTS),
+            storage_texture_entry(LINEAR_OUTPUT, LINEAR_FORMAT),
+            storage_entry(COUNTERS, false),
+            storage_entry(ACCUMULATION, false),
+            float_texture_entry(IMAGES, wgpu::TextureViewDimension::D2Array),
+            record(BVH_NODES),
+            record(BVH_PRIMS),
+            storage_entry(PATHS, false),
+            storage_entry(RAY_STACK, false),
+            storage_entry(TRACES, false),
+            storage_entry(TRAVERSAL_STACK, false),
+            storage_entry(TRIANGLE_ATTRIBUTES, true),
+            storage_entry(EMITTERS, true),
+            storage_entry(ENVIRONMENT, true),
+        ];
+        if acceleration_structure {
+            entries.push(compute_entry(
+                SCENE_TLAS,
+                wgpu::BindingType::AccelerationStructure {
+                    vertex_return: false,
+                },
+            ));
+        }
         let bind_group = capture(device, "trace bind group layout", Caught::Resource, || {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(if uniform_records {
-                    "gpu-render trace bindings (uniform records)"
-                } else {
-                    "gpu-render trace bindings"
+                label: Some(match (uniform_records, acceleration_structure) {
+                    (true, _) => "gpu-render trace bindings (uniform records)",
+                    (false, true) => "gpu-render trace bindings (acceleration structure)",
+                    (false, false) => "gpu-render trace bindings",
                 }),
-                entries: &[
-                    uniform_entry(FRAME),
-                    record(SPHERES),
-                    record(PLANES),
-                    record(POLYGONS),
-                    record(POLYGON_POINTS),
-                    record(TRIANGLES),
-                    record(MATERIALS),
-                    record(LIGHTS),
-                    storage_texture_entry(LINEAR_OUTPUT, LINEAR_FORMAT),
-                    storage_entry(COUNTERS, false),
-                    storage_entry(ACCUMULATION, false),
-                    float_texture_entry(IMAGES, wgpu::TextureViewDimension::D2Array),
-                    record(BVH_NODES),
-                    record(BVH_PRIMS),
-                    storage_entry(PATHS, false),
-                    storage_entry(RAY_STACK, false),
-                    storage_entry(TRACES, false),
-                    storage_entry(TRAVERSAL_STACK, false),
-                    storage_entry(TRIANGLE_ATTRIBUTES, true),
-                    storage_entry(EMITTERS, true),
-                    storage_entry(ENVIRONMENT, true),
-                ],
+                entries: &entries,
             })
         })?;
         let pipeline = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -161,6 +178,10 @@ pub(crate) struct Pipelines {
     /// With uniform records, where the device binds enough uniform buffers
     /// (`uniform_records::device_allows`).
     uniform_layout: Option<TraceLayout>,
+    /// With storage records and the hardware traversal's acceleration structure,
+    /// where the device has ray queries
+    /// ([`super::ray_query::hardware_traversal_available`]).
+    hardware_layout: Option<TraceLayout>,
     pub display_bind_group_layout: wgpu::BindGroupLayout,
     pub display: wgpu::ComputePipeline,
     /// Trace pipelines by feature set and schedule, built on first use.
@@ -235,9 +256,14 @@ impl Pipelines {
         device: &wgpu::Device,
         cache: Option<wgpu::PipelineCache>,
     ) -> Result<Self, RenderError> {
-        let storage_layout = TraceLayout::new(device, false)?;
+        let storage_layout = TraceLayout::new(device, false, false)?;
         let uniform_layout = if device_allows(&device.limits()) {
-            Some(TraceLayout::new(device, true)?)
+            Some(TraceLayout::new(device, true, false)?)
+        } else {
+            None
+        };
+        let hardware_layout = if hardware_traversal_available(device) {
+            Some(TraceLayout::new(device, false, true)?)
         } else {
             None
         };
@@ -268,6 +294,7 @@ impl Pipelines {
         Ok(Self {
             storage_layout,
             uniform_layout,
+            hardware_layout,
             display_bind_group_layout,
             display,
             trace: Mutex::new(HashMap::new()),
@@ -328,12 +355,23 @@ impl Pipelines {
     /// storage or uniform buffers).
     ///
     /// Errors: [`RenderError::Limit`] for uniform records on a device that binds too
-    /// few uniform buffers (an upload never chooses them there).
+    /// few uniform buffers, [`RenderError::MissingFeature`] for the hardware traversal
+    /// on a device without ray queries (an upload never chooses them there).
     fn trace_layout(
         &self,
         device: &wgpu::Device,
         features: &ShaderFeatures,
     ) -> Result<&TraceLayout, RenderError> {
+        if features.hardware_traversal {
+            return self
+                .hardware_layout
+                .as_ref()
+                .ok_or(RenderError::MissingFeature {
+                    what: "hardware traversal",
+                    feature: "EXPERIMENTAL_RAY_QUERY",
+                    hint: "",
+                });
+        }
         if !features.uniform_records {
             return Ok(&self.storage_layout);
         }
@@ -349,8 +387,14 @@ impl Pipelines {
     /// The bind group layout of the trace modules for a prepared scene's `features`
     /// (uploads choose uniform records only where the device has their layout).
     pub fn trace_bind_group_layout(&self, features: &ShaderFeatures) -> &wgpu::BindGroupLayout {
-        match (&self.uniform_layout, features.uniform_records) {
-            (Some(uniform), true) => &uniform.bind_group,
+        match (
+            &self.uniform_layout,
+            &self.hardware_layout,
+            features.uniform_records,
+            features.hardware_traversal,
+        ) {
+            (_, Some(hardware), _, true) => &hardware.bind_group,
+            (Some(uniform), _, true, _) => &uniform.bind_group,
             _ => &self.storage_layout.bind_group,
         }
     }

@@ -26,7 +26,7 @@ use super::limits::{check_limits, required_limits};
 use super::pipelines::{Pipelines, TracePipelines};
 use super::scene_buffers::{UploadOptions, upload_scene};
 use super::wavefront::{Schedule, default_schedule, iteration_budget_for, warm_up};
-use super::{RenderError, ShaderFeatures};
+use super::{RenderError, ShaderFeatures, Traversal};
 use crate::accel::SceneGeometry;
 use crate::scene::{Camera, Scene, view_problem};
 
@@ -89,6 +89,16 @@ pub struct RendererOptions {
     /// On CPU devices, test the primitives of scenes small enough unrolled instead of
     /// walking their BVH (`true`, faster there; see [`ShaderFeatures::unrolled`]).
     pub unrolled: bool,
+    /// How the scene's triangles are found: the software walk of the wide BVH, or
+    /// the device's ray queries ([`ShaderFeatures::hardware_traversal`]), which need
+    /// a device created with [`wgpu::Features::EXPERIMENTAL_RAY_QUERY`] (and, as wgpu
+    /// requires of that feature, `experimental_features:
+    /// unsafe { wgpu::ExperimentalFeatures::enabled() }`; [`super::HeadlessGpu`]
+    /// does both where the adapter offers it). [`Traversal::Auto`] (the default)
+    /// takes the hardware path where it exists and pays; the image differs only where
+    /// the hardware's triangle test and ours differ (`docs/model.md`, "Hardware
+    /// traversal").
+    pub traversal: Traversal,
     /// For tests of the safety net: every traversal leaves its loop early without
     /// reaching an exit, as when a driver cuts loops (llvmpipe before Mesa 25:
     /// [`super::driver_loop_limit`]), so that the kernels report it and every trace
@@ -117,6 +127,7 @@ impl Default for RendererOptions {
             uniform_records: true,
             refill_lanes: true,
             unrolled: true,
+            traversal: Traversal::Auto,
             simulate_loop_cut: false,
             pipeline_cache: None,
         }
@@ -306,6 +317,7 @@ impl Renderer {
                 allow_refill_lanes: self.options.refill_lanes,
                 allow_unrolled: self.options.unrolled,
                 aov: self.options.aov,
+                traversal: self.options.traversal,
             },
         )?;
         let cached = self.pipelines.has_trace(&prepared.features, self.schedule);

@@ -10,9 +10,14 @@ use super::environment::environment_buffer;
 use super::features::ShaderFeatures;
 use super::layout::FrameUniforms;
 use super::pipelines::binding;
+use super::ray_query::{
+    Acceleration, Traversal, build_acceleration, fits_hardware, wants_hardware,
+};
 use super::readback::{Caught, capture};
-use super::upload::{SceneRecords, frame_uniforms, image_layers};
-use crate::accel::{BrdfMapCdfs, BvhStats, EnvironmentLight, MAX_PLANES, SceneGeometry};
+use super::upload::{InstanceLayout, SceneRecords, frame_uniforms, image_layers};
+use crate::accel::{
+    BrdfMapCdfs, BuildMethod, BvhStats, EnvironmentLight, MAX_PLANES, SceneGeometry,
+};
 use crate::scene::{Integrator, Scene};
 
 /// The storage buffers of an uploaded scene.
@@ -45,6 +50,9 @@ pub(crate) struct DeviceScene {
     pub(crate) buffers: SceneBuffers,
     /// Albedo textures and BRDF maps, one layer each (see [`image_layers`]).
     pub(crate) images: wgpu::TextureView,
+    /// The acceleration structures of the hardware traversal
+    /// ([`ShaderFeatures::hardware_traversal`]), if it is used.
+    pub(crate) acceleration: Option<Acceleration>,
     bvh: BvhStats,
     scene_bytes: u64,
     image_bytes: u64,
@@ -121,6 +129,8 @@ pub(crate) struct UploadOptions {
     /// The module records the auxiliary passes ([`ShaderFeatures::aov`]; the general
     /// module always can).
     pub aov: bool,
+    /// How the triangles are found ([`super::RendererOptions::traversal`]).
+    pub traversal: Traversal,
 }
 
 /// Uploads `scene` (as loaded: it is converted to its lighting space here) with its
@@ -144,6 +154,7 @@ pub(crate) fn upload_scene(
         allow_refill_lanes,
         allow_unrolled,
         aov,
+        traversal,
     } = options;
     scene.render.check().map_err(RenderError::InvalidSettings)?;
     if geometry.planes.len() > MAX_PLANES {
@@ -154,9 +165,26 @@ pub(crate) fn upload_scene(
         });
     }
     let shaded = scene.in_lighting_space();
-    let records = SceneRecords::new(&shaded, geometry);
+    let limits = device.limits();
+    // The hardware traversal walks a tree of the analytic shapes alone: the
+    // structures hold the triangles and instances.
+    let analytic = if wants_hardware(traversal, device, geometry)? {
+        let tree = geometry.analytic_bvh(BuildMethod::Sah);
+        let layout = InstanceLayout::with_scene_nodes(geometry, tree.wide.len());
+        fits_hardware(traversal, geometry, &layout, &limits)?.then_some((tree, layout))
+    } else {
+        None
+    };
+    let hardware = analytic.is_some();
+    let records = match &analytic {
+        Some((tree, _)) => SceneRecords::with_scene_tree(&shaded, geometry, tree),
+        None => SceneRecords::new(&shaded, geometry),
+    };
     let path = scene.render.integrator == Integrator::Path;
     let mut frame = frame_uniforms(&shaded, geometry);
+    if let Some((tree, _)) = &analytic {
+        frame.node_count = u32::try_from(tree.wide.len()).unwrap_or(u32::MAX);
+    }
     let emitters = if path {
         // The integrator is a flag of the trace: every trace of the scene keeps it.
         frame.flags |= FLAG_PATH;
@@ -177,12 +205,14 @@ pub(crate) fn upload_scene(
             })
             .as_ref(),
     );
-    let limits = device.limits();
     let max_binding = limits
         .max_storage_buffer_binding_size
         .min(limits.max_buffer_size);
     let padded = records.padded();
+    // The hardware traversal's triangle buffer is the structures' vertex buffer: a
+    // storage buffer.
     let uniform_records = allow_uniform_records
+        && !hardware
         && uniform_records::preferred(&device.adapter_info())
         && uniform_records::fits(&padded, &limits);
     let mut scene_bytes = 0;
@@ -208,6 +238,10 @@ pub(crate) fn upload_scene(
                     size,
                     usage: if uniform_bytes.is_some() {
                         wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST
+                    } else if hardware && binding == binding::TRIANGLES {
+                        wgpu::BufferUsages::STORAGE
+                            | wgpu::BufferUsages::COPY_DST
+                            | wgpu::BufferUsages::BLAS_INPUT
                     } else {
                         wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST
                     },
@@ -278,6 +312,7 @@ pub(crate) fn upload_scene(
         environment: upload("environment map", binding::ENVIRONMENT, &environment)?,
     };
     let unrolled = if allow_unrolled
+        && !hardware
         && unrolled::preferred(&device.adapter_info())
         && geometry.instances.is_empty()
         && geometry.instanced_meshes.is_empty()
@@ -287,6 +322,18 @@ pub(crate) fn upload_scene(
         UnrolledPrimitives::for_scene(&records.bvh_prims, records.planes.len(), &records.polygons)
     } else {
         None
+    };
+    let alpha = ShaderFeatures::for_scene(scene).alpha;
+    let acceleration = match &analytic {
+        Some((_, layout)) => Some(build_acceleration(
+            device,
+            queue,
+            &buffers.triangles,
+            geometry,
+            layout,
+            !alpha,
+        )?),
+        None => None,
     };
     let (images, image_bytes) = upload_images(device, queue, &shaded, &limits)?;
     Ok(DeviceScene {
@@ -302,13 +349,14 @@ pub(crate) fn upload_scene(
             refill_lanes: allow_refill_lanes
                 && device.features().contains(wgpu::Features::SUBGROUP),
             unrolled,
+            hardware_traversal: hardware,
             aov: aov || !specialise,
             ..if specialise {
                 ShaderFeatures::for_scene(scene)
             } else {
                 // The general module, with the alpha test only where it is needed.
                 ShaderFeatures {
-                    alpha: ShaderFeatures::for_scene(scene).alpha,
+                    alpha,
                     ..ShaderFeatures::ALL
                 }
             }
@@ -316,6 +364,7 @@ pub(crate) fn upload_scene(
         encode_srgb: scene.display_encodes_srgb(),
         buffers,
         images,
+        acceleration,
         bvh: geometry.bvh.stats,
         scene_bytes,
         image_bytes,

@@ -43,7 +43,7 @@ macro_rules! shader_modules {
 }
 
 /// Every module of `shaders/`, the lower ones first.
-pub const SHADER_MODULES: [ShaderModule; 29] = shader_modules![
+pub const SHADER_MODULES: [ShaderModule; 31] = shader_modules![
     "types",
     "path_types",
     "math",
@@ -58,6 +58,8 @@ pub const SHADER_MODULES: [ShaderModule; 29] = shader_modules![
     "bxdf",
     "instance",
     "intersect",
+    "coverage",
+    "ray_query",
     "unrolled",
     "traverse",
     "environment",
@@ -258,6 +260,34 @@ mod tests {
         for name in ["limits", "records"] {
             validate(name, &compose(name, &ShaderFeatures::ALL).expect(name));
         }
+    }
+
+    /// The trace module of the hardware traversal begins with the ray-query
+    /// extension's directive, and validates where ray queries are a capability, with
+    /// and without alpha coverage's candidate loop.
+    #[test]
+    fn the_hardware_traversal_module_enables_ray_queries_and_validates() {
+        for alpha in [false, true] {
+            let features = ShaderFeatures {
+                hardware_traversal: true,
+                alpha,
+                ..ShaderFeatures::ALL
+            };
+            let source = trace_shader_source(&features).expect("composes");
+            assert!(source.starts_with("enable wgpu_ray_query;\n"));
+            assert_eq!(source.matches("enable wgpu_ray_query;").count(), 1);
+            assert!(source.contains("fn hardware_triangles("));
+            let module = naga::front::wgsl::parse_str(&source)
+                .unwrap_or_else(|e| panic!("does not parse:\n{}", e.emit_to_string(&source)));
+            naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::RAY_QUERY,
+            )
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("does not validate:\n{}", e.emit_to_string(&source)));
+        }
+        let software = trace_shader_source(&ShaderFeatures::ALL).expect("composes");
+        assert!(!software.contains("wgpu_ray_query") && !software.contains("hardware_triangles"));
     }
 
     #[test]

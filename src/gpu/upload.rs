@@ -16,7 +16,7 @@ use super::layout::{
     WRAP_REPEAT,
 };
 use crate::accel::{
-    BrdfMapCdfs, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry, TriangleAttributes,
+    BrdfMapCdfs, Bvh, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry, TriangleAttributes,
     TriangleShape, WideNode,
 };
 use crate::camera::CameraFrame;
@@ -64,6 +64,14 @@ impl SceneRecords {
     /// Converts the materials and lights of `scene` (already in lighting space) and
     /// the primitives and BVH of its `geometry`.
     pub fn new(scene: &Scene, geometry: &SceneGeometry) -> Self {
+        Self::with_scene_tree(scene, geometry, &geometry.bvh)
+    }
+
+    /// [`SceneRecords::new`] with `scene_tree` in place of the geometry's own tree as
+    /// the scene's tree (node 0 on): for the hardware traversal, the tree of the
+    /// analytic shapes alone ([`SceneGeometry::analytic_bvh`]). The instanced meshes'
+    /// trees and the instances' records follow it as always.
+    pub fn with_scene_tree(scene: &Scene, geometry: &SceneGeometry, scene_tree: &Bvh) -> Self {
         let shift_uvs = may_shift_uvs(scene);
         let mut records = Self {
             spheres: geometry
@@ -98,8 +106,8 @@ impl SceneRecords {
                 .iter()
                 .map(|a| triangle_attributes_record(a, shift_uvs))
                 .collect(),
-            bvh_nodes: geometry.bvh.wide.clone(),
-            bvh_prims: geometry.bvh.prims.iter().map(|p| p.0).collect(),
+            bvh_nodes: scene_tree.wide.clone(),
+            bvh_prims: scene_tree.prims.iter().map(|p| p.0).collect(),
             ..Self::default()
         };
         records.append_instances(geometry, shift_uvs);
@@ -167,7 +175,13 @@ impl SceneRecords {
                 .extend(instance_records(instance, root, index(i), first_triangle));
         }
         let record = |i: usize| index(first_record + INSTANCE_RECORD_NODES * i);
-        for prim in &mut self.bvh_prims[..geometry.bvh.prims.len()] {
+        let scene_prims = self.bvh_prims.len()
+            - geometry
+                .instanced_meshes
+                .iter()
+                .map(|mesh| mesh.bvh.prims.len())
+                .sum::<usize>();
+        for prim in &mut self.bvh_prims[..scene_prims] {
             let p = PrimRef(*prim);
             if p.kind() == PrimKind::Instance {
                 *prim = PrimRef::new(PrimKind::Instance, record(p.index())).0;
@@ -209,9 +223,15 @@ pub struct InstanceLayout {
 impl InstanceLayout {
     /// The layout of `geometry`'s instanced meshes and instances.
     pub fn new(geometry: &SceneGeometry) -> Self {
+        Self::with_scene_nodes(geometry, geometry.bvh.wide.len())
+    }
+
+    /// The layout of `geometry`'s instanced meshes and instances after a scene tree of
+    /// `scene_nodes` wide nodes ([`SceneRecords::with_scene_tree`]).
+    pub fn with_scene_nodes(geometry: &SceneGeometry, scene_nodes: usize) -> Self {
         let index = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
         let mut triangles = geometry.triangles.len();
-        let mut nodes = geometry.bvh.wide.len();
+        let mut nodes = scene_nodes;
         let mut first_triangle = Vec::with_capacity(geometry.instanced_meshes.len());
         for mesh in &geometry.instanced_meshes {
             first_triangle.push(index(triangles));
@@ -224,14 +244,27 @@ impl InstanceLayout {
         }
     }
 
+    /// The index in the triangle buffer of instanced mesh `mesh`'s first triangle.
+    pub fn first_triangle(&self, mesh: usize) -> u32 {
+        self.first_triangle[mesh]
+    }
+
+    /// The node index of instance `instance`'s records.
+    pub fn record(&self, instance: u32) -> u32 {
+        self.first_record
+            .saturating_add((INSTANCE_RECORD_NODES as u32).saturating_mul(instance))
+    }
+
     /// The names a GPU hit on triangle `triangle` of instance `instance`'s mesh
     /// carries: its `PrimRef` in the triangle buffer and the node index of the
     /// instance's records.
     pub fn surface(&self, geometry: &SceneGeometry, instance: u32, triangle: usize) -> (u32, u32) {
         let mesh = geometry.instances[instance as usize].mesh as usize;
         let prim = self.first_triangle[mesh] + triangle as u32;
-        let node = self.first_record + INSTANCE_RECORD_NODES as u32 * instance;
-        (PrimRef::new(PrimKind::Triangle, prim).0, node)
+        (
+            PrimRef::new(PrimKind::Triangle, prim).0,
+            self.record(instance),
+        )
     }
 }
 

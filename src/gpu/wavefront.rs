@@ -357,38 +357,45 @@ impl SlotBuffers {
             }
         }
         let s = &scene.buffers;
+        let mut entries = vec![
+            buffer(binding::FRAME, &self.uniforms),
+            buffer(binding::SPHERES, &s.spheres),
+            buffer(binding::PLANES, &s.planes),
+            buffer(binding::POLYGONS, &s.polygons),
+            buffer(binding::POLYGON_POINTS, &s.polygon_points),
+            buffer(binding::TRIANGLES, &s.triangles),
+            buffer(binding::MATERIALS, &s.materials),
+            buffer(binding::LIGHTS, &s.lights),
+            wgpu::BindGroupEntry {
+                binding: binding::LINEAR_OUTPUT,
+                resource: wgpu::BindingResource::TextureView(target),
+            },
+            buffer(binding::COUNTERS, &self.counters),
+            buffer(binding::ACCUMULATION, &self.accumulation),
+            wgpu::BindGroupEntry {
+                binding: binding::IMAGES,
+                resource: wgpu::BindingResource::TextureView(&scene.images),
+            },
+            buffer(binding::BVH_NODES, &s.bvh_nodes),
+            buffer(binding::BVH_PRIMS, &s.bvh_prims),
+            buffer(binding::PATHS, &self.paths),
+            buffer(binding::RAY_STACK, &self.ray_stack),
+            buffer(binding::TRACES, &self.traces),
+            buffer(binding::TRAVERSAL_STACK, &self.traversal_stack),
+            buffer(binding::TRIANGLE_ATTRIBUTES, &s.triangle_attributes),
+            buffer(binding::EMITTERS, &s.emitters),
+            buffer(binding::ENVIRONMENT, &s.environment),
+        ];
+        if let Some(acceleration) = &scene.acceleration {
+            entries.push(wgpu::BindGroupEntry {
+                binding: binding::SCENE_TLAS,
+                resource: wgpu::BindingResource::AccelerationStructure(&acceleration.tlas),
+            });
+        }
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gpu-render trace bind group"),
             layout,
-            entries: &[
-                buffer(binding::FRAME, &self.uniforms),
-                buffer(binding::SPHERES, &s.spheres),
-                buffer(binding::PLANES, &s.planes),
-                buffer(binding::POLYGONS, &s.polygons),
-                buffer(binding::POLYGON_POINTS, &s.polygon_points),
-                buffer(binding::TRIANGLES, &s.triangles),
-                buffer(binding::MATERIALS, &s.materials),
-                buffer(binding::LIGHTS, &s.lights),
-                wgpu::BindGroupEntry {
-                    binding: binding::LINEAR_OUTPUT,
-                    resource: wgpu::BindingResource::TextureView(target),
-                },
-                buffer(binding::COUNTERS, &self.counters),
-                buffer(binding::ACCUMULATION, &self.accumulation),
-                wgpu::BindGroupEntry {
-                    binding: binding::IMAGES,
-                    resource: wgpu::BindingResource::TextureView(&scene.images),
-                },
-                buffer(binding::BVH_NODES, &s.bvh_nodes),
-                buffer(binding::BVH_PRIMS, &s.bvh_prims),
-                buffer(binding::PATHS, &self.paths),
-                buffer(binding::RAY_STACK, &self.ray_stack),
-                buffer(binding::TRACES, &self.traces),
-                buffer(binding::TRAVERSAL_STACK, &self.traversal_stack),
-                buffer(binding::TRIANGLE_ATTRIBUTES, &s.triangle_attributes),
-                buffer(binding::EMITTERS, &s.emitters),
-                buffer(binding::ENVIRONMENT, &s.environment),
-            ],
+            entries: &entries,
         })
     }
 }

@@ -148,7 +148,7 @@ fn base_scene(width: u32, meshes: Vec<Mesh>) -> Scene {
 
 /// The scene with the mesh placed as [`placements`] says: one scene mesh per
 /// material, sharing the geometry (as two `[[objects]]` of one file would).
-fn instanced_scene(width: u32, mesh: &Mesh) -> Scene {
+pub(crate) fn instanced_scene(width: u32, mesh: &Mesh) -> Scene {
     let mut meshes: Vec<Mesh> = Vec::new();
     for (transform, material) in placements() {
         match meshes.iter_mut().find(|m| m.material == material) {

@@ -41,6 +41,7 @@ mod path_gpu;
 mod path_reference;
 mod path_tracing;
 mod radiometry;
+mod ray_query;
 mod recipes;
 mod sampler_chi2;
 mod sampling_bias;

@@ -84,7 +84,7 @@ fn gpu_agrees(label: &str, scene: &Scene) {
     assert_backends_agree(&gpu, &renderer, label, scene, TWIN_TOLERANCE);
 }
 
-fn path_traced(scene: &Scene, samples: u32) -> Scene {
+pub(crate) fn path_traced(scene: &Scene, samples: u32) -> Scene {
     let mut path = scene.clone();
     path.render.integrator = Integrator::Path;
     path.render.samples_per_pixel = samples;
@@ -120,7 +120,7 @@ fn masked(cutoff: f64) -> Material {
 
 /// Checkered quads in front of the backdrop: one mesh placed twice (x = -1 and 1, an
 /// instanced mesh) and one placed once (x = -3, world-space triangles).
-fn checker_scene(mode: AlphaMode) -> Scene {
+pub(crate) fn checker_scene(mode: AlphaMode) -> Scene {
     let mut once = quad(0, vec![DMat4::IDENTITY]);
     once.positions.iter_mut().for_each(|p| p.x -= 3.0);
     ambient_scene(
@@ -181,7 +181,7 @@ fn a_masked_checker_shows_the_backdrop_exactly_where_alpha_is_below_the_cutoff()
 /// of alpha 1 and 0, clamped: the bilinear alpha crosses 0.5 at x = 0), in front of
 /// the backdrop, lit by a directional light slanted towards +x whose shadows on the
 /// backdrop lie 0.5 to the right of what casts them.
-fn shadow_scene() -> Scene {
+pub(crate) fn shadow_scene() -> Scene {
     let mut leaf = quad(0, vec![DMat4::IDENTITY]);
     leaf.positions.iter_mut().for_each(|p| *p *= 0.5);
     let half = Image {

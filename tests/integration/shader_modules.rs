@@ -122,6 +122,7 @@ fn feature_sets() -> Vec<ShaderFeatures> {
         uniform_records: false,
         refill_lanes: false,
         unrolled: None,
+        hardware_traversal: false,
     };
     type Toggle = fn(&mut ShaderFeatures, bool);
     let toggles: [Toggle; 17] = [
@@ -157,6 +158,16 @@ fn feature_sets() -> Vec<ShaderFeatures> {
             uniform_records: true,
             refill_lanes: true,
             unrolled,
+            ..ShaderFeatures::ALL
+        },
+        // The hardware traversal, with and without alpha coverage.
+        ShaderFeatures {
+            hardware_traversal: true,
+            ..ShaderFeatures::ALL
+        },
+        ShaderFeatures {
+            hardware_traversal: true,
+            alpha: true,
             ..ShaderFeatures::ALL
         },
     ];
@@ -213,6 +224,7 @@ fn imports_and_uses(
 fn each_module_imports_exactly_the_modules_whose_names_it_uses() {
     let every = ShaderFeatures {
         alpha: true,
+        hardware_traversal: true,
         ..ShaderFeatures::ALL
     };
     let mut problems = Vec::new();
@@ -329,6 +341,13 @@ const WITHOUT_RUST_TWIN: &[(&str, &[&str], &str)] = &[
         &["*"],
         "the unrolled primitive tests of small scenes on lavapipe, a GPU-only strategy \
          (src/gpu/cpu_device/unrolled.rs writes the calls)",
+    ),
+    (
+        "ray_query",
+        &["*"],
+        "the hardware traversal's ray queries, a GPU-only path (src/gpu/ray_query.rs \
+         builds its structures); the CPU reference and the software walk are what \
+         tests/integration/ray_query.rs compares it with",
     ),
     (
         "draw",

@@ -168,6 +168,7 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         uniform_records: false,
         refill_lanes: false,
         unrolled: None,
+        hardware_traversal: false,
     };
     type Toggle = fn(&mut ShaderFeatures, bool);
     let toggles: [Toggle; 17] = [

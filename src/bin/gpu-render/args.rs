@@ -714,6 +714,17 @@ pub struct DeviceArgs {
         help_heading = "Device"
     )]
     pub gpu_timeout: Option<std::time::Duration>,
+
+    /// GPU only: how the triangles are found: the device's ray queries where it has
+    /// them and is a real GPU (auto), always ray queries (an error without them), or
+    /// always the software walk of the BVH. The summary says when ray queries ran.
+    #[arg(
+        long,
+        value_enum,
+        default_value_t = TraversalArg::Auto,
+        help_heading = "Device"
+    )]
+    pub traversal: TraversalArg,
 }
 
 impl SettingsArgs {
@@ -836,6 +847,27 @@ pub enum BackendArg {
     Gpu,
     /// The CPU reference tracer.
     Cpu,
+}
+
+/// `--traversal` values ([`gpu_render::gpu::Traversal`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum TraversalArg {
+    /// Ray queries where the device has them and is not a CPU emulation.
+    Auto,
+    /// The software walk of the BVH.
+    Software,
+    /// The device's ray queries; fail if it has none.
+    Hardware,
+}
+
+impl From<TraversalArg> for gpu_render::gpu::Traversal {
+    fn from(arg: TraversalArg) -> Self {
+        match arg {
+            TraversalArg::Auto => Self::Auto,
+            TraversalArg::Software => Self::Software,
+            TraversalArg::Hardware => Self::Hardware,
+        }
+    }
 }
 
 /// `--adapter` values.

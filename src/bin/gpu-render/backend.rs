@@ -68,6 +68,8 @@ pub struct Frame {
     /// How long the GPU spent compiling the scene's kernels (zero when they were
     /// cached); `None` on the CPU reference.
     pub compile: Option<std::time::Duration>,
+    /// Whether the GPU found the triangles by ray query (`--traversal`).
+    pub hardware_traversal: bool,
 }
 
 impl Frame {
@@ -83,6 +85,7 @@ impl Frame {
             noise: rendered.noise,
             aov: None,
             compile: None,
+            hardware_traversal: false,
         }
     }
 }
@@ -98,6 +101,8 @@ pub struct GpuOptions {
     pub noise: bool,
     /// Record the auxiliary passes (`--aov`, `--denoise`); on either backend.
     pub aov: bool,
+    /// `--traversal`.
+    pub traversal: gpu::Traversal,
 }
 
 /// An opened backend, ready to render any number of scenes.
@@ -193,6 +198,7 @@ impl Backend {
             poll_timeout: options.timeout,
             noise_estimate: options.noise,
             aov: options.aov,
+            traversal: options.traversal,
             pipeline_cache: pipeline_cache.as_ref().map(PipelineCacheFile::cache),
             ..RendererOptions::default()
         };
@@ -274,6 +280,7 @@ impl Backend {
                     noise: rendered.noise,
                     aov: None,
                     compile: Some(uploaded.compile_time()),
+                    hardware_traversal: uploaded.features().hardware_traversal,
                 })
             }
             Backend::Cpu { noise, .. } => {
@@ -366,6 +373,7 @@ impl Backend {
                     noise: rendered.noise,
                     aov: rendered.aov,
                     compile: Some(uploaded.compile_time()),
+                    hardware_traversal: uploaded.features().hardware_traversal,
                 })
             }
             Backend::Cpu { noise, aov, .. } => {

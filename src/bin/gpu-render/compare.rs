@@ -39,6 +39,7 @@ pub fn side_by_side(left: &Frame, right: &Frame) -> Result<Frame> {
         noise: None,
         aov: None,
         compile: left.compile.zip(right.compile).map(|(a, b)| a + b),
+        hardware_traversal: left.hardware_traversal || right.hardware_traversal,
     })
 }
 
@@ -59,6 +60,7 @@ mod tests {
             noise: None,
             aov: None,
             compile: None,
+            hardware_traversal: false,
         }
     }
 

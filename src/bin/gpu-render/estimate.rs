@@ -72,6 +72,7 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
         timeout: args.device.gpu_timeout,
         noise: false,
         aov: false,
+        traversal: args.device.traversal.into(),
     };
     let backend = Backend::open(
         args.device.backend,

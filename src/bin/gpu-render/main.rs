@@ -239,6 +239,7 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
         noise: standard_error_path.is_some()
             || denoiser.as_ref().is_some_and(Denoiser::needs_noise),
         aov: args.aov.is_some() || denoiser.is_some(),
+        traversal: args.device.traversal.into(),
     };
     let backend = Backend::open(
         args.device.backend,
@@ -344,7 +345,11 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
             passes: if args.compare_gamma { 2 } else { 1 },
             piece: piece_name.as_deref(),
             frame: frame.map(|(k, _)| k),
-            backend: &backend.describe(),
+            backend: &if rendered.hardware_traversal {
+                format!("{}, triangles by ray query", backend.describe())
+            } else {
+                backend.describe()
+            },
             wall,
             compile: rendered.compile,
             stats: rendered.stats,

@@ -152,8 +152,16 @@ impl Composition<'_> {
     }
 }
 
+/// The WGSL extension the ray queries of `shaders/ray_query.wgsl` need. An `enable`
+/// directive must precede every declaration of the whole source (naga refuses it
+/// after the first), and the modules are emitted in their imports' order, so the
+/// composition itself begins with it.
+const RAY_QUERY_DIRECTIVE: &str = "enable wgpu_ray_query;\n";
+
 /// The module `root`, whose text is `source`, composed with everything it imports
-/// (found by `lookup`) and specialised to `features`.
+/// (found by `lookup`) and specialised to `features`; with
+/// [`ShaderFeatures::hardware_traversal`] it begins with the ray-query extension's
+/// `enable` directive.
 pub(crate) fn compose(
     root: &str,
     source: &str,
@@ -165,7 +173,11 @@ pub(crate) fn compose(
         features,
         path: Vec::new(),
         done: BTreeSet::new(),
-        output: String::new(),
+        output: if features.hardware_traversal {
+            RAY_QUERY_DIRECTIVE.to_string()
+        } else {
+            String::new()
+        },
     };
     composition.add(root, source)?;
     Ok(composition.output)

@@ -1,0 +1,316 @@
+//! Hardware traversal (issue 30, item 2): the triangles found by the device's ray
+//! queries in acceleration structures (`src/gpu/ray_query.rs`,
+//! `shaders/ray_query.wgsl`), the analytic shapes by the software walk of their own
+//! tree. lavapipe (Mesa 25) emulates ray queries in software, so these tests run in CI.
+//!
+//! - Images: scenes with world-space triangles, instanced meshes (translated, rotated,
+//!   scaled, mirrored), spheres, polygons and planes, Whitted and path traced, alpha
+//!   masked and blended, rendered with `Traversal::Hardware` agree per pixel with the
+//!   CPU reference and with the GPU's software traversal within the twin tolerance
+//!   (`TWIN_TOLERANCE`: a channel within `1e-3 + 5e-3·|expected|`, 0.5% of the pixels
+//!   may fail: the hardware's triangle test is not ours, so a ray that grazes an edge
+//!   may take the neighbouring triangle, and its distance differs by a few ulps), and
+//!   their ray counts within 1%.
+//! - A device without ray queries: `Traversal::Hardware` is an error naming
+//!   `EXPERIMENTAL_RAY_QUERY`, `Auto` renders with the software walk.
+//! - A scene beyond the structures' limits: `Hardware` is refused naming the limit.
+//! - A scene without triangles, and a degenerate tree (many identical triangles),
+//!   trace on the hardware path as on the software one.
+
+use glam::DVec3;
+use gpu_render::gpu::{
+    HeadlessGpu, RenderError, Renderer, RendererOptions, Traversal, hardware_traversal_available,
+};
+use gpu_render::scene::{AlphaMode, Integrator, RenderOverrides, Scene, Shape};
+
+use crate::support::compare::assert_images_match;
+use crate::support::geometry::blob;
+use crate::support::scenes::{reduced, shipped};
+use crate::support::twins::{TWIN_TOLERANCE, assert_backends_agree, assert_ray_counts_agree};
+
+/// A device with ray queries, or `None` off CI where the driver has none.
+///
+/// # Panics
+///
+/// In CI (`CI` set), when the device has no ray queries: the lavapipe the project
+/// installs (Mesa 25.0.7) has them, so the hardware path must be tested there.
+fn ray_query_gpu() -> Option<HeadlessGpu> {
+    let gpu = crate::support::gpu::headless_gpu()?;
+    if hardware_traversal_available(&gpu.device) {
+        return Some(gpu);
+    }
+    assert!(
+        std::env::var_os("CI").is_none(),
+        "CI is set but the device ({}) has no ray queries: install the lavapipe of \
+         scripts/lib.sh (Mesa 25)",
+        gpu.adapter_info().name
+    );
+    eprintln!("note: skipping the hardware traversal test, the device has no ray queries");
+    None
+}
+
+fn renderer(gpu: &HeadlessGpu, traversal: Traversal) -> Renderer {
+    crate::support::gpu::renderer_with(
+        gpu,
+        RendererOptions {
+            traversal,
+            ..RendererOptions::default()
+        },
+    )
+}
+
+/// Renders `scene` with the hardware traversal and asserts that it took it, that it
+/// agrees with the CPU reference and with the software traversal (images within the
+/// twin tolerance, ray counts within 1%).
+fn hardware_agrees(gpu: &HeadlessGpu, label: &str, scene: &Scene) {
+    let hardware = renderer(gpu, Traversal::Hardware);
+    let uploaded = hardware
+        .upload(&gpu.device, &gpu.queue, scene)
+        .unwrap_or_else(|e| panic!("{label}: upload failed: {e}"));
+    assert!(
+        uploaded.features().hardware_traversal,
+        "{label}: Traversal::Hardware must trace with ray queries"
+    );
+    assert_backends_agree(
+        gpu,
+        &hardware,
+        &format!("{label}-hardware-vs-cpu"),
+        scene,
+        TWIN_TOLERANCE,
+    );
+    let software = renderer(gpu, Traversal::Software);
+    let soft = software
+        .render(&gpu.device, &gpu.queue, scene, None)
+        .unwrap_or_else(|e| panic!("{label}: software render failed: {e}"));
+    let hard = hardware
+        .render(&gpu.device, &gpu.queue, scene, None)
+        .unwrap_or_else(|e| panic!("{label}: hardware render failed: {e}"));
+    let comparison = assert_images_match(
+        &format!("{label}-hardware-vs-software"),
+        &soft.image,
+        &hard.image,
+        TWIN_TOLERANCE,
+    );
+    eprintln!(
+        "{label}: hardware against software traversal: {} of {} pixels outside, max |Δ| \
+         {:.2e}; rays {} and {}",
+        comparison.outliers,
+        comparison.pixels,
+        comparison.max_abs_error,
+        soft.stats.rays_traced,
+        hard.stats.rays_traced
+    );
+    assert_ray_counts_agree(label, &soft.stats, &hard.stats, 0.01);
+}
+
+#[test]
+fn instanced_meshes_with_analytic_shapes_render_as_the_cpu_and_the_software_walk_do() {
+    let Some(gpu) = ray_query_gpu() else {
+        return;
+    };
+    // A plane and a mirror sphere (the analytic tree), a blob placed four times
+    // (translated, rotated, scaled, mirrored), a point and a directional light.
+    let scene = crate::instancing::instanced_scene(64, &blob(12, 16));
+    hardware_agrees(&gpu, "ray-query-instances", &scene);
+}
+
+#[test]
+fn shipped_mesh_and_polygon_scenes_render_as_the_cpu_does() {
+    let Some(gpu) = ray_query_gpu() else {
+        return;
+    };
+    // OBJ and glTF models (world-space triangles) beside spheres and polygons.
+    let models = reduced(shipped("models.toml"), 64, RenderOverrides::default());
+    hardware_agrees(&gpu, "ray-query-models", &models);
+    // Path traced: the Cornell box's polygons and its emitter through the analytic
+    // tree, a few samples.
+    let cornell = reduced(
+        shipped("cornell-box.toml"),
+        48,
+        RenderOverrides {
+            samples_per_pixel: Some(4),
+            ..RenderOverrides::default()
+        },
+    );
+    assert_eq!(cornell.render.integrator, Integrator::Path);
+    let hardware = renderer(&gpu, Traversal::Hardware);
+    assert_backends_agree(
+        &gpu,
+        &hardware,
+        "ray-query-cornell-path",
+        &cornell,
+        TWIN_TOLERANCE,
+    );
+}
+
+#[test]
+fn alpha_masked_and_blended_triangles_are_candidates_the_shader_decides() {
+    let Some(gpu) = ray_query_gpu() else {
+        return;
+    };
+    let mask = crate::model_alpha::checker_scene(AlphaMode::Mask { cutoff: 0.5 });
+    hardware_agrees(&gpu, "ray-query-alpha-mask", &mask);
+    let blend = crate::model_alpha::checker_scene(AlphaMode::Blend);
+    hardware_agrees(&gpu, "ray-query-alpha-blend", &blend);
+    // Shadow rays through a cut-out leaf, Whitted and path traced (stochastic
+    // transparency's draws name the hit as the software walk does).
+    let shadow = crate::model_alpha::shadow_scene();
+    hardware_agrees(&gpu, "ray-query-alpha-shadow", &shadow);
+    hardware_agrees(
+        &gpu,
+        "ray-query-alpha-shadow-path",
+        &crate::model_alpha::path_traced(&shadow, 2),
+    );
+}
+
+/// A grey scene of `shapes` seen from +z, lit by one point light.
+fn shapes_scene(shapes: Vec<Shape>) -> Scene {
+    let mut scene = crate::instancing::instanced_scene(48, &blob(4, 4));
+    scene.meshes.clear();
+    scene.shapes = shapes;
+    scene
+}
+
+#[test]
+fn a_scene_without_triangles_and_a_degenerate_tree_trace_on_the_hardware_path() {
+    let Some(gpu) = ray_query_gpu() else {
+        return;
+    };
+    // Spheres and a plane only: an empty top-level structure.
+    let analytic = shapes_scene(vec![
+        Shape::Sphere {
+            center: DVec3::new(0.0, 0.0, 0.0),
+            radius: 1.0,
+            material: 1,
+        },
+        Shape::Plane {
+            normal: DVec3::Y,
+            offset: -1.2,
+            material: 0,
+        },
+    ]);
+    hardware_agrees(&gpu, "ray-query-no-triangles", &analytic);
+    // 20,000 copies of one triangle: a tree of identical boxes, ties everywhere
+    // (which copy is hit may differ; the image may not).
+    let triangle = Shape::Triangle {
+        vertices: [
+            DVec3::new(-1.5, -1.0, 0.0),
+            DVec3::new(1.5, -1.0, 0.0),
+            DVec3::new(0.0, 1.5, 0.0),
+        ],
+        material: 2,
+    };
+    hardware_agrees(
+        &gpu,
+        "ray-query-identical-triangles",
+        &shapes_scene(vec![triangle; 20_000]),
+    );
+}
+
+/// A device for `gpu`'s adapter with the renderer's limits and `features`, and
+/// `limits` changed by `adjust`.
+fn device_with(
+    gpu: &HeadlessGpu,
+    features: wgpu::Features,
+    adjust: impl FnOnce(&mut wgpu::Limits),
+) -> (wgpu::Device, wgpu::Queue) {
+    let mut limits = Renderer::required_limits(&gpu.adapter.limits());
+    adjust(&mut limits);
+    let experimental_features = if features.contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
+        // SAFETY: the test uses the experimental ray queries the renderer uses.
+        unsafe { wgpu::ExperimentalFeatures::enabled() }
+    } else {
+        wgpu::ExperimentalFeatures::disabled()
+    };
+    pollster::block_on(gpu.adapter.request_device(&wgpu::DeviceDescriptor {
+        label: Some("ray query test device"),
+        required_features: features,
+        required_limits: limits,
+        experimental_features,
+        ..Default::default()
+    }))
+    .expect("the adapter gives a device")
+}
+
+#[test]
+fn without_ray_queries_hardware_is_an_error_and_auto_takes_the_software_walk() {
+    let Some(gpu) = crate::support::gpu::headless_gpu() else {
+        return;
+    };
+    let (device, queue) = device_with(
+        &gpu,
+        Renderer::optional_features(gpu.adapter.features()),
+        |_| {},
+    );
+    assert!(!hardware_traversal_available(&device));
+    let scene = crate::instancing::instanced_scene(32, &blob(6, 8));
+    let options = |traversal| RendererOptions {
+        traversal,
+        ..RendererOptions::default()
+    };
+    let hardware = Renderer::new(&device, options(Traversal::Hardware)).expect("renderer");
+    let error = hardware
+        .upload(&device, &queue, &scene)
+        .expect_err("Traversal::Hardware without ray queries must fail");
+    assert!(
+        matches!(error, RenderError::MissingFeature { .. }),
+        "{error:?}"
+    );
+    let message = error.to_string();
+    assert!(
+        message.contains("EXPERIMENTAL_RAY_QUERY") && message.contains("hardware traversal"),
+        "{message}"
+    );
+    let auto = Renderer::new(&device, options(Traversal::Auto)).expect("renderer");
+    let uploaded = auto
+        .upload(&device, &queue, &scene)
+        .expect("Traversal::Auto renders without ray queries");
+    assert!(!uploaded.features().hardware_traversal);
+    let rendered = auto
+        .render(&device, &queue, &scene, None)
+        .expect("the software walk renders");
+    assert!(rendered.stats.rays_traced > 0);
+}
+
+#[test]
+fn a_scene_beyond_the_structures_limits_is_refused_naming_the_limit() {
+    let Some(gpu) = ray_query_gpu() else {
+        return;
+    };
+    // Bottom-level structures of at most 30 vertices: ten triangles.
+    let (device, queue) = device_with(
+        &gpu,
+        Renderer::optional_features(gpu.adapter.features())
+            | wgpu::Features::EXPERIMENTAL_RAY_QUERY,
+        |limits| limits.max_blas_primitive_count = 30,
+    );
+    assert!(hardware_traversal_available(&device));
+    let scene = crate::instancing::instanced_scene(32, &blob(6, 8));
+    let hardware = Renderer::new(
+        &device,
+        RendererOptions {
+            traversal: Traversal::Hardware,
+            ..RendererOptions::default()
+        },
+    )
+    .expect("renderer");
+    let error = hardware
+        .upload(&device, &queue, &scene)
+        .expect_err("a mesh beyond max_blas_primitive_count must be refused");
+    let message = error.to_string();
+    assert!(
+        matches!(error, RenderError::SceneTooLarge { .. })
+            && message.contains("bottom-level acceleration structure")
+            && message.contains("30"),
+        "{message}"
+    );
+    // A lone small triangle fits, and renders.
+    let small = shapes_scene(vec![Shape::Triangle {
+        vertices: [DVec3::new(-1.0, -1.0, 0.0), DVec3::X, DVec3::Y],
+        material: 1,
+    }]);
+    let rendered = hardware
+        .render(&device, &queue, &small, None)
+        .expect("a scene within the limits renders");
+    assert!(rendered.stats.rays_traced > 0);
+}
