@@ -182,16 +182,9 @@ impl HeadlessGpu {
         // Timestamp queries and subgroup operations, where the adapter offers them;
         // ray queries too (the hardware traversal), which wgpu offers only as an
         // experimental feature: it is enabled where they are requested.
-        let ray_query = adapter.features() & wgpu::Features::EXPERIMENTAL_RAY_QUERY;
+        let (ray_query, experimental_features) =
+            super::ray_query::ray_query_features(adapter.features());
         let required_features = super::limits::optional_features(adapter.features()) | ray_query;
-        let experimental_features = if ray_query.is_empty() {
-            wgpu::ExperimentalFeatures::disabled()
-        } else {
-            // SAFETY: wgpu's experimental features may have bugs an application must
-            // accept; gpu-render uses only ray queries, checked against the software
-            // traversal on every scene of its test suite (tests/integration/ray_query.rs).
-            unsafe { wgpu::ExperimentalFeatures::enabled() }
-        };
         let desc = wgpu::DeviceDescriptor {
             label: Some("gpu-render headless device"),
             required_features,

@@ -65,7 +65,7 @@ pub use features::ShaderFeatures;
 pub use film::Film;
 pub use gpu_scene::GpuScene;
 pub use pipelines::{DISPLAY_FORMAT, LINEAR_FORMAT, TRACE_STORAGE_BUFFERS, TracePipelines};
-pub use ray_query::{Traversal, hardware_traversal_available};
+pub use ray_query::{Traversal, hardware_traversal_available, ray_query_features};
 pub use readback::read_texture;
 pub use renderer::{
     BufferWrites, FilmImage, RenderedImage, Renderer, RendererOptions, TraceRegion, image_tiles,

@@ -59,6 +59,30 @@ pub const WORLD_TRIANGLES: u32 = 0x00ff_ffff;
 /// The feature the hardware path needs, as messages name it.
 const RAY_QUERY_FEATURE: &str = "EXPERIMENTAL_RAY_QUERY";
 
+/// What to add to a device request for the hardware traversal, where the adapter
+/// (of features `adapter_features`) offers ray queries: the feature, and wgpu's
+/// opt-in to its experimental features, which ray queries still are (without it the
+/// request fails). Nothing elsewhere.
+///
+/// ```
+/// let (features, _experimental) =
+///     gpu_render::gpu::ray_query_features(wgpu::Features::EXPERIMENTAL_RAY_QUERY);
+/// assert_eq!(features, wgpu::Features::EXPERIMENTAL_RAY_QUERY);
+/// assert!(gpu_render::gpu::ray_query_features(wgpu::Features::empty()).0.is_empty());
+/// ```
+pub fn ray_query_features(
+    adapter_features: wgpu::Features,
+) -> (wgpu::Features, wgpu::ExperimentalFeatures) {
+    let features = adapter_features & wgpu::Features::EXPERIMENTAL_RAY_QUERY;
+    if features.is_empty() {
+        return (features, wgpu::ExperimentalFeatures::disabled());
+    }
+    // SAFETY: wgpu's experimental features may have bugs an application must accept;
+    // gpu-render uses only ray queries, and checks their images against the software
+    // traversal and the CPU reference (tests/integration/ray_query.rs).
+    (features, unsafe { wgpu::ExperimentalFeatures::enabled() })
+}
+
 /// Whether `device` can run the hardware traversal: it was created with
 /// [`wgpu::Features::EXPERIMENTAL_RAY_QUERY`] and binds an acceleration structure
 /// beside the trace kernels' buffers.

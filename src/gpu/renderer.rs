@@ -91,10 +91,10 @@ pub struct RendererOptions {
     pub unrolled: bool,
     /// How the scene's triangles are found: the software walk of the wide BVH, or
     /// the device's ray queries ([`ShaderFeatures::hardware_traversal`]), which need
-    /// a device created with [`wgpu::Features::EXPERIMENTAL_RAY_QUERY`] (and, as wgpu
-    /// requires of that feature, `experimental_features:
-    /// unsafe { wgpu::ExperimentalFeatures::enabled() }`; [`super::HeadlessGpu`]
-    /// does both where the adapter offers it). [`Traversal::Auto`] (the default)
+    /// a device created with [`wgpu::Features::EXPERIMENTAL_RAY_QUERY`] and, as wgpu
+    /// requires of that feature, its experimental features enabled
+    /// ([`super::ray_query_features`] says what to request; [`super::HeadlessGpu`] and
+    /// the viewer request it where the adapter offers it). [`Traversal::Auto`] (the default)
     /// takes the hardware path where it exists and pays; the image differs only where
     /// the hardware's triangle test and ours differ (`docs/model.md`, "Hardware
     /// traversal").

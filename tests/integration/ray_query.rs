@@ -110,7 +110,7 @@ fn instanced_meshes_with_analytic_shapes_render_as_the_cpu_and_the_software_walk
     };
     // A plane and a mirror sphere (the analytic tree), a blob placed four times
     // (translated, rotated, scaled, mirrored), a point and a directional light.
-    let scene = crate::instancing::instanced_scene(64, &blob(12, 16));
+    let scene = crate::instancing::instanced_scene(48, &blob(12, 16));
     hardware_agrees(&gpu, "ray-query-instances", &scene);
 }
 
@@ -120,15 +120,22 @@ fn shipped_mesh_and_polygon_scenes_render_as_the_cpu_does() {
         return;
     };
     // OBJ and glTF models (world-space triangles) beside spheres and polygons.
-    let models = reduced(shipped("models.toml"), 64, RenderOverrides::default());
+    let models = reduced(
+        shipped("models.toml"),
+        48,
+        RenderOverrides {
+            samples_per_pixel: Some(1),
+            ..RenderOverrides::default()
+        },
+    );
     hardware_agrees(&gpu, "ray-query-models", &models);
     // Path traced: the Cornell box's polygons and its emitter through the analytic
     // tree, a few samples.
     let cornell = reduced(
         shipped("cornell-box.toml"),
-        48,
+        32,
         RenderOverrides {
-            samples_per_pixel: Some(4),
+            samples_per_pixel: Some(2),
             ..RenderOverrides::default()
         },
     );
@@ -313,4 +320,48 @@ fn a_scene_beyond_the_structures_limits_is_refused_naming_the_limit() {
         .render(&device, &queue, &small, None)
         .expect("a scene within the limits renders");
     assert!(rendered.stats.rays_traced > 0);
+}
+
+#[test]
+fn the_cli_says_when_ray_queries_found_the_triangles() {
+    let Some(gpu) = ray_query_gpu() else {
+        return;
+    };
+    let cpu_device = gpu.adapter_info().device_type == wgpu::DeviceType::Cpu;
+    drop(gpu);
+    let dir = crate::support::compare::output_dir().join("ray-query-cli");
+    std::fs::create_dir_all(&dir).expect("output dir");
+    let model = crate::support::repo_root().join("scenes/models/torus.obj");
+    let run = |traversal: &str| {
+        let output = dir.join(format!("{traversal}.png"));
+        let run = crate::support::process::gpu_render(&[
+            model.as_os_str(),
+            "-o".as_ref(),
+            output.as_os_str(),
+            "--backend".as_ref(),
+            "gpu".as_ref(),
+            "--traversal".as_ref(),
+            traversal.as_ref(),
+            "--width".as_ref(),
+            "24".as_ref(),
+            "--height".as_ref(),
+            "16".as_ref(),
+            "--spp".as_ref(),
+            "1".as_ref(),
+        ]);
+        assert_eq!(run.status, Some(0), "{traversal}: {}", run.stderr);
+        run.stderr
+    };
+    let hardware = run("hardware");
+    assert!(hardware.contains("triangles by ray query"), "{hardware}");
+    let software = run("software");
+    assert!(!software.contains("ray query"), "{software}");
+    // On a CPU device (lavapipe) auto keeps the software walk, on a real GPU it takes
+    // the ray queries.
+    let auto = run("auto");
+    assert_eq!(
+        auto.contains("triangles by ray query"),
+        !cpu_device,
+        "{auto}"
+    );
 }

@@ -25,8 +25,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use gpu_render::gpu::RendererOptions;
 use gpu_render::gpu::{AdapterChoice, HeadlessGpu, Renderer, Schedule};
+use gpu_render::gpu::{RendererOptions, Traversal};
 use gpu_render::scene::{RenderOverrides, load_scene};
 
 #[derive(Parser)]
@@ -77,6 +77,10 @@ struct Args {
     /// at one ray per pixel.
     #[arg(long)]
     traversal: bool,
+    /// How the GPU finds the triangles: `auto`, `software` or `hardware` (ray queries;
+    /// `RendererOptions::traversal`).
+    #[arg(long, default_value = "auto")]
+    gpu_traversal: String,
     /// Placements in `generated:instances`.
     #[arg(long, default_value_t = 100)]
     copies: usize,
@@ -405,6 +409,12 @@ fn main() -> Result<()> {
         Some("wavefront") => Some(Schedule::Wavefront),
         Some(other) => anyhow::bail!("--schedule must be fused or wavefront, not {other}"),
     };
+    let traversal = match args.gpu_traversal.as_str() {
+        "auto" => Traversal::Auto,
+        "software" => Traversal::Software,
+        "hardware" => Traversal::Hardware,
+        other => anyhow::bail!("--gpu-traversal must be auto, software or hardware, not {other}"),
+    };
     let renderer = Renderer::new(
         &gpu.device,
         RendererOptions {
@@ -413,6 +423,7 @@ fn main() -> Result<()> {
             unrolled: !args.no_unrolled,
             slot_count: args.slots,
             schedule,
+            traversal,
             ..RendererOptions::default()
         },
     )?;
@@ -440,7 +451,8 @@ fn main() -> Result<()> {
     let primitives = gpu_render::low_level::accel::SceneGeometry::new(&scene).bounded_count();
     println!(
         "GPU scene buffers: {} bytes for {primitives} bounded primitives ({:.1} bytes each, \
-         BVH included); BVH built in {:.1} ms; records in {} buffers; closest hit {}",
+         BVH included); BVH built in {:.1} ms; records in {} buffers; closest hit {}; \
+         triangles by {}",
         prepared.scene_bytes(),
         prepared.scene_bytes() as f64 / primitives.max(1) as f64,
         prepared.bvh_stats().build_time.as_secs_f64() * 1e3,
@@ -453,6 +465,11 @@ fn main() -> Result<()> {
             "unrolled"
         } else {
             "by the BVH"
+        },
+        if prepared.features().hardware_traversal {
+            "ray query"
+        } else {
+            "the software BVH walk"
         }
     );
     drop(prepared);

@@ -306,10 +306,14 @@ impl Viewer {
             .context("no GPU adapter can present to this window")?,
             Some(choice) => choose_adapter(&instance, viewer_backends(), &surface, choice)?,
         };
+        // Ray queries where the adapter offers them (`RendererOptions::traversal`).
+        let (ray_query, experimental_features) =
+            gpu_render::gpu::ray_query_features(adapter.features());
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("gpu-render viewer"),
             required_limits: Renderer::required_limits(&adapter.limits()),
-            required_features: Renderer::optional_features(adapter.features()),
+            required_features: Renderer::optional_features(adapter.features()) | ray_query,
+            experimental_features,
             ..Default::default()
         }))
         .context("cannot open the GPU device")?;
