@@ -7,7 +7,7 @@ use std::sync::{Mutex, PoisonError};
 use super::RenderError;
 use super::cpu_device::uniform_records::{UNIFORM_BUFFERS, device_allows, is_uniform_record};
 use super::features::ShaderFeatures;
-use super::ray_query::hardware_traversal_available;
+use super::ray_query::{RAY_QUERY_FEATURE, hardware_traversal_available};
 use super::readback::{Caught, capture};
 use super::shaders::{
     DISPLAY_ENTRY_POINT, FUSED_ENTRY_POINT, SHADE_ENTRY_POINT, TRACE_ENTRY_POINT,
@@ -368,7 +368,7 @@ impl Pipelines {
                 .as_ref()
                 .ok_or(RenderError::MissingFeature {
                     what: "hardware traversal",
-                    feature: "EXPERIMENTAL_RAY_QUERY",
+                    feature: RAY_QUERY_FEATURE,
                     hint: "",
                 });
         }

@@ -40,24 +40,13 @@ pub enum Traversal {
     Hardware,
 }
 
-impl Traversal {
-    /// The name `--traversal` takes.
-    pub fn name(self) -> &'static str {
-        match self {
-            Traversal::Auto => "auto",
-            Traversal::Software => "software",
-            Traversal::Hardware => "hardware",
-        }
-    }
-}
-
 /// The top-level instance data of the structure holding the scene's own triangles
 /// (`WORLD_TRIANGLES` in `shaders/ray_query.wgsl`): the largest 24-bit value, which no
 /// instance record's node index may take.
 pub const WORLD_TRIANGLES: u32 = 0x00ff_ffff;
 
 /// The feature the hardware path needs, as messages name it.
-const RAY_QUERY_FEATURE: &str = "EXPERIMENTAL_RAY_QUERY";
+pub(crate) const RAY_QUERY_FEATURE: &str = "EXPERIMENTAL_RAY_QUERY";
 
 /// What to add to a device request for the hardware traversal, where the adapter
 /// (of features `adapter_features`) offers ray queries: the feature, and wgpu's
@@ -87,21 +76,41 @@ pub fn ray_query_features(
 /// [`wgpu::Features::EXPERIMENTAL_RAY_QUERY`] and binds an acceleration structure
 /// beside the trace kernels' buffers.
 pub fn hardware_traversal_available(device: &wgpu::Device) -> bool {
-    device
-        .features()
-        .contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY)
-        && missing_binding_room(&device.limits()).is_none()
+    missing_requirement(device).is_none()
 }
 
-/// The limit that leaves no room to bind the scene's acceleration structure, if one
-/// does.
-fn missing_binding_room(limits: &wgpu::Limits) -> Option<&'static str> {
+/// Why `device` cannot run the hardware traversal, if it cannot: no ray queries, or
+/// a limit that leaves no room to bind the scene's acceleration structure.
+fn missing_requirement(device: &wgpu::Device) -> Option<RenderError> {
+    let missing = |feature, hint| {
+        Some(RenderError::MissingFeature {
+            what: "hardware traversal",
+            feature,
+            hint,
+        })
+    };
+    if !device
+        .features()
+        .contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY)
+    {
+        return missing(
+            RAY_QUERY_FEATURE,
+            "; use --traversal software or auto, or create the device with \
+             Features::EXPERIMENTAL_RAY_QUERY and experimental features enabled where \
+             the adapter offers it",
+        );
+    }
+    let limits = device.limits();
+    let room = " (an acceleration structure beside the trace kernels' buffers)";
     if limits.max_acceleration_structures_per_shader_stage < 1 {
-        return Some("max_acceleration_structures_per_shader_stage");
+        return missing("max_acceleration_structures_per_shader_stage", room);
     }
     // The trace kernels' storage buffers, their uniform buffer and the structure.
     if limits.max_buffers_and_acceleration_structures_per_shader_stage < TRACE_STORAGE_BUFFERS + 2 {
-        return Some("max_buffers_and_acceleration_structures_per_shader_stage");
+        return missing(
+            "max_buffers_and_acceleration_structures_per_shader_stage",
+            room,
+        );
     }
     None
 }
@@ -170,28 +179,10 @@ pub(crate) fn wants_hardware(
         Traversal::Auto => Ok(hardware_traversal_available(device)
             && device.adapter_info().device_type != wgpu::DeviceType::Cpu
             && (!geometry.triangles.is_empty() || !geometry.instances.is_empty())),
-        Traversal::Hardware => {
-            if !device
-                .features()
-                .contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY)
-            {
-                return Err(RenderError::MissingFeature {
-                    what: "hardware traversal",
-                    feature: RAY_QUERY_FEATURE,
-                    hint: "; use --traversal software or auto, or create the device with \
-                           Features::EXPERIMENTAL_RAY_QUERY and experimental features \
-                           enabled where the adapter offers it",
-                });
-            }
-            match missing_binding_room(&device.limits()) {
-                Some(limit) => Err(RenderError::MissingFeature {
-                    what: "hardware traversal",
-                    feature: limit,
-                    hint: " (an acceleration structure beside the trace kernels' buffers)",
-                }),
-                None => Ok(true),
-            }
-        }
+        Traversal::Hardware => match missing_requirement(device) {
+            Some(error) => Err(error),
+            None => Ok(true),
+        },
     }
 }
 
@@ -409,14 +400,5 @@ mod tests {
                 1.0, 4.0, 7.0, 10.0, 2.0, 5.0, 8.0, 11.0, 3.0, 6.0, 9.0, 12.0
             ]
         );
-    }
-
-    #[test]
-    fn traversal_names_are_the_cli_values() {
-        let names: Vec<_> = [Traversal::Auto, Traversal::Software, Traversal::Hardware]
-            .iter()
-            .map(|t| t.name())
-            .collect();
-        assert_eq!(names, ["auto", "software", "hardware"]);
     }
 }

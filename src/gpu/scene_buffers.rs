@@ -165,6 +165,7 @@ pub(crate) fn upload_scene(
         });
     }
     let shaded = scene.in_lighting_space();
+    let scene_features = ShaderFeatures::for_scene(scene);
     let limits = device.limits();
     // The hardware traversal walks a tree of the analytic shapes alone: the
     // structures hold the triangles and instances.
@@ -317,13 +318,12 @@ pub(crate) fn upload_scene(
         && geometry.instances.is_empty()
         && geometry.instanced_meshes.is_empty()
         // The unrolled test has no alpha coverage.
-        && !ShaderFeatures::for_scene(scene).alpha
+        && !scene_features.alpha
     {
         UnrolledPrimitives::for_scene(&records.bvh_prims, records.planes.len(), &records.polygons)
     } else {
         None
     };
-    let alpha = ShaderFeatures::for_scene(scene).alpha;
     let acceleration = match &analytic {
         Some((_, layout)) => Some(build_acceleration(
             device,
@@ -331,7 +331,7 @@ pub(crate) fn upload_scene(
             &buffers.triangles,
             geometry,
             layout,
-            !alpha,
+            !scene_features.alpha,
         )?),
         None => None,
     };
@@ -352,11 +352,11 @@ pub(crate) fn upload_scene(
             hardware_traversal: hardware,
             aov: aov || !specialise,
             ..if specialise {
-                ShaderFeatures::for_scene(scene)
+                scene_features
             } else {
                 // The general module, with the alpha test only where it is needed.
                 ShaderFeatures {
-                    alpha,
+                    alpha: scene_features.alpha,
                     ..ShaderFeatures::ALL
                 }
             }

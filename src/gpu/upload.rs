@@ -138,6 +138,8 @@ impl SceneRecords {
             return;
         }
         let index = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+        // The scene tree's references come first; the meshes' follow.
+        let scene_prims = self.bvh_prims.len();
         let mut roots = Vec::with_capacity(geometry.instanced_meshes.len());
         for mesh in &geometry.instanced_meshes {
             let first_triangle = index(self.triangles.len());
@@ -175,12 +177,6 @@ impl SceneRecords {
                 .extend(instance_records(instance, root, index(i), first_triangle));
         }
         let record = |i: usize| index(first_record + INSTANCE_RECORD_NODES * i);
-        let scene_prims = self.bvh_prims.len()
-            - geometry
-                .instanced_meshes
-                .iter()
-                .map(|mesh| mesh.bvh.prims.len())
-                .sum::<usize>();
         for prim in &mut self.bvh_prims[..scene_prims] {
             let p = PrimRef(*prim);
             if p.kind() == PrimKind::Instance {

@@ -49,14 +49,16 @@ fn ray_query_gpu() -> Option<HeadlessGpu> {
     None
 }
 
+/// The default options but `traversal`.
+fn options(traversal: Traversal) -> RendererOptions {
+    RendererOptions {
+        traversal,
+        ..RendererOptions::default()
+    }
+}
+
 fn renderer(gpu: &HeadlessGpu, traversal: Traversal) -> Renderer {
-    crate::support::gpu::renderer_with(
-        gpu,
-        RendererOptions {
-            traversal,
-            ..RendererOptions::default()
-        },
-    )
+    crate::support::gpu::renderer_with(gpu, options(traversal))
 }
 
 /// Renders `scene` with the hardware traversal and asserts that it took it, that it
@@ -223,12 +225,7 @@ fn device_with(
 ) -> (wgpu::Device, wgpu::Queue) {
     let mut limits = Renderer::required_limits(&gpu.adapter.limits());
     adjust(&mut limits);
-    let experimental_features = if features.contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
-        // SAFETY: the test uses the experimental ray queries the renderer uses.
-        unsafe { wgpu::ExperimentalFeatures::enabled() }
-    } else {
-        wgpu::ExperimentalFeatures::disabled()
-    };
+    let (_, experimental_features) = gpu_render::gpu::ray_query_features(features);
     pollster::block_on(gpu.adapter.request_device(&wgpu::DeviceDescriptor {
         label: Some("ray query test device"),
         required_features: features,
@@ -251,10 +248,6 @@ fn without_ray_queries_hardware_is_an_error_and_auto_takes_the_software_walk() {
     );
     assert!(!hardware_traversal_available(&device));
     let scene = crate::instancing::instanced_scene(32, &blob(6, 8));
-    let options = |traversal| RendererOptions {
-        traversal,
-        ..RendererOptions::default()
-    };
     let hardware = Renderer::new(&device, options(Traversal::Hardware)).expect("renderer");
     let error = hardware
         .upload(&device, &queue, &scene)
@@ -293,14 +286,7 @@ fn a_scene_beyond_the_structures_limits_is_refused_naming_the_limit() {
     );
     assert!(hardware_traversal_available(&device));
     let scene = crate::instancing::instanced_scene(32, &blob(6, 8));
-    let hardware = Renderer::new(
-        &device,
-        RendererOptions {
-            traversal: Traversal::Hardware,
-            ..RendererOptions::default()
-        },
-    )
-    .expect("renderer");
+    let hardware = Renderer::new(&device, options(Traversal::Hardware)).expect("renderer");
     let error = hardware
         .upload(&device, &queue, &scene)
         .expect_err("a mesh beyond max_blas_primitive_count must be refused");
