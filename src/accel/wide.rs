@@ -25,6 +25,7 @@
 //! waiting siblings per level) never overflows.
 
 use bytemuck::{Pod, Zeroable};
+use glam::Vec4;
 
 use super::bvh::{Aabb32, BvhNode, MAX_BVH_DEPTH};
 
@@ -132,12 +133,13 @@ fn step_of(biased: u32) -> f32 {
 fn axis_exponent(lo: f32, hi: f32) -> u32 {
     let extent = f64::from(hi) - f64::from(lo);
     let mut biased = if extent > 0.0 {
-        ((extent / 255.0).log2().ceil() as i64 + 127).clamp(1, 254) as u32
+        (ceil_log2(extent / 255.0) + 127).clamp(1, 254) as u32
     } else {
         1
     };
     // The estimate may be one too large or, where the decoder's sum rounds down, one
-    // too small.
+    // too small. The decoded reach grows with the exponent, so these steps end on the
+    // smallest exponent that reaches `hi` whatever the estimate.
     while biased > 1 && dequantize(lo, step_of(biased - 1), 255) >= hi {
         biased -= 1;
     }
@@ -147,11 +149,34 @@ fn axis_exponent(lo: f32, hi: f32) -> u32 {
     biased
 }
 
+/// `ceil(log2(x))` for a positive normal `x`, read from its bits: the exponent, plus
+/// one unless `x` is a power of two. Exact, and far cheaper than `log2` (three calls
+/// per wide node); [`axis_exponent`] corrects its result in any case.
+fn ceil_log2(x: f64) -> i64 {
+    let bits = x.to_bits();
+    let exponent = ((bits >> 52) & 0x7ff) as i64 - 1023;
+    let fraction = bits & ((1 << 52) - 1);
+    if fraction == 0 {
+        exponent
+    } else {
+        exponent + 1
+    }
+}
+
+/// `(x - origin) / step` truncated into `0..=255`: the first guess at `x`'s quantized
+/// value, which [`quantize_down`] and [`quantize_up`] correct. `1 / step` is a power
+/// of two, so a product replaces the division; the saturating cast replaces `floor`
+/// and `ceil` (library calls on the baseline x86-64 target) at the cost of at most
+/// one more correction step.
+fn quantize_estimate(origin: f32, inverse_step: f64, x: f32) -> u32 {
+    (((f64::from(x) - f64::from(origin)) * inverse_step) as u32).min(255)
+}
+
 /// The largest `q` whose decoded value is at or below `x` (0 if none is: the origin
-/// lies at or below every child's bound).
-fn quantize_down(origin: f32, step: f32, x: f32) -> u32 {
-    let estimate = ((f64::from(x) - f64::from(origin)) / f64::from(step)).floor();
-    let mut q = estimate.clamp(0.0, 255.0) as u32;
+/// lies at or below every child's bound). The decoded value grows with `q`, so the
+/// corrections end on that `q` whatever the estimate.
+fn quantize_down(origin: f32, step: f32, inverse_step: f64, x: f32) -> u32 {
+    let mut q = quantize_estimate(origin, inverse_step, x);
     while q > 0 && dequantize(origin, step, q) > x {
         q -= 1;
     }
@@ -163,9 +188,8 @@ fn quantize_down(origin: f32, step: f32, x: f32) -> u32 {
 
 /// The smallest `q` whose decoded value is at or above `x` (255 if none is: the
 /// exponent was chosen so that 255 reaches the node's upper bound).
-fn quantize_up(origin: f32, step: f32, x: f32) -> u32 {
-    let estimate = ((f64::from(x) - f64::from(origin)) / f64::from(step)).ceil();
-    let mut q = estimate.clamp(0.0, 255.0) as u32;
+fn quantize_up(origin: f32, step: f32, inverse_step: f64, x: f32) -> u32 {
+    let mut q = quantize_estimate(origin, inverse_step, x);
     while q < 255 && dequantize(origin, step, q) < x {
         q += 1;
     }
@@ -173,6 +197,66 @@ fn quantize_up(origin: f32, step: f32, x: f32) -> u32 {
         q -= 1;
     }
     q
+}
+
+/// The quantized bounds on `axis` of up to [`WIDTH`] `children` of a node whose axis
+/// starts at `origin` with steps `step`: [`quantize_down`] of each lower bound and
+/// [`quantize_up`] of each upper bound (slots past the children hold nothing useful).
+///
+/// The four children are estimated and checked together in SIMD lanes: an estimate
+/// is kept where the decoder's own arithmetic confirms it is the value the scalar
+/// search defines (its decoded bound on the right side of the child's, the next
+/// value's on the wrong side), which is almost always; any other slot takes the
+/// scalar search. So the result is the scalar one, at a fraction of its cost.
+fn quantize_children(
+    origin: f32,
+    step: f32,
+    children: &[(WideChild, Aabb32)],
+    axis: usize,
+) -> ([u32; WIDTH], [u32; WIDTH]) {
+    let mut lows = [origin; WIDTH];
+    let mut highs = [origin; WIDTH];
+    for (slot, (_, aabb)) in children.iter().enumerate().take(WIDTH) {
+        lows[slot] = aabb.min[axis];
+        highs[slot] = aabb.max[axis];
+    }
+    let (x_low, x_high) = (Vec4::from_array(lows), Vec4::from_array(highs));
+    let (origin4, step4) = (Vec4::splat(origin), Vec4::splat(step));
+    // `step` is a power of two: its inverse is exact (subnormal at worst).
+    let inverse4 = Vec4::splat(1.0 / step);
+    // Twin of `dequantize`: an exact product, then one rounding.
+    let decode = |q: Vec4| origin4 + q * step4;
+    let (zero, top) = (Vec4::ZERO, Vec4::splat(255.0));
+    let q_low = ((x_low - origin4) * inverse4).floor().clamp(zero, top);
+    let q_high = ((x_high - origin4) * inverse4).ceil().clamp(zero, top);
+    // quantize_down's answer: the largest q decoding at or below x (0 if none).
+    let low_ok = (q_low.cmpeq(zero) | decode(q_low).cmple(x_low))
+        & (q_low.cmpeq(top) | decode(q_low + Vec4::ONE).cmpgt(x_low));
+    // quantize_up's answer: the smallest q decoding at or above x (255 if none).
+    let high_ok = (q_high.cmpeq(top) | decode(q_high).cmpge(x_high))
+        & (q_high.cmpeq(zero) | decode(q_high - Vec4::ONE).cmplt(x_high));
+    let mut low = q_low.as_uvec4().to_array();
+    let mut high = q_high.as_uvec4().to_array();
+    let used = children.len().min(WIDTH);
+    let all = (1 << used) - 1;
+    let inverse_step = 1.0 / f64::from(step);
+    if (low_ok & high_ok).bitmask() & all != all {
+        for slot in 0..used {
+            low[slot] = quantize_down(origin, step, inverse_step, lows[slot]);
+            high[slot] = quantize_up(origin, step, inverse_step, highs[slot]);
+        }
+    }
+    for slot in 0..used {
+        debug_assert_eq!(
+            (low[slot], high[slot]),
+            (
+                quantize_down(origin, step, inverse_step, lows[slot]),
+                quantize_up(origin, step, inverse_step, highs[slot])
+            ),
+            "the lanes' estimate is the scalar search's answer"
+        );
+    }
+    (low, high)
 }
 
 /// A lower box bound the decoder reads the same way with or without flushing
@@ -207,11 +291,10 @@ impl WideNode {
             let biased = axis_exponent(start, bounds.max[axis]);
             node.exponents |= biased << (8 * axis);
             let step = step_of(biased);
-            for (slot, (_, aabb)) in children.iter().enumerate() {
-                let lo = quantize_down(start, step, aabb.min[axis]);
-                let hi = quantize_up(start, step, aabb.max[axis]);
-                node.low[axis] |= lo << (8 * slot);
-                node.high[axis] |= hi << (8 * slot);
+            let (lows, highs) = quantize_children(start, step, children, axis);
+            for slot in 0..children.len() {
+                node.low[axis] |= lows[slot] << (8 * slot);
+                node.high[axis] |= highs[slot] << (8 * slot);
             }
             // Empty slots: an inverted box, never read (the child word says empty).
             for slot in children.len()..WIDTH {
@@ -266,66 +349,197 @@ impl WideNode {
 /// The binary tree `nodes` (depth-first, an inner node's children at `first` and
 /// `first + 1`) collapsed into wide nodes, node 0 the root. A binary leaf keeps its
 /// primitive range, so the wide tree shares the binary tree's primitive order.
+///
+/// Two passes: [`plan`] walks the tree once, choosing each wide node's children and
+/// numbering the wide nodes; [`encode`] then quantizes every node on its own, which
+/// splits across threads without changing a byte.
 pub fn collapse(nodes: &[BvhNode]) -> Vec<WideNode> {
     if nodes.is_empty() {
         return Vec::new();
     }
+    let planned = plan(nodes);
+    let threads = if planned.len() >= PARALLEL_ENCODE_THRESHOLD {
+        std::thread::available_parallelism().map_or(1, usize::from)
+    } else {
+        1
+    };
+    encode(nodes, &planned, threads)
+}
+
+/// Wide nodes below this count are encoded on the current thread: a thread's start
+/// costs more than encoding them.
+const PARALLEL_ENCODE_THRESHOLD: usize = 8192;
+
+/// A wide node chosen but not yet encoded.
+#[derive(Debug, Clone, Copy)]
+struct Planned {
+    /// The binary node it stands for (its box is the wide node's).
+    binary: u32,
+    /// Its children as binary nodes, in slot order; `len` of them are used.
+    members: [u32; WIDTH],
+    /// Number of children.
+    len: u32,
+    /// The wide index of its first inner child; the others follow in slot order.
+    first_child: u32,
+}
+
+/// A candidate child while a wide node is being filled.
+#[derive(Debug, Clone, Copy)]
+struct Member {
+    /// The binary node.
+    node: u32,
+    /// Its binary depth below the wide node's binary node.
+    depth: u32,
+    /// Its box's half area (in `f64`), the tie-break between equally deep nodes.
+    half_area: f64,
+}
+
+impl Member {
+    fn new(nodes: &[BvhNode], node: u32, depth: u32) -> Self {
+        let n = &nodes[node as usize];
+        let e = [0, 1, 2].map(|a| f64::from(n.max[a]) - f64::from(n.min[a]));
+        Self {
+            node,
+            depth,
+            half_area: e[0] * e[1] + e[1] * e[2] + e[2] * e[0],
+        }
+    }
+}
+
+/// The children of the wide node that stands for binary node `binary`, in slot order
+/// (the module's greedy rule): its binary children, then repeatedly the inner member
+/// of smallest depth (the larger box first, the earlier slot at a tie) replaced by
+/// its two children, the last member moving into its slot, until there are
+/// [`WIDTH`] or only leaves. A leaf (a tree that is one leaf) is its own only child.
+fn choose_members(nodes: &[BvhNode], binary: u32) -> ([u32; WIDTH], usize) {
+    let node = &nodes[binary as usize];
+    let mut members = [Member {
+        node: 0,
+        depth: 0,
+        half_area: 0.0,
+    }; WIDTH];
+    let mut len;
+    if node.is_leaf() {
+        members[0] = Member::new(nodes, binary, 0);
+        len = 1;
+    } else {
+        members[0] = Member::new(nodes, node.first, 1);
+        members[1] = Member::new(nodes, node.first + 1, 1);
+        len = 2;
+    }
+    while len < WIDTH {
+        let mut open: Option<usize> = None;
+        for (i, m) in members[..len].iter().enumerate() {
+            if nodes[m.node as usize].is_leaf() {
+                continue;
+            }
+            let better = open.is_none_or(|o| {
+                let best = &members[o];
+                m.depth
+                    .cmp(&best.depth)
+                    .then(best.half_area.total_cmp(&m.half_area))
+                    .is_lt()
+            });
+            if better {
+                open = Some(i);
+            }
+        }
+        let Some(i) = open else { break };
+        let opened = members[i];
+        // `Vec::swap_remove`: the last member takes the opened one's slot.
+        members[i] = members[len - 1];
+        let first = nodes[opened.node as usize].first;
+        members[len - 1] = Member::new(nodes, first, opened.depth + 1);
+        members[len] = Member::new(nodes, first + 1, opened.depth + 1);
+        len += 1;
+    }
+    (members.map(|m| m.node), len)
+}
+
+/// Chooses every wide node's children and numbers the wide nodes: a wide node's inner
+/// children get consecutive indices when it is taken from the stack of pending nodes,
+/// and the last of them is taken first (the order the tracers' buffers have always
+/// had).
+fn plan(nodes: &[BvhNode]) -> Vec<Planned> {
+    let unplanned = Planned {
+        binary: 0,
+        members: [0; WIDTH],
+        len: 0,
+        first_child: 0,
+    };
+    let mut planned = Vec::with_capacity(nodes.len() / 4 + 1);
+    planned.push(unplanned);
+    // (binary node, its wide node's index)
+    let mut pending = vec![(0u32, 0usize)];
+    while let Some((binary, slot)) = pending.pop() {
+        let (members, len) = choose_members(nodes, binary);
+        let first_child = planned.len();
+        for &member in &members[..len] {
+            if !nodes[member as usize].is_leaf() {
+                pending.push((member, planned.len()));
+                planned.push(unplanned);
+            }
+        }
+        planned[slot] = Planned {
+            binary,
+            members,
+            len: len as u32,
+            first_child: u32::try_from(first_child).unwrap_or(CHILD_INDEX_MASK),
+        };
+    }
+    planned
+}
+
+/// Encodes the planned wide nodes, `threads` contiguous runs of them at once.
+fn encode(nodes: &[BvhNode], planned: &[Planned], threads: usize) -> Vec<WideNode> {
+    let mut wide = vec![WideNode::zeroed(); planned.len()];
+    let chunk = planned.len().div_ceil(threads.max(1)).max(1);
+    std::thread::scope(|scope| {
+        let mut runs = wide.chunks_mut(chunk).zip(planned.chunks(chunk));
+        // The first run is encoded here, the others on threads of their own.
+        let first = runs.next();
+        for (out, plans) in runs {
+            scope.spawn(move || encode_run(nodes, plans, out));
+        }
+        if let Some((out, plans)) = first {
+            encode_run(nodes, plans, out);
+        }
+    });
+    wide
+}
+
+/// Encodes `plans` into `out` (as long).
+fn encode_run(nodes: &[BvhNode], plans: &[Planned], out: &mut [WideNode]) {
+    for (plan, slot) in plans.iter().zip(out) {
+        *slot = encode_one(nodes, plan);
+    }
+}
+
+/// The wide node `plan` describes.
+fn encode_one(nodes: &[BvhNode], plan: &Planned) -> WideNode {
     let aabb = |n: &BvhNode| Aabb32 {
         min: n.min,
         max: n.max,
     };
-    let half_area = |n: &BvhNode| {
-        let e = [0, 1, 2].map(|a| f64::from(n.max[a]) - f64::from(n.min[a]));
-        e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
-    };
-    let mut wide = vec![WideNode::zeroed()];
-    // (binary node, its wide node's index)
-    let mut pending = vec![(0usize, 0usize)];
-    while let Some((binary, slot)) = pending.pop() {
-        let node = &nodes[binary];
-        // (binary node, binary depth below `node`)
-        let mut members: Vec<(usize, u32)> = if node.is_leaf() {
-            vec![(binary, 0)]
+    let mut children = [(WideChild::Empty, Aabb32::EMPTY); WIDTH];
+    let mut next_inner = plan.first_child;
+    for (slot, &member) in plan.members[..plan.len as usize].iter().enumerate() {
+        let child = &nodes[member as usize];
+        let named = if child.is_leaf() {
+            WideChild::Leaf {
+                first: child.first,
+                count: child.count,
+            }
         } else {
-            vec![(node.first as usize, 1), (node.first as usize + 1, 1)]
+            next_inner += 1;
+            WideChild::Node(next_inner - 1)
         };
-        while members.len() < WIDTH {
-            let open = members
-                .iter()
-                .enumerate()
-                .filter(|(_, (n, _))| !nodes[*n].is_leaf())
-                .min_by(|(_, (a, da)), (_, (b, db))| {
-                    da.cmp(db)
-                        .then(half_area(&nodes[*b]).total_cmp(&half_area(&nodes[*a])))
-                })
-                .map(|(i, _)| i);
-            let Some(i) = open else { break };
-            let (n, depth) = members.swap_remove(i);
-            let first = nodes[n].first as usize;
-            members.push((first, depth + 1));
-            members.push((first + 1, depth + 1));
-        }
-        let children: Vec<(WideChild, Aabb32)> = members
-            .iter()
-            .map(|&(n, _)| {
-                let child = &nodes[n];
-                let named = if child.is_leaf() {
-                    WideChild::Leaf {
-                        first: child.first,
-                        count: child.count,
-                    }
-                } else {
-                    let index = wide.len();
-                    wide.push(WideNode::zeroed());
-                    pending.push((n, index));
-                    WideChild::Node(u32::try_from(index).unwrap_or(CHILD_INDEX_MASK))
-                };
-                (named, aabb(child))
-            })
-            .collect();
-        wide[slot] = WideNode::new(aabb(node), &children);
+        children[slot] = (named, aabb(child));
     }
-    wide
+    WideNode::new(
+        aabb(&nodes[plan.binary as usize]),
+        &children[..plan.len as usize],
+    )
 }
 
 #[cfg(test)]
