@@ -22,7 +22,7 @@
 use std::time::{Duration, Instant};
 
 use bytemuck::{Pod, Zeroable};
-use glam::{DVec3, Vec3A};
+use glam::{DVec3, Vec3A, Vec4};
 
 use super::geometry::PrimRef;
 use super::wide::{WideNode, collapse};
@@ -209,20 +209,51 @@ pub const MEDIAN_SPLIT_DEPTH: u32 = 30;
 /// Subtrees with fewer primitives than this are built on the current thread.
 const PARALLEL_THRESHOLD: usize = 50_000;
 
-/// One primitive as the builders move it around: its box (the lanes' fourth float
-/// holds its position in the input). Kept contiguous and reordered in place, so each
-/// pass over a node's primitives reads memory in order.
+/// One primitive as the builders move it around: its box, with its position in the
+/// input in the lower corner's fourth lane. Kept contiguous and reordered in place, so
+/// each pass over a node's primitives reads memory in order; 32 bytes (the index in a
+/// field of its own made it 48), as the passes over the primitives are bound by
+/// memory.
 #[derive(Debug, Clone, Copy)]
 struct BuildPrim {
-    min: Vec3A,
+    /// The lower corner in `x, y, z`; `w` holds [`BuildPrim::INDEX_TAG`]` | index` as
+    /// `f32` bits: never a subnormal, so the lane's arithmetic in
+    /// [`BuildPrim::centroid`] (whose result no one reads) is never slow.
+    min_and_index: Vec4,
+    /// The upper corner.
     max: Vec3A,
-    index: u32,
 }
 
 impl BuildPrim {
+    /// Bit 30 set: whatever the index below it, the tagged bits have a nonzero
+    /// exponent, so they are never a subnormal.
+    const INDEX_TAG: u32 = 1 << 30;
+
+    /// The index bits: builds are of at most 2^30 primitives (as
+    /// [`MEDIAN_SPLIT_DEPTH`]'s depth bound assumes; 32 GiB of these records).
+    const INDEX_MASK: u32 = Self::INDEX_TAG - 1;
+
+    fn new(index: u32, aabb: &Aabb32) -> Self {
+        let tagged = f32::from_bits(Self::INDEX_TAG | (index & Self::INDEX_MASK));
+        Self {
+            min_and_index: Vec4::new(aabb.min[0], aabb.min[1], aabb.min[2], tagged),
+            max: Vec3A::from_array(aabb.max),
+        }
+    }
+
+    /// The lower corner.
+    fn min(&self) -> Vec3A {
+        Vec3A::from_vec4(self.min_and_index)
+    }
+
+    /// The position in the input.
+    fn index(&self) -> usize {
+        (self.min_and_index.w.to_bits() & Self::INDEX_MASK) as usize
+    }
+
     /// Twice the box's centre: the factor cancels in every comparison.
     fn centroid(&self) -> Vec3A {
-        self.min + self.max
+        self.min() + self.max
     }
 }
 
@@ -274,7 +305,7 @@ impl NodeBounds {
     };
 
     fn add(&mut self, prim: &BuildPrim) {
-        self.boxes.min = self.boxes.min.min(prim.min);
+        self.boxes.min = self.boxes.min.min(prim.min());
         self.boxes.max = self.boxes.max.max(prim.max);
         let centroid = prim.centroid();
         self.centroids.min = self.centroids.min.min(centroid);
@@ -299,26 +330,61 @@ fn build_tree(primitives: &[(PrimRef, Aabb32)], method: BuildMethod) -> Bvh {
     if primitives.is_empty() {
         return Bvh::default();
     }
+    let threads = std::thread::available_parallelism().map_or(1, usize::from);
+    // The root's bounds are gathered in the same pass that makes the records.
+    let mut bounds = NodeBounds::EMPTY;
     let mut prims: Vec<BuildPrim> = primitives
         .iter()
         .enumerate()
-        .map(|(i, (_, b))| BuildPrim {
-            min: Vec3A::from_array(b.min),
-            max: Vec3A::from_array(b.max),
-            index: i as u32,
+        .map(|(i, (_, b))| {
+            let prim = BuildPrim::new(i as u32, b);
+            bounds.add(&prim);
+            prim
         })
         .collect();
-    let threads = std::thread::available_parallelism().map_or(1, usize::from);
     let mut arena = Vec::with_capacity(2 * primitives.len() / MAX_LEAF_PRIMITIVES as usize + 1);
-    let bounds = NodeBounds::of(&prims);
     build_subtree(method, &mut prims, bounds, 0, 1, threads, &mut arena);
-    let order: Vec<PrimRef> = prims
-        .iter()
-        .map(|p| primitives[p.index as usize].0)
-        .collect();
-    let mut bvh = flatten(&arena, &order);
+    let order = build_order(primitives, &prims, threads);
+    drop(prims);
+    let mut bvh = flatten(&arena, order, threads);
     bvh.stats.method = method;
     bvh
+}
+
+/// The primitive references in the order the build left `prims` in, `threads` runs
+/// at once.
+fn build_order(
+    primitives: &[(PrimRef, Aabb32)],
+    prims: &[BuildPrim],
+    threads: usize,
+) -> Vec<PrimRef> {
+    let mut order = vec![PrimRef(0); prims.len()];
+    let chunk = prims
+        .len()
+        .div_ceil(if prims.len() >= PARALLEL_THRESHOLD {
+            threads.max(1)
+        } else {
+            1
+        })
+        .max(1);
+    std::thread::scope(|scope| {
+        let mut runs = order.chunks_mut(chunk).zip(prims.chunks(chunk));
+        let first = runs.next();
+        for (out, run) in runs {
+            scope.spawn(move || fill_order(primitives, run, out));
+        }
+        if let Some((out, run)) = first {
+            fill_order(primitives, run, out);
+        }
+    });
+    order
+}
+
+/// `out[i]` = the reference of `prims[i]`.
+fn fill_order(primitives: &[(PrimRef, Aabb32)], prims: &[BuildPrim], out: &mut [PrimRef]) {
+    for (slot, prim) in out.iter_mut().zip(prims) {
+        *slot = primitives[prim.index()].0;
+    }
 }
 
 /// Reorders `prims` for a split and returns how many go left (between 1 and
@@ -486,57 +552,133 @@ fn append_arena(arena: &mut Vec<BuildNode>, subtree: Vec<BuildNode>) -> usize {
     shift
 }
 
-/// Lays a built tree out depth-first with sibling pairs adjacent, the leaves'
-/// primitives (`order`, the build order) in the same order, and measures it.
-fn flatten(tree: &[BuildNode], order: &[PrimRef]) -> Bvh {
-    let mut bvh = Bvh::default();
-    let record = |aabb: &Aabb32| BvhNode {
-        min: aabb.min,
-        first: 0,
-        max: aabb.max,
-        count: 0,
+/// Lays a built tree out depth-first with sibling pairs adjacent (a node's children
+/// come before its left child's descendants, which come before its right child's),
+/// the leaves' primitives (`order`, the build order) in the same order, and measures
+/// it.
+///
+/// The builder numbers the primitives left to right, as this layout visits the
+/// leaves, so `order` is already the leaves' primitives in layout order and a leaf's
+/// first primitive is its start in the build order. The arena is in preorder (a
+/// node, its left subtree, its right subtree), so a subtree's size is the distance
+/// between its children: every subtree's slots are known before it is laid out, and
+/// the two halves of the top levels are laid out on separate threads.
+fn flatten(tree: &[BuildNode], order: Vec<PrimRef>, threads: usize) -> Bvh {
+    let mut nodes = vec![BvhNode::zeroed(); tree.len()];
+    nodes[0] = record(tree, 0, 1);
+    let (depth, leaves) = match tree[0] {
+        BuildNode::Leaf { .. } => (1, 1),
+        BuildNode::Inner { .. } => {
+            let layout = Layout { tree, threads };
+            layout.place_children(0, tree.len(), 1, 1, &mut nodes[1..])
+        }
     };
     let area = |n: &BvhNode| {
         let e = [0, 1, 2].map(|a| f64::from(n.max[a]) - f64::from(n.min[a]));
         e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
     };
-    let root_aabb = match &tree[0] {
-        BuildNode::Inner { aabb, .. } | BuildNode::Leaf { aabb, .. } => aabb,
-    };
-    bvh.nodes.push(record(root_aabb));
-    // (tree node, output slot, depth)
-    let mut pending = vec![(0usize, 0usize, 1u32)];
-    while let Some((source, slot, depth)) = pending.pop() {
-        bvh.stats.depth = bvh.stats.depth.max(depth);
-        match &tree[source] {
-            BuildNode::Leaf { start, count, .. } => {
-                bvh.nodes[slot].first = u32::try_from(bvh.prims.len()).unwrap_or(u32::MAX);
-                bvh.nodes[slot].count = *count as u32;
-                bvh.prims.extend_from_slice(&order[*start..*start + *count]);
-                bvh.stats.leaves += 1;
-            }
-            BuildNode::Inner { children, .. } => {
-                let first = bvh.nodes.len();
-                bvh.nodes[slot].first = u32::try_from(first).unwrap_or(u32::MAX);
-                for &child in children {
-                    let aabb = match &tree[child] {
-                        BuildNode::Inner { aabb, .. } | BuildNode::Leaf { aabb, .. } => aabb,
-                    };
-                    bvh.nodes.push(record(aabb));
-                }
-                pending.push((children[1], first + 1, depth + 1));
-                pending.push((children[0], first, depth + 1));
-            }
-        }
-    }
-    let root_area = area(&bvh.nodes[0]).max(f64::MIN_POSITIVE);
-    bvh.stats.sah_cost = bvh
-        .nodes
+    let root_area = area(&nodes[0]).max(f64::MIN_POSITIVE);
+    // Summed in layout order, one node after the other, as it always was.
+    let sah_cost = nodes
         .iter()
         .map(|n| area(n) / root_area * if n.is_leaf() { f64::from(n.count) } else { 1.0 })
         .sum();
-    bvh.stats.nodes = bvh.nodes.len();
-    bvh
+    Bvh {
+        stats: BvhStats {
+            depth,
+            nodes: nodes.len(),
+            leaves,
+            sah_cost,
+            ..BvhStats::default()
+        },
+        nodes,
+        wide: Vec::new(),
+        prims: order,
+    }
+}
+
+/// The record of arena node `source`, whose children (if it has any) go to slot
+/// `first_child` of the layout.
+fn record(tree: &[BuildNode], source: usize, first_child: usize) -> BvhNode {
+    match &tree[source] {
+        BuildNode::Inner { aabb, .. } => BvhNode {
+            min: aabb.min,
+            first: u32::try_from(first_child).unwrap_or(u32::MAX),
+            max: aabb.max,
+            count: 0,
+        },
+        BuildNode::Leaf { aabb, start, count } => BvhNode {
+            min: aabb.min,
+            first: u32::try_from(*start).unwrap_or(u32::MAX),
+            max: aabb.max,
+            count: *count as u32,
+        },
+    }
+}
+
+/// Subtrees of fewer nodes than this are laid out on the current thread.
+const PARALLEL_LAYOUT_THRESHOLD: usize = 20_000;
+
+/// What [`flatten`]'s layout reads: the built tree and how many threads it may use.
+struct Layout<'a> {
+    tree: &'a [BuildNode],
+    threads: usize,
+}
+
+impl Layout<'_> {
+    /// Lays out the descendants of the inner arena node `source` (whose subtree has
+    /// `size` nodes, at binary depth `depth`) into `out`, which is slots `base ..
+    /// base + size - 1` of the layout, its two children first. Returns the deepest
+    /// depth below it and its number of leaves.
+    fn place_children(
+        &self,
+        source: usize,
+        size: usize,
+        depth: u32,
+        base: usize,
+        out: &mut [BvhNode],
+    ) -> (u32, usize) {
+        let BuildNode::Inner { children, .. } = self.tree[source] else {
+            return (depth, 1);
+        };
+        let [left, right] = children;
+        // Preorder: the left subtree fills the arena up to the right child.
+        let left_size = right - left;
+        let right_size = size - 1 - left_size;
+        let left_base = base + 2;
+        let right_base = left_base + left_size - 1;
+        out[0] = record(self.tree, left, left_base);
+        out[1] = record(self.tree, right, right_base);
+        let (left_out, right_out) = out[2..].split_at_mut(left_size - 1);
+        let place = |source, size, base, out: &mut [BvhNode], threads| {
+            let layout = Layout {
+                tree: self.tree,
+                threads,
+            };
+            layout.place_children(source, size, depth + 1, base, out)
+        };
+        let ((left_depth, left_leaves), (right_depth, right_leaves)) = if self.threads > 1
+            && size >= PARALLEL_LAYOUT_THRESHOLD
+        {
+            let half = self.threads / 2;
+            let rest = self.threads - half;
+            std::thread::scope(|scope| {
+                let worker = scope.spawn(|| place(right, right_size, right_base, right_out, half));
+                let left = place(left, left_size, left_base, left_out, rest);
+                // A panic in the worker is a bug in this layout: raise it here.
+                match worker.join() {
+                    Ok(right) => (left, right),
+                    Err(panic) => std::panic::resume_unwind(panic),
+                }
+            })
+        } else {
+            (
+                place(left, left_size, left_base, left_out, 1),
+                place(right, right_size, right_base, right_out, 1),
+            )
+        };
+        (left_depth.max(right_depth), left_leaves + right_leaves)
+    }
 }
 
 #[cfg(test)]
