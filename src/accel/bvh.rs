@@ -726,6 +726,74 @@ mod tests {
         assert!(bvh.stats.depth <= MAX_BVH_DEPTH);
     }
 
+    /// The layout as it was first written (a stack of pending nodes, each leaf's
+    /// primitives copied in visiting order), the reference [`flatten`] must match.
+    fn reference_flatten(
+        tree: &[BuildNode],
+        order: &[PrimRef],
+    ) -> (Vec<BvhNode>, Vec<PrimRef>, u32) {
+        let aabb_of = |node: &BuildNode| match node {
+            BuildNode::Inner { aabb, .. } | BuildNode::Leaf { aabb, .. } => *aabb,
+        };
+        let record = |aabb: Aabb32| BvhNode {
+            min: aabb.min,
+            first: 0,
+            max: aabb.max,
+            count: 0,
+        };
+        let mut nodes = vec![record(aabb_of(&tree[0]))];
+        let mut prims = Vec::new();
+        let mut deepest = 0;
+        let mut pending = vec![(0usize, 0usize, 1u32)];
+        while let Some((source, slot, depth)) = pending.pop() {
+            deepest = deepest.max(depth);
+            match &tree[source] {
+                BuildNode::Leaf { start, count, .. } => {
+                    nodes[slot].first = prims.len() as u32;
+                    nodes[slot].count = *count as u32;
+                    prims.extend_from_slice(&order[*start..*start + *count]);
+                }
+                BuildNode::Inner { children, .. } => {
+                    let first = nodes.len();
+                    nodes[slot].first = first as u32;
+                    for &child in children {
+                        nodes.push(record(aabb_of(&tree[child])));
+                    }
+                    pending.push((children[1], first + 1, depth + 1));
+                    pending.push((children[0], first, depth + 1));
+                }
+            }
+        }
+        (nodes, prims, deepest)
+    }
+
+    #[test]
+    fn the_parallel_layout_matches_the_stack_layout() {
+        // Enough primitives for the build and the layout to use two threads.
+        let prims = boxes(120_000, 0.37);
+        let mut records: Vec<BuildPrim> = prims
+            .iter()
+            .enumerate()
+            .map(|(i, (_, b))| BuildPrim::new(i as u32, b))
+            .collect();
+        assert!(records.iter().enumerate().all(|(i, r)| r.index() == i));
+        let bounds = NodeBounds::of(&records);
+        let mut arena = Vec::new();
+        build_subtree(BuildMethod::Sah, &mut records, bounds, 0, 1, 2, &mut arena);
+        let order: Vec<PrimRef> = records.iter().map(|r| prims[r.index()].0).collect();
+        let (nodes, leaf_prims, depth) = reference_flatten(&arena, &order);
+        for threads in [1, 2, 3] {
+            let bvh = flatten(&arena, order.clone(), threads);
+            assert_eq!(bvh.nodes, nodes);
+            assert_eq!(bvh.prims, leaf_prims);
+            assert_eq!(bvh.stats.depth, depth);
+            assert_eq!(
+                bvh.stats.leaves,
+                nodes.iter().filter(|n| n.is_leaf()).count()
+            );
+        }
+    }
+
     #[test]
     fn both_builders_make_valid_trees() {
         for n in [1, 2, 5, 100, 3000] {

@@ -607,6 +607,174 @@ mod tests {
             .collect()
     }
 
+    /// Boxes of many sizes scattered over several orders of magnitude (a fixed
+    /// pseudo-random sequence).
+    fn scattered_boxes(n: usize) -> Vec<(PrimRef, Aabb32)> {
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        (0..n)
+            .map(|i| {
+                let scale = 10f64.powf(next() * 6.0 - 3.0);
+                let c = DVec3::new(next(), next(), next()) * 1000.0 - 500.0;
+                let half = DVec3::new(next(), next(), next()) * scale;
+                (
+                    PrimRef::new(PrimKind::Triangle, i as u32),
+                    Aabb32::around(c - half, c + half),
+                )
+            })
+            .collect()
+    }
+
+    /// The collapse as it was first written, one node at a time with the scalar
+    /// quantization (`log2`, division, `floor` and `ceil`): the reference the planned,
+    /// parallel and SIMD collapse must match bit for bit.
+    fn reference_collapse(nodes: &[BvhNode]) -> Vec<WideNode> {
+        fn exponent(lo: f32, hi: f32) -> u32 {
+            let extent = f64::from(hi) - f64::from(lo);
+            let mut biased = if extent > 0.0 {
+                ((extent / 255.0).log2().ceil() as i64 + 127).clamp(1, 254) as u32
+            } else {
+                1
+            };
+            while biased > 1 && dequantize(lo, step_of(biased - 1), 255) >= hi {
+                biased -= 1;
+            }
+            while biased < 254 && dequantize(lo, step_of(biased), 255) < hi {
+                biased += 1;
+            }
+            biased
+        }
+        fn down(origin: f32, step: f32, x: f32) -> u32 {
+            let e = ((f64::from(x) - f64::from(origin)) / f64::from(step)).floor();
+            let mut q = e.clamp(0.0, 255.0) as u32;
+            while q > 0 && dequantize(origin, step, q) > x {
+                q -= 1;
+            }
+            while q < 255 && dequantize(origin, step, q + 1) <= x {
+                q += 1;
+            }
+            q
+        }
+        fn up(origin: f32, step: f32, x: f32) -> u32 {
+            let e = ((f64::from(x) - f64::from(origin)) / f64::from(step)).ceil();
+            let mut q = e.clamp(0.0, 255.0) as u32;
+            while q < 255 && dequantize(origin, step, q) < x {
+                q += 1;
+            }
+            while q > 0 && dequantize(origin, step, q - 1) >= x {
+                q -= 1;
+            }
+            q
+        }
+        let encode = |bounds: Aabb32, children: &[(WideChild, Aabb32)]| {
+            let origin = bounds.min.map(normal_or_zero_below);
+            let mut node = WideNode {
+                origin,
+                exponents: 0,
+                low: [0; 3],
+                spare_low: 0,
+                high: [0; 3],
+                spare_high: 0,
+                children: [EMPTY_CHILD; WIDTH],
+            };
+            for (axis, &start) in origin.iter().enumerate() {
+                let biased = exponent(start, bounds.max[axis]);
+                node.exponents |= biased << (8 * axis);
+                let step = step_of(biased);
+                for (slot, (_, aabb)) in children.iter().enumerate() {
+                    node.low[axis] |= down(start, step, aabb.min[axis]) << (8 * slot);
+                    node.high[axis] |= up(start, step, aabb.max[axis]) << (8 * slot);
+                }
+                for slot in children.len()..WIDTH {
+                    node.low[axis] |= 0xff << (8 * slot);
+                }
+            }
+            for (slot, (child, _)) in children.iter().enumerate() {
+                node.children[slot] = child.word();
+            }
+            node
+        };
+        let aabb = |n: &BvhNode| Aabb32 {
+            min: n.min,
+            max: n.max,
+        };
+        let half_area = |n: &BvhNode| {
+            let e = [0, 1, 2].map(|a| f64::from(n.max[a]) - f64::from(n.min[a]));
+            e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
+        };
+        let mut wide = vec![WideNode::zeroed()];
+        let mut pending = vec![(0usize, 0usize)];
+        while let Some((binary, slot)) = pending.pop() {
+            let node = &nodes[binary];
+            let mut members: Vec<(usize, u32)> = if node.is_leaf() {
+                vec![(binary, 0)]
+            } else {
+                vec![(node.first as usize, 1), (node.first as usize + 1, 1)]
+            };
+            while members.len() < WIDTH {
+                let open = members
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, (n, _))| !nodes[*n].is_leaf())
+                    .min_by(|(_, (a, da)), (_, (b, db))| {
+                        da.cmp(db)
+                            .then(half_area(&nodes[*b]).total_cmp(&half_area(&nodes[*a])))
+                    })
+                    .map(|(i, _)| i);
+                let Some(i) = open else { break };
+                let (n, depth) = members.swap_remove(i);
+                let first = nodes[n].first as usize;
+                members.push((first, depth + 1));
+                members.push((first + 1, depth + 1));
+            }
+            let children: Vec<(WideChild, Aabb32)> = members
+                .iter()
+                .map(|&(n, _)| {
+                    let child = &nodes[n];
+                    let named = if child.is_leaf() {
+                        WideChild::Leaf {
+                            first: child.first,
+                            count: child.count,
+                        }
+                    } else {
+                        wide.push(WideNode::zeroed());
+                        pending.push((n, wide.len() - 1));
+                        WideChild::Node((wide.len() - 1) as u32)
+                    };
+                    (named, aabb(child))
+                })
+                .collect();
+            wide[slot] = encode(aabb(node), &children);
+        }
+        wide
+    }
+
+    #[test]
+    fn the_collapse_matches_the_one_pass_scalar_collapse_bit_for_bit() {
+        for prims in [
+            scattered_boxes(40_000),
+            boxes(20_000, 1e-6, 1e3),
+            boxes(3000, 1e12, -1e15),
+            boxes(5, 1.0, 0.0),
+        ] {
+            for method in [BuildMethod::Sah, BuildMethod::MedianSplit] {
+                let bvh = Bvh::build(&prims, method);
+                let reference = reference_collapse(&bvh.nodes);
+                assert_eq!(bvh.wide, reference);
+                // The runs split across threads and encoded on one agree too.
+                let planned = plan(&bvh.nodes);
+                assert_eq!(encode(&bvh.nodes, &planned, 1), reference);
+                assert_eq!(encode(&bvh.nodes, &planned, 3), reference);
+                check(&bvh.wide, &bvh, &prims);
+            }
+        }
+    }
+
     #[test]
     fn every_primitive_is_reached_once_through_boxes_that_contain_it() {
         for (n, scale, offset) in [
