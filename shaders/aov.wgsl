@@ -45,14 +45,17 @@ struct FirstHitAov {
 }
 
 // The first hit `trace` found for the camera ray `ray` as the passes see it (the ray
-// hit something). Twin of first_hit_aov.
-fn first_hit_aov(ray: Ray, trace: TraceRay) -> FirstHitAov {
+// hit something), its textures looked up at the footprint of the ray's cone,
+// `cone_width` wide at its origin. Twin of first_hit_aov.
+fn first_hit_aov(ray: Ray, trace: TraceRay, cone_width: f32) -> FirstHitAov {
     let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
-    let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.color);
+    let footprint = cone_footprint(cone_width + frame.cone_spread * hit.t, ray.direction, hit.normal, hit.uv_density, hit.uv_axis);
+    let texels = material_texels(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, footprint);
+    let material = shading_material(materials[hit.material], hit.color, texels);
     let entering = dot(ray.direction, hit.normal) < 0.0;
     let ng = select(-hit.normal, hit.normal, entering);
     //#if MESH_ATTRIBUTES
-    let mapped = mapped_normal(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.shading_normal, hit.tangent);
+    let mapped = mapped_normal(materials[hit.material], hit.normal, hit.shading_normal, hit.tangent, texels[UV_SLOT_NORMAL]);
     let ns = select(-mapped, mapped, entering);
     let n = shading_frame_normal(ray.direction, ng, ns);
     //#else
@@ -71,8 +74,8 @@ fn clear_pixel_aov(pixel: u32) {
 // Adds the first hit of the camera ray from `origin` along `direction`, found by
 // `trace`, to region pixel `pixel`'s sums (an escaped ray adds nothing):
 // trace_pixel_aov's sum, one sample at a time, in sample order. `pass_throughs` back
-// faces have been passed already.
-fn add_first_hit_aov(pixel: u32, origin: vec3<f32>, direction: vec3<f32>, trace: TraceRay, pass_throughs: u32) {
+// faces have been passed already; the ray's cone is `cone_width` wide at `origin`.
+fn add_first_hit_aov(pixel: u32, origin: vec3<f32>, direction: vec3<f32>, trace: TraceRay, pass_throughs: u32, cone_width: f32) {
     let at = aov_index(pixel);
     if trace.best_prim == NO_PRIM {
         accumulation[at + 1u].w += 1.0;
@@ -85,7 +88,7 @@ fn add_first_hit_aov(pixel: u32, origin: vec3<f32>, direction: vec3<f32>, trace:
         && culls_back_face(materials[passed.material].cull_back_faces != 0u, 0u, direction, passed.normal) {
         return;
     }
-    let first = first_hit_aov(Ray(origin, direction), trace);
+    let first = first_hit_aov(Ray(origin, direction), trace, cone_width);
     accumulation[at] += vec4<f32>(first.albedo, first.depth);
     accumulation[at + 1u] += vec4<f32>(first.normal, 1.0);
 }

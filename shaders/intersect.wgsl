@@ -41,13 +41,21 @@ struct Hit {
     // The instance of an instanced mesh's triangle (its record's node index; `prim`
     // then names the mesh's triangle), else NO_INSTANCE.
     instance: u32,
+    // A mesh triangle's texture-coordinate area per world area, sets 0 and 1 (uv_density),
+    // else 0: the texture level of detail's density term.
+    uv_density: vec2<f32>,
+    // The change of a mesh triangle's texture coordinates per unit of world distance
+    // along the footprint's long axis (the ray projected onto the surface), sets 0 (xy)
+    // and 1 (zw), else 0: the anisotropic texture lookup's direction (triangle_uv_axis).
+    uv_axis: vec4<f32>,
 }
 
 // A hit without vertex attributes: shading normal = geometric normal, texture
 // coordinates (0, 0), colour white.
 fn flat_hit(prim: u32, t: f32, normal: vec3<f32>, material: u32, position: vec3<f32>) -> Hit {
     return Hit(t, normal, material, true, position, prim, normal, vec2<f32>(0.0),
-               vec2<f32>(0.0), vec3<f32>(1.0), vec4<f32>(0.0), vec3<f32>(1.0, 0.0, 0.0), NO_INSTANCE);
+               vec2<f32>(0.0), vec3<f32>(1.0), vec4<f32>(0.0), vec3<f32>(1.0, 0.0, 0.0), NO_INSTANCE,
+               vec2<f32>(0.0), vec4<f32>(0.0));
 }
 
 //#if MESH_ATTRIBUTES
@@ -516,8 +524,10 @@ fn intersect_prim(prim: u32, ray: Ray, sheared: ShearedRay, t_max: f32) -> f32 {
 //#if TRIANGLES
 // The hit record of the world-space `triangle` (primitive `prim` of `instance`) at
 // the point p = ray_at(ray, t): its winding normal, p projected onto its plane, its
-// barycentric coordinates and its interpolated attributes. CPU twin: triangle_hit.
-fn triangle_hit(prim: u32, instance: u32, triangle: Triangle, p: vec3<f32>, t: f32) -> Hit {
+// barycentric coordinates, its interpolated attributes and its texture coordinates'
+// density and change along the ray's footprint. CPU twin: triangle_hit.
+fn triangle_hit(prim: u32, instance: u32, triangle: Triangle, ray: Ray, t: f32) -> Hit {
+    let p = ray_at(ray, t);
     let normal = triangle_normal(triangle.v0, triangle.v1, triangle.v2);
     var hit = flat_hit(prim, t, normal, triangle.material,
                        project_onto_plane(p, normal, dot(normal, triangle.v0)));
@@ -525,11 +535,64 @@ fn triangle_hit(prim: u32, instance: u32, triangle: Triangle, p: vec3<f32>, t: f
     hit.barycentrics = triangle_barycentrics(hit.position, triangle.v0, triangle.v1, triangle.v2);
     //#if MESH_ATTRIBUTES
     if triangle.attributes != NO_ATTRIBUTES {
-        apply_triangle_attributes(&hit, world_attributes(triangle.attributes, instance, normal));
+        let attributes = world_attributes(triangle.attributes, instance, normal);
+        apply_triangle_attributes(&hit, attributes);
+        let world_area = length(cross(triangle.v1 - triangle.v0, triangle.v2 - triangle.v0));
+        // The footprint's long axis (footprint_axis in src/texture.rs).
+        let axis = normalize_or_zero(ray.direction - normal * dot(ray.direction, normal));
+        if attributes.has_uvs != 0u {
+            hit.uv_density.x = triangle_uv_density(world_area, attributes.uv01.xy, attributes.uv01.zw, attributes.uv2);
+            hit.uv_axis = vec4<f32>(triangle_uv_axis(triangle.v0, triangle.v1, triangle.v2, attributes.uv01.xy,
+                                                     attributes.uv01.zw, attributes.uv2, axis), hit.uv_axis.zw);
+        }
+        if attributes.has_uvs1 != 0u {
+            hit.uv_density.y = triangle_uv_density(world_area, attributes.uv1_01.xy, attributes.uv1_01.zw, attributes.uv1_2);
+            hit.uv_axis = vec4<f32>(hit.uv_axis.xy, triangle_uv_axis(triangle.v0, triangle.v1, triangle.v2,
+                                                                      attributes.uv1_01.xy, attributes.uv1_01.zw,
+                                                                      attributes.uv1_2, axis));
+        }
     }
     //#endif
     return hit;
 }
+
+//#if MESH_ATTRIBUTES
+// A triangle's texture-coordinate area over its world area (`world_area` = |(v1 − v0) ×
+// (v2 − v0)|, twice its area, as the uv term is): t_a/p_a of Ray Tracing Gems ch. 20,
+// eq. 34, without the texture's size; 0 when not finite. CPU twin: triangle_uv_density.
+fn triangle_uv_density(world_area: f32, uv0: vec2<f32>, uv1: vec2<f32>, uv2: vec2<f32>) -> f32 {
+    let e1 = uv1 - uv0;
+    let e2 = uv2 - uv0;
+    let density = abs(e1.x * e2.y - e1.y * e2.x) / world_area;
+    // Finite and not NaN: |density| below the largest f32.
+    if abs(density) <= 3.4028235e38 {
+        return density;
+    }
+    return 0.0;
+}
+
+// The change of texture coordinates (corner coordinates uv0, uv1, uv2) per unit of
+// world distance along `axis`, a unit vector in the plane of the triangle v0 v1 v2:
+// axis = β1·e1 + β2·e2 over its edges e1 = v1 − v0, e2 = v2 − v0, by Cramer's rule in
+// the plane (β1 = (axis × e2)·n / |e1 × e2|, β2 = (e1 × axis)·n / |e1 × e2|, n the unit
+// winding normal), gives β1·(uv1 − uv0) + β2·(uv2 − uv0); 0 when not finite. CPU twin:
+// triangle_uv_axis.
+fn triangle_uv_axis(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, uv0: vec2<f32>, uv1: vec2<f32>, uv2: vec2<f32>, axis: vec3<f32>) -> vec2<f32> {
+    let e1 = v1 - v0;
+    let e2 = v2 - v0;
+    let c = cross(e1, e2);
+    let area = length(c);
+    let n = c / area;
+    let b1 = dot(cross(axis, e2), n) / area;
+    let b2 = dot(cross(e1, axis), n) / area;
+    let change = (uv1 - uv0) * b1 + (uv2 - uv0) * b2;
+    // Finite and not NaN in both components.
+    if abs(change.x) <= 3.4028235e38 && abs(change.y) <= 3.4028235e38 {
+        return change;
+    }
+    return vec2<f32>(0.0);
+}
+//#endif
 //#endif
 
 // hit_record of the surface (`prim`, `instance`): for an instanced mesh's triangle,
@@ -540,7 +603,7 @@ fn hit_record_keyed(prim: u32, instance: u32, ray: Ray, t: f32) -> Hit {
     //#if TRIANGLES
     if instance != NO_INSTANCE {
         return triangle_hit(prim, instance, instance_world_triangle(prim_index(prim), instance),
-                            ray_at(ray, t), t);
+                            ray, t);
     }
     //#endif
     //#endif
@@ -578,7 +641,7 @@ fn hit_record(prim: u32, ray: Ray, t: f32) -> Hit {
         //#endif
         //#if TRIANGLES
         case PRIM_TRIANGLE: {
-            return triangle_hit(prim, NO_INSTANCE, triangles[i], p, t);
+            return triangle_hit(prim, NO_INSTANCE, triangles[i], ray, t);
         }
         //#endif
         default: {

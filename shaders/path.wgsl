@@ -318,6 +318,8 @@ fn path_emitter_sample(path: ptr<function, PathState>) -> EmitterSample {
 // probability clamp(max channel, MIN_SURVIVAL, 1) (dimension 7) and is divided by it.
 // A throughput that is not finite ends the path. Twin of the end of path_radiance's loop.
 fn path_continue(path: ptr<function, PathState>, origin: vec3<f32>, direction: vec3<f32>, throughput: vec3<f32>, medium: MediumStack) {
+    // The continuation starts as wide as the cone is at the hit (path_closest_hit
+    // keeps that width in cone_width) and keeps the spread.
     let depth = (*path).depth + 1u;
     var weight = throughput;
     if depth >= ROULETTE_DEPTH {
@@ -330,7 +332,7 @@ fn path_continue(path: ptr<function, PathState>, origin: vec3<f32>, direction: v
     if !finite_radiance(weight) {
         return;
     }
-    hold_top(path, StackEntry(origin, depth, direction, medium.depth, weight, 0u, medium.iors));
+    hold_top(path, StackEntry(origin, depth, direction, medium.depth, weight, (*path).cone_width, medium.iors));
     (*path).stack_len = 1u;
 }
 
@@ -360,13 +362,18 @@ fn path_closest_hit(path: ptr<function, PathState>, trace: TraceRay) {
         return;
     }
     let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
+    // From here on cone_width is the cone's width at the hit, where every ray spawned
+    // here starts (every bounce keeps the camera's spread, as path_radiance does).
+    (*path).cone_width += frame.cone_spread * hit.t;
     if (*path).pass_throughs < MAX_PASS_THROUGHS
         && culls_back_face(materials[hit.material].cull_back_faces != 0u, (*path).depth, ray.direction, hit.normal) {
         (*path).origin = offset_ray_origin(hit.position, hit.normal, frame.offset_scale);
         (*path).phase = PHASE_PASS_THROUGH;
         return;
     }
-    let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.color);
+    let footprint = cone_footprint((*path).cone_width, ray.direction, hit.normal, hit.uv_density, hit.uv_axis);
+    let texels = material_texels(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, footprint);
+    let material = shading_material(materials[hit.material], hit.color, texels);
     // Emission, weighted against next-event estimation where that could have found it;
     // shadow_origin still holds the previous hit's, where that estimation sampled from.
     if max_component(material.emission) > 0.0 && emits_towards(hit, ray.direction, material.two_sided != 0u) {
@@ -386,7 +393,7 @@ fn path_closest_hit(path: ptr<function, PathState>, trace: TraceRay) {
     let outside_ior = 1.0;
     //#endif
     //#if MESH_ATTRIBUTES
-    let mapped = mapped_normal(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.shading_normal, hit.tangent);
+    let mapped = mapped_normal(materials[hit.material], hit.normal, hit.shading_normal, hit.tangent, texels[UV_SLOT_NORMAL]);
     let ns = select(-mapped, mapped, entering);
     let n = shading_frame_normal(ray.direction, ng, ns);
     let lifted = shadow_terminator_point(hit, ng);
@@ -529,7 +536,13 @@ fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
                                           Ray((*path).shadow_origin, sample.wi), trace.best_t);
             let light_material = materials[light_hit.material];
             if light_material.emission_layer != NO_IMAGE {
-                radiance = shading_emission(light_material, light_hit.position, light_hit.normal, light_hit.uv, light_hit.uv1);
+                // At the footprint there of the path's cone, cone_width wide at the
+                // hit the shadow ray leaves.
+                let light_footprint = cone_footprint((*path).cone_width + frame.cone_spread * light_hit.t,
+                                                     sample.wi, light_hit.normal, light_hit.uv_density,
+                                                     light_hit.uv_axis);
+                radiance = shading_emission(light_material, light_hit.position, light_hit.normal, light_hit.uv,
+                                            light_hit.uv1, light_footprint);
             }
         }
         //#endif

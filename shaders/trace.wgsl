@@ -155,13 +155,20 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
         return;
     }
     let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
+    // Every ray spawned here starts as wide as the cone is here and keeps the spread
+    // (PreparedScene::cone_width_at; the specular bounces of JCGT 10(1), 2021, §3,
+    // without the curvature term).
+    let cone_width = (*path).cone_width + frame.cone_spread * hit.t;
     if (*path).pass_throughs < MAX_PASS_THROUGHS
         && culls_back_face(materials[hit.material].cull_back_faces != 0u, (*path).depth, ray.direction, hit.normal) {
         (*path).origin = offset_ray_origin(hit.position, hit.normal, frame.offset_scale);
+        (*path).cone_width = cone_width;
         (*path).phase = PHASE_PASS_THROUGH;
         return;
     }
-    let material = shading_material(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.color);
+    let footprint = cone_footprint(cone_width, ray.direction, hit.normal, hit.uv_density, hit.uv_axis);
+    let texels = material_texels(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, footprint);
+    let material = shading_material(materials[hit.material], hit.color, texels);
     let entering = dot(ray.direction, hit.normal) < 0.0;
     // Shading happens on the side the ray came from.
     let ng = select(-hit.normal, hit.normal, entering);
@@ -176,7 +183,7 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
             let beyond = select(-hit.normal, hit.normal, dot(ray.direction, hit.normal) > 0.0);
             push_branch(slot, path, StackEntry(
                 offset_ray_origin(hit.position, beyond, frame.offset_scale), (*path).depth + 1u,
-                ray.direction, medium.depth, (*path).weight * (1.0 - alpha), 0u, medium.iors));
+                ray.direction, medium.depth, (*path).weight * (1.0 - alpha), cone_width, medium.iors));
         }
         (*path).weight *= alpha;
     }
@@ -188,7 +195,7 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
     let outside_ior = 1.0;
     //#endif
     //#if MESH_ATTRIBUTES
-    let mapped = mapped_normal(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, hit.shading_normal, hit.tangent);
+    let mapped = mapped_normal(materials[hit.material], hit.normal, hit.shading_normal, hit.tangent, texels[UV_SLOT_NORMAL]);
     let ns = select(-mapped, mapped, entering);
     let n = shading_frame_normal(ray.direction, ng, ns);
     let lifted = shadow_terminator_point(hit, ng);
@@ -211,12 +218,12 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
         push_branch(slot, path, StackEntry(
             offset_ray_origin(hit.position, -ng, frame.offset_scale), (*path).depth + 1u,
             response.transmit_direction, inside.depth,
-            (*path).weight * response.transmit, 0u, inside.iors));
+            (*path).weight * response.transmit, cone_width, inside.iors));
         //#endif
         push_branch(slot, path, StackEntry(
             offset_ray_origin(hit.position, ng, frame.offset_scale), (*path).depth + 1u,
             reflected, medium.depth,
-            (*path).weight * response.reflect, 0u, medium.iors));
+            (*path).weight * response.reflect, cone_width, medium.iors));
     }
     if has_base_brdf(material.kind) && response.base > 0.0 {
         (*path).direct = material.diffuse * frame.ambient;

@@ -40,8 +40,11 @@ struct FrameUniforms {
     // distance of the plane in focus along `forward`.
     lens_radius: f32,
     focus_distance: f32,
-    _pad0: u32,
-    _pad1: u32,
+    // A camera ray's ray cone (Akenine-Möller et al., JCGT 10(1), 2021): its width at
+    // the origin and its width growth per unit distance, 2·tan(α/2) (CPU twin:
+    // CameraFrame::pixel_cone); both 0 without texture filtering.
+    cone_width: f32,
+    cone_spread: f32,
 }
 
 // FrameUniforms.flags: also store each finished pixel's sample sum and luminance m2 in
@@ -69,6 +72,12 @@ struct DenoiseUniforms {
 // FrameUniforms.flags: the camera is orthographic; tan_half_fov_y holds half the view's
 // height in scene units (camera_ray_origin).
 const FLAG_ORTHOGRAPHIC: u32 = 16u;
+// FrameUniforms.flags: textures are filtered; the host fills cone_width and
+// cone_spread (the shaders read only those).
+const FLAG_TEXTURE_FILTERING: u32 = 32u;
+// FrameUniforms.flags: texture lookups take up to MAX_TEXTURE_PROBES probes along the
+// footprint's long axis (texture_filtering = "anisotropic"), else one.
+const FLAG_ANISOTROPIC_TEXTURES: u32 = 64u;
 
 // A sphere through its anchor (its point nearest the origin) with the outward normal
 // there: see src/scene/sphere.rs.
@@ -389,6 +398,12 @@ struct PathState {
     // Back faces the current sample's camera ray has passed through (PHASE_PASS_THROUGH,
     // at most MAX_PASS_THROUGHS).
     pass_throughs: u32,
+    // The current ray's cone width at its origin (texture level of detail; its spread
+    // is frame.cone_spread).
+    cone_width: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // One pending reflected or refracted ray on a slot's bounce stack.
@@ -398,7 +413,8 @@ struct StackEntry {
     direction: vec3<f32>,
     medium_depth: u32,
     weight: vec3<f32>,
-    _pad: u32,
+    // The ray cone's width at `origin` (its spread is frame.cone_spread).
+    cone_width: f32,
     medium_iors: vec4<f32>,
 }
 

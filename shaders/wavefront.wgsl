@@ -65,7 +65,8 @@ fn consume_closest_trace(slot: u32, path: ptr<function, PathState>, trace: Trace
     //#if AOV
     // Depth 0 is the camera ray: every branch and bounce is one deeper.
     if aov_mode() && (*path).depth == 0u {
-        add_first_hit_aov((*path).pixel, (*path).origin, (*path).direction, trace, (*path).pass_throughs);
+        add_first_hit_aov((*path).pixel, (*path).origin, (*path).direction, trace, (*path).pass_throughs,
+                          (*path).cone_width);
     }
     //#endif
     //#if PATH
@@ -133,6 +134,7 @@ fn pop_ray(slot: u32, path: ptr<function, PathState>, trace: ptr<function, Trace
     (*path).depth = entry.depth;
     (*path).medium_depth = entry.medium_depth;
     (*path).medium_iors = entry.medium_iors;
+    (*path).cone_width = entry.cone_width;
     (*path).rays += 1u;
     start_trace(trace, entry.origin, entry.direction, bitcast<f32>(0x7f800000u), false);
     seed_blend(path, trace);
@@ -158,6 +160,7 @@ fn start_sample(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) 
     (*path).stack_len = 0u;
     (*path).held_top = 0u;
     (*path).pass_throughs = 0u;
+    (*path).cone_width = frame.cone_width;
     (*path).rays += 1u;
     start_trace(trace, origin, direction, bitcast<f32>(0x7f800000u), false);
     seed_blend(path, trace);

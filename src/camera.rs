@@ -97,6 +97,36 @@ impl CameraFrame {
             .normalize()
     }
 
+    /// The ray cone of a camera ray of an image `height` pixels high rendered with
+    /// `samples_per_pixel` samples, for the texture level of detail: its width at the
+    /// ray's origin and its spread, the growth of its width per unit distance,
+    /// `2·tan(α/2)` with the pixel's spread angle `α = atan(2·tan(fov_y/2) / height)`
+    /// (Akenine-Möller et al., "Texture Level of Detail Strategies for Real-Time Ray
+    /// Tracing", Ray Tracing Gems ch. 20, 2019, eq. 30; "Improved Shader and Texture
+    /// Level of Detail Using Ray Cones", JCGT 10(1), 2021, §3), both scaled by
+    /// [`cone_sample_scale`]: the pixel's samples already average over it, so each
+    /// filters only its share. A pinhole's cone starts at width 0; an orthographic
+    /// camera's rays are parallel: width one pixel's height in scene units (scaled),
+    /// spread 0. A thin lens is taken as its pinhole (its defocus is not part of the
+    /// footprint: the cone is right at the plane in focus and too narrow elsewhere).
+    pub fn pixel_cone(&self, height: u32, samples_per_pixel: u32) -> PixelCone {
+        let height = f64::from(height.max(1));
+        let scale = cone_sample_scale(samples_per_pixel);
+        match self.orthographic_half_height {
+            Some(half_height) => PixelCone {
+                width: 2.0 * half_height / height * scale,
+                spread: 0.0,
+            },
+            None => {
+                let alpha = (2.0 * self.tan_half_fov_y / height).atan();
+                PixelCone {
+                    width: 0.0,
+                    spread: 2.0 * (0.5 * alpha).tan() * scale,
+                }
+            }
+        }
+    }
+
     /// Where the ray through image position (`x`, `y`) starts: the eye for a pinhole
     /// camera; for an orthographic one the point of the view plane through the eye
     /// that the position maps to, `eye + right·(ndc_x·aspect·h) + up·(ndc_y·h)` with
@@ -111,6 +141,27 @@ impl CameraFrame {
             + self.right * (ndc_x * self.aspect * half_height)
             + self.up * (ndc_y * half_height)
     }
+}
+
+/// The share of a pixel's footprint each of its `samples_per_pixel` samples filters
+/// textures over: `max(1/8, 1/√n)`, the scale pbrt gives its camera rays' differentials
+/// (Pharr, Jakob and Humphreys, "Physically Based Rendering", 3rd ed., §7.2: the
+/// `ScaleDifferentials` call of `SamplerIntegrator::Render`; 4th ed., §5.1, with the
+/// floor of 1/8). `n` samples stratified over the pixel each cover about `1/n` of
+/// its area, so a full pixel's cone per sample would blur the texture twice, by the
+/// samples' average and by the lookup.
+pub fn cone_sample_scale(samples_per_pixel: u32) -> f64 {
+    (1.0 / f64::from(samples_per_pixel.max(1)).sqrt()).max(0.125)
+}
+
+/// A camera ray's cone ([`CameraFrame::pixel_cone`]): at distance `t` from the ray's
+/// origin it is `width + spread·t` wide.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PixelCone {
+    /// The width at the ray's origin, in scene units.
+    pub width: f64,
+    /// The growth of the width per unit distance along the ray, `2·tan(α/2)`.
+    pub spread: f64,
 }
 
 /// The stratum grid of `samples_per_pixel` samples: `n` columns and `n` rows of
@@ -266,6 +317,49 @@ mod tests {
             samples_per_pixel,
             ..RenderSettings::default()
         }
+    }
+
+    #[test]
+    fn a_pixel_cone_spreads_by_a_pixel_per_unit_distance() {
+        let camera = Camera {
+            eye: DVec3::ZERO,
+            look_at: DVec3::NEG_Z,
+            up: DVec3::Y,
+            fov_y_degrees: 60.0,
+            orthographic_half_height: None,
+            lens: None,
+        };
+        let frame = CameraFrame::new(&camera, 1920, 1080);
+        let cone = frame.pixel_cone(1080, 1);
+        assert_eq!(cone.width, 0.0);
+        // A pixel's height at unit distance, 2·tan(30°)/1080, to first order in α.
+        let pixel = 2.0 * (30f64).to_radians().tan() / 1080.0;
+        assert!((cone.spread / pixel - 1.0).abs() < 1e-6, "{cone:?}");
+        // Exactly 2·tan(α/2) with tan α = 2·tan(fov/2)/height: 1 for 90° over 2 rows.
+        let wide = CameraFrame::new(
+            &Camera {
+                fov_y_degrees: 90.0,
+                ..camera
+            },
+            2,
+            2,
+        );
+        let expected = 2.0 * (std::f64::consts::FRAC_PI_8).tan();
+        assert!((wide.pixel_cone(2, 1).spread - expected).abs() < 1e-12);
+        // n samples per pixel filter 1/√n of it each, down to an eighth.
+        assert!((wide.pixel_cone(2, 4).spread - expected / 2.0).abs() < 1e-12);
+        assert!((wide.pixel_cone(2, 1024).spread - expected / 8.0).abs() < 1e-12);
+        // Orthographic rays are parallel, a pixel's height apart.
+        let orthographic = CameraFrame::new(
+            &Camera {
+                orthographic_half_height: Some(3.0),
+                ..camera
+            },
+            640,
+            480,
+        );
+        let cone = orthographic.pixel_cone(480, 1);
+        assert_eq!((cone.width, cone.spread), (6.0 / 480.0, 0.0));
     }
 
     #[test]

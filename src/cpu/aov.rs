@@ -29,7 +29,7 @@ use super::trace::{PreparedScene, shading_frame_normal};
 use super::traverse::intersect_scene_with;
 use crate::denoise::GuidePasses;
 use crate::scene::{Integrator, Material, MaterialKind, Scene};
-use crate::texture::{mapped_normal, shading_material};
+use crate::texture::{ConeFootprint, mapped_normal, shading_material};
 
 /// What a camera ray's first hit contributes to the auxiliary passes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -58,13 +58,16 @@ pub fn aov_albedo(material: &Material) -> DVec3 {
 /// the ray escapes.
 /// A camera ray passes through the back faces of single-sided materials
 /// ([`culls_back_face`]), as the image's does, and the hit is shaded with its vertex
-/// colour, both texture-coordinate sets and its normal map, as the image's is.
+/// colour, both texture-coordinate sets and its normal map, as the image's is, at its
+/// ray cone's footprint.
 /// Blended surfaces stop it as `blend` says: as they stop the image's camera ray.
 pub fn first_hit_aov(scene: &PreparedScene, ray: &Ray, blend: BlendRule) -> Option<FirstHitAov> {
     let mut ray = *ray;
     let mut passes = 0;
+    let mut cone_width = scene.cone.width;
     let hit = loop {
         let hit = intersect_scene_with(&scene.geometry, &ray, f64::INFINITY, blend)?;
+        cone_width = scene.cone_width_at(cone_width, &hit);
         let record = &scene.materials[hit.material as usize];
         if passes == MAX_PASS_THROUGHS
             || !culls_back_face(record.cull_back_faces, 0, ray.direction, hit.normal)
@@ -76,17 +79,17 @@ pub fn first_hit_aov(scene: &PreparedScene, ray: &Ray, blend: BlendRule) -> Opti
     };
     let record = &scene.materials[hit.material as usize];
     let uvs = [hit.uv, hit.uv1];
-    let material = shading_material(
-        record,
-        &scene.images,
-        hit.position,
+    let textures = scene.textures(ConeFootprint::new(
+        cone_width,
+        ray.direction,
         hit.normal,
-        uvs,
-        hit.color,
-    );
+        hit.uv_density,
+        hit.uv_axis,
+    ));
+    let material = shading_material(record, &textures, hit.position, hit.normal, uvs, hit.color);
     let mapped = mapped_normal(
         record,
-        &scene.images,
+        &textures,
         hit.position,
         hit.normal,
         uvs,

@@ -10,6 +10,7 @@ use crate::accel::{
 };
 use crate::scene::PolygonPlane;
 pub use crate::scene::project_to_plane;
+use crate::texture::footprint_axis;
 
 /// A ray `origin + t · direction`, `direction` of unit length.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -61,6 +62,16 @@ pub struct Hit {
     /// The instance of an instanced mesh's triangle (then `prim` indexes its mesh's
     /// triangles), else `None`.
     pub instance: InstanceId,
+    /// A mesh triangle's texture-coordinate area over its world area, per coordinate
+    /// set (`[uv, uv1]`), for the texture level of detail
+    /// ([`crate::texture::ConeFootprint::uv_density`]); 0 without such coordinates.
+    pub uv_density: [f64; 2],
+    /// The change of a mesh triangle's texture coordinates per unit of world distance
+    /// along the footprint's long axis ([`crate::texture::footprint_axis`] of the ray
+    /// and the geometric normal), per coordinate set (`[uv, uv1]`;
+    /// [`triangle_uv_axis`]): the anisotropic texture lookup's direction; zero
+    /// without such coordinates.
+    pub uv_axis: [DVec2; 2],
 }
 
 impl Hit {
@@ -160,7 +171,7 @@ pub fn hit_record_keyed(geometry: &SceneGeometry, key: HitKey, ray: &Ray, t: f64
     if key.instance.is_some()
         && let Some((triangle, attributes)) = world_triangle(geometry, key)
     {
-        return triangle_hit(&triangle, attributes.as_ref(), key, ray.at(t), t);
+        return triangle_hit(&triangle, attributes.as_ref(), key, ray, t);
     }
     let prim = key.prim;
     let point = ray.at(t);
@@ -170,7 +181,7 @@ pub fn hit_record_keyed(geometry: &SceneGeometry, key: HitKey, ray: &Ray, t: f64
         let attributes = triangle
             .attributes
             .map(|a| &geometry.triangle_attributes[a as usize]);
-        return triangle_hit(triangle, attributes, key, point, t);
+        return triangle_hit(triangle, attributes, key, ray, t);
     }
     let (normal, position) = match prim.kind() {
         PrimKind::Sphere => {
@@ -214,20 +225,23 @@ pub fn flat_hit(prim: PrimRef, t: f64, normal: DVec3, material: u32, position: D
         tangent: DVec4::ZERO,
         barycentrics: DVec3::X,
         instance: None,
+        uv_density: [0.0; 2],
+        uv_axis: [DVec2::ZERO; 2],
     }
 }
 
 /// The hit record of a world-space `triangle` (with its world-space `attributes`) at
-/// `point = ray.at(t)`: the winding normal, the point projected onto its plane, its
-/// barycentric coordinates, and the interpolated shading normal and texture
-/// coordinates.
+/// `ray.at(t)`: the winding normal, the point projected onto its plane, its
+/// barycentric coordinates, the interpolated shading normal and texture coordinates,
+/// and the coordinates' density and change along the ray's footprint.
 fn triangle_hit(
     triangle: &TriangleShape,
     attributes: Option<&TriangleAttributes>,
     key: HitKey,
-    point: DVec3,
+    ray: &Ray,
     t: f64,
 ) -> Hit {
+    let point = ray.at(t);
     let vertices = &triangle.vertices;
     let normal = triangle_normal(vertices);
     let position = project_onto_plane(point, normal, normal.dot(vertices[0]));
@@ -236,8 +250,56 @@ fn triangle_hit(
     hit.barycentrics = triangle_barycentrics(position, vertices);
     if let Some(attributes) = attributes {
         apply_triangle_attributes(&mut hit, attributes);
+        hit.uv_density = [
+            attributes
+                .uvs
+                .map_or(0.0, |uv| triangle_uv_density(vertices, &uv)),
+            attributes
+                .uvs1
+                .map_or(0.0, |uv| triangle_uv_density(vertices, &uv)),
+        ];
+        let axis = footprint_axis(ray.direction, normal);
+        hit.uv_axis = [attributes.uvs, attributes.uvs1]
+            .map(|uv| uv.map_or(DVec2::ZERO, |uv| triangle_uv_axis(vertices, &uv, axis)));
     }
     hit
+}
+
+/// The change of texture coordinates (corner coordinates `uv`) per unit of world
+/// distance along `axis`, a unit vector in the plane of the triangle with corners
+/// `vertices`: `axis = β1·e1 + β2·e2` over its edges `e1 = v1 − v0`, `e2 = v2 − v0`,
+/// solved by Cramer's rule in the plane (`β1 = (axis × e2)·n / |e1 × e2|`, `β2 = (e1
+/// × axis)·n / |e1 × e2|`, `n` the unit winding normal), gives `β1·(uv1 − uv0) +
+/// β2·(uv2 − uv0)`. Zero for a degenerate triangle or a zero axis. Twin of
+/// `triangle_uv_axis` in `shaders/intersect.wgsl`.
+pub fn triangle_uv_axis(vertices: &[DVec3; 3], uv: &[DVec2; 3], axis: DVec3) -> DVec2 {
+    let (e1, e2) = (vertices[1] - vertices[0], vertices[2] - vertices[0]);
+    let cross = e1.cross(e2);
+    let area = cross.length();
+    let normal = cross / area;
+    let b1 = axis.cross(e2).dot(normal) / area;
+    let b2 = e1.cross(axis).dot(normal) / area;
+    let change = (uv[1] - uv[0]) * b1 + (uv[2] - uv[0]) * b2;
+    if change.is_finite() {
+        change
+    } else {
+        DVec2::ZERO
+    }
+}
+
+/// The texture-coordinate area of a triangle with corner coordinates `uv` over its
+/// world area (corners `vertices`): `|(uv1 − uv0) × (uv2 − uv0)| / |(v1 − v0) × (v2 −
+/// v0)|`, the ratio `t_a / p_a` of Akenine-Möller et al., "Texture Level of Detail
+/// Strategies for Real-Time Ray Tracing" (Ray Tracing Gems, ch. 20, 2019, eq. 34),
+/// without the texture's size. 0 for a degenerate triangle. Twin of `triangle_uv_density` in
+/// `shaders/intersect.wgsl`.
+pub fn triangle_uv_density(vertices: &[DVec3; 3], uv: &[DVec2; 3]) -> f64 {
+    let uv_area = (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]).abs();
+    let world_area = (vertices[1] - vertices[0])
+        .cross(vertices[2] - vertices[0])
+        .length();
+    let density = uv_area / world_area;
+    if density.is_finite() { density } else { 0.0 }
 }
 
 /// Whether a camera ray (`depth` 0) travelling along `direction` passes through the

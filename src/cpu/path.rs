@@ -42,7 +42,7 @@ use crate::sample::{
     sample_triangle_barycentrics,
 };
 use crate::scene::{Material, MaterialKind, MediumStack, MicrofacetDistribution};
-use crate::texture::{mapped_normal, shading_emission, shading_material};
+use crate::texture::{ConeFootprint, mapped_normal, shading_emission, shading_material};
 
 /// Bounces after which Russian roulette may end a path.
 pub const ROULETTE_DEPTH: u32 = 3;
@@ -211,6 +211,12 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
     let mut previous_point = ray.origin;
     let mut depth = 0u32;
     let mut passes = 0u32;
+    // The ray cone's width at the ray's origin. Every bounce keeps the camera's
+    // spread: exact for perfect specular events (JCGT 10(1), 2021, §3, without the
+    // curvature term), and for diffuse and glossy ones a lower bound on the
+    // footprint of their wider lobes, so that their lookups are never blurrier than
+    // a mirror's (docs/materials.md, "Texture filtering").
+    let mut cone_width = scene.cone.width;
     loop {
         let first_dimension = 2 + depth * DIMENSIONS_PER_BOUNCE;
         let random = move |k: u32| random_number(pixel, sample, first_dimension + k);
@@ -238,6 +244,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
             break;
         };
         let record = &scene.materials[hit.material as usize];
+        cone_width = scene.cone_width_at(cone_width, &hit);
         if passes < MAX_PASS_THROUGHS
             && culls_back_face(record.cull_back_faces, depth, ray.direction, hit.normal)
         {
@@ -246,9 +253,16 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
             ray.origin = offset_ray_origin(hit.position, hit.normal, geometry.offset_scale);
             continue;
         }
+        let textures = scene.textures(ConeFootprint::new(
+            cone_width,
+            ray.direction,
+            hit.normal,
+            hit.uv_density,
+            hit.uv_axis,
+        ));
         let material = shading_material(
             record,
-            &scene.images,
+            &textures,
             hit.position,
             hit.normal,
             [hit.uv, hit.uv1],
@@ -273,7 +287,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
         let ng = if entering { hit.normal } else { -hit.normal };
         let mapped = mapped_normal(
             record,
-            &scene.images,
+            &textures,
             hit.position,
             hit.normal,
             [hit.uv, hit.uv1],
@@ -344,6 +358,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
                     emitter,
                     selection * (1.0 - p_environment),
                     &material,
+                    cone_width,
                     shadow_origin,
                     n,
                     wo,
@@ -427,7 +442,9 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
 
 /// Next-event estimation of one emitter (chosen with probability `selection`) from
 /// `origin`: a sample on it, `f · L · cos θ / pdf` if nothing blocks it (`L` the
-/// emitter's radiance at the point the shadow ray reaches, [`shading_emission`]),
+/// emitter's radiance at the point the shadow ray reaches, [`shading_emission`],
+/// looked up at the footprint there of the path's cone, `cone_width` wide at the hit
+/// the shadow ray leaves),
 /// weighted by the power heuristic against the BRDF's sampler when `mis` (the path
 /// goes on, so that a BRDF sample could find the same light). Returns it and the rays
 /// traced.
@@ -437,6 +454,7 @@ fn sample_emitter(
     emitter: &Emitter,
     selection: f64,
     material: &Material,
+    cone_width: f64,
     origin: DVec3,
     n: DVec3,
     wo: DVec3,
@@ -490,9 +508,16 @@ fn sample_emitter(
     // The radiance of the sampled point: the emitter's own, times its emission texture
     // at the point where the shadow ray meets it (that point, found with the texture
     // coordinates of its barycentrics as every hit is).
+    let footprint = ConeFootprint::new(
+        scene.cone_width_at(cone_width, &light_hit),
+        wi,
+        light_hit.normal,
+        light_hit.uv_density,
+        light_hit.uv_axis,
+    );
     let radiance = shading_emission(
         &scene.materials[light_hit.material as usize],
-        &scene.images,
+        &scene.textures(footprint),
         light_hit.position,
         light_hit.normal,
         [light_hit.uv, light_hit.uv1],

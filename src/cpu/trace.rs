@@ -14,11 +14,13 @@ use super::path::path_radiance;
 use super::traverse::{intersect_scene, transmittance};
 use crate::accel::SceneGeometry;
 use crate::accel::{AreaLights, BrdfMapCdfs, EnvironmentLight};
-use crate::camera::{CameraFrame, SamplePattern, lens_sample};
+use crate::camera::{CameraFrame, PixelCone, SamplePattern, lens_sample};
 use crate::noise::luminance_m2_step;
 pub use crate::scene::MediumStack;
 use crate::scene::{AlphaMode, Image, Integrator, Light, Material, RenderSettings, Scene};
-use crate::texture::{mapped_normal, shading_alpha, shading_material};
+use crate::texture::{
+    ConeFootprint, TextureLookup, mapped_normal, mip_levels, shading_alpha, shading_material,
+};
 
 /// The scene in the form the tracer reads: colours in the lighting space, the geometry
 /// with its BVH, the camera basis.
@@ -47,6 +49,12 @@ pub struct PreparedScene {
     pub camera_medium: MediumStack,
     /// Albedo textures and BRDF maps.
     pub images: Vec<Image>,
+    /// The mip-map levels beyond 0 of every image ([`mip_levels`]), parallel to
+    /// `images`; empty without texture filtering.
+    pub image_levels: Vec<Vec<Image>>,
+    /// A camera ray's cone ([`CameraFrame::pixel_cone`]); zero (no footprint, level 0
+    /// lookups) without texture filtering.
+    pub cone: PixelCone,
     /// The emissive shapes the path integrator samples.
     pub area_lights: AreaLights,
     /// The inverse-CDF tables of the BRDF maps, which the path integrator samples
@@ -71,9 +79,18 @@ impl PreparedScene {
             ),
             Integrator::Whitted => (AreaLights::default(), BrdfMapCdfs::default()),
         };
+        let camera = CameraFrame::new(&scene.camera, scene.render.width, scene.render.height);
+        let (image_levels, cone) = if scene.render.texture_filtering.filters() {
+            (
+                scene.images.iter().map(mip_levels).collect(),
+                camera.pixel_cone(scene.render.height, scene.render.samples_per_pixel),
+            )
+        } else {
+            (Vec::new(), PixelCone::default())
+        };
         Self {
             settings: scene.render,
-            camera: CameraFrame::new(&scene.camera, scene.render.width, scene.render.height),
+            camera,
             samples: SamplePattern::new(&scene.render),
             background: scene.environment.background,
             environment: scene
@@ -87,9 +104,29 @@ impl PreparedScene {
             geometry,
             camera_medium: MediumStack::from_outermost_first(&scene.camera_medium()),
             images: scene.images,
+            image_levels,
+            cone,
             area_lights,
             brdf_map_cdfs,
         }
+    }
+
+    /// The scene's textures looked up at `footprint` (filtered as the scene's
+    /// `texture_filtering` says: [`crate::texture::texel_footprint`] with its probe
+    /// limit).
+    pub fn textures(&self, footprint: ConeFootprint) -> TextureLookup<'_> {
+        TextureLookup {
+            images: &self.images,
+            levels: &self.image_levels,
+            footprint: footprint.with_max_probes(self.settings.texture_filtering.max_probes()),
+        }
+    }
+
+    /// The width at `hit` of a ray cone `width` wide at the ray's origin: `width +
+    /// spread·t` (JCGT 10(1), 2021, §3: a cone's width grows linearly along the ray;
+    /// the ray's direction is a unit vector, so `t` is the distance).
+    pub fn cone_width_at(&self, width: f64, hit: &Hit) -> f64 {
+        width + self.cone.spread * hit.t
     }
 
     /// The camera ray of sample `index` of pixel (`x`, `y`), at `offset` inside the
@@ -164,6 +201,9 @@ struct StackEntry {
     depth: u32,
     /// The dielectrics the ray travels inside.
     medium: MediumStack,
+    /// The ray cone's width at the ray's origin (its spread is the camera's,
+    /// [`PreparedScene::cone`]).
+    cone_width: f64,
 }
 
 /// Radiance and ray count of one pixel.
@@ -230,6 +270,7 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
         weight: DVec3::ONE,
         depth: 0,
         medium: scene.camera_medium,
+        cone_width: scene.cone.width,
     });
     let mut radiance = DVec3::ZERO;
     let mut rays = 0u64;
@@ -244,6 +285,10 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
             continue;
         };
         let material = &scene.materials[hit.material as usize];
+        // Every ray spawned here (through, reflected, refracted) starts as wide as the
+        // cone is here, and keeps the spread: the specular bounces of JCGT 10(1), 2021,
+        // §3 without the curvature term.
+        let cone_width = scene.cone_width_at(entry.cone_width, &hit);
         if passes < MAX_PASS_THROUGHS
             && culls_back_face(
                 material.cull_back_faces,
@@ -259,6 +304,7 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
                     origin,
                     ..entry.ray
                 },
+                cone_width,
                 ..entry
             });
             continue;
@@ -288,12 +334,20 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
                         weight,
                         depth: entry.depth + 1,
                         medium: entry.medium,
+                        cone_width,
                     });
                 }
             }
             entry.weight *= alpha;
         }
-        let shaded = shade_hit(scene, &entry.ray, &hit, &entry.medium);
+        let footprint = ConeFootprint::new(
+            cone_width,
+            entry.ray.direction,
+            hit.normal,
+            hit.uv_density,
+            hit.uv_axis,
+        );
+        let shaded = shade_hit(scene, &entry.ray, &hit, &entry.medium, footprint);
         add_contribution(&mut radiance, entry.weight * shaded.radiance);
         rays += shaded.shadow_rays;
         if entry.depth >= scene.settings.max_depth {
@@ -314,6 +368,7 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
                     weight,
                     depth: entry.depth + 1,
                     medium,
+                    cone_width,
                 });
             }
         }
@@ -399,12 +454,20 @@ pub fn keep_on_side(d: DVec3, side: DVec3) -> DVec3 {
 /// re-projected hit point moved off the surface by [`offset_ray_origin`], to the side
 /// the ray leaves on (shadow rays of smooth meshes from [`shadow_terminator_point`]).
 /// Which side the ray enters is decided by the geometric normal; the BRDF, the mirror
-/// direction and refraction use [`shading_frame_normal`].
-pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumStack) -> ShadedHit {
+/// direction and refraction use [`shading_frame_normal`]. Textures are looked up at
+/// the ray cone's `footprint` ([`PreparedScene::textures`]).
+pub fn shade_hit(
+    scene: &PreparedScene,
+    ray: &Ray,
+    hit: &Hit,
+    medium: &MediumStack,
+    footprint: ConeFootprint,
+) -> ShadedHit {
     let position = hit.position;
+    let textures = scene.textures(footprint);
     let material = shading_material(
         &scene.materials[hit.material as usize],
-        &scene.images,
+        &textures,
         position,
         hit.normal,
         [hit.uv, hit.uv1],
@@ -417,7 +480,7 @@ pub fn shade_hit(scene: &PreparedScene, ray: &Ray, hit: &Hit, medium: &MediumSta
     let outside_ior = medium.medium_outside_ior(entering);
     let mapped = mapped_normal(
         &scene.materials[hit.material as usize],
-        &scene.images,
+        &textures,
         position,
         hit.normal,
         [hit.uv, hit.uv1],

@@ -8,11 +8,11 @@ use std::time::Duration;
 use wgpu::util::DeviceExt;
 
 use super::ShaderFeatures;
-use super::layout::{DisplayUniforms, FLAG_ORTHOGRAPHIC, FrameUniforms};
+use super::layout::{DisplayUniforms, FLAG_ORTHOGRAPHIC, FLAG_TEXTURE_FILTERING, FrameUniforms};
 use super::pipelines::TracePipelines;
 use super::scene_buffers::DeviceScene;
 use crate::accel::BvhStats;
-use crate::camera::CameraFrame;
+use crate::camera::{CameraFrame, PixelCone};
 use crate::scene::{Camera, DielectricSphere, MediumStack, media_around};
 
 /// Identities of uploaded scenes, so that a film knows which scene its bind group
@@ -158,6 +158,12 @@ impl GpuScene {
         let v = |d: glam::DVec3| d.as_vec3().to_array();
         let (tan_half_fov_y, projection_flag) = super::upload::projection_uniforms(&camera);
         let flags = (self.prepared.frame.flags & !FLAG_ORTHOGRAPHIC) | projection_flag;
+        // This camera's ray cone where the scene filters its textures.
+        let cone = if flags & FLAG_TEXTURE_FILTERING != 0 {
+            camera.pixel_cone(height, self.prepared.frame.samples_per_pixel)
+        } else {
+            PixelCone::default()
+        };
         FrameUniforms {
             eye: v(camera.eye),
             tan_half_fov_y: tan_half_fov_y as f32,
@@ -178,6 +184,8 @@ impl GpuScene {
             target_y: 0,
             lens_radius: camera.lens_radius as f32,
             focus_distance: camera.focus_distance as f32,
+            cone_width: cone.width as f32,
+            cone_spread: cone.spread as f32,
             ..self.prepared.frame
         }
     }

@@ -88,10 +88,12 @@ pub struct FrameUniforms {
     pub lens_radius: f32,
     /// Distance from the eye to the plane in focus along `forward` (with a lens).
     pub focus_distance: f32,
-    /// Padding.
-    pub _pad0: u32,
-    /// Padding.
-    pub _pad1: u32,
+    /// A camera ray's cone width at its origin
+    /// ([`crate::camera::CameraFrame::pixel_cone`]); 0 without texture filtering.
+    pub cone_width: f32,
+    /// A camera ray's cone width growth per unit distance, `2·tan(α/2)`
+    /// ([`crate::camera::CameraFrame::pixel_cone`]); 0 without texture filtering.
+    pub cone_spread: f32,
 }
 
 /// Most rounds of pixels handed out in a fixed order ([`static_pixels_for`]).
@@ -131,6 +133,15 @@ pub const FLAG_AOV: u32 = 8;
 /// `FrameUniforms.flags`: the camera is orthographic, and `tan_half_fov_y` holds half
 /// the view's height in scene units ([`crate::camera::CameraFrame::ray_origin`]).
 pub const FLAG_ORTHOGRAPHIC: u32 = 16;
+/// `FrameUniforms.flags`: textures are filtered (`[render] texture_filtering =
+/// "trilinear"` or `"anisotropic"`): the host then fills `cone_width` and
+/// `cone_spread` of each frame's camera (the shaders read only those, which are 0
+/// without filtering).
+pub const FLAG_TEXTURE_FILTERING: u32 = 32;
+/// `FrameUniforms.flags`: texture lookups take up to
+/// [`crate::texture::MAX_TEXTURE_PROBES`] probes along the footprint's long axis
+/// (`texture_filtering = "anisotropic"`), else one.
+pub const FLAG_ANISOTROPIC_TEXTURES: u32 = 64;
 
 /// One traversal of one ray, resumable (`TraceRay` in WGSL). Only the shaders read and
 /// write it; the host zeroes it (`TRACE_IDLE`).
@@ -262,6 +273,14 @@ pub struct GpuPathState {
     /// Back faces the current sample's camera ray has passed through (at most
     /// [`crate::cpu::intersect::MAX_PASS_THROUGHS`]).
     pub pass_throughs: u32,
+    /// The ray cone's width at `origin`, the current ray's (texture level of detail).
+    pub cone_width: f32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
 }
 
 /// One pending ray on a slot's bounce stack (`StackEntry` in WGSL).
@@ -278,8 +297,9 @@ pub struct GpuStackEntry {
     pub medium_depth: u32,
     /// Path weight.
     pub weight: [f32; 3],
-    /// Padding.
-    pub _pad: u32,
+    /// The ray cone's width at `origin` (texture level of detail; its spread is the
+    /// camera's, `FrameUniforms::cone_spread`).
+    pub cone_width: f32,
     /// Indices of refraction of the dielectrics it is inside.
     pub medium_iors: [f32; 4],
 }

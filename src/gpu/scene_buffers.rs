@@ -14,11 +14,14 @@ use super::ray_query::{
     Acceleration, Traversal, build_acceleration, fits_hardware, wants_hardware,
 };
 use super::readback::{Caught, capture};
-use super::upload::{InstanceLayout, SceneRecords, frame_uniforms, image_layers};
+use super::upload::{
+    InstanceLayout, SceneRecords, frame_uniforms, image_layer_levels, image_layers,
+};
 use crate::accel::{
     BrdfMapCdfs, BuildMethod, BvhStats, EnvironmentLight, MAX_PLANES, SceneGeometry,
 };
-use crate::scene::{Integrator, Scene};
+use crate::scene::{Image, Integrator, Scene};
+use crate::texture::mip_levels;
 
 /// The storage buffers of an uploaded scene.
 #[derive(Debug)]
@@ -372,7 +375,8 @@ pub(crate) fn upload_scene(
 }
 
 /// Uploads the scene's images as one `Rgba32Float` 2D array texture (one layer per
-/// image, see [`image_layers`]) and returns its view and its bytes.
+/// image, see [`image_layers`]), with its mip chain where the scene filters textures
+/// ([`image_layer_levels`]), and returns its view and its bytes (every level's).
 fn upload_images(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -393,11 +397,19 @@ fn upload_images(
         height,
         depth_or_array_layers: layers,
     };
+    // With texture filtering, the array's mip chain: level k of every image in level k
+    // of its layer (the CPU reference's PreparedScene::image_levels).
+    let mip_chain = if scene.render.texture_filtering.filters() {
+        let levels: Vec<Vec<Image>> = scene.images.iter().map(mip_levels).collect();
+        image_layer_levels(&levels, width, height, layers)
+    } else {
+        Vec::new()
+    };
     let texture = capture(device, "image array", Caught::Resource, || {
         device.create_texture(&wgpu::TextureDescriptor {
             label: Some("gpu-render images"),
             size,
-            mip_level_count: 1,
+            mip_level_count: 1 + mip_chain.len() as u32,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: wgpu::TextureFormat::Rgba32Float,
@@ -415,9 +427,32 @@ fn upload_images(
         },
         size,
     );
+    let mut bytes = std::mem::size_of_val(texels.as_slice()) as u64;
+    for (level, (w, h, texels)) in mip_chain.iter().enumerate() {
+        queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: level as u32 + 1,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            bytemuck::cast_slice(texels),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(w * 16),
+                rows_per_image: Some(*h),
+            },
+            wgpu::Extent3d {
+                width: *w,
+                height: *h,
+                depth_or_array_layers: layers,
+            },
+        );
+        bytes += std::mem::size_of_val(texels.as_slice()) as u64;
+    }
     let view = texture.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2Array),
         ..Default::default()
     });
-    Ok((view, std::mem::size_of_val(texels.as_slice()) as u64))
+    Ok((view, bytes))
 }

@@ -6,23 +6,23 @@
 use glam::{DVec2, DVec3};
 
 use super::layout::{
-    DISTRIBUTION_BECKMANN, DISTRIBUTION_GGX, FLAG_ORTHOGRAPHIC, FRESNEL_EXACT, FRESNEL_SCHLICK,
-    FrameUniforms, GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle,
-    GpuTriangleAttributes, LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_SPOT, MAPPING_PLANAR,
-    MAPPING_SPHERICAL, MAPPING_UV, MATERIAL_BLINN_PHONG, MATERIAL_COOK_TORRANCE,
-    MATERIAL_DIELECTRIC, MATERIAL_EMISSIVE, MATERIAL_LAMBERT, MATERIAL_MIRROR, MATERIAL_OREN_NAYAR,
-    MATERIAL_PBR, MATERIAL_TABULATED, NO_ATTRIBUTES, NO_IMAGE, UV_SLOT_ALBEDO, UV_SLOT_EMISSION,
-    UV_SLOT_METALLIC_ROUGHNESS, UV_SLOT_NORMAL, WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT,
-    WRAP_REPEAT,
+    DISTRIBUTION_BECKMANN, DISTRIBUTION_GGX, FLAG_ANISOTROPIC_TEXTURES, FLAG_ORTHOGRAPHIC,
+    FLAG_TEXTURE_FILTERING, FRESNEL_EXACT, FRESNEL_SCHLICK, FrameUniforms, GpuLight, GpuMaterial,
+    GpuPlane, GpuPolygon, GpuSphere, GpuTriangle, GpuTriangleAttributes, LIGHT_DIRECTIONAL,
+    LIGHT_POINT, LIGHT_SPOT, MAPPING_PLANAR, MAPPING_SPHERICAL, MAPPING_UV, MATERIAL_BLINN_PHONG,
+    MATERIAL_COOK_TORRANCE, MATERIAL_DIELECTRIC, MATERIAL_EMISSIVE, MATERIAL_LAMBERT,
+    MATERIAL_MIRROR, MATERIAL_OREN_NAYAR, MATERIAL_PBR, MATERIAL_TABULATED, NO_ATTRIBUTES,
+    NO_IMAGE, UV_SLOT_ALBEDO, UV_SLOT_EMISSION, UV_SLOT_METALLIC_ROUGHNESS, UV_SLOT_NORMAL,
+    WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT, WRAP_REPEAT,
 };
 use crate::accel::{
     BrdfMapCdfs, Bvh, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry, TriangleAttributes,
     TriangleShape, WideNode,
 };
-use crate::camera::CameraFrame;
+use crate::camera::{CameraFrame, PixelCone};
 use crate::scene::{
     AlphaMode, FresnelModel, Image, Light, Material, MaterialKind, MediumStack,
-    MicrofacetDistribution, Scene, TextureMapping, TextureWrap, project_to_plane,
+    MicrofacetDistribution, Scene, TextureFiltering, TextureMapping, TextureWrap, project_to_plane,
 };
 
 /// Every record list of a scene, ready for upload. The lists hold exactly the scene's
@@ -613,6 +613,43 @@ pub fn image_layers(images: &[Image], cdfs: &BrdfMapCdfs) -> (u32, u32, u32, Vec
     (width, height, layers as u32, texels)
 }
 
+/// Levels 1 and up of the image array's mip chain (level 0 is [`image_layers`]): the
+/// `k`-th of them is `max(1, width >> k) × max(1, height >> k)` texels per layer (the
+/// array's level size, wgpu's), each layer holding level `k` of its image's chain
+/// `levels[layer]` ([`crate::texture::mip_levels`], whose level sizes are the same
+/// shifts of the image's own size, so it fits) in its top-left corner, the rest zero;
+/// a layer whose image's chain is shorter than the array's holds its last level there
+/// (the shaders clamp each image's level of detail to its own chain). `width` and
+/// `height` are the array's level 0 size; the array has `⌊log2(max(width, height))⌋`
+/// levels beyond 0. Returns each level's `(width, height, texels)`, layer by layer,
+/// row-major.
+pub fn image_layer_levels(
+    levels: &[Vec<Image>],
+    width: u32,
+    height: u32,
+    layers: u32,
+) -> Vec<(u32, u32, Vec<[f32; 4]>)> {
+    let count = width.max(height).max(1).ilog2();
+    (1..=count)
+        .map(|k| {
+            let (w, h) = ((width >> k).max(1), (height >> k).max(1));
+            let mut texels = vec![[0.0; 4]; w as usize * h as usize * layers as usize];
+            for (layer, chain) in levels.iter().enumerate() {
+                let Some(image) = chain.get(k as usize - 1).or(chain.last()) else {
+                    continue;
+                };
+                for y in 0..image.height.min(h) as usize {
+                    let row =
+                        &image.texels[y * image.width as usize..][..image.width.min(w) as usize];
+                    let start = (layer * h as usize + y) * w as usize;
+                    texels[start..start + row.len()].copy_from_slice(row);
+                }
+            }
+            (w, h, texels)
+        })
+        .collect()
+}
+
 /// The record of one light.
 pub fn light_record(light: &Light) -> GpuLight {
     let record = |position_or_direction: DVec3, kind: u32, power: DVec3| GpuLight {
@@ -667,6 +704,19 @@ pub fn frame_uniforms(scene: &Scene, geometry: &SceneGeometry) -> FrameUniforms 
     // The same stack the CPU reference starts its camera rays with.
     let camera_medium = MediumStack::from_outermost_first(&scene.camera_medium());
     let (tan_half_fov_y, projection_flag) = projection_uniforms(&camera);
+    // The camera's ray cone where textures are filtered, else none (level 0): the
+    // CPU reference's PreparedScene::cone.
+    let (cone, filtering_flag) = match settings.texture_filtering {
+        TextureFiltering::None => (PixelCone::default(), 0),
+        TextureFiltering::Trilinear => (
+            camera.pixel_cone(settings.height, settings.samples_per_pixel),
+            FLAG_TEXTURE_FILTERING,
+        ),
+        TextureFiltering::Anisotropic => (
+            camera.pixel_cone(settings.height, settings.samples_per_pixel),
+            FLAG_TEXTURE_FILTERING | FLAG_ANISOTROPIC_TEXTURES,
+        ),
+    };
     FrameUniforms {
         eye: vec3(camera.eye),
         tan_half_fov_y: tan_half_fov_y as f32,
@@ -696,15 +746,15 @@ pub fn frame_uniforms(scene: &Scene, geometry: &SceneGeometry) -> FrameUniforms 
         slot_count: 0,
         stack_size: settings.stack_size,
         iteration_budget: u32::MAX,
-        flags: projection_flag,
+        flags: projection_flag | filtering_flag,
         offset_scale: geometry.offset_scale as f32,
         min_ray_weight: settings.min_ray_weight as f32,
         lattice_generator: crate::camera::lattice_generator(settings.samples_per_pixel),
         static_pixels: 0,
         lens_radius: camera.lens_radius as f32,
         focus_distance: camera.focus_distance as f32,
-        _pad0: 0,
-        _pad1: 0,
+        cone_width: cone.width as f32,
+        cone_spread: cone.spread as f32,
     }
 }
 
@@ -727,6 +777,7 @@ mod tests {
                 lighting_space: LightingSpace::Linear,
                 min_ray_weight: 0.0,
                 integrator: crate::scene::Integrator::Whitted,
+                texture_filtering: crate::scene::TextureFiltering::Trilinear,
             },
             camera: Camera {
                 eye: DVec3::new(0.0, 0.0, 5.0),

@@ -110,6 +110,41 @@ pub struct RenderSettings {
     pub min_ray_weight: f64,
     /// The light-transport algorithm.
     pub integrator: Integrator,
+    /// How surface textures are filtered (`[render] texture_filtering`).
+    pub texture_filtering: TextureFiltering,
+}
+
+/// How surface textures are looked up (`[render] texture_filtering`,
+/// docs/scene-format.md).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TextureFiltering {
+    /// Bilinear at level 0, whatever the distance (aliases far away).
+    None,
+    /// Trilinear between mip-map levels at the footprint of a ray cone, isotropic: one
+    /// probe at the level of the footprint's long axis ([`crate::texture::texture_lod`]).
+    Trilinear,
+    /// Trilinear probes along the long axis of a ray cone's footprint, each at the
+    /// level of its share of it ([`crate::texture::texel_footprint`]): sharp at grazing
+    /// angles where `Trilinear` blurs across the view.
+    #[default]
+    Anisotropic,
+}
+
+impl TextureFiltering {
+    /// Whether textures have mip-map chains and are looked up at a ray cone's
+    /// footprint.
+    pub fn filters(self) -> bool {
+        self != Self::None
+    }
+
+    /// The most trilinear probes one lookup takes
+    /// ([`crate::texture::ConeFootprint::max_probes`]).
+    pub fn max_probes(self) -> u32 {
+        match self {
+            Self::None | Self::Trilinear => 1,
+            Self::Anisotropic => crate::texture::MAX_TEXTURE_PROBES,
+        }
+    }
 }
 
 impl Default for RenderSettings {
@@ -125,6 +160,7 @@ impl Default for RenderSettings {
             lighting_space: LightingSpace::Linear,
             min_ray_weight: 0.0,
             integrator: Integrator::Whitted,
+            texture_filtering: TextureFiltering::Anisotropic,
         }
     }
 }

@@ -208,7 +208,11 @@ fn a_textured_albedo_pass_is_the_texel() {
         texture_scale: 1.5,
         ..Material::lambert(diffuse)
     };
-    let scene = plane_scene(material, vec![texture.clone()], 1);
+    let mut scene = plane_scene(material, vec![texture.clone()], 1);
+    // Level 0: the blocks are 2 × 2 texels, so a bilinear lookup inside one is its
+    // texel; the far pixels' filtered lookups would mix blocks at level 1 (whose
+    // texel centres are the blocks' centres).
+    scene.render.texture_filtering = gpu_render::scene::TextureFiltering::None;
     let cpu = gpu_render::low_level::cpu::aov::render_aovs(&scene);
     // Pixels whose lookup lies inside a block (between its four texel centres, with a
     // margin) show that block's texel times the diffuse factor.

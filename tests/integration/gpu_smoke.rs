@@ -31,6 +31,7 @@ fn scene(samples_per_pixel: u32) -> Scene {
             lighting_space: LightingSpace::Linear,
             min_ray_weight: 0.0,
             integrator: gpu_render::scene::Integrator::Whitted,
+            texture_filtering: gpu_render::scene::TextureFiltering::Trilinear,
         },
         camera: Camera {
             eye: DVec3::new(0.0, 1.0, 4.0),

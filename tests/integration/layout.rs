@@ -72,8 +72,8 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 static_pixels,
                 lens_radius,
                 focus_distance,
-                _pad0,
-                _pad1,
+                cone_width,
+                cone_spread,
             }),
         ),
         (
@@ -267,7 +267,11 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 held_top,
                 image_x,
                 image_y,
-                pass_throughs
+                pass_throughs,
+                cone_width,
+                _pad0,
+                _pad1,
+                _pad2
             }),
         ),
         (
@@ -305,7 +309,7 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 direction,
                 medium_depth,
                 weight,
-                _pad,
+                cone_width,
                 medium_iors
             }),
         ),

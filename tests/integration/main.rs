@@ -52,6 +52,7 @@ mod shader_modules;
 mod shading_normals;
 mod specialisation;
 mod stress_scenes;
+mod texture_filtering;
 mod thin_lens;
 mod tiles;
 mod uniform_records;

@@ -19,6 +19,7 @@ fn furnace_scene(albedo: f64, radius: f64, intensity: f64) -> Scene {
             lighting_space: LightingSpace::Linear,
             min_ray_weight: 0.0,
             integrator: gpu_render::scene::Integrator::Whitted,
+            texture_filtering: gpu_render::scene::TextureFiltering::Trilinear,
         },
         camera: Camera {
             eye: DVec3::new(0.1, -0.2, 0.05) * radius,

@@ -324,6 +324,14 @@ fn the_import_graph_has_no_cycle() {
 /// short: a new function gets a twin, or a reason as good as these.
 const WITHOUT_RUST_TWIN: &[(&str, &[&str], &str)] = &[
     (
+        "texture",
+        &["material_texels", "slot_image"],
+        "a hit's four texture lookups gathered in one loop over the slots, so that \
+         lavapipe, which inlines every call, compiles the filtered lookup once per call \
+         site; the CPU reference makes the same lookups where it uses them \
+         (shading_material, mapped_normal in src/texture.rs)",
+    ),
+    (
         "wavefront",
         &["*"],
         "the trace kernels and their schedule of slots, phases and dispatches: the CPU \

@@ -30,6 +30,7 @@ fn settings(width: u32, height: u32, samples: u32, depth: u32) -> RenderSettings
         lighting_space: LightingSpace::Linear,
         min_ray_weight: 0.0,
         integrator: gpu_render::scene::Integrator::Whitted,
+        texture_filtering: gpu_render::scene::TextureFiltering::Trilinear,
     }
 }
 

@@ -598,6 +598,7 @@ pub fn minimal_settings() -> RenderSettings {
         lighting_space: LightingSpace::Linear,
         min_ray_weight: 0.0,
         integrator: gpu_render::scene::Integrator::Whitted,
+        texture_filtering: gpu_render::scene::TextureFiltering::None,
     }
 }
 

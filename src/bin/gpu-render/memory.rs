@@ -192,7 +192,19 @@ fn scene_bytes(scene: &Scene) -> u64 {
             _ => 0,
         })
         .sum();
-    let texels: usize = scene.images.iter().map(|image| image.texels.len()).sum();
+    // With texture filtering every image keeps its mip chain too, about a third more
+    // (the CPU's PreparedScene::image_levels, the GPU array's levels).
+    let texels: usize = scene
+        .images
+        .iter()
+        .map(|image| {
+            if scene.render.texture_filtering.filters() {
+                gpu_render::low_level::texture::mip_chain_texels(image.width, image.height) as usize
+            } else {
+                image.texels.len()
+            }
+        })
+        .sum();
     // A world-space mesh triangle: 3 f64 corners plus a material and attribute index
     // (80 B), its attributes (3 normals and 3 UVs, 128 B) and its BVH share (~40 B).
     let (mut mesh_triangles, mut instances) = (0, 0);

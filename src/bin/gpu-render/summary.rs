@@ -121,6 +121,7 @@ mod tests {
             lighting_space: LightingSpace::Linear,
             min_ray_weight: 0.0,
             integrator: gpu_render::scene::Integrator::Whitted,
+            texture_filtering: gpu_render::scene::TextureFiltering::Trilinear,
         };
         let summary = Summary {
             settings: &settings,

@@ -70,6 +70,16 @@ pub struct RawRender {
     pub lighting: Option<RawLighting>,
     pub min_ray_weight: Option<f64>,
     pub integrator: Option<RawIntegrator>,
+    pub texture_filtering: Option<RawTextureFiltering>,
+}
+
+/// `render.texture_filtering`.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RawTextureFiltering {
+    None,
+    Trilinear,
+    Anisotropic,
 }
 
 /// `render.integrator`.

@@ -9,12 +9,14 @@ use toml::Spanned;
 use super::LoadOptions;
 use super::check::{ColourRange, Item, Source};
 use super::paths::confined_path;
-use super::raw::{RawCamera, RawEnvironment, RawIntegrator, RawLighting, RawRender};
+use super::raw::{
+    RawCamera, RawEnvironment, RawIntegrator, RawLighting, RawRender, RawTextureFiltering,
+};
 use crate::echo::{echo_path, short};
 use crate::scene::{
     Camera, Environment, EnvironmentMap, Image, Integrator, LightingSpace,
-    MAX_ORTHOGRAPHIC_HALF_HEIGHT, MAX_RADIANCE, RenderSettings, SceneError, ThinLens,
-    load_confined_image, load_image,
+    MAX_ORTHOGRAPHIC_HALF_HEIGHT, MAX_RADIANCE, RenderSettings, SceneError, TextureFiltering,
+    ThinLens, load_confined_image, load_image,
 };
 
 /// Default image width in pixels.
@@ -52,6 +54,11 @@ pub fn render(
         integrator: match raw.integrator {
             None | Some(RawIntegrator::Whitted) => Integrator::Whitted,
             Some(RawIntegrator::Path) => Integrator::Path,
+        },
+        texture_filtering: match raw.texture_filtering {
+            None | Some(RawTextureFiltering::Anisotropic) => TextureFiltering::Anisotropic,
+            Some(RawTextureFiltering::Trilinear) => TextureFiltering::Trilinear,
+            Some(RawTextureFiltering::None) => TextureFiltering::None,
         },
     };
     let item = source.item("render".into(), span);
