@@ -175,6 +175,7 @@ fn million_triangle_scene() -> gpu_render::scene::Scene {
             lighting_space: LightingSpace::Linear,
             min_ray_weight: 0.0,
             integrator: gpu_render::scene::Integrator::Whitted,
+            texture_filtering: gpu_render::scene::TextureFiltering::default(),
         },
         camera: Camera {
             eye: DVec3::new(0.0, 2.5, 7.0),

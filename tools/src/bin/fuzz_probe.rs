@@ -95,7 +95,13 @@ fn main() {
                 );
                 continue;
             };
-            let shaded = shade_hit(&prepared, &ray, &hit, &medium);
+            let shaded = shade_hit(
+                &prepared,
+                &ray,
+                &hit,
+                &medium,
+                gpu_render::low_level::texture::ConeFootprint::NONE,
+            );
             println!(
                 "{indent}d{depth} o {:?} u {:?} w {:?}: {:?} t {:e} at {:?} n {:?} cos {:.6e}, adds {:?}",
                 ray.origin,
