@@ -32,7 +32,7 @@ fn defaults_are_applied() {
             lighting_space: LightingSpace::Linear,
             min_ray_weight: 0.0,
             integrator: crate::scene::Integrator::Whitted,
-            texture_filtering: crate::scene::TextureFiltering::Trilinear,
+            texture_filtering: crate::scene::TextureFiltering::Anisotropic,
         }
     );
     assert_eq!(scene.camera.up, DVec3::Y);
