@@ -18,7 +18,7 @@ fn image_texel(layer: u32, x: u32, y: u32) -> vec3<f32> {
 }
 
 // The most trilinear probes of an anisotropic lookup (MAX_TEXTURE_PROBES in
-// src/texture.rs).
+// src/scene/model.rs).
 const MAX_TEXTURE_PROBES: u32 = 16u;
 
 // The footprint of a ray cone at a hit (twin of ConeFootprint in src/texture.rs): its

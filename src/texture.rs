@@ -20,11 +20,6 @@ use glam::{DVec2, DVec3};
 
 use crate::scene::{Image, Material, TextureMapping, TextureTransform, TextureWrap};
 
-/// The most trilinear probes an anisotropic lookup takes along a footprint's long
-/// axis ([`texel_footprint`]): 16, the largest anisotropy of common GPU samplers
-/// (`maxSamplerAnisotropy`, Vulkan 1.3 §33.1; wgpu's `anisotropy_clamp` ≤ 16).
-pub const MAX_TEXTURE_PROBES: u32 = 16;
-
 /// The footprint of a ray cone where it meets a surface: what [`texel_footprint`] needs
 /// besides the texture. [`ConeFootprint::NONE`] (width 0) looks textures up at level 0,
 /// bilinearly, as without filtering. Twin of `ConeFootprint` in
@@ -50,7 +45,7 @@ pub struct ConeFootprint {
     pub uv_axis: [DVec2; 2],
     /// The most trilinear probes a lookup may take along the long axis: 1 is the
     /// isotropic trilinear lookup (`texture_filtering = "trilinear"`),
-    /// [`MAX_TEXTURE_PROBES`] the anisotropic one.
+    /// [`crate::scene::MAX_TEXTURE_PROBES`] the anisotropic one.
     pub max_probes: u32,
 }
 
@@ -754,6 +749,7 @@ pub fn shading_alpha(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::MAX_TEXTURE_PROBES;
 
     /// A `width × height` image whose texel `(x, y)` is `f(x, y)` in every channel.
     fn image(width: u32, height: u32, f: impl Fn(u32, u32) -> f32) -> Image {
@@ -951,44 +947,6 @@ mod tests {
             (capped.lod - (100.0f64 / 16.0).log2()).abs() < 1e-6,
             "{capped:?}"
         );
-    }
-
-    #[test]
-    fn a_mesh_footprint_follows_the_triangles_texture_coordinates() {
-        // A triangle in the floor whose coordinates run 4 times faster along x than
-        // along z (u = 4x, v = z): looked at along +x the long axis is u, along +z v.
-        let vertices = [DVec3::ZERO, DVec3::X, DVec3::Z];
-        let uv = [DVec2::ZERO, DVec2::new(4.0, 0.0), DVec2::new(0.0, 1.0)];
-        let density = crate::cpu::intersect::triangle_uv_density(&vertices, &uv);
-        assert!((density - 4.0).abs() < 1e-12);
-        let material = Material {
-            texture_mapping: TextureMapping::Uv,
-            ..planar_material(1.0)
-        };
-        let image = image(64, 64, |_, _| 1.0);
-        let footprint = |direction: DVec3| {
-            let axis = footprint_axis(direction, DVec3::Y);
-            let uv_axis = crate::cpu::intersect::triangle_uv_axis(&vertices, &uv, axis);
-            let cone = ConeFootprint::new(
-                1.0 / 256.0,
-                direction,
-                DVec3::Y,
-                [density, 0.0],
-                [uv_axis, DVec2::ZERO],
-            )
-            .with_max_probes(MAX_TEXTURE_PROBES);
-            texel_footprint(&material, &TextureTransform::IDENTITY, &image, 6, &cone)
-        };
-        let along = DVec3::new(0.5f64.sqrt(), -0.5f64.sqrt(), 0.0);
-        let x = footprint(along);
-        // Along x: the long axis √2/256 world units = 4·√2/256 of u = √2 texels, the
-        // width 1/256 along z = 1/4 texel... ratio 4√2: 6 probes (rounded).
-        assert!(x.axis.y.abs() < 1e-12 && x.axis.x > 0.0, "{x:?}");
-        assert!((x.axis.x * 64.0 - 2.0f64.sqrt() * 4.0 * 64.0 / 256.0).abs() < 1e-9);
-        assert_eq!(x.probes, 6);
-        let z = footprint(DVec3::new(0.0, -0.5f64.sqrt(), 0.5f64.sqrt()));
-        // Along z: √2/256 of v (0.35 texel) long, 1 texel wide: the width rules.
-        assert_eq!(z.probes, 1);
     }
 
     #[test]

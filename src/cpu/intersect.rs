@@ -716,7 +716,8 @@ pub fn offset_ray_origin(point: DVec3, normal: DVec3, scale: f64) -> DVec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::polygon_plane;
+    use crate::scene::{Image, Material, TextureMapping, TextureTransform, polygon_plane};
+    use crate::texture;
 
     fn ray(origin: DVec3, direction: DVec3) -> Ray {
         Ray {
@@ -969,5 +970,49 @@ mod tests {
             let back = offset_ray_origin(p, DVec3::NEG_Y, 1.0);
             assert!(back.y < p.y, "scale {scale}");
         }
+    }
+
+    #[test]
+    fn a_mesh_footprint_follows_the_triangles_texture_coordinates() {
+        // A triangle in the floor whose coordinates run 4 times faster along x than
+        // along z (u = 4x, v = z): looked at along +x the long axis is u, along +z v.
+        let vertices = [DVec3::ZERO, DVec3::X, DVec3::Z];
+        let uv = [DVec2::ZERO, DVec2::new(4.0, 0.0), DVec2::new(0.0, 1.0)];
+        let density = triangle_uv_density(&vertices, &uv);
+        assert!((density - 4.0).abs() < 1e-12);
+        let material = Material {
+            albedo_texture: Some(0),
+            texture_mapping: TextureMapping::Uv,
+            ..Material::lambert(DVec3::ONE)
+        };
+        let image = Image {
+            path: "<test>".into(),
+            width: 64,
+            height: 64,
+            texels: vec![[1.0; 4]; 64 * 64],
+        };
+        let footprint = |direction: DVec3| {
+            let axis = footprint_axis(direction, DVec3::Y);
+            let uv_axis = triangle_uv_axis(&vertices, &uv, axis);
+            let cone = texture::ConeFootprint::new(
+                1.0 / 256.0,
+                direction,
+                DVec3::Y,
+                [density, 0.0],
+                [uv_axis, DVec2::ZERO],
+            )
+            .with_max_probes(crate::scene::MAX_TEXTURE_PROBES);
+            texture::texel_footprint(&material, &TextureTransform::IDENTITY, &image, 6, &cone)
+        };
+        let along = DVec3::new(0.5f64.sqrt(), -0.5f64.sqrt(), 0.0);
+        let x = footprint(along);
+        // Along x: the long axis √2/256 world units = 4·√2/256 of u = √2 texels, the
+        // width 1/256 along z = 1/4 texel... ratio 4√2: 6 probes (rounded).
+        assert!(x.axis.y.abs() < 1e-12 && x.axis.x > 0.0, "{x:?}");
+        assert!((x.axis.x * 64.0 - 2.0f64.sqrt() * 4.0 * 64.0 / 256.0).abs() < 1e-9);
+        assert_eq!(x.probes, 6);
+        let z = footprint(DVec3::new(0.0, -0.5f64.sqrt(), 0.5f64.sqrt()));
+        // Along z: √2/256 of v (0.35 texel) long, 1 texel wide: the width rules.
+        assert_eq!(z.probes, 1);
     }
 }

@@ -139,7 +139,7 @@ pub const FLAG_ORTHOGRAPHIC: u32 = 16;
 /// without filtering).
 pub const FLAG_TEXTURE_FILTERING: u32 = 32;
 /// `FrameUniforms.flags`: texture lookups take up to
-/// [`crate::texture::MAX_TEXTURE_PROBES`] probes along the footprint's long axis
+/// [`crate::scene::MAX_TEXTURE_PROBES`] probes along the footprint's long axis
 /// (`texture_filtering = "anisotropic"`), else one.
 pub const FLAG_ANISOTROPIC_TEXTURES: u32 = 64;
 

@@ -114,6 +114,12 @@ pub struct RenderSettings {
     pub texture_filtering: TextureFiltering,
 }
 
+/// The most trilinear probes an anisotropic lookup takes along a footprint's long
+/// axis ([`crate::texture::texel_footprint`]): 16, the largest anisotropy of common
+/// GPU samplers (`maxSamplerAnisotropy`, Vulkan 1.3 §33.1; wgpu's `anisotropy_clamp`
+/// ≤ 16).
+pub const MAX_TEXTURE_PROBES: u32 = 16;
+
 /// How surface textures are looked up (`[render] texture_filtering`,
 /// docs/scene-format.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -142,7 +148,7 @@ impl TextureFiltering {
     pub fn max_probes(self) -> u32 {
         match self {
             Self::None | Self::Trilinear => 1,
-            Self::Anisotropic => crate::texture::MAX_TEXTURE_PROBES,
+            Self::Anisotropic => MAX_TEXTURE_PROBES,
         }
     }
 }

@@ -579,6 +579,11 @@ fn wgsl_constants_equal_their_rust_twins() {
         gpu_render::low_level::cpu::path::ROULETTE_DEPTH
     );
     assert!(path.lines().any(|l| l == roulette), "{roulette}");
+    let probes = format!(
+        "const MAX_TEXTURE_PROBES: u32 = {}u;",
+        gpu_render::scene::MAX_TEXTURE_PROBES
+    );
+    assert!(module("texture").lines().any(|l| l == probes), "{probes}");
     let [r, g, b] = gpu_render::low_level::color::LUMINANCE_WEIGHTS.map(|w| w as f32);
     let weights = format!("const LUMINANCE_WEIGHTS: vec3<f32> = vec3<f32>({r:?}, {g:?}, {b:?});");
     assert!(module("color").lines().any(|l| l == weights), "{weights}");
