@@ -51,7 +51,7 @@ fn first_hit_aov(ray: Ray, trace: TraceRay, cone_width: f32) -> FirstHitAov {
     let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
     let footprint = cone_footprint(cone_width + frame.cone_spread * hit.t, ray.direction, hit.normal, hit.uv_density, hit.uv_axis);
     let texels = material_texels(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, footprint);
-    let material = shading_material(materials[hit.material], hit.color, texels);
+    let material = shading_material(materials[hit.material], hit.color.rgb, texels);
     let entering = dot(ray.direction, hit.normal) < 0.0;
     let ng = select(-hit.normal, hit.normal, entering);
     //#if MESH_ATTRIBUTES

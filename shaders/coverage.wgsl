@@ -24,7 +24,7 @@ fn hit_coverage(prim: u32, instance: u32, ray: Ray, t: f32) -> f32 {
     if !(material.alpha_cutoff > 0.0) && material.alpha_blend == 0u {
         return 1.0;
     }
-    let alpha = shading_alpha(material, hit.position, hit.normal, hit.uv, hit.uv1);
+    let alpha = shading_alpha(material, hit.position, hit.normal, hit.uv, hit.uv1, hit.color.a);
     if material.alpha_blend != 0u {
         return alpha;
     }

@@ -32,8 +32,8 @@ struct Hit {
     uv: vec2<f32>,
     // The second set of texture coordinates, likewise.
     uv1: vec2<f32>,
-    // A mesh triangle's interpolated vertex colour, else white.
-    color: vec3<f32>,
+    // A mesh triangle's interpolated vertex colour (RGBA), else opaque white.
+    color: vec4<f32>,
     // A mesh triangle's interpolated tangent (w: the bitangent's handedness), else 0.
     tangent: vec4<f32>,
     // Barycentric coordinates in a triangle, else (1, 0, 0).
@@ -51,10 +51,10 @@ struct Hit {
 }
 
 // A hit without vertex attributes: shading normal = geometric normal, texture
-// coordinates (0, 0), colour white.
+// coordinates (0, 0), colour opaque white.
 fn flat_hit(prim: u32, t: f32, normal: vec3<f32>, material: u32, position: vec3<f32>) -> Hit {
     return Hit(t, normal, material, true, position, prim, normal, vec2<f32>(0.0),
-               vec2<f32>(0.0), vec3<f32>(1.0), vec4<f32>(0.0), vec3<f32>(1.0, 0.0, 0.0), NO_INSTANCE,
+               vec2<f32>(0.0), vec4<f32>(1.0), vec4<f32>(0.0), vec3<f32>(1.0, 0.0, 0.0), NO_INSTANCE,
                vec2<f32>(0.0), vec4<f32>(0.0));
 }
 

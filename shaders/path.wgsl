@@ -373,7 +373,7 @@ fn path_closest_hit(path: ptr<function, PathState>, trace: TraceRay) {
     }
     let footprint = cone_footprint((*path).cone_width, ray.direction, hit.normal, hit.uv_density, hit.uv_axis);
     let texels = material_texels(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, footprint);
-    let material = shading_material(materials[hit.material], hit.color, texels);
+    let material = shading_material(materials[hit.material], hit.color.rgb, texels);
     // Emission, weighted against next-event estimation where that could have found it;
     // shadow_origin still holds the previous hit's, where that estimation sampled from.
     if max_component(material.emission) > 0.0 && emits_towards(hit, ray.direction, material.two_sided != 0u) {

@@ -288,18 +288,22 @@ fn sample_texture_alpha(layer: u32, width: u32, height: u32, uv: vec2<f32>, wrap
 //#endif
 
 //#if ALPHA
-// The alpha (coverage) at a hit: material.alpha times the albedo texture's alpha at
-// the albedo's coordinates (glTF 2.0 §3.9.4). Twin of shading_alpha (src/texture.rs).
-fn shading_alpha(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, uv1: vec2<f32>) -> f32 {
+// The alpha (coverage) at a hit: material.alpha times the interpolated vertex-colour
+// alpha `vertex_alpha` (1 without vertex colours) times the albedo texture's alpha at
+// the albedo's coordinates (glTF 2.0 §3.9.4, COLOR_0 a factor of the base colour:
+// §3.7.2.1). Twin of shading_alpha (src/texture.rs).
+fn shading_alpha(material: Material, position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, uv1: vec2<f32>,
+                 vertex_alpha: f32) -> f32 {
+    let alpha = material.alpha * vertex_alpha;
     //#if TEXTURES
     if material.texture_layer != NO_IMAGE {
         let st = texture_coordinates(material, UV_SLOT_ALBEDO, position, normal, uv, uv1);
         let wrap = vec2<u32>(material.texture_wrap_u, material.texture_wrap_v);
-        return material.alpha * sample_texture_alpha(material.texture_layer, material.texture_width,
-                                                     material.texture_height, st, wrap);
+        return alpha * sample_texture_alpha(material.texture_layer, material.texture_width,
+                                            material.texture_height, st, wrap);
     }
     //#endif
-    return material.alpha;
+    return alpha;
 }
 //#endif
 

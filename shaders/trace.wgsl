@@ -138,7 +138,7 @@ fn keep_on_side(d: vec3<f32>, side: vec3<f32>) -> vec3<f32> {
 // The alpha of a blended `material` at `hit` (shading_alpha), clamped to [0, 1]: the
 // fraction of light the surface stops. CPU twin: blend_alpha.
 fn blend_alpha(material: Material, hit: Hit) -> f32 {
-    return clamp(shading_alpha(material, hit.position, hit.normal, hit.uv, hit.uv1), 0.0, 1.0);
+    return clamp(shading_alpha(material, hit.position, hit.normal, hit.uv, hit.uv1, hit.color.a), 0.0, 1.0);
 }
 //#endif
 
@@ -168,7 +168,7 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
     }
     let footprint = cone_footprint(cone_width, ray.direction, hit.normal, hit.uv_density, hit.uv_axis);
     let texels = material_texels(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, footprint);
-    let material = shading_material(materials[hit.material], hit.color, texels);
+    let material = shading_material(materials[hit.material], hit.color.rgb, texels);
     let entering = dot(ray.direction, hit.normal) < 0.0;
     // Shading happens on the side the ray came from.
     let ng = select(-hit.normal, hit.normal, entering);

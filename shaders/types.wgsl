@@ -137,12 +137,10 @@ struct TriangleAttributes {
     uv1_01: vec4<f32>,
     uv1_2: vec2<f32>,
     _pad1: vec2<u32>,
-    c0: vec3<f32>,
-    _pad2: u32,
-    c1: vec3<f32>,
-    _pad3: u32,
-    c2: vec3<f32>,
-    _pad4: u32,
+    // Linear RGBA vertex colours.
+    c0: vec4<f32>,
+    c1: vec4<f32>,
+    c2: vec4<f32>,
     // Unit tangents, the bitangent's handedness in w (normal maps).
     t0: vec4<f32>,
     t1: vec4<f32>,

@@ -724,25 +724,28 @@ pub fn shading_albedo(
     }
 }
 
-/// The alpha (coverage) at a hit at `position` with geometric normal `normal` and mesh
-/// texture coordinates `uvs` (sets 0 and 1): `material.alpha` times the alpha of the
-/// albedo texture `texture` (the material's `albedo_texture`, if any) at the albedo's
-/// coordinates (glTF 2.0 §3.9.4: the base colour's alpha). Vertex colours do not
-/// contribute (their alpha is not kept).
+/// The alpha (coverage) at a hit at `position` with geometric normal `normal`, mesh
+/// texture coordinates `uvs` (sets 0 and 1) and interpolated vertex-colour alpha
+/// `vertex_alpha` (1 without vertex colours): `material.alpha` times `vertex_alpha`
+/// times the alpha of the albedo texture `texture` (the material's `albedo_texture`,
+/// if any) at the albedo's coordinates (glTF 2.0 §3.9.4: the base colour's alpha, of
+/// which `COLOR_0` is a factor, §3.7.2.1).
 pub fn shading_alpha(
     material: &Material,
     texture: Option<&Image>,
     position: DVec3,
     normal: DVec3,
     uvs: [DVec2; 2],
+    vertex_alpha: f64,
 ) -> f64 {
+    let alpha = material.alpha * vertex_alpha;
     match texture {
         Some(image) => {
             let transform = &material.texture_transform;
             let (u, v) = texture_coordinates(material, transform, position, normal, uvs);
-            material.alpha * sample_texture_alpha(image, u, v, material.texture_wrap)
+            alpha * sample_texture_alpha(image, u, v, material.texture_wrap)
         }
-        None => material.alpha,
+        None => alpha,
     }
 }
 

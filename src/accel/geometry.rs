@@ -133,8 +133,8 @@ pub struct TriangleAttributes {
     pub uvs: Option<[DVec2; 3]>,
     /// The second set of vertex texture coordinates, if the mesh has it.
     pub uvs1: Option<[DVec2; 3]>,
-    /// Linear RGB vertex colours, if the mesh has them.
-    pub colors: Option<[DVec3; 3]>,
+    /// Linear RGBA vertex colours, if the mesh has them.
+    pub colors: Option<[DVec4; 3]>,
     /// Unit tangents with the bitangent's handedness in `w`, if the mesh has them.
     pub tangents: Option<[DVec4; 3]>,
 }

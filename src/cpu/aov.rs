@@ -86,7 +86,14 @@ pub fn first_hit_aov(scene: &PreparedScene, ray: &Ray, blend: BlendRule) -> Opti
         hit.uv_density,
         hit.uv_axis,
     ));
-    let material = shading_material(record, &textures, hit.position, hit.normal, uvs, hit.color);
+    let material = shading_material(
+        record,
+        &textures,
+        hit.position,
+        hit.normal,
+        uvs,
+        hit.color.truncate(),
+    );
     let mapped = mapped_normal(
         record,
         &textures,

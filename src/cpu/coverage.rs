@@ -51,6 +51,7 @@ pub fn hit_coverage(geometry: &SceneGeometry, key: HitKey, ray: &Ray, t: f64) ->
         hit.position,
         hit.normal,
         [hit.uv, hit.uv1],
+        hit.color.w,
     );
     match mask.mode {
         AlphaMode::Mask { cutoff } => {

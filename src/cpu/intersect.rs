@@ -51,8 +51,9 @@ pub struct Hit {
     pub uv: DVec2,
     /// The second set of texture coordinates, likewise.
     pub uv1: DVec2,
-    /// A mesh triangle's vertex colours interpolated at the hit, else white (1, 1, 1).
-    pub color: DVec3,
+    /// A mesh triangle's vertex colours (RGBA) interpolated at the hit, else opaque
+    /// white (1, 1, 1, 1).
+    pub color: DVec4,
     /// A mesh triangle's vertex tangents interpolated at the hit (`w`: the bitangent's
     /// handedness, interpolated too; its sign is used), else zero (no normal map).
     pub tangent: DVec4,
@@ -209,7 +210,7 @@ pub fn hit_record_keyed(geometry: &SceneGeometry, key: HitKey, ray: &Ray, t: f64
 }
 
 /// A hit without vertex attributes: its shading normal is its geometric normal, its
-/// texture coordinates `(0, 0)`, its colour white, its barycentric coordinates
+/// texture coordinates `(0, 0)`, its colour opaque white, its barycentric coordinates
 /// `(1, 0, 0)`.
 pub fn flat_hit(prim: PrimRef, t: f64, normal: DVec3, material: u32, position: DVec3) -> Hit {
     Hit {
@@ -221,7 +222,7 @@ pub fn flat_hit(prim: PrimRef, t: f64, normal: DVec3, material: u32, position: D
         shading_normal: normal,
         uv: DVec2::ZERO,
         uv1: DVec2::ZERO,
-        color: DVec3::ONE,
+        color: DVec4::ONE,
         tangent: DVec4::ZERO,
         barycentrics: DVec3::X,
         instance: None,

@@ -266,7 +266,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
             hit.position,
             hit.normal,
             [hit.uv, hit.uv1],
-            hit.color,
+            hit.color.truncate(),
         );
         // Emission, weighted against next-event estimation where that could have
         // found it.

@@ -389,6 +389,7 @@ pub fn blend_alpha(scene: &PreparedScene, material: &Material, hit: &Hit) -> f64
         hit.position,
         hit.normal,
         [hit.uv, hit.uv1],
+        hit.color.w,
     )
     .clamp(0.0, 1.0)
 }
@@ -471,7 +472,7 @@ pub fn shade_hit(
         position,
         hit.normal,
         [hit.uv, hit.uv1],
-        hit.color,
+        hit.color.truncate(),
     );
     let material = &material;
     let entering = ray.direction.dot(hit.normal) < 0.0;

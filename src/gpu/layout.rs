@@ -556,18 +556,12 @@ pub struct GpuTriangleAttributes {
     pub uv1_2: [f32; 2],
     /// Padding.
     pub _pad1: [u32; 2],
-    /// Linear RGB colour at the first corner.
-    pub c0: [f32; 3],
-    /// Padding.
-    pub _pad2: u32,
-    /// Linear RGB colour at the second corner.
-    pub c1: [f32; 3],
-    /// Padding.
-    pub _pad3: u32,
-    /// Linear RGB colour at the third corner.
-    pub c2: [f32; 3],
-    /// Padding.
-    pub _pad4: u32,
+    /// Linear RGBA colour at the first corner.
+    pub c0: [f32; 4],
+    /// Linear RGBA colour at the second corner.
+    pub c1: [f32; 4],
+    /// Linear RGBA colour at the third corner.
+    pub c2: [f32; 4],
     /// Unit tangent and bitangent handedness at the first corner.
     pub t0: [f32; 4],
     /// Unit tangent and bitangent handedness at the second corner.

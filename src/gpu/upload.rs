@@ -3,7 +3,7 @@
 //! Nothing here touches wgpu, so it is unit-tested on any machine. Call it with the
 //! scene as the tracers shade it ([`Scene::in_lighting_space`]); the renderer does.
 
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, DVec4};
 
 use super::layout::{
     DISTRIBUTION_BECKMANN, DISTRIBUTION_GGX, FLAG_ANISOTROPIC_TEXTURES, FLAG_ORTHOGRAPHIC,
@@ -543,7 +543,10 @@ pub fn triangle_attributes_record(
     };
     let uvs = near(attributes.uvs);
     let uvs1 = near(attributes.uvs1);
-    let colors = attributes.colors.unwrap_or([DVec3::ONE; 3]);
+    let colors = attributes
+        .colors
+        .unwrap_or([DVec4::ONE; 3])
+        .map(|c| c.as_vec4().to_array());
     let tangents = attributes
         .tangents
         .unwrap_or_default()
@@ -572,12 +575,9 @@ pub fn triangle_attributes_record(
         ],
         uv1_2: [uvs1[2].x as f32, uvs1[2].y as f32],
         _pad1: [0; 2],
-        c0: vec3(colors[0]),
-        _pad2: 0,
-        c1: vec3(colors[1]),
-        _pad3: 0,
-        c2: vec3(colors[2]),
-        _pad4: 0,
+        c0: colors[0],
+        c1: colors[1],
+        c2: colors[2],
         t0: tangents[0],
         t1: tangents[1],
         t2: tangents[2],

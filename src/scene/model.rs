@@ -49,9 +49,11 @@ pub struct Mesh {
     /// A second set of texture coordinates (glTF's `TEXCOORD_1`), parallel to
     /// `positions`, for the textures whose [`TextureTransform::set`] is 1.
     pub uvs1: Option<Vec<DVec2>>,
-    /// Linear RGB vertex colours in [0, 1], parallel to `positions`, multiplying the
-    /// albedo (glTF's `COLOR_0`, OBJ's `v x y z r g b`).
-    pub colors: Option<Vec<DVec3>>,
+    /// Linear RGBA vertex colours in [0, 1], parallel to `positions` (glTF's `COLOR_0`,
+    /// OBJ's `v x y z r g b` with alpha 1): the colour multiplies the albedo, the alpha
+    /// the material's alpha where its alpha mode reads alpha (glTF 2.0 §3.7.2.1,
+    /// §3.9.4; [`AlphaMode`]).
+    pub colors: Option<Vec<glam::DVec4>>,
     /// Unit tangents (`xyz`) with the bitangent's handedness (`w`, ±1), parallel to
     /// `positions`, for normal maps: glTF's `TANGENT`, or MikkTSpace's from the
     /// normals and texture coordinates; the bitangent is `w · (normal × tangent)`.

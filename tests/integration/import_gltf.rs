@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use base64::Engine;
-use glam::{DMat4, DQuat, DVec2, DVec3};
+use glam::{DMat4, DQuat, DVec2, DVec3, DVec4};
 use gpu_render::low_level::camera::CameraFrame;
 use gpu_render::low_level::color::srgb_decode;
 use gpu_render::scene::import::{
@@ -556,8 +556,12 @@ fn vertex_colours_are_read_and_further_sets_named_in_one_warning() {
     );
     let model = imported("colours.gltf", doc.embedded(&body).as_bytes());
     assert_eq!(model.meshes.len(), 3);
-    // Normalized bytes read as [0, 1], linear (glTF 2.0 §3.7.2.1).
-    let primaries = Some(vec![DVec3::X, DVec3::Y, DVec3::Z]);
+    // Normalized bytes read as [0, 1], linear (glTF 2.0 §3.7.2.1); VEC3 is opaque.
+    let primaries = Some(vec![
+        DVec4::new(1.0, 0.0, 0.0, 1.0),
+        DVec4::new(0.0, 1.0, 0.0, 1.0),
+        DVec4::new(0.0, 0.0, 1.0, 1.0),
+    ]);
     assert_eq!(model.meshes[0].colors, primaries);
     assert_eq!(model.meshes[1].colors, None);
     assert_eq!(model.meshes[2].colors, primaries);
@@ -574,7 +578,8 @@ fn vertex_colours_are_read_and_further_sets_named_in_one_warning() {
 #[test]
 fn float_and_short_vertex_colours_read_with_alpha_and_range_warned_about() {
     let (mut doc, _) = triangle_doc();
-    // VEC4 floats: one out of range (clamped), one alpha below 1 (ignored).
+    // VEC4 floats: one out of range (clamped), one alpha below 1 (kept: it multiplies
+    // the base colour's alpha).
     let rgba = doc.vec4(&[
         [0.25, 0.5, 0.75, 1.0],
         [2.0, 0.0, 0.0, 0.5],
@@ -587,19 +592,16 @@ fn float_and_short_vertex_colours_read_with_alpha_and_range_warned_about() {
     let model = imported("rgba.gltf", doc.embedded(&body).as_bytes());
     assert_eq!(
         model.meshes[0].colors,
-        Some(vec![DVec3::new(0.25, 0.5, 0.75), DVec3::X, DVec3::Z])
+        Some(vec![
+            DVec4::new(0.25, 0.5, 0.75, 1.0),
+            DVec4::new(1.0, 0.0, 0.0, 0.5),
+            DVec4::new(0.0, 0.0, 1.0, 1.0)
+        ])
     );
-    assert_eq!(model.warnings.len(), 2, "{:?}", model.warnings);
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
     assert!(
         model.warnings.iter().any(|w| w.ends_with(
-            "rgba.gltf: mesh 0, primitive 0: COLOR_0 has alpha below 1, which is ignored (alpha modes read the base colour's alpha factor and texture only): the surface is opaque"
-        )),
-        "{:?}",
-        model.warnings
-    );
-    assert!(
-        model.warnings.iter().any(|w| w.ends_with(
-            "rgba.gltf: mesh 0, primitive 0: 1 vertex colour outside [0, 1] (the first at vertex 1: [2, 0, 0]); clamped"
+            "rgba.gltf: mesh 0, primitive 0: 1 vertex colour outside [0, 1] (the first at vertex 1: [2, 0, 0, 0.5]); clamped"
         )),
         "{:?}",
         model.warnings

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, DVec4};
 use gpu_render::low_level::color::srgb_decode;
 use gpu_render::scene::import::{ImportedModel, WrapMode, import_model, import_obj, parse_obj};
 use gpu_render::scene::{AlphaMode, MaterialKind, SceneError};
@@ -828,14 +828,18 @@ fn vertex_colours_are_read_and_uncoloured_vertices_are_white() {
     assert!(model.warnings.is_empty(), "{:?}", model.warnings);
     assert_eq!(
         model.meshes[0].colors,
-        Some(vec![DVec3::X, DVec3::Y, DVec3::Z])
+        Some(
+            [DVec3::X, DVec3::Y, DVec3::Z]
+                .map(|c| c.extend(1.0))
+                .to_vec()
+        )
     );
     // Before and after the coloured ones, as tinyobjloader reads them: white.
     let obj = "v 0 0 0\nv 1 0 0 0.5 0.5 0.5\nv 0 1 0\nf 1 2 3\n";
     let model = imported(&[("some.obj", obj)]);
     assert_eq!(
         model.meshes[0].colors,
-        Some(vec![DVec3::ONE, DVec3::splat(0.5), DVec3::ONE])
+        Some(vec![DVec4::ONE, DVec3::splat(0.5).extend(1.0), DVec4::ONE])
     );
     // No colour anywhere: none.
     let model = imported(&[("none.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")]);

@@ -291,11 +291,8 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 uv1_2,
                 _pad1,
                 c0,
-                _pad2,
                 c1,
-                _pad3,
                 c2,
-                _pad4,
                 t0,
                 t1,
                 t2

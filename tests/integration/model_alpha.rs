@@ -1,6 +1,7 @@
 //! glTF's alpha coverage (issue 28; glTF 2.0 §3.9.4 "Alpha Coverage"): a material in
 //! `MASK` mode is fully opaque where its alpha (the base colour factor's alpha times the
-//! base colour texture's texel alpha) is greater than or equal to its cutoff, and does
+//! base colour texture's texel alpha and the vertex colour's alpha) is greater than or
+//! equal to its cutoff, and does
 //! not exist for any ray where it is below: camera rays see what lies behind, shadow
 //! rays pass, the AOV pass records what is behind. A material in `BLEND` mode stops the
 //! fraction alpha of the light (docs/models.md, "Alpha coverage"): Whitted shows
@@ -18,7 +19,8 @@ use gpu_render::scene::{
 };
 
 use crate::support::quads::{
-    EYE_Z, HEIGHT, WIDTH, assert_colour, at, camera, colour, pixel_at_uv, pixel_of, quad,
+    EYE_Z, HEIGHT, WIDTH, assert_colour, assert_colour_within, at, camera, colour, pixel_at_uv,
+    pixel_of, quad,
 };
 use crate::support::twins::{TWIN_TOLERANCE, assert_backends_agree};
 
@@ -173,6 +175,72 @@ fn a_masked_checker_shows_the_backdrop_exactly_where_alpha_is_below_the_cutoff()
         "opaque",
         &opaque.image,
         pixel_at_uv(1.0, 0.375, 0.125),
+        DVec3::ONE,
+    );
+}
+
+/// Quads placed as [`checker_scene`]'s, untextured, white, with alpha 1 at their left
+/// corners' vertex colours and 0 at their right ones' (glTF's `COLOR_0`, a factor of
+/// the base colour's alpha, glTF 2.0 §3.7.2.1, §3.9.4): their alpha is `1 − u`.
+fn vertex_alpha_scene(mode: AlphaMode) -> Scene {
+    let opaque_left = |mut mesh: Mesh| {
+        let alphas = [1.0, 0.0, 0.0, 1.0];
+        mesh.colors = Some(alphas.map(|a| DVec3::ONE.extend(a)).to_vec());
+        mesh
+    };
+    let mut once = opaque_left(quad(0, vec![DMat4::IDENTITY]));
+    once.positions.iter_mut().for_each(|p| p.x -= 3.0);
+    ambient_scene(
+        vec![
+            Material {
+                alpha_mode: mode,
+                ..Material::lambert(DVec3::ONE)
+            },
+            Material::lambert(GREEN),
+        ],
+        vec![
+            opaque_left(quad(0, vec![at(-1.0), at(1.0)])),
+            once,
+            backdrop(1),
+        ],
+        vec![],
+    )
+}
+
+#[test]
+fn vertex_colour_alpha_multiplies_the_coverage() {
+    // Masked at 0.5: the left half (alpha above 0.5) is there, the right half is not.
+    let masked = vertex_alpha_scene(AlphaMode::Mask { cutoff: CUTOFF });
+    let cpu = gpu_render::cpu::render(&masked, None);
+    for centre in [-3.0, -1.0, 1.0] {
+        for (u, expected) in [(0.2, DVec3::ONE), (0.8, GREEN)] {
+            let label = format!("mask: quad at {centre}, u = {u}");
+            assert_colour(&label, &cpu.image, pixel_at_uv(centre, u, 0.5), expected);
+        }
+    }
+    gpu_agrees("vertex-alpha-mask-whitted", &masked);
+    gpu_agrees("vertex-alpha-mask-path", &path_traced(&masked, 2));
+
+    // Blended: alpha 1 − u of the white quad over the green backdrop.
+    let blended = vertex_alpha_scene(AlphaMode::Blend);
+    let cpu = gpu_render::cpu::render(&blended, None);
+    for centre in [-3.0, -1.0, 1.0] {
+        for u in [0.25, 0.5, 0.75] {
+            let pixel = pixel_at_uv(centre, u, 0.5);
+            let expected = DVec3::ONE * (1.0 - u) + GREEN * u;
+            // A pixel spans 0.05 scene units, 0.028 of `u`: its colour is within 0.03.
+            let label = format!("blend: quad at {centre}, u = {u}");
+            assert_colour_within(&label, &cpu.image, pixel, expected, 0.03);
+        }
+    }
+    gpu_agrees("vertex-alpha-blend-whitted", &blended);
+
+    // Opaque, the vertex alpha is ignored as the material's is (§3.9.4).
+    let opaque = gpu_render::cpu::render(&vertex_alpha_scene(AlphaMode::Opaque), None);
+    assert_colour(
+        "opaque",
+        &opaque.image,
+        pixel_at_uv(1.0, 0.8, 0.5),
         DVec3::ONE,
     );
 }

@@ -58,7 +58,7 @@ const RIGHT: DVec3 = DVec3::Z;
 #[test]
 fn a_vertex_colour_gradient_renders_the_gradient_on_both_backends() {
     let mut plain = quad(0, vec![at(-3.0)]);
-    plain.colors = Some(vec![LEFT, RIGHT, RIGHT, LEFT]);
+    plain.colors = Some([LEFT, RIGHT, RIGHT, LEFT].map(|c| c.extend(1.0)).to_vec());
     // Placed twice, the second time mirrored left to right (an instanced mesh, corners
     // 1 and 2 swapped): its gradient runs the other way.
     let mut placed = plain.clone();

@@ -14,7 +14,7 @@ use ::gltf::khr_lights_punctual::Kind;
 use ::gltf::mesh::Mode;
 use ::gltf::texture::WrappingMode;
 use base64::Engine;
-use glam::{DMat4, DQuat, DVec2, DVec3};
+use glam::{DMat4, DQuat, DVec2, DVec3, DVec4};
 
 use super::accessor::{Expect, Normalized, read, view_bytes};
 use super::mesh::{Budget, RawMesh, finish_mesh};
@@ -1060,16 +1060,15 @@ impl Importer<'_> {
     }
 
     /// Reads `COLOR_0` of `primitive` (of `count` vertices), if it has it: `VEC3` or
-    /// `VEC4` of floats or normalized unsigned bytes or shorts (glTF 2.0 §3.7.2.1), the
-    /// alpha of `VEC4` left out (alpha masks read the base colour's alpha factor and
-    /// texture only; a warning says so when it is not 1). An accessor that breaks these rules is left out with a warning:
-    /// the model still renders, in its materials' colours.
+    /// `VEC4` of floats or normalized unsigned bytes or shorts (glTF 2.0 §3.7.2.1),
+    /// `VEC3` with alpha 1. An accessor that breaks these rules is left out with a
+    /// warning: the model still renders, in its materials' colours.
     fn colors(
         &mut self,
         primitive: &::gltf::Primitive<'_>,
         name: &str,
         count: usize,
-    ) -> Option<Vec<DVec3>> {
+    ) -> Option<Vec<DVec4>> {
         let accessor = primitive.get(&::gltf::Semantic::Colors(0))?;
         let dimensions = accessor.dimensions();
         let read_colors = || -> Result<Vec<f64>, String> {
@@ -1104,18 +1103,10 @@ impl Importer<'_> {
             }
         };
         let components = dimensions.multiplicity();
-        if components == 4 && values.chunks_exact(4).any(|c| c[3] != 1.0) {
-            self.warn_once(
-                "color alpha",
-                format!(
-                    "{name}: COLOR_0 has alpha below 1, which is ignored (alpha modes read the base colour's alpha factor and texture only): the surface is opaque"
-                ),
-            );
-        }
         Some(
             values
                 .chunks_exact(components)
-                .map(|c| DVec3::new(c[0], c[1], c[2]))
+                .map(|c| DVec4::new(c[0], c[1], c[2], c.get(3).copied().unwrap_or(1.0)))
                 .collect(),
         )
     }

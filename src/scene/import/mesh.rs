@@ -43,7 +43,7 @@ pub(super) struct RawMesh {
     pub normals: Option<Vec<DVec3>>,
     pub uvs: Option<Vec<DVec2>>,
     pub uvs1: Option<Vec<DVec2>>,
-    pub colors: Option<Vec<DVec3>>,
+    pub colors: Option<Vec<glam::DVec4>>,
     pub tangents: Option<Vec<glam::DVec4>>,
     pub triangles: Vec<[u32; 3]>,
 }
@@ -159,7 +159,7 @@ pub(super) fn finish_mesh(
         Some(
             colors
                 .into_iter()
-                .map(|c| c.clamp(DVec3::ZERO, DVec3::ONE))
+                .map(|c| c.clamp(glam::DVec4::ZERO, glam::DVec4::ONE))
                 .collect(),
         )
     });

@@ -113,9 +113,10 @@ pub struct ImportedMesh {
     /// A second set of texture coordinates (glTF `TEXCOORD_1`, read when a texture of
     /// the mesh's material asks for it), like `uvs`.
     pub uvs1: Option<Vec<DVec2>>,
-    /// Linear RGB vertex colours in [0, 1] (glTF `COLOR_0`, OBJ `v x y z r g b`),
-    /// parallel to `positions`, multiplying the material's albedo.
-    pub colors: Option<Vec<DVec3>>,
+    /// Linear RGBA vertex colours in [0, 1] (glTF `COLOR_0`, OBJ `v x y z r g b` with
+    /// alpha 1), parallel to `positions`: the colour multiplies the material's albedo,
+    /// the alpha its alpha.
+    pub colors: Option<Vec<glam::DVec4>>,
     /// Unit tangents with the bitangent's handedness in `w` (±1), parallel to
     /// `positions`, for a normal map: glTF `TANGENT`, or MikkTSpace's.
     pub tangents: Option<Vec<glam::DVec4>>,

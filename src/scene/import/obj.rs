@@ -360,7 +360,7 @@ impl FaceGroup {
             colors: (!file.colors.is_empty()).then(|| {
                 self.vertices
                     .iter()
-                    .map(|corner| file.colors[corner[0] as usize])
+                    .map(|corner| file.colors[corner[0] as usize].extend(1.0))
                     .collect()
             }),
             triangles: self.triangles,

@@ -112,7 +112,10 @@ pub(super) fn with_mikktspace_tangents(raw: RawMesh, uvs: &[DVec2]) -> Option<Ra
         normals: raw.normals.as_deref().map(pick),
         uvs: raw.uvs.as_deref().map(pick2),
         uvs1: raw.uvs1.as_deref().map(pick2),
-        colors: raw.colors.as_deref().map(pick),
+        colors: raw
+            .colors
+            .as_deref()
+            .map(|values| source.iter().map(|&i| values[i]).collect()),
         tangents: Some(vertex_tangents),
         triangles,
     })
