@@ -13,7 +13,7 @@ use gpu_render::low_level::color::srgb_decode;
 use gpu_render::scene::import::{
     ImportedModel, LUMENS_PER_WATT, WrapMode, import_gltf, import_model, parse_gltf,
 };
-use gpu_render::scene::{AlphaMode, Light, MaterialKind};
+use gpu_render::scene::{AlphaMode, Light, MaterialKind, TextureTransform};
 
 /// A glTF document under construction: one binary buffer and its views and accessors.
 #[derive(Default)]
@@ -1081,7 +1081,6 @@ fn textures_read_the_texture_coordinate_set_they_ask_for() {
 
 #[test]
 fn texture_transforms_are_read_as_offset_rotation_and_scale() {
-    use gpu_render::scene::TextureTransform;
     let transformed = |extension: &str| {
         let (mut doc, _) = triangle_doc();
         let body = two_uv_sets(&mut doc, Some(0), None, None).replace(
@@ -1667,6 +1666,21 @@ fn unsupported_features_that_are_not_required_are_warnings() {
 /// 2 × 2 different tilts, with or without a `TANGENT` of +x and handedness +1 (the
 /// bitangent `normal × tangent` = +y, up the image: glTF's "+Y is up").
 fn normal_mapped_quad(with_tangents: bool) -> (Doc, String) {
+    normal_mapped_quad_with(
+        with_tangents,
+        &[
+            [200, 128, 220, 255],
+            [60, 128, 220, 255],
+            [128, 200, 220, 255],
+            [128, 60, 220, 255],
+        ],
+        "",
+    )
+}
+
+/// [`normal_mapped_quad`] with a normal map of one texel or of 2 × 2 `texels`, and
+/// `extra` JSON members of its `normalTexture` (after its `scale`).
+fn normal_mapped_quad_with(with_tangents: bool, texels: &[[u8; 4]], extra: &str) -> (Doc, String) {
     let mut doc = Doc::default();
     let positions = doc.vec3(&[
         [-1.0, -1.0, 0.0],
@@ -1678,16 +1692,8 @@ fn normal_mapped_quad(with_tangents: bool) -> (Doc, String) {
     let uvs = doc.vec2(&[[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]);
     let tangents = doc.vec4(&[[1.0, 0.0, 0.0, 1.0]; 4]);
     let indices = doc.indices(&[0, 1, 2, 0, 2, 3]);
-    let png = png(
-        2,
-        2,
-        &[
-            [200, 128, 220, 255],
-            [60, 128, 220, 255],
-            [128, 200, 220, 255],
-            [128, 60, 220, 255],
-        ],
-    );
+    let side = if texels.len() == 1 { 1 } else { 2 };
+    let png = png(side, side, texels);
     let uri = format!(
         "data:image/png;base64,{}",
         base64::engine::general_purpose::STANDARD.encode(&png)
@@ -1700,7 +1706,7 @@ fn normal_mapped_quad(with_tangents: bool) -> (Doc, String) {
     let body = format!(
         r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":{positions},"NORMAL":{normals},"TEXCOORD_0":{uvs}{tangent}}},"indices":{indices},"material":0}}]}}],
-           "materials":[{{"normalTexture":{{"index":0,"scale":0.8}},"pbrMetallicRoughness":{{"metallicFactor":0}}}}],
+           "materials":[{{"normalTexture":{{"index":0,"scale":0.8{extra}}},"pbrMetallicRoughness":{{"metallicFactor":0}}}}],
            "textures":[{{"source":0}}],"images":[{{"uri":"{uri}"}}]"#
     );
     (doc, body)
@@ -1745,4 +1751,109 @@ fn generated_tangents_give_the_image_given_ones_give() {
     flat.materials[0].normal_texture = None;
     let c = render(&flat);
     assert!(a.iter().zip(&c).any(|(p, q)| (p[0] - q[0]).abs() > 1e-2));
+}
+
+/// A normal map whose `KHR_texture_transform` turns it a quarter: its axes turn with
+/// it, given (`TANGENT`, turned by the importer) or generated (MikkTSpace on the
+/// transformed coordinates), and it shades as the map turned by hand does.
+#[test]
+fn a_normal_map_s_texture_transform_turns_its_axes() {
+    const QUARTER: &str = r#","extensions":{"KHR_texture_transform":{"rotation":1.5707964}}"#;
+    // Tilted 0.6 towards the map's +x; the same tilt towards its −y.
+    let towards_x = [[204, 128, 230, 255]];
+    let towards_minus_y = [[128, 51, 230, 255]];
+    let model = |tangents: bool, texel: &[[u8; 4]], extra: &str| {
+        let (doc, body) = normal_mapped_quad_with(tangents, texel, extra);
+        let model = imported("turned.gltf", doc.embedded(&body).as_bytes());
+        assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+        model
+    };
+    let given = model(true, &towards_x, QUARTER);
+    let generated = model(false, &towards_x, QUARTER);
+    let turned_by_hand = model(true, &towards_minus_y, "");
+    let unturned = model(true, &towards_x, "");
+    let transform = given.materials[0].normal_texture.expect("map").transform;
+    assert_eq!(
+        transform,
+        TextureTransform::offset_rotation_scale(
+            0,
+            DVec2::ZERO,
+            f64::from(1.570_796_4_f32),
+            DVec2::ONE
+        )
+    );
+    // u' = v, v' = −u: the map's +x runs along increasing v, down the quad (−y); its
+    // +y (decreasing v') along +u (+x): a right-handed frame.
+    for model in [&given, &generated] {
+        for tangent in model.meshes[0].tangents.as_ref().expect("tangents") {
+            assert!(
+                (*tangent - DVec4::new(0.0, -1.0, 0.0, 1.0)).length() < 1e-6,
+                "{tangent}"
+            );
+        }
+    }
+    let settings = gpu_render::scene::RenderSettings {
+        width: 32,
+        height: 24,
+        ..Default::default()
+    };
+    let scene = |model: &ImportedModel| {
+        let mut scene = model.into_scene(settings);
+        scene.camera.eye = DVec3::new(0.0, 0.0, 4.0);
+        scene.camera.look_at = DVec3::ZERO;
+        scene
+    };
+    let render = |model: &ImportedModel| gpu_render::cpu::render(&scene(model), None).image;
+    let largest = |a: &gpu_render::film::LinearImage, b: &gpu_render::film::LinearImage| {
+        crate::support::compare::max_channel_difference(a, b)
+    };
+    let reference = render(&turned_by_hand);
+    for (what, model) in [("given", &given), ("generated", &generated)] {
+        let difference = largest(&render(model), &reference);
+        assert!(
+            difference < 1e-5,
+            "{what} tangents: images differ by {difference}"
+        );
+    }
+    // Read without its transform the map tilts the other way: a different image.
+    let difference = largest(&render(&unturned), &reference);
+    assert!(
+        difference > 1e-2,
+        "the quarter turn changes nothing ({difference})"
+    );
+    // And the GPU agrees, on the transformed lookup and the turned frame.
+    if let Some(gpu) = crate::support::gpu::headless_gpu() {
+        let renderer = crate::support::gpu::renderer(&gpu);
+        crate::support::twins::assert_backends_agree(
+            &gpu,
+            &renderer,
+            "normal-map-quarter-turn",
+            &scene(&given),
+            crate::support::twins::TWIN_TOLERANCE,
+        );
+    }
+
+    // Bad input: a located error, as on the other textures.
+    let (doc, body) = normal_mapped_quad_with(
+        true,
+        &towards_x,
+        r#","extensions":{"KHR_texture_transform":{"offset":[1e300,0]}}"#,
+    );
+    let message = failure("bad.gltf", doc.embedded(&body).as_bytes());
+    assert!(
+        message
+            .contains("bad.gltf: material 0: normalTexture: KHR_texture_transform offset [inf, 0]"),
+        "{message}"
+    );
+    let (doc, body) = normal_mapped_quad_with(
+        true,
+        &towards_x,
+        r#","extensions":{"KHR_texture_transform":{"rotation":"a quarter"}}"#,
+    );
+    let message = failure("bad.gltf", doc.embedded(&body).as_bytes());
+    assert!(
+        message
+            .contains("bad.gltf: material 0: normalTexture: KHR_texture_transform: invalid type"),
+        "{message}"
+    );
 }

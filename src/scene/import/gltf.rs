@@ -526,9 +526,35 @@ struct MaterialUse {
     index: u32,
     /// Whether a texture reads `TEXCOORD_1`.
     uses_set1: bool,
-    /// The texture coordinate set of its normal map, if it has one: the primitive then
-    /// needs tangents.
-    normal_set: Option<u32>,
+    /// The coordinates of its normal map (set and `KHR_texture_transform`), if it has
+    /// one: the primitive then needs tangents, for the map's axes.
+    normal_map: Option<TextureTransform>,
+}
+
+/// A texture's `KHR_texture_transform` as its JSON gives it (checked by
+/// [`Importer::transform`]).
+#[derive(Debug, Clone, Copy)]
+struct TransformExtension {
+    offset: [f32; 2],
+    rotation: f32,
+    scale: [f32; 2],
+    /// The texture coordinate set that overrides the texture's `texCoord`.
+    tex_coord: Option<u32>,
+}
+
+impl TransformExtension {
+    /// Reads the extension's object where gltf 1.4 leaves it unparsed (on a
+    /// `normalTexture`, whose extensions it keeps as JSON).
+    fn from_json(value: &::gltf::json::Value) -> Result<Self, String> {
+        let json: ::gltf::json::extensions::texture::TextureTransform =
+            ::gltf::json::deserialize::from_value(value.clone()).map_err(|e| e.to_string())?;
+        Ok(Self {
+            offset: json.offset.0,
+            rotation: json.rotation.0,
+            scale: json.scale.0,
+            tex_coord: json.tex_coord,
+        })
+    }
 }
 
 /// `what N ('name')`, or `what N` for an unnamed element.
@@ -929,7 +955,7 @@ impl Importer<'_> {
                 indices.len() % 3
             ));
         }
-        let Some(normal_set) = uses.normal_set else {
+        let Some(normal_map) = uses.normal_map else {
             return Ok(RawMesh {
                 positions,
                 normals,
@@ -941,7 +967,7 @@ impl Importer<'_> {
             });
         };
         let tangents = self.tangents(primitive, name, count)?;
-        let raw = RawMesh {
+        let mut raw = RawMesh {
             positions,
             normals,
             uvs,
@@ -950,11 +976,27 @@ impl Importer<'_> {
             tangents,
             triangles,
         };
-        if raw.tangents.is_some() {
+        if let Some(given) = raw.tangents.as_mut() {
+            // TANGENT runs along the mesh's coordinates, the map's axes along the
+            // transformed ones (a TANGENT without NORMAL, which glTF says to ignore, is
+            // kept as it is).
+            if let Some(normals) = &raw.normals {
+                super::tangents::follow_texture_transform(given, normals, &normal_map);
+            }
             return Ok(raw);
         }
-        // No TANGENT: MikkTSpace's, from the normals and the normal map's coordinates.
-        let map_uvs = if normal_set == 1 { &raw.uvs1 } else { &raw.uvs };
+        // No TANGENT: MikkTSpace's, from the normals and the normal map's coordinates as
+        // the map reads them (`KHR_texture_transform` applied).
+        let map_uvs = if normal_map.set == 1 {
+            &raw.uvs1
+        } else {
+            &raw.uvs
+        };
+        let map_uvs = map_uvs.as_ref().map(|uvs| {
+            uvs.iter()
+                .map(|&uv| normal_map.apply(uv))
+                .collect::<Vec<_>>()
+        });
         let generated = match (&raw.normals, map_uvs.clone()) {
             (Some(_), Some(map_uvs)) => super::tangents::with_mikktspace_tangents(
                 RawMesh {
@@ -1150,7 +1192,7 @@ impl Importer<'_> {
         if let Some(&known) = self.materials.get(&index) {
             return Ok(known);
         }
-        let (imported, uses_set1, normal_set) =
+        let (imported, uses_set1, normal_map) =
             match index.and_then(|i| self.document.materials().nth(i)) {
                 Some(material) => self.map_material(&material)?,
                 None => (
@@ -1180,18 +1222,19 @@ impl Importer<'_> {
         let uses = MaterialUse {
             index: ours,
             uses_set1,
-            normal_set,
+            normal_map,
         };
         self.materials.insert(index, uses);
         Ok(uses)
     }
 
     /// Maps a glTF metallic-roughness material onto ours (the table in `docs/models.md`),
-    /// with whether one of its textures reads `TEXCOORD_1`.
+    /// with whether one of its textures reads `TEXCOORD_1` and the coordinates of its
+    /// normal map, if any.
     fn map_material(
         &mut self,
         material: &::gltf::Material<'_>,
-    ) -> Result<(ImportedMaterial, bool, Option<u32>), SceneError> {
+    ) -> Result<(ImportedMaterial, bool, Option<TextureTransform>), SceneError> {
         let name = describe("material", material.index().unwrap_or(0), material.name());
         let pbr = material.pbr_metallic_roughness();
         let [r, g, b, alpha] = pbr.base_color_factor().map(f64::from);
@@ -1328,17 +1371,14 @@ impl Importer<'_> {
                         self.fail(format!("{name}: normalTexture scale {scale} is not finite"))
                     );
                 }
-                let mut set = normal.tex_coord();
-                if set > 1 {
-                    self.warn(format!(
-                        "{name}: normalTexture uses TEXCOORD_{set}, but only TEXCOORD_0 and TEXCOORD_1 are read; TEXCOORD_0 is used"
-                    ));
-                    set = 0;
-                }
-                let transform = TextureTransform {
-                    set,
-                    ..TextureTransform::IDENTITY
+                let extension = match normal.extension_value("KHR_texture_transform") {
+                    Some(value) => Some(TransformExtension::from_json(value).map_err(|e| {
+                        self.fail(format!("{name}: normalTexture: KHR_texture_transform: {e}"))
+                    })?),
+                    None => None,
                 };
+                let transform =
+                    self.transform(normal.tex_coord(), extension, &name, "normalTexture")?;
                 let texture = self.texture_of(
                     normal.texture(),
                     transform,
@@ -1370,7 +1410,7 @@ impl Importer<'_> {
             emissive_texture,
             normal_texture,
         };
-        Ok((imported, uses_set1, normal_texture.map(|t| t.transform.set)))
+        Ok((imported, uses_set1, normal_texture.map(|t| t.transform)))
     }
 
     /// Loads the image of a material's texture and keeps its sampler's wrap modes, its
@@ -1382,7 +1422,15 @@ impl Importer<'_> {
         material: &str,
         slot: &str,
     ) -> Result<TextureRef, SceneError> {
-        let transform = self.transform(info, material, slot)?;
+        let extension = info
+            .texture_transform()
+            .map(|extension| TransformExtension {
+                offset: extension.offset(),
+                rotation: extension.rotation(),
+                scale: extension.scale(),
+                tex_coord: extension.tex_coord(),
+            });
+        let transform = self.transform(info.tex_coord(), extension, material, slot)?;
         self.texture_of(info.texture(), transform, encoding, material, slot)
     }
 
@@ -1453,17 +1501,18 @@ impl Importer<'_> {
     /// no fraction of a texel), is an error.
     fn transform(
         &mut self,
-        info: &::gltf::texture::Info<'_>,
+        tex_coord: u32,
+        extension: Option<TransformExtension>,
         material: &str,
         slot: &str,
     ) -> Result<TextureTransform, SceneError> {
-        let mut set = info.tex_coord();
+        let mut set = tex_coord;
         let mut transform = TextureTransform::IDENTITY;
-        if let Some(extension) = info.texture_transform() {
-            set = extension.tex_coord().unwrap_or(set);
-            let offset = DVec2::from_array(extension.offset().map(f64::from));
-            let rotation = f64::from(extension.rotation());
-            let scale = DVec2::from_array(extension.scale().map(f64::from));
+        if let Some(extension) = extension {
+            set = extension.tex_coord.unwrap_or(set);
+            let offset = DVec2::from_array(extension.offset.map(f64::from));
+            let rotation = f64::from(extension.rotation);
+            let scale = DVec2::from_array(extension.scale.map(f64::from));
             let in_range =
                 |v: DVec2| v.is_finite() && v.abs().max_element() <= MAX_TEXTURE_TRANSFORM;
             if !(in_range(offset) && in_range(scale) && rotation.is_finite()) {

@@ -9,6 +9,7 @@ use std::collections::HashMap;
 use glam::{DVec2, DVec3, DVec4};
 
 use super::mesh::RawMesh;
+use crate::scene::TextureTransform;
 
 /// The geometry `mikktspace` reads, corner by corner, and the tangents it writes.
 struct Corners<'a> {
@@ -119,4 +120,118 @@ pub(super) fn with_mikktspace_tangents(raw: RawMesh, uvs: &[DVec2]) -> Option<Ra
         tangents: Some(vertex_tangents),
         triangles,
     })
+}
+
+/// Turns `tangents` (`TANGENT`'s, along the mesh's own texture coordinates) into the
+/// axes of a normal map read through `transform` (`KHR_texture_transform`), at vertices
+/// of unit-length `normals`. The map's `x` and `y` run along increasing `u'` and
+/// decreasing `v'` of the transformed coordinates `(u', v') = L·(u, v) + offset`; with
+/// the given frame `T = ∂P/∂x`, `B = w·(N × T) = ∂P/∂y` (glTF 2.0 §3.7.2.1) and `L` in
+/// image axes, `L_img = F·L·F` with `F = diag(1, −1)`, the chain rule gives
+/// `(∂P/∂x', ∂P/∂y') = (T, B)·L_img⁻¹`. The new tangent is `∂P/∂x'` made orthogonal to
+/// `N` and normalized, its handedness the sign of `(N × T')·∂P/∂y'`: exact for a
+/// rotation, a uniform scale and any mirror, which keep the axes orthogonal (the frame
+/// stays orthonormal, as MikkTSpace's does, under the rest). A transform that is an
+/// offset only leaves them as they are; so does a singular one (a zero scale: the map
+/// then reads one texel, whatever the frame).
+pub(super) fn follow_texture_transform(
+    tangents: &mut [DVec4],
+    normals: &[DVec3],
+    transform: &TextureTransform,
+) {
+    if transform.is_linear_identity() {
+        return;
+    }
+    let [r0, r1] = transform.rows;
+    let determinant = r0.x * r1.y - r0.y * r1.x;
+    if determinant == 0.0 || !determinant.is_finite() {
+        return;
+    }
+    for (tangent, &normal) in tangents.iter_mut().zip(normals) {
+        let along = tangent.truncate();
+        let bitangent = normal.cross(along) * if tangent.w < 0.0 { -1.0 } else { 1.0 };
+        // Columns of L_img⁻¹ = [[r11, r01], [r10, r00]] / det.
+        let x_axis = (along * r1.y + bitangent * r1.x) / determinant;
+        let y_axis = (along * r0.y + bitangent * r0.x) / determinant;
+        let in_plane = x_axis - normal * normal.dot(x_axis);
+        let length = in_plane.length();
+        if !(length > 0.0 && length.is_finite()) {
+            continue;
+        }
+        let turned = in_plane / length;
+        let handedness = if normal.cross(turned).dot(y_axis) < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+        *tangent = turned.extend(handedness);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const N: DVec3 = DVec3::Z;
+
+    fn followed(tangent: DVec4, transform: TextureTransform) -> DVec4 {
+        let mut tangents = [tangent];
+        follow_texture_transform(&mut tangents, &[N], &transform);
+        tangents[0]
+    }
+
+    fn assert_close(a: DVec4, b: DVec4) {
+        assert!((a - b).abs().max_element() < 1e-12, "{a} against {b}");
+    }
+
+    #[test]
+    fn a_quarter_turn_turns_the_frame_the_other_way() {
+        // u' = v, v' = −u: the map's x (increasing u') runs along increasing v, which is
+        // −B (B points up the image, against v); its y (decreasing v') along +u, +T.
+        let quarter = TextureTransform::offset_rotation_scale(
+            0,
+            DVec2::ZERO,
+            std::f64::consts::FRAC_PI_2,
+            DVec2::ONE,
+        );
+        let t = DVec4::new(1.0, 0.0, 0.0, 1.0);
+        assert_close(followed(t, quarter), DVec4::new(0.0, -1.0, 0.0, 1.0));
+        // A left-handed frame (B = −y): the map's x along −B = +y.
+        let mirrored = DVec4::new(1.0, 0.0, 0.0, -1.0);
+        assert_close(followed(mirrored, quarter), DVec4::new(0.0, 1.0, 0.0, -1.0));
+    }
+
+    #[test]
+    fn a_mirroring_scale_flips_the_handedness_only() {
+        // SheenCloth's scale [30, −30]: the map's x still along T, its y against B.
+        let scale =
+            TextureTransform::offset_rotation_scale(0, DVec2::ZERO, 0.0, DVec2::new(30.0, -30.0));
+        let t = DVec4::new(0.0, 1.0, 0.0, 1.0);
+        assert_close(followed(t, scale), DVec4::new(0.0, 1.0, 0.0, -1.0));
+    }
+
+    #[test]
+    fn offsets_and_singular_maps_leave_the_frame_alone() {
+        let t = DVec4::new(0.6, 0.8, 0.0, -1.0);
+        let offset =
+            TextureTransform::offset_rotation_scale(1, DVec2::new(0.25, 3.0), 0.0, DVec2::ONE);
+        assert_eq!(followed(t, offset), t);
+        let flat =
+            TextureTransform::offset_rotation_scale(0, DVec2::ZERO, 0.3, DVec2::new(0.0, 1.0));
+        assert_eq!(followed(t, flat), t);
+    }
+
+    #[test]
+    fn any_rotation_turns_the_frame_by_its_angle() {
+        // A rotation by θ of the coordinates turns the map's axes by −θ on the surface
+        // (the image turns clockwise under a counter-clockwise turn of the coordinates
+        // and v runs down): here T = +x, B = +y, so T' = (cos θ, −sin θ).
+        for k in 0..16 {
+            let theta = f64::from(k) * 0.4 - 3.0;
+            let rotation =
+                TextureTransform::offset_rotation_scale(0, DVec2::ZERO, theta, DVec2::splat(2.5));
+            let t = followed(DVec4::new(1.0, 0.0, 0.0, 1.0), rotation);
+            assert_close(t, DVec4::new(theta.cos(), -theta.sin(), 0.0, 1.0));
+        }
+    }
 }
