@@ -1210,3 +1210,103 @@ fn dissolve_makes_a_blended_material_of_that_alpha() {
         model.warnings
     );
 }
+
+/// `map_d` (MTL's dissolve texture) is coverage, as tinyobjloader, assimp and three.js
+/// read it: a grey mask's values, or a cut-out's alpha, become the alpha of the albedo
+/// texture (blended, as `d` is), at `map_Kd`'s size; without `map_Kd`, on a white
+/// texture that `Kd` colours.
+#[test]
+fn map_d_is_coverage_in_the_albedo_texture_s_alpha() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    write_png(
+        &dir.path().join("leaf.png"),
+        2,
+        1,
+        &[[255, 0, 0, 255], [0, 255, 0, 255]],
+    );
+    // A grey mask at twice the size: its texels average in pairs.
+    write_png(
+        &dir.path().join("leaf mask.png"),
+        4,
+        2,
+        &[
+            [0, 0, 0, 255],
+            [0, 0, 0, 255],
+            [255, 255, 255, 255],
+            [128, 128, 128, 255],
+        ]
+        .repeat(2),
+    );
+    // A cut-out whose colour is black but whose alpha holds the mask.
+    write_png(
+        &dir.path().join("cutout.png"),
+        2,
+        1,
+        &[[0, 0, 0, 0], [0, 0, 0, 255]],
+    );
+    std::fs::write(
+        dir.path().join("leaf.mtl"),
+        "newmtl leaf\nKd 1 1 1\nmap_Kd leaf.png\nmap_d leaf mask.png\n\
+         newmtl cut\nKd 0.5 0.5 0.5\nmap_d -imfchan m cutout.png\n\
+         newmtl auto\nmap_d cutout.png\n\
+         newmtl glass\nillum 7\nmap_d cutout.png\n\
+         newmtl lost\nmap_d nowhere.png\n",
+    )
+    .expect("mtl");
+    std::fs::write(
+        dir.path().join("leaf.obj"),
+        "mtllib leaf.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n\
+         usemtl leaf\nf 1/1 2/2 3/3\nusemtl cut\nf 1/1 2/2 3/3\nusemtl auto\nf 1/1 2/2 3/3\n\
+         usemtl glass\nf 1/1 2/2 3/3\nusemtl lost\nf 1/1 2/2 3/3\n",
+    )
+    .expect("obj");
+    let model = import_obj(&dir.path().join("leaf.obj")).expect("imports");
+    let material = |name: &str| {
+        model
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .unwrap_or_else(|| panic!("material {name}"))
+    };
+    let texels = |name: &str| {
+        let texture = material(name).base_color_texture.expect("a texture");
+        let image = &model.images[texture.image as usize];
+        (0..image.width)
+            .map(|x| image.texel(x, 0))
+            .collect::<Vec<_>>()
+    };
+
+    // The colour texture keeps its (linearised) colours; its alpha is the mask's mean
+    // over each texel, the file's values (a scalar texture is not linearised).
+    let leaf = texels("leaf");
+    assert_eq!(leaf.len(), 2, "map_Kd's size");
+    assert_eq!(leaf[0], [1.0, 0.0, 0.0, 0.0]);
+    let grey = (1.0 + 128.0 / 255.0) / 2.0;
+    assert!((leaf[1][3] - grey).abs() < 1e-6, "{:?}", leaf[1]);
+    assert_eq!(leaf[1][1], 1.0);
+    assert_eq!(material("leaf").material.alpha_mode, AlphaMode::Blend);
+    assert_eq!(material("leaf").material.alpha, 1.0);
+    // `-imfchan m`: the alpha; on white, Kd giving the colour.
+    let cut = texels("cut");
+    assert_eq!(cut, vec![[1.0, 1.0, 1.0, 0.0], [1.0; 4]]);
+    assert_eq!(material("cut").material.diffuse, DVec3::splat(0.5));
+    // Without -imfchan an image with alpha gives its alpha (its colour, all black,
+    // would cover nothing); without Kd the default grey.
+    assert_eq!(texels("auto"), cut);
+    assert_eq!(material("auto").material.diffuse, DVec3::splat(0.8));
+    // Glass ignores it, as it ignores d; a missing mask is a warning.
+    assert_eq!(material("glass").material.alpha_mode, AlphaMode::Opaque);
+    assert!(material("glass").base_color_texture.is_none());
+    assert_eq!(material("lost").material.alpha_mode, AlphaMode::Opaque);
+    for needle in [
+        "material 'glass': map_d is ignored on glass",
+        "material 'lost': map_d: the texture",
+    ] {
+        assert!(
+            model.warnings.iter().any(|w| w.contains(needle)),
+            "{needle}: {:?}",
+            model.warnings
+        );
+    }
+    assert_eq!(model.warnings.len(), 2, "{:?}", model.warnings);
+}

@@ -15,6 +15,7 @@
 //! missing library or texture, an empty `usemtl`, normal indices in a file without
 //! `vn`, and a number followed by junk (`3.1+e2`) are warnings, never errors.
 
+mod dissolve;
 mod face;
 mod mtl;
 

@@ -63,6 +63,29 @@ impl Textures {
             .map_err(|e| e.message(fail))
     }
 
+    /// The index of an image made from loaded ones by `make` (a colour texture with a
+    /// dissolve texture's coverage), made once per `key`, after charging its `width ×
+    /// height` texels to `budget`.
+    pub fn derived(
+        &mut self,
+        key: String,
+        (width, height): (u32, u32),
+        make: impl FnOnce(&[Image]) -> Image,
+        budget: &mut Budget,
+    ) -> Result<u32, String> {
+        // A NUL cannot start a path, so no file's key meets a derived one.
+        let key = (format!("\0derived {key}"), Encoding::Color);
+        if let Some(&index) = self.loaded.get(&key) {
+            return Ok(index);
+        }
+        budget.charge_texels(width, height).map_err(String::from)?;
+        let image = make(&self.images);
+        let index = self.images.len() as u32;
+        self.images.push(image);
+        self.loaded.insert(key, index);
+        Ok(index)
+    }
+
     /// Decodes the image file `bytes` (read from or named `path`) and adds it, after
     /// charging its texels to `budget` from its header, before its texels are
     /// allocated.

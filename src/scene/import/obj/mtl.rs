@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 
+use super::dissolve::{CoverageChannel, coverage_size, with_coverage};
 use super::{DEFAULT_OBJ_ALBEDO, Notes, at, decode_text, finite, is_integer, strip_comment, words};
 use crate::echo::{echo, echo_path, short, short3};
 use crate::input::{InputError, read_input};
@@ -37,6 +38,8 @@ pub(super) struct SourceMaterial {
     map_kd_at: Option<(usize, usize)>,
     /// `map_Ke` line and column, when it has one.
     map_ke_at: Option<(usize, usize)>,
+    /// `map_d` line and column, when it has one.
+    map_d_at: Option<(usize, usize)>,
 }
 
 /// The material libraries an OBJ file names.
@@ -143,6 +146,7 @@ impl Libraries {
                 line,
                 map_kd_at,
                 map_ke_at,
+                map_d_at,
             },
         ) in materials.into_iter().zip(lines)
         {
@@ -155,6 +159,7 @@ impl Libraries {
                 mtllib_line,
                 map_kd_at,
                 map_ke_at,
+                map_d_at,
             });
         }
         Ok(())
@@ -208,11 +213,12 @@ const MTL_SCALARS: &[&str] = &[
 ];
 
 /// Where a material of an MTL library is defined: the line of its `newmtl`, and the line
-/// and column of its `map_Kd` and `map_Ke`, when it has them.
+/// and column of its `map_Kd`, `map_Ke` and `map_d`, when it has them.
 struct MtlLines {
     line: usize,
     map_kd_at: Option<(usize, usize)>,
     map_ke_at: Option<(usize, usize)>,
+    map_d_at: Option<(usize, usize)>,
 }
 
 /// Checks every line of an MTL library and returns the text for `tobj` (colours with one
@@ -252,6 +258,7 @@ fn scan_mtl(
                 line: n,
                 map_kd_at: None,
                 map_ke_at: None,
+                map_d_at: None,
             });
         } else if MTL_COLOURS.contains(&keyword) {
             if values
@@ -333,10 +340,11 @@ fn scan_mtl(
                     format!("`{}` needs a file name", echo(keyword)),
                 ));
             }
-            if keyword == "map_Kd" || keyword == "map_Ke" {
+            if matches!(keyword, "map_Kd" | "map_Ke" | "map_d") {
                 match lines.last_mut() {
                     Some(last) if keyword == "map_Kd" => last.map_kd_at = Some((n, column)),
-                    Some(last) => last.map_ke_at = Some((n, column)),
+                    Some(last) if keyword == "map_Ke" => last.map_ke_at = Some((n, column)),
+                    Some(last) => last.map_d_at = Some((n, column)),
                     None => kept.clear(),
                 }
             }
@@ -387,16 +395,20 @@ pub(super) fn map_material(
     let mut warn = |message: String| warnings.push(format!("{place}: {message}"));
     let colour = |c: Option<[f64; 3]>| c.map(|[r, g, b]| DVec3::new(r, g, b));
 
-    // A colour texture statement (`map_Kd`, `map_Ke`) at `at`, loaded relative to the
-    // library's directory.
-    let mut colour_texture = |key: &str,
-                              spec: Option<&String>,
-                              at_line: Option<(usize, usize)>|
+    // A texture statement (`map_Kd`, `map_Ke`, `map_d`) at `at`, loaded relative to the
+    // library's directory (`map_d`'s `-imfchan` is read by the caller).
+    let mut load_texture = |key: &str,
+                            spec: Option<&String>,
+                            at_line: Option<(usize, usize)>,
+                            encoding: Encoding|
      -> Result<Option<TextureRef>, SceneError> {
         let (Some(spec), Some((line, column))) = (spec, at_line) else {
             return Ok(None);
         };
-        let (file, wrap, ignored) = texture_options(spec);
+        let (file, wrap, mut ignored) = texture_options(spec);
+        if key == "map_d" {
+            ignored.retain(|option| !option.starts_with("-imfchan"));
+        }
         if !ignored.is_empty() {
             warn(format!(
                 "{key} options {} are not supported; ignored",
@@ -417,16 +429,14 @@ pub(super) fn map_material(
             ));
             return Ok(None);
         }
-        let image = textures
-            .file(&file_path, Encoding::Color, budget)
-            .map_err(|e| {
-                at(
-                    &source.library,
-                    line,
-                    column,
-                    format!("material '{}': {key}: {e}", echo(&m.name)),
-                )
-            })?;
+        let image = textures.file(&file_path, encoding, budget).map_err(|e| {
+            at(
+                &source.library,
+                line,
+                column,
+                format!("material '{}': {key}: {e}", echo(&m.name)),
+            )
+        })?;
         Ok(Some(TextureRef {
             image,
             wrap_u: wrap,
@@ -434,15 +444,39 @@ pub(super) fn map_material(
             transform: crate::scene::TextureTransform::IDENTITY,
         }))
     };
-    let base_color_texture =
-        colour_texture("map_Kd", m.diffuse_texture.as_ref(), source.map_kd_at)?;
-    let emissive_texture =
-        colour_texture("map_Ke", m.unknown_param.get("map_Ke"), source.map_ke_at)?;
+    let mut base_color_texture = load_texture(
+        "map_Kd",
+        m.diffuse_texture.as_ref(),
+        source.map_kd_at,
+        Encoding::Color,
+    )?;
+    let emissive_texture = load_texture(
+        "map_Ke",
+        m.unknown_param.get("map_Ke"),
+        source.map_ke_at,
+        Encoding::Color,
+    )?;
+    // A scalar texture: the file's values, not linearised.
+    let dissolve_texture = load_texture(
+        "map_d",
+        m.dissolve_texture.as_ref(),
+        source.map_d_at,
+        Encoding::Data,
+    )?;
+    let coverage_channel = match m.dissolve_texture.as_deref().and_then(imfchan) {
+        None => CoverageChannel::Auto,
+        Some(letter) => CoverageChannel::from_imfchan(&letter).unwrap_or_else(|| {
+            warn(format!(
+                "map_d -imfchan {} is not supported (r, g, b, m or l are); its alpha, or else its luminance, is the coverage",
+                echo(&letter)
+            ));
+            CoverageChannel::Auto
+        }),
+    };
     for (key, present) in [
         ("map_Ks", m.specular_texture.is_some()),
         ("map_Ka", m.ambient_texture.is_some()),
         ("map_Ns", m.shininess_texture.is_some()),
-        ("map_d", m.dissolve_texture.is_some()),
         ("bump", m.normal_texture.is_some()),
     ] {
         if present {
@@ -601,6 +635,47 @@ pub(super) fn map_material(
         material.alpha_mode = AlphaMode::Blend;
         material.alpha = dissolve.max(0.0);
     }
+    // `map_d` as coverage too, in the albedo texture's alpha (made once per pair of
+    // images); ignored on glass as `d` is.
+    if let Some(mask) = dissolve_texture {
+        if material.kind == MaterialKind::Dielectric {
+            warn("map_d is ignored on glass (illum 4, 6, 7, 9), as d is".into());
+        } else {
+            let base = base_color_texture.map(|t| t.image);
+            let size = coverage_size(
+                base.map(|i| &textures.images[i as usize]),
+                &textures.images[mask.image as usize],
+            );
+            let key = format!("{base:?} {} {coverage_channel:?}", mask.image);
+            let image = textures
+                .derived(
+                    key,
+                    size,
+                    |images| {
+                        with_coverage(
+                            base.map(|i| &images[i as usize]),
+                            &images[mask.image as usize],
+                            coverage_channel,
+                        )
+                    },
+                    budget,
+                )
+                .map_err(|e| {
+                    let (line, column) = source.map_d_at.unwrap_or((source.line, 1));
+                    at(
+                        &source.library,
+                        line,
+                        column,
+                        format!("material '{}': map_d: {e}", echo(&m.name)),
+                    )
+                })?;
+            base_color_texture = Some(TextureRef {
+                image,
+                ..base_color_texture.unwrap_or(mask)
+            });
+            material.alpha_mode = AlphaMode::Blend;
+        }
+    }
     Ok(ImportedMaterial {
         name: m.name.clone(),
         material,
@@ -609,6 +684,15 @@ pub(super) fn map_material(
         emissive_texture,
         normal_texture: None,
     })
+}
+
+/// The argument of a texture statement's `-imfchan` option, if it has one.
+fn imfchan(spec: &str) -> Option<String> {
+    let (_, _, options) = texture_options(spec);
+    options
+        .iter()
+        .find_map(|option| option.strip_prefix("-imfchan "))
+        .map(str::to_string)
 }
 
 /// Splits a texture statement (`-clamp on -s 2 2 file name.png`) into the file name, the
