@@ -105,4 +105,8 @@ pub mod gpu {
     pub mod cpu_device {
         pub use crate::gpu::cpu_device::unrolled;
     }
+    /// The hardware traversal's acceleration structures.
+    pub mod ray_query {
+        pub use crate::gpu::ray_query::{Acceleration, build_acceleration};
+    }
 }

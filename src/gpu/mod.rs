@@ -44,7 +44,7 @@ mod gpu_scene;
 pub(crate) mod layout;
 mod limits;
 mod pipelines;
-mod ray_query;
+pub(crate) mod ray_query;
 mod readback;
 mod renderer;
 mod scene_buffers;

@@ -208,7 +208,7 @@ pub(crate) fn fits_hardware(
 /// A scene's acceleration structures on the device: the top-level one the trace
 /// kernels bind, and the bottom-level ones it places (kept alive with it).
 #[derive(Debug)]
-pub(crate) struct Acceleration {
+pub struct Acceleration {
     /// The top-level structure (`scene_tlas` in `shaders/ray_query.wgsl`).
     pub tlas: wgpu::Tlas,
     /// The scene's own triangles' structure, then each instanced mesh's.
@@ -248,7 +248,7 @@ struct BottomLevel {
 ///
 /// Errors: [`RenderError::OutOfMemory`] or [`RenderError::Wgpu`] if wgpu refuses a
 /// structure or its build.
-pub(crate) fn build_acceleration(
+pub fn build_acceleration(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     triangles: &wgpu::Buffer,

@@ -34,7 +34,7 @@ use crate::support::twins::{TWIN_TOLERANCE, assert_backends_agree, assert_ray_co
 ///
 /// In CI (`CI` set), when the device has no ray queries: the lavapipe the project
 /// installs (Mesa 25.0.7) has them, so the hardware path must be tested there.
-fn ray_query_gpu() -> Option<HeadlessGpu> {
+pub(crate) fn ray_query_gpu() -> Option<HeadlessGpu> {
     let gpu = crate::support::gpu::headless_gpu()?;
     if hardware_traversal_available(&gpu.device) {
         return Some(gpu);
