@@ -29,7 +29,7 @@ use super::trace::{PreparedScene, shading_frame_normal};
 use super::traverse::intersect_scene_with;
 use crate::denoise::GuidePasses;
 use crate::scene::{Integrator, Material, MaterialKind, Scene};
-use crate::texture::{ConeFootprint, mapped_normal, shading_material};
+use crate::texture::{mapped_normal, shading_material};
 
 /// What a camera ray's first hit contributes to the auxiliary passes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -79,13 +79,7 @@ pub fn first_hit_aov(scene: &PreparedScene, ray: &Ray, blend: BlendRule) -> Opti
     };
     let record = &scene.materials[hit.material as usize];
     let uvs = [hit.uv, hit.uv1];
-    let textures = scene.textures(ConeFootprint::new(
-        cone_width,
-        ray.direction,
-        hit.normal,
-        hit.uv_density,
-        hit.uv_axis,
-    ));
+    let textures = scene.textures(hit.footprint(cone_width, ray.direction));
     let material = shading_material(
         record,
         &textures,

@@ -10,7 +10,7 @@ use crate::accel::{
 };
 use crate::scene::PolygonPlane;
 pub use crate::scene::project_to_plane;
-use crate::texture::footprint_axis;
+use crate::texture::{ConeFootprint, footprint_axis};
 
 /// A ray `origin + t · direction`, `direction` of unit length.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -76,6 +76,19 @@ pub struct Hit {
 }
 
 impl Hit {
+    /// The texture footprint here of a ray cone `cone_width` wide at the hit, met
+    /// along `direction` ([`ConeFootprint::new`] with the hit's normal and texture
+    /// coordinate density and axis).
+    pub fn footprint(&self, cone_width: f64, direction: DVec3) -> ConeFootprint {
+        ConeFootprint::new(
+            cone_width,
+            direction,
+            self.normal,
+            self.uv_density,
+            self.uv_axis,
+        )
+    }
+
     /// The surface that was hit: its primitive and instance.
     pub fn key(&self) -> HitKey {
         HitKey {

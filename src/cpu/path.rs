@@ -42,7 +42,7 @@ use crate::sample::{
     sample_triangle_barycentrics,
 };
 use crate::scene::{Material, MaterialKind, MediumStack, MicrofacetDistribution};
-use crate::texture::{ConeFootprint, mapped_normal, shading_emission, shading_material};
+use crate::texture::{mapped_normal, shading_emission, shading_material};
 
 /// Bounces after which Russian roulette may end a path.
 pub const ROULETTE_DEPTH: u32 = 3;
@@ -253,13 +253,7 @@ pub fn path_radiance(scene: &PreparedScene, primary: Ray, pixel: u32, sample: u3
             ray.origin = offset_ray_origin(hit.position, hit.normal, geometry.offset_scale);
             continue;
         }
-        let textures = scene.textures(ConeFootprint::new(
-            cone_width,
-            ray.direction,
-            hit.normal,
-            hit.uv_density,
-            hit.uv_axis,
-        ));
+        let textures = scene.textures(hit.footprint(cone_width, ray.direction));
         let material = shading_material(
             record,
             &textures,
@@ -508,13 +502,7 @@ fn sample_emitter(
     // The radiance of the sampled point: the emitter's own, times its emission texture
     // at the point where the shadow ray meets it (that point, found with the texture
     // coordinates of its barycentrics as every hit is).
-    let footprint = ConeFootprint::new(
-        scene.cone_width_at(cone_width, &light_hit),
-        wi,
-        light_hit.normal,
-        light_hit.uv_density,
-        light_hit.uv_axis,
-    );
+    let footprint = light_hit.footprint(scene.cone_width_at(cone_width, &light_hit), wi);
     let radiance = shading_emission(
         &scene.materials[light_hit.material as usize],
         &scene.textures(footprint),

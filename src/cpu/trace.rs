@@ -340,13 +340,7 @@ pub fn trace_radiance(scene: &PreparedScene, primary: Ray) -> (DVec3, u64) {
             }
             entry.weight *= alpha;
         }
-        let footprint = ConeFootprint::new(
-            cone_width,
-            entry.ray.direction,
-            hit.normal,
-            hit.uv_density,
-            hit.uv_axis,
-        );
+        let footprint = hit.footprint(cone_width, entry.ray.direction);
         let shaded = shade_hit(scene, &entry.ray, &hit, &entry.medium, footprint);
         add_contribution(&mut radiance, entry.weight * shaded.radiance);
         rays += shaded.shadow_rays;

@@ -307,6 +307,14 @@ fn run_kernel(
     bytemuck::pod_collect_to_vec(&bytes)
 }
 
+/// Every ray as a closest-hit query, then again as a shadow ray (any hit) to distance 3.
+fn closest_and_shadow_queries(rays: &[Ray]) -> Vec<(Ray, f32, bool)> {
+    let closest = rays.iter().map(|r| (*r, f32::INFINITY, false));
+    closest
+        .chain(rays.iter().map(|r| (*r, 3.0, true)))
+        .collect()
+}
+
 /// Checks the traversal on `rays`; with `watertight`, every closest-hit ray must hit.
 fn check(
     gpu: &gpu_render::gpu::HeadlessGpu,
@@ -317,10 +325,7 @@ fn check(
 ) {
     let scene = scene_of(shapes);
     let geometry = SceneGeometry::with_method(&scene, BuildMethod::Sah);
-    // Every ray as a closest-hit query, and again as a shadow ray to distance 3.
-    let mut queries: Vec<(Ray, f32, bool)> =
-        rays.iter().map(|r| (*r, f32::INFINITY, false)).collect();
-    queries.extend(rays.iter().map(|r| (*r, 3.0, true)));
+    let queries = closest_and_shadow_queries(&rays);
     let budget = gpu_render::gpu::iteration_budget_for(&gpu.adapter_info());
     let traversed = run_kernel(
         gpu,
@@ -464,9 +469,7 @@ fn gpu_traversal_through_instances_resumes_and_agrees_with_the_cpu() {
     let geometry = SceneGeometry::with_method(&scene, BuildMethod::Sah);
     assert_eq!(geometry.instances.len(), 5);
     let rays = random_rays(4000, 23);
-    let mut queries: Vec<(Ray, f32, bool)> =
-        rays.iter().map(|r| (*r, f32::INFINITY, false)).collect();
-    queries.extend(rays.iter().map(|r| (*r, 3.0, true)));
+    let queries = closest_and_shadow_queries(&rays);
     let budget = gpu_render::gpu::iteration_budget_for(&gpu.adapter_info());
     let traversed = run_kernel(
         &gpu,
@@ -608,9 +611,7 @@ fn hardware_traversal_finds_the_hits_of_the_software_walk() {
     let budget = gpu_render::gpu::iteration_budget_for(&gpu.adapter_info());
     for (name, scene, rays) in cases {
         let geometry = SceneGeometry::with_method(&scene, BuildMethod::Sah);
-        let mut queries: Vec<(Ray, f32, bool)> =
-            rays.iter().map(|r| (*r, f32::INFINITY, false)).collect();
-        queries.extend(rays.iter().map(|r| (*r, 3.0, true)));
+        let queries = closest_and_shadow_queries(&rays);
         let run = |walk| {
             run_kernel(
                 &gpu,

@@ -16,6 +16,7 @@ use glam::{DMat4, DVec2, DVec3};
 use gpu_render::film::LinearImage;
 use gpu_render::low_level::cpu::traverse::intersect_scene;
 use gpu_render::low_level::texture::{sample_texture, texture_coordinates};
+use gpu_render::low_level::tradeoff::rmse;
 use gpu_render::scene::{
     Camera, Environment, Image, Integrator, Light, Material, MaterialKind, Mesh, RenderSettings,
     Scene, Shape, TextureFiltering, TextureMapping, load_scene,
@@ -40,18 +41,6 @@ fn horizon(width: u32, height: u32, spp: u32, filtering: TextureFiltering) -> Sc
     scene.lights.clear();
     scene.environment.ambient = DVec3::ONE;
     scene
-}
-
-/// The root-mean-square difference over every pixel's red, green and blue.
-fn rmse(a: &LinearImage, b: &LinearImage) -> f64 {
-    let sum: f64 = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .flat_map(|(p, q)| (0..3).map(move |c| f64::from(p[c]) - f64::from(q[c])))
-        .map(|d| d * d)
-        .sum();
-    (sum / (3 * a.pixels.len()) as f64).sqrt()
 }
 
 /// The RMSE of rows 16 to 31 (the sky, the horizon at row 21 and the ten rows below

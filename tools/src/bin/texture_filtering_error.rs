@@ -17,20 +17,8 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use gpu_render::film::LinearImage;
 use gpu_render::gpu::{AdapterChoice, HeadlessGpu, Renderer, RendererOptions};
+use gpu_render::low_level::tradeoff::rmse;
 use gpu_render::scene::{Scene, TextureFiltering, load_scene};
-
-/// The root-mean-square difference of two images of the same size, over every pixel's
-/// red, green and blue.
-fn rmse(a: &LinearImage, b: &LinearImage) -> f64 {
-    let sum: f64 = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .flat_map(|(p, q)| (0..3).map(move |c| f64::from(p[c]) - f64::from(q[c])))
-        .map(|d| d * d)
-        .sum();
-    (sum / (3 * a.pixels.len()) as f64).sqrt()
-}
 
 /// `scene` with `filtering`.
 fn with_filtering(scene: &Scene, filtering: TextureFiltering) -> Scene {
