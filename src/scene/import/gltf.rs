@@ -997,19 +997,8 @@ impl Importer<'_> {
                 .map(|&uv| normal_map.apply(uv))
                 .collect::<Vec<_>>()
         });
-        let generated = match (&raw.normals, map_uvs.clone()) {
-            (Some(_), Some(map_uvs)) => super::tangents::with_mikktspace_tangents(
-                RawMesh {
-                    positions: raw.positions.clone(),
-                    normals: raw.normals.clone(),
-                    uvs: raw.uvs.clone(),
-                    uvs1: raw.uvs1.clone(),
-                    colors: raw.colors.clone(),
-                    tangents: None,
-                    triangles: raw.triangles.clone(),
-                },
-                &map_uvs,
-            ),
+        let generated = match (&raw.normals, &map_uvs) {
+            (Some(_), Some(map_uvs)) => super::tangents::with_mikktspace_tangents(&raw, map_uvs),
             _ => None,
         };
         match generated {

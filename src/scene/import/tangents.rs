@@ -63,7 +63,7 @@ impl mikktspace::Geometry for Corners<'_> {
 /// (the set its normal map reads), parallel to them. Corners of one vertex that get
 /// different tangents (across a UV seam or a mirror line) become vertices of their own,
 /// every attribute copied. `None` when `raw` has no normals or the generator fails.
-pub(super) fn with_mikktspace_tangents(raw: RawMesh, uvs: &[DVec2]) -> Option<RawMesh> {
+pub(super) fn with_mikktspace_tangents(raw: &RawMesh, uvs: &[DVec2]) -> Option<RawMesh> {
     let normals = raw.normals.as_ref()?;
     if normals.len() != raw.positions.len()
         || uvs.len() != raw.positions.len()
