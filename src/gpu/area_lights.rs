@@ -124,14 +124,16 @@ pub fn emitter_record(entry: &EmitterEntry) -> GpuEmitter {
 }
 
 /// The emitter records of `geometry` with `materials` (in the lighting space) and the
-/// scene's `images`, as the CPU's [`AreaLights::new`] finds them; [`GpuEmitter::NONE`]
-/// alone when there are none.
+/// scene's `images`, as the CPU's [`AreaLights::new`] finds them, their instances named
+/// by where `layout` puts the instances' records (after the tree the GPU walks: the
+/// scene's, [`InstanceLayout::new`], or with the hardware traversal the analytic
+/// shapes'); [`GpuEmitter::NONE`] alone when there are none.
 pub fn emitter_records(
     geometry: &SceneGeometry,
+    layout: &InstanceLayout,
     materials: &[Material],
     images: &[Image],
 ) -> Vec<GpuEmitter> {
-    let layout = InstanceLayout::new(geometry);
     let mut records: Vec<GpuEmitter> = AreaLights::new(geometry, materials, images)
         .entries()
         .iter()
@@ -197,7 +199,7 @@ mod tests {
             },
         ];
         let geometry = SceneGeometry::from_shapes(&shapes, BuildMethod::Sah);
-        let records = emitter_records(&geometry, &materials, &[]);
+        let records = emitter_records(&geometry, &InstanceLayout::new(&geometry), &materials, &[]);
         // The lamp sphere, the square's two triangles, the triangle.
         assert_eq!(records.len(), 4, "{records:?}");
         assert!(records.windows(2).all(|w| w[0].prim <= w[1].prim));
@@ -213,7 +215,7 @@ mod tests {
         assert!((records[1].area_density - records[3].area_density).abs() < 1e-6);
         let dark = [materials[0], materials[0]];
         assert_eq!(
-            emitter_records(&geometry, &dark, &[]),
+            emitter_records(&geometry, &InstanceLayout::new(&geometry), &dark, &[]),
             vec![GpuEmitter::NONE]
         );
     }

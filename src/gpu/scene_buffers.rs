@@ -193,7 +193,12 @@ pub(crate) fn upload_scene(
         // The integrator is a flag of the trace: every trace of the scene keeps it.
         frame.flags |= FLAG_PATH;
         frame.stack_size = frame.stack_size.max(1);
-        emitter_records(geometry, &shaded.materials, &shaded.images)
+        // Instances named where the records put them: after the tree the GPU walks.
+        let layout = match &analytic {
+            Some((_, layout)) => layout.clone(),
+            None => InstanceLayout::new(geometry),
+        };
+        emitter_records(geometry, &layout, &shaded.materials, &shaded.images)
     } else {
         vec![GpuEmitter::NONE]
     };

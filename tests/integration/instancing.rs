@@ -538,8 +538,10 @@ fn emissive_copies_are_instanced_with_an_emitter_record_per_triangle_and_copy() 
     };
     let (one, ten) = (record_bytes(&scene(1)), record_bytes(&scene(10)));
     let triangles = mesh.triangles.len();
+    let geometry = SceneGeometry::new(&scene(10));
     let emitters = gpu_render::low_level::gpu::area_lights::emitter_records(
-        &SceneGeometry::new(&scene(10)),
+        &geometry,
+        &gpu_render::low_level::gpu::upload::InstanceLayout::new(&geometry),
         &scene(10).materials,
         &[],
     );

@@ -351,3 +351,33 @@ fn the_cli_says_when_ray_queries_found_the_triangles() {
         "{auto}"
     );
 }
+
+/// Path traced with emissive instanced meshes: next-event estimation samples the
+/// instances' triangles, whose emitter records must name the instances' records where
+/// the hardware path lays them out (after the analytic shapes' tree, not the scene's).
+#[test]
+fn emissive_instances_are_sampled_as_the_hardware_path_names_them() {
+    let Some(gpu) = ray_query_gpu() else {
+        return;
+    };
+    let mut scene = crate::instancing::instanced_scene(40, &blob(8, 12));
+    for mesh in &scene.meshes {
+        scene.materials[mesh.material as usize].emission = DVec3::new(2.0, 1.5, 1.0);
+    }
+    // Small spheres behind the camera: the scene's tree (spheres and instances) and
+    // the analytic shapes' tree (spheres alone) get different node counts.
+    let eye = scene.camera.eye;
+    let material = scene.meshes[0].material;
+    scene.shapes.extend((0..24).map(|i| Shape::Sphere {
+        center: eye + DVec3::new(f64::from(i % 6) - 2.5, f64::from(i / 6) - 1.5, 3.0),
+        radius: 0.1,
+        material,
+    }));
+    scene.render.integrator = Integrator::Path;
+    scene.render.samples_per_pixel = 4;
+    scene.render.max_depth = 3;
+    let geometry = gpu_render::low_level::accel::SceneGeometry::new(&scene);
+    let analytic = geometry.analytic_bvh(gpu_render::low_level::accel::BuildMethod::Sah);
+    assert_ne!(geometry.bvh.wide.len(), analytic.wide.len());
+    hardware_agrees(&gpu, "ray-query-emissive-instances", &scene);
+}
