@@ -125,7 +125,9 @@ impl GpuScene {
         self.prepared.features()
     }
 
-    /// How the scene's BVH was built.
+    /// How the BVH the GPU walks was built: the scene's, or with the hardware
+    /// traversal the analytic shapes' alone (the driver builds the triangles'
+    /// structures, whose figures wgpu does not give).
     pub fn bvh_stats(&self) -> &BvhStats {
         self.prepared.bvh_stats()
     }

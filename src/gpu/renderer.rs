@@ -24,10 +24,10 @@ use super::film::Film;
 use super::gpu_scene::GpuScene;
 use super::limits::{check_limits, required_limits};
 use super::pipelines::{Pipelines, TracePipelines};
-use super::scene_buffers::{UploadOptions, upload_scene};
+use super::scene_buffers::{UploadOptions, hardware_plan, upload_scene};
 use super::wavefront::{Schedule, default_schedule, iteration_budget_for, warm_up};
 use super::{RenderError, ShaderFeatures, Traversal};
-use crate::accel::SceneGeometry;
+use crate::accel::{BuildMethod, SceneGeometry};
 use crate::scene::{Camera, Scene, view_problem};
 
 mod blocking;
@@ -294,7 +294,13 @@ impl Renderer {
         queue: &wgpu::Queue,
         scene: &Scene,
     ) -> Result<GpuScene, RenderError> {
-        self.upload_with_geometry(device, queue, scene, &SceneGeometry::new(scene))
+        // The hardware traversal walks a tree of the analytic shapes alone: the
+        // scene's tree (over every triangle) is built only for the software walk.
+        let mut geometry = SceneGeometry::without_scene_tree(scene, BuildMethod::Sah);
+        if hardware_plan(self.options.traversal, device, &geometry)?.is_none() {
+            geometry.build_scene_tree(BuildMethod::Sah);
+        }
+        self.upload_with_geometry(device, queue, scene, &geometry)
     }
 
     /// [`Renderer::upload`] with geometry already built from `scene` (for example the

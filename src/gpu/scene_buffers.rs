@@ -18,7 +18,7 @@ use super::upload::{
     InstanceLayout, SceneRecords, frame_uniforms, image_layer_levels, image_layers,
 };
 use crate::accel::{
-    BrdfMapCdfs, BuildMethod, BvhStats, EnvironmentLight, MAX_PLANES, SceneGeometry,
+    BrdfMapCdfs, BuildMethod, Bvh, BvhStats, EnvironmentLight, MAX_PLANES, SceneGeometry,
 };
 use crate::scene::{Image, Integrator, Scene};
 use crate::texture::mip_levels;
@@ -99,7 +99,9 @@ impl DeviceScene {
         &self.frame
     }
 
-    /// How the scene's BVH was built.
+    /// How the BVH the GPU walks was built: the scene's, or with the hardware
+    /// traversal the analytic shapes' alone (the driver builds the triangles'
+    /// structures, whose figures wgpu does not give).
     pub fn bvh_stats(&self) -> &BvhStats {
         &self.bvh
     }
@@ -144,6 +146,25 @@ pub(crate) struct UploadOptions {
 /// ([`ShaderFeatures::refill_lanes`]) where the device has subgroup operations. With
 /// `allow_unrolled`, a small scene's closest-hit test is unrolled
 /// ([`ShaderFeatures::unrolled`]) where the device prefers it.
+/// The hardware traversal's plan for `geometry` on `device` where `traversal` takes
+/// it: the tree of the analytic shapes the software walk keeps (the structures hold
+/// the triangles and instances) and where the instances' records go after it; `None`
+/// for the software walk of the scene's tree.
+///
+/// Errors: as [`wants_hardware`] and [`fits_hardware`], for [`Traversal::Hardware`].
+pub(crate) fn hardware_plan(
+    traversal: Traversal,
+    device: &wgpu::Device,
+    geometry: &SceneGeometry,
+) -> Result<Option<(Bvh, InstanceLayout)>, RenderError> {
+    if !wants_hardware(traversal, device, geometry)? {
+        return Ok(None);
+    }
+    let tree = geometry.analytic_bvh(BuildMethod::Sah);
+    let layout = InstanceLayout::with_scene_nodes(geometry, tree.wide.len());
+    Ok(fits_hardware(traversal, geometry, &layout, &device.limits())?.then_some((tree, layout)))
+}
+
 pub(crate) fn upload_scene(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -169,17 +190,20 @@ pub(crate) fn upload_scene(
     }
     let shaded = scene.in_lighting_space();
     let scene_features = ShaderFeatures::for_scene(scene);
-    let limits = device.limits();
-    // The hardware traversal walks a tree of the analytic shapes alone: the
-    // structures hold the triangles and instances.
-    let analytic = if wants_hardware(traversal, device, geometry)? {
-        let tree = geometry.analytic_bvh(BuildMethod::Sah);
-        let layout = InstanceLayout::with_scene_nodes(geometry, tree.wide.len());
-        fits_hardware(traversal, geometry, &layout, &limits)?.then_some((tree, layout))
-    } else {
-        None
-    };
+    let analytic = hardware_plan(traversal, device, geometry)?;
     let hardware = analytic.is_some();
+    // Geometry made without its tree (Renderer::upload, for the hardware path) that
+    // the software walk traced would find nothing: a bug, not a user's error.
+    debug_assert!(
+        hardware
+            || !geometry.bvh.prims.is_empty()
+            || (geometry.spheres.is_empty()
+                && geometry.polygons.is_empty()
+                && geometry.triangles.is_empty()
+                && geometry.instances.is_empty()),
+        "the software walk needs the scene's tree"
+    );
+    let limits = device.limits();
     let records = match &analytic {
         Some((tree, _)) => SceneRecords::with_scene_tree(&shaded, geometry, tree),
         None => SceneRecords::new(&shaded, geometry),
@@ -373,7 +397,10 @@ pub(crate) fn upload_scene(
         buffers,
         images,
         acceleration,
-        bvh: geometry.bvh.stats,
+        bvh: match &analytic {
+            Some((tree, _)) => tree.stats,
+            None => geometry.bvh.stats,
+        },
         scene_bytes,
         image_bytes,
     })

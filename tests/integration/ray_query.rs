@@ -381,3 +381,36 @@ fn emissive_instances_are_sampled_as_the_hardware_path_names_them() {
     assert_ne!(geometry.bvh.wide.len(), analytic.wide.len());
     hardware_agrees(&gpu, "ray-query-emissive-instances", &scene);
 }
+
+/// The hardware path builds no software tree over the triangles (the driver's
+/// structures hold them): the upload's tree is the analytic shapes' alone, and the
+/// scene's buffers hold no node or reference of a triangle.
+#[test]
+fn the_hardware_path_builds_no_tree_over_the_triangles() {
+    let Some(gpu) = ray_query_gpu() else {
+        return;
+    };
+    let mut scene = crate::instancing::instanced_scene(32, &blob(24, 32));
+    // One placement of the blob: world-space triangles, the scene tree's bulk.
+    scene.meshes.truncate(1);
+    scene.meshes[0].instances.truncate(1);
+    let geometry = gpu_render::low_level::accel::SceneGeometry::new(&scene);
+    let analytic = geometry.analytic_bvh(gpu_render::low_level::accel::BuildMethod::Sah);
+    assert!(geometry.triangles.len() > 1000 && geometry.instances.is_empty());
+    let upload = |traversal| {
+        renderer(&gpu, traversal)
+            .upload(&gpu.device, &gpu.queue, &scene)
+            .unwrap_or_else(|e| panic!("{traversal:?}: {e}"))
+    };
+    let (hardware, software) = (upload(Traversal::Hardware), upload(Traversal::Software));
+    assert_eq!(hardware.bvh_stats().nodes, analytic.stats.nodes);
+    assert_eq!(software.bvh_stats().nodes, geometry.bvh.stats.nodes);
+    assert!(analytic.stats.nodes * 10 < geometry.bvh.stats.nodes);
+    assert!(
+        hardware.scene_bytes() < software.scene_bytes(),
+        "{} against {} bytes",
+        hardware.scene_bytes(),
+        software.scene_bytes()
+    );
+    hardware_agrees(&gpu, "ray-query-world-triangles", &scene);
+}
