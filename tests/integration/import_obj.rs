@@ -1310,3 +1310,113 @@ fn map_d_is_coverage_in_the_albedo_texture_s_alpha() {
     }
     assert_eq!(model.warnings.len(), 2, "{:?}", model.warnings);
 }
+
+/// Normal maps: `norm`, and `bump` / `map_Bump` where the image is a tangent-space
+/// normal map (Blender's exporter writes its normal maps so, `-bm` the strength); a
+/// grey `bump` image is a height map, not supported, and left out with a warning.
+/// Tangents come from MikkTSpace over the normals and texture coordinates.
+#[test]
+fn norm_and_normal_map_bumps_map_normals_and_height_maps_are_warned_about() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    // Tilted 0.6 towards the map's +x; a flat blue normal map; a grey height map.
+    write_png(&dir.path().join("tilt.png"), 1, 1, &[[204, 128, 230, 255]]);
+    write_png(&dir.path().join("blue.png"), 1, 1, &[[128, 128, 255, 255]]);
+    write_png(&dir.path().join("height.png"), 1, 1, &[[90, 90, 90, 255]]);
+    std::fs::write(
+        dir.path().join("maps.mtl"),
+        "newmtl norm\nKd 0.8 0.8 0.8\nnorm tilt.png\n\
+         newmtl blender\nKd 0.8 0.8 0.8\nmap_Bump -bm 0.5 blue.png\n\
+         newmtl height\nKd 0.8 0.8 0.8\nbump height.png\n\
+         newmtl plain\nKd 0.8 0.8 0.8\n",
+    )
+    .expect("mtl");
+    let obj = |material: &str| format!("mtllib maps.mtl\nusemtl {material}\n{QUAD}");
+    let import_with = |material: &str| {
+        std::fs::write(dir.path().join("quad.obj"), obj(material)).expect("obj");
+        import_obj(&dir.path().join("quad.obj")).expect("imports")
+    };
+    let find = |model: &ImportedModel, name: &str| {
+        model
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .unwrap_or_else(|| panic!("material {name}"))
+            .clone()
+    };
+
+    let model = import_with("norm");
+    assert!(find(&model, "norm").normal_texture.is_some());
+    assert_eq!(find(&model, "norm").material.normal_scale, 1.0);
+    assert_eq!(find(&model, "blender").material.normal_scale, 0.5);
+    assert!(find(&model, "blender").normal_texture.is_some());
+    assert!(find(&model, "height").normal_texture.is_none());
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    assert!(
+        model.warnings[0].contains("material 'height': bump: the image")
+            && model.warnings[0].contains("is grey, a height map: bump mapping is not supported"),
+        "{:?}",
+        model.warnings
+    );
+    // MikkTSpace's tangents: along +u (+x), handedness +1 (v runs up +y in OBJ).
+    let tangents = model.meshes[0].tangents.as_ref().expect("tangents");
+    for tangent in tangents {
+        assert!(
+            (*tangent - DVec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-6,
+            "{tangent}"
+        );
+    }
+
+    // Rendered: the tilt shows against the plain quad, on both backends.
+    let settings = gpu_render::scene::RenderSettings {
+        width: 32,
+        height: 24,
+        ..Default::default()
+    };
+    let scene = |model: &ImportedModel| {
+        let mut scene = model.into_scene(settings);
+        scene.camera.eye = DVec3::new(1.0, 0.5, 4.0);
+        scene.camera.look_at = DVec3::new(1.0, 0.5, 0.0);
+        scene
+    };
+    let mapped = scene(&model);
+    let plain = scene(&import_with("plain"));
+    let (a, b) = (
+        gpu_render::cpu::render(&mapped, None).image,
+        gpu_render::cpu::render(&plain, None).image,
+    );
+    let difference = crate::support::compare::max_channel_difference(&a, &b);
+    assert!(
+        difference > 1e-2,
+        "the normal map changes nothing ({difference})"
+    );
+    if let Some(gpu) = crate::support::gpu::headless_gpu() {
+        let renderer = crate::support::gpu::renderer(&gpu);
+        crate::support::twins::assert_backends_agree(
+            &gpu,
+            &renderer,
+            "obj-norm",
+            &mapped,
+            crate::support::twins::TWIN_TOLERANCE,
+        );
+    }
+
+    // Without vn the tangents cannot be made: a warning, the map not applied.
+    let no_normals = QUAD
+        .replace("vn 0 0 1\n", "")
+        .replace("/1 ", "/ ")
+        .replace("/1\n", "/\n");
+    std::fs::write(
+        dir.path().join("bare.obj"),
+        format!("mtllib maps.mtl\nusemtl norm\n{no_normals}"),
+    )
+    .expect("obj");
+    let bare = import_obj(&dir.path().join("bare.obj")).expect("imports");
+    assert!(bare.meshes[0].tangents.is_none());
+    assert!(
+        bare.warnings
+            .iter()
+            .any(|w| w.contains("its material's normal map needs tangents")),
+        "{:?}",
+        bare.warnings
+    );
+}

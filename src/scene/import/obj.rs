@@ -18,6 +18,7 @@
 mod dissolve;
 mod face;
 mod mtl;
+mod normal_map;
 
 use std::borrow::Cow;
 use std::collections::{HashMap, HashSet};
@@ -143,7 +144,22 @@ fn parse_obj_within(
         budget
             .charge_mesh(group.vertices.len(), group.triangles.len())
             .map_err(|e| e.at(path))?;
-        let raw = group.into_raw_mesh(&file);
+        let mut raw = group.into_raw_mesh(&file);
+        if model.materials[material as usize].normal_texture.is_some() {
+            // A normal map needs tangents: MikkTSpace's, from the normals and texture
+            // coordinates (glTF 2.0 §3.7.2.1 asks for them; OBJ has no tangents).
+            match raw
+                .uvs
+                .as_deref()
+                .and_then(|uvs| super::tangents::with_mikktspace_tangents(&raw, uvs))
+            {
+                Some(with_tangents) => raw = with_tangents,
+                None => model.warnings.push(format!(
+                    "{}: {name}: its material's normal map needs tangents, made from every vertex's normal (vn) and texture coordinates (vt), which it lacks; the normal map is not applied",
+                    path.display()
+                )),
+            }
+        }
         if let Some(mesh) = finish_mesh(name, path, raw, material, &mut model.warnings)
             .map_err(|e| error(path, e))?
         {

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 
 use super::dissolve::{CoverageChannel, coverage_size, with_coverage};
+use super::normal_map::{BumpImage, bump_multiplier, classify};
 use super::{DEFAULT_OBJ_ALBEDO, Notes, at, decode_text, finite, is_integer, strip_comment, words};
 use crate::echo::{echo, echo_path, short, short3};
 use crate::input::{InputError, read_input};
@@ -40,6 +41,10 @@ pub(super) struct SourceMaterial {
     map_ke_at: Option<(usize, usize)>,
     /// `map_d` line and column, when it has one.
     map_d_at: Option<(usize, usize)>,
+    /// `norm` line and column, when it has one.
+    norm_at: Option<(usize, usize)>,
+    /// `bump` (or `map_Bump`, `map_bump`) line and column, when it has one.
+    bump_at: Option<(usize, usize)>,
 }
 
 /// The material libraries an OBJ file names.
@@ -147,6 +152,8 @@ impl Libraries {
                 map_kd_at,
                 map_ke_at,
                 map_d_at,
+                norm_at,
+                bump_at,
             },
         ) in materials.into_iter().zip(lines)
         {
@@ -160,6 +167,8 @@ impl Libraries {
                 map_kd_at,
                 map_ke_at,
                 map_d_at,
+                norm_at,
+                bump_at,
             });
         }
         Ok(())
@@ -219,6 +228,8 @@ struct MtlLines {
     map_kd_at: Option<(usize, usize)>,
     map_ke_at: Option<(usize, usize)>,
     map_d_at: Option<(usize, usize)>,
+    norm_at: Option<(usize, usize)>,
+    bump_at: Option<(usize, usize)>,
 }
 
 /// Checks every line of an MTL library and returns the text for `tobj` (colours with one
@@ -259,6 +270,8 @@ fn scan_mtl(
                 map_kd_at: None,
                 map_ke_at: None,
                 map_d_at: None,
+                norm_at: None,
+                bump_at: None,
             });
         } else if MTL_COLOURS.contains(&keyword) {
             if values
@@ -340,11 +353,16 @@ fn scan_mtl(
                     format!("`{}` needs a file name", echo(keyword)),
                 ));
             }
-            if matches!(keyword, "map_Kd" | "map_Ke" | "map_d") {
+            if matches!(
+                keyword,
+                "map_Kd" | "map_Ke" | "map_d" | "norm" | "bump" | "map_Bump" | "map_bump"
+            ) {
                 match lines.last_mut() {
                     Some(last) if keyword == "map_Kd" => last.map_kd_at = Some((n, column)),
                     Some(last) if keyword == "map_Ke" => last.map_ke_at = Some((n, column)),
-                    Some(last) => last.map_d_at = Some((n, column)),
+                    Some(last) if keyword == "map_d" => last.map_d_at = Some((n, column)),
+                    Some(last) if keyword == "norm" => last.norm_at = Some((n, column)),
+                    Some(last) => last.bump_at = Some((n, column)),
                     None => kept.clear(),
                 }
             }
@@ -395,8 +413,9 @@ pub(super) fn map_material(
     let mut warn = |message: String| warnings.push(format!("{place}: {message}"));
     let colour = |c: Option<[f64; 3]>| c.map(|[r, g, b]| DVec3::new(r, g, b));
 
-    // A texture statement (`map_Kd`, `map_Ke`, `map_d`) at `at`, loaded relative to the
-    // library's directory (`map_d`'s `-imfchan` is read by the caller).
+    // A texture statement (`map_Kd`, `map_Ke`, `map_d`, `norm`, `bump`) at `at`, loaded
+    // relative to the library's directory (`map_d`'s `-imfchan` and the normal map's
+    // `-bm` are read by the caller).
     let mut load_texture = |key: &str,
                             spec: Option<&String>,
                             at_line: Option<(usize, usize)>,
@@ -406,8 +425,13 @@ pub(super) fn map_material(
             return Ok(None);
         };
         let (file, wrap, mut ignored) = texture_options(spec);
-        if key == "map_d" {
-            ignored.retain(|option| !option.starts_with("-imfchan"));
+        let handled = match key {
+            "map_d" => "-imfchan ",
+            "norm" | "bump" => "-bm ",
+            _ => "",
+        };
+        if !handled.is_empty() {
+            ignored.retain(|option| !option.starts_with(handled));
         }
         if !ignored.is_empty() {
             warn(format!(
@@ -463,6 +487,13 @@ pub(super) fn map_material(
         source.map_d_at,
         Encoding::Data,
     )?;
+    // A normal map: `norm`, else `bump` (`map_Bump`) where its image is one.
+    let norm = m.unknown_param.get("norm");
+    let (normal_key, normal_spec, normal_at) = match norm {
+        Some(spec) => ("norm", Some(spec), source.norm_at),
+        None => ("bump", m.normal_texture.as_ref(), source.bump_at),
+    };
+    let normal_texture = load_texture(normal_key, normal_spec, normal_at, Encoding::Data)?;
     let coverage_channel = match m.dissolve_texture.as_deref().and_then(imfchan) {
         None => CoverageChannel::Auto,
         Some(letter) => CoverageChannel::from_imfchan(&letter).unwrap_or_else(|| {
@@ -477,7 +508,6 @@ pub(super) fn map_material(
         ("map_Ks", m.specular_texture.is_some()),
         ("map_Ka", m.ambient_texture.is_some()),
         ("map_Ns", m.shininess_texture.is_some()),
-        ("bump", m.normal_texture.is_some()),
     ] {
         if present {
             warn(format!("{key} is not supported; ignored"));
@@ -488,13 +518,41 @@ pub(super) fn map_material(
         .keys()
         .filter(|k| {
             (k.starts_with("map_") && k.as_str() != "map_Ke")
-                || matches!(k.as_str(), "disp" | "decal" | "refl" | "norm")
+                || matches!(k.as_str(), "disp" | "decal" | "refl")
         })
         .collect();
     others.sort();
     for key in others {
         warn(format!("{} is not supported; ignored", echo(key)));
     }
+    if norm.is_some() && m.normal_texture.is_some() {
+        warn("bump is ignored: norm gives the normal map".into());
+    }
+    let normal_texture = normal_texture.and_then(|texture| {
+        let image = &textures.images[texture.image as usize];
+        let why = match classify(image) {
+            BumpImage::NormalMap => return Some(texture),
+            BumpImage::HeightMap => "is grey, a height map: bump mapping is not supported (tangent-space normal maps are)",
+            BumpImage::Unclear => "is not a tangent-space normal map (its blue channel, the normal's z, averages below one half)",
+        };
+        warn(format!(
+            "{normal_key}: the image {} {why}; ignored",
+            echo_path(&image.path)
+        ));
+        None
+    });
+    let normal_scale = match normal_spec.and_then(|spec| bump_multiplier(&texture_options(spec).2))
+    {
+        Some(Ok(scale)) => scale,
+        Some(Err(text)) => {
+            warn(format!(
+                "{normal_key} -bm {} is not a finite number; the normal map's strength is 1",
+                echo(&text)
+            ));
+            1.0
+        }
+        None => 1.0,
+    };
 
     let default_albedo = if base_color_texture.is_some() {
         1.0
@@ -676,13 +734,16 @@ pub(super) fn map_material(
             material.alpha_mode = AlphaMode::Blend;
         }
     }
+    if normal_texture.is_some() {
+        material.normal_scale = normal_scale;
+    }
     Ok(ImportedMaterial {
         name: m.name.clone(),
         material,
         base_color_texture,
         metallic_roughness_texture: None,
         emissive_texture,
-        normal_texture: None,
+        normal_texture,
     })
 }
 
