@@ -1133,7 +1133,7 @@ fn texture_transforms_are_read_as_offset_rotation_and_scale() {
 }
 
 #[test]
-fn occlusion_textures_are_left_to_the_path_tracer_and_normal_maps_need_normals() {
+fn occlusion_textures_are_left_to_the_path_tracer_and_normal_maps_get_flat_normals() {
     let (mut doc, _) = triangle_doc();
     let body = two_uv_sets(&mut doc, None, None, None).replace(
         r#""name":"multi","#,
@@ -1141,18 +1141,35 @@ fn occlusion_textures_are_left_to_the_path_tracer_and_normal_maps_need_normals()
     );
     let model = imported("baked.gltf", doc.embedded(&body).as_bytes());
     assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    // A normal map on a triangle without NORMAL: flat normals, as glTF 2.0 §3.7.2.1
+    // asks (the winding normal, +z here), and MikkTSpace's tangents from them and the
+    // texture coordinates (u along +x, v along +y, so the image's "up" is −y: tangent
+    // +x, handedness −1).
     let body = body.replace(r#""occlusionTexture""#, r#""normalTexture""#);
-    // A normal map on a triangle without NORMAL or TANGENT: no tangents can be made.
     let model = imported("bumpy.gltf", doc.embedded(&body).as_bytes());
-    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    assert!(model.materials[0].normal_texture.is_some());
+    let mesh = &model.meshes[0];
+    assert_eq!(mesh.normals.as_deref(), Some(&[DVec3::Z; 3][..]));
+    for tangent in mesh.tangents.as_ref().expect("tangents") {
+        assert!(
+            (*tangent - DVec4::new(1.0, 0.0, 0.0, -1.0)).length() < 1e-6,
+            "{tangent}"
+        );
+    }
+    // Without texture coordinates no tangents can be made: a warning.
+    let bare = body
+        .replace(r#","TEXCOORD_0":2,"TEXCOORD_1":3"#, "")
+        .replace(r#","texCoord":1"#, "");
+    assert_ne!(bare, body, "the texture coordinates are removed");
+    let model = imported("bare.gltf", doc.embedded(&bare).as_bytes());
     assert!(
-        model.warnings[0].ends_with(
-            "bumpy.gltf: mesh 0, primitive 0: its material's normalTexture needs tangents, and without TANGENT they are generated from NORMAL and the normal map's texture coordinates, which it lacks; the normal map is not applied"
-        ),
+        model.warnings.iter().any(|w| w.ends_with(
+            "bare.gltf: mesh 0, primitive 0: its material's normalTexture needs tangents, and without TANGENT they are generated from NORMAL and the normal map's texture coordinates, which it lacks; the normal map is not applied"
+        )),
         "{:?}",
         model.warnings
     );
-    assert!(model.materials[0].normal_texture.is_some());
     assert_eq!(model.meshes[0].tangents, None);
 }
 

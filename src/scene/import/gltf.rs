@@ -976,10 +976,19 @@ impl Importer<'_> {
             tangents,
             triangles,
         };
+        if raw.normals.is_none() {
+            // glTF 2.0 §3.7.2.1: without NORMAL, flat normals (and TANGENT ignored),
+            // from which MikkTSpace makes the normal map's tangents below.
+            self.budget
+                .charge_mesh(3 * raw.triangles.len(), 0)
+                .map_err(String::from)?;
+            if let Some(flat) = super::tangents::with_flat_normals(&raw) {
+                raw = flat;
+            }
+        }
         if let Some(given) = raw.tangents.as_mut() {
             // TANGENT runs along the mesh's coordinates, the map's axes along the
-            // transformed ones (a TANGENT without NORMAL, which glTF says to ignore, is
-            // kept as it is).
+            // transformed ones.
             if let Some(normals) = &raw.normals {
                 super::tangents::follow_texture_transform(given, normals, &normal_map);
             }

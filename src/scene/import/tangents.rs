@@ -122,6 +122,51 @@ pub(super) fn with_mikktspace_tangents(raw: &RawMesh, uvs: &[DVec2]) -> Option<R
     })
 }
 
+/// `raw` flat-shaded, as glTF 2.0 §3.7.2.1 asks of a primitive without `NORMAL`
+/// ("client implementations MUST calculate flat normals and the provided tangents (if
+/// present) MUST be ignored"): every triangle its own three vertices, each with the
+/// triangle's winding normal (zero for a degenerate one, which `finish_mesh` skips),
+/// its other attributes copied, no tangents. `None` where an index is out of range
+/// (`finish_mesh` reports it).
+pub(super) fn with_flat_normals(raw: &RawMesh) -> Option<RawMesh> {
+    let count = raw.positions.len();
+    if raw.triangles.iter().flatten().any(|&i| i as usize >= count) {
+        return None;
+    }
+    let corners: Vec<usize> = raw
+        .triangles
+        .iter()
+        .flatten()
+        .map(|&i| i as usize)
+        .collect();
+    let normals = raw
+        .triangles
+        .iter()
+        .flat_map(|t| {
+            let [a, b, c] = t.map(|i| raw.positions[i as usize]);
+            [(b - a).cross(c - a).normalize_or_zero(); 3]
+        })
+        .collect();
+    let pick = |values: &[DVec3]| corners.iter().map(|&i| values[i]).collect::<Vec<_>>();
+    let pick2 = |values: &[DVec2]| corners.iter().map(|&i| values[i]).collect::<Vec<_>>();
+    let short = |len: usize| len != count;
+    Some(RawMesh {
+        positions: pick(&raw.positions),
+        normals: Some(normals),
+        uvs: raw.uvs.as_deref().filter(|v| !short(v.len())).map(pick2),
+        uvs1: raw.uvs1.as_deref().filter(|v| !short(v.len())).map(pick2),
+        colors: raw
+            .colors
+            .as_deref()
+            .filter(|v| !short(v.len()))
+            .map(|values| corners.iter().map(|&i| values[i]).collect()),
+        tangents: None,
+        triangles: (0..raw.triangles.len() as u32)
+            .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+            .collect(),
+    })
+}
+
 /// Turns `tangents` (`TANGENT`'s, along the mesh's own texture coordinates) into the
 /// axes of a normal map read through `transform` (`KHR_texture_transform`), at vertices
 /// of unit-length `normals`. The map's `x` and `y` run along increasing `u'` and
@@ -182,6 +227,33 @@ mod tests {
 
     fn assert_close(a: DVec4, b: DVec4) {
         assert!((a - b).abs().max_element() < 1e-12, "{a} against {b}");
+    }
+
+    #[test]
+    fn flat_normals_split_the_vertices_of_a_fold() {
+        // Two triangles folded along their shared edge (x = 0..1 at y = z = 0).
+        let raw = RawMesh {
+            positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(0.0, 0.0, -1.0)],
+            normals: None,
+            uvs: Some(vec![DVec2::ZERO, DVec2::X, DVec2::Y, DVec2::ONE]),
+            uvs1: None,
+            colors: None,
+            tangents: Some(vec![DVec4::X; 4]),
+            triangles: vec![[0, 1, 2], [1, 0, 3]],
+        };
+        let flat = with_flat_normals(&raw).expect("in range");
+        assert_eq!(flat.positions.len(), 6);
+        assert_eq!(flat.triangles, vec![[0, 1, 2], [3, 4, 5]]);
+        let normals = flat.normals.expect("normals");
+        assert_eq!(&normals[..3], &[DVec3::Z; 3]);
+        assert_eq!(&normals[3..], &[DVec3::NEG_Y; 3]);
+        assert_eq!(flat.uvs.expect("uvs")[5], DVec2::ONE);
+        assert!(flat.tangents.is_none(), "TANGENT without NORMAL is ignored");
+        let broken = RawMesh {
+            triangles: vec![[0, 1, 9]],
+            ..raw
+        };
+        assert!(with_flat_normals(&broken).is_none());
     }
 
     #[test]
