@@ -344,8 +344,69 @@ fn map_kd_loads_an_srgb_texture_linearised_with_its_wrap_mode() {
     assert_eq!((image.width, image.height), (2, 1));
     let expected = srgb_decode(128.0 / 255.0) as f32;
     assert!((image.texel(0, 0)[0] - expected).abs() < 1e-6);
+    // `-s 2 2 1`: the texture repeats twice along u and v (three.js's `repeat`), about
+    // the OBJ's origin at the bottom left, which is v = 1 in our v-down coordinates.
+    let t = texture.transform;
+    assert_eq!(t.apply(DVec2::new(0.25, 1.0)), DVec2::new(0.5, 1.0));
+    assert_eq!(t.apply(DVec2::new(0.0, 0.5)), DVec2::new(0.0, 0.0));
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+}
+
+/// MTL's `-s` and `-o` place the texture as tinyobjloader reads them and three.js's
+/// MTLLoader applies them (`uv · s + o` in OBJ's v-up coordinates); a value that is not
+/// a finite number is a warning and the texture is placed without the option.
+#[test]
+fn texture_scale_and_offset_options_place_the_texture() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    write_png(&dir.path().join("t.png"), 1, 1, &[[255, 255, 255, 255]]);
+    std::fs::write(
+        dir.path().join("t.mtl"),
+        "newmtl placed
+map_Kd -o 0.25 0.5 -s 3 0.5 t.png
+         newmtl bad
+map_Kd -s nan 2 t.png
+",
+    )
+    .expect("mtl");
+    std::fs::write(
+        dir.path().join("t.obj"),
+        format!(
+            "mtllib t.mtl
+usemtl placed
+{QUAD}usemtl bad
+f 1/1/1 2/2/1 3/3/1
+"
+        ),
+    )
+    .expect("obj");
+    let model = import_obj(&dir.path().join("t.obj")).expect("imports");
+    let transform = |name: &str| {
+        model
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .and_then(|m| m.base_color_texture)
+            .unwrap_or_else(|| panic!("material {name}"))
+            .transform
+    };
+    // An OBJ texture coordinate (u, v_obj) lands at (3u + 0.25, 0.5 v_obj + 0.5) of the
+    // image in OBJ's coordinates; ours run v down (v = 1 − v_obj) on both sides.
+    for (u, v_obj) in [(0.0, 0.0), (1.0, 1.0), (0.3, 0.7)] {
+        let ours = transform("placed").apply(DVec2::new(u, 1.0 - v_obj));
+        let expected = DVec2::new(3.0 * u + 0.25, 1.0 - (0.5 * v_obj + 0.5));
+        assert!(
+            (ours - expected).length() < 1e-12,
+            "{ours} against {expected}"
+        );
+    }
+    assert_eq!(
+        transform("bad"),
+        gpu_render::scene::TextureTransform::IDENTITY
+    );
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
     assert!(
-        model.warnings.iter().any(|w| w.contains("-s 2 2")),
+        model.warnings[0]
+            .contains("material 'bad': map_Kd -s nan 2: a scale or offset must be finite"),
         "{:?}",
         model.warnings
     );

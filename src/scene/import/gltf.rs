@@ -71,9 +71,10 @@ const TEXCOORD_TYPES: &[DataType] = &[
     DataType::I16,
     DataType::U16,
 ];
-/// Largest offset or scale (in size) of a `KHR_texture_transform` accepted: beyond it
-/// an `f32` texture coordinate keeps less than 1/16 of a repeat.
-const MAX_TEXTURE_TRANSFORM: f64 = 1e6;
+/// Largest offset or scale (in size) of a `KHR_texture_transform` (or an MTL texture's
+/// `-o` and `-s`) accepted: beyond it an `f32` texture coordinate keeps less than 1/16
+/// of a repeat.
+pub(super) const MAX_TEXTURE_TRANSFORM: f64 = 1e6;
 /// Component types of `COLOR_0`: `FLOAT` and normalized unsigned bytes and shorts
 /// (glTF 2.0 §3.7.2.1).
 const COLOR_TYPES: &[DataType] = &[DataType::F32, DataType::U8, DataType::U16];

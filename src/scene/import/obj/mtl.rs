@@ -6,17 +6,18 @@ use std::collections::{HashMap, HashSet};
 use std::io::{Cursor, ErrorKind};
 use std::path::{Path, PathBuf};
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use super::dissolve::{CoverageChannel, coverage_size, with_coverage};
 use super::normal_map::{BumpImage, bump_multiplier, classify};
 use super::{DEFAULT_OBJ_ALBEDO, Notes, at, decode_text, finite, is_integer, strip_comment, words};
 use crate::echo::{echo, echo_path, short, short3};
 use crate::input::{InputError, read_input};
+use crate::scene::import::gltf::MAX_TEXTURE_TRANSFORM;
 use crate::scene::import::mesh::Budget;
 use crate::scene::import::texture::{Encoding, Textures};
 use crate::scene::import::{ImportedMaterial, MAX_MODEL_FILE_BYTES, TextureRef, WrapMode, error};
-use crate::scene::{AlphaMode, MAX_RADIANCE, Material, MaterialKind, SceneError};
+use crate::scene::{AlphaMode, MAX_RADIANCE, Material, MaterialKind, SceneError, TextureTransform};
 
 /// Index of refraction assumed for glass (`illum` 4, 6, 7, 9) and coats (`illum` 3, 5, 8)
 /// whose material gives no usable `Ni`.
@@ -433,6 +434,14 @@ pub(super) fn map_material(
         if !handled.is_empty() {
             ignored.retain(|option| !option.starts_with(handled));
         }
+        let transform = scale_and_offset(&mut ignored).unwrap_or_else(|text| {
+            warn(format!(
+                "{key} {}: a scale or offset must be finite and at most {} in size; the texture is placed without it",
+                echo(&text),
+                short(MAX_TEXTURE_TRANSFORM)
+            ));
+            TextureTransform::IDENTITY
+        });
         if !ignored.is_empty() {
             warn(format!(
                 "{key} options {} are not supported; ignored",
@@ -465,7 +474,7 @@ pub(super) fn map_material(
             image,
             wrap_u: wrap,
             wrap_v: wrap,
-            transform: crate::scene::TextureTransform::IDENTITY,
+            transform,
         }))
     };
     let mut base_color_texture = load_texture(
@@ -699,6 +708,12 @@ pub(super) fn map_material(
         if material.kind == MaterialKind::Dielectric {
             warn("map_d is ignored on glass (illum 4, 6, 7, 9), as d is".into());
         } else {
+            if base_color_texture.is_some_and(|b| b.transform != mask.transform) {
+                warn(
+                    "map_d's -s or -o differ from map_Kd's; its coverage is placed as map_Kd is"
+                        .into(),
+                );
+            }
             let base = base_color_texture.map(|t| t.image);
             let size = coverage_size(
                 base.map(|i| &textures.images[i as usize]),
@@ -747,6 +762,42 @@ pub(super) fn map_material(
     })
 }
 
+/// The `-s` (scale) and `-o` (origin offset) options of a texture statement, taken out
+/// of `options` (its unsupported ones, as [`texture_options`] lists them), as the map
+/// of the texture's coordinates that tinyobjloader reads and three.js's MTLLoader
+/// applies (`repeat` and `offset`: `uv · s + o`), in our coordinates, whose `v` runs
+/// down (`v = 1 − v_obj`): scale `(s_u, s_v)`, offset `(o_u, 1 − s_v − o_v)`. Missing
+/// values are MTL's defaults (scale 1, offset 0); the third (`w`) is ignored. `Err`
+/// with the option's text where a value is not a finite number of at most
+/// [`MAX_TEXTURE_TRANSFORM`] in size.
+fn scale_and_offset(options: &mut Vec<String>) -> Result<TextureTransform, String> {
+    let mut scale = DVec2::ONE;
+    let mut offset = DVec2::ZERO;
+    let mut problem = None;
+    options.retain(|option| {
+        let mut words = option.split_whitespace();
+        let target = match words.next() {
+            Some("-s") => &mut scale,
+            Some("-o") => &mut offset,
+            _ => return true,
+        };
+        for (axis, word) in words.take(2).enumerate() {
+            match word.parse::<f64>() {
+                Ok(v) if v.is_finite() && v.abs() <= MAX_TEXTURE_TRANSFORM => target[axis] = v,
+                _ => problem = Some(option.clone()),
+            }
+        }
+        false
+    });
+    if let Some(option) = problem {
+        return Err(option);
+    }
+    let offset = DVec2::new(offset.x, 1.0 - scale.y - offset.y);
+    Ok(TextureTransform::offset_rotation_scale(
+        0, offset, 0.0, scale,
+    ))
+}
+
 /// The argument of a texture statement's `-imfchan` option, if it has one.
 fn imfchan(spec: &str) -> Option<String> {
     let (_, _, options) = texture_options(spec);
@@ -782,33 +833,49 @@ pub(super) fn texture_options(spec: &str) -> (String, WrapMode, Vec<String>) {
         return (String::new(), wrap, Vec::new());
     }
     let mut ignored = Vec::new();
-    let mut i = 0;
-    while i < words.len() {
-        let Some(&(option, most)) = OPTIONS.iter().find(|(o, _)| *o == words[i]) else {
-            break;
-        };
-        let mut taken = 0;
-        while taken < most
-            && i + 1 + taken < words.len() - 1
-            && (taken == 0 || words[i + 1 + taken].parse::<f64>().is_ok())
-        {
-            taken += 1;
-        }
-        let arguments = &words[i + 1..i + 1 + taken];
-        if option == "-clamp" {
-            if arguments.first() == Some(&"on") {
-                wrap = WrapMode::ClampToEdge;
+    // The options from word `i` on, each with at most its count of arguments (all but
+    // the last numbers), none past `end`: returns the word after them.
+    let mut options = |mut i: usize, end: usize| {
+        while i < end {
+            let Some(&(option, most)) = OPTIONS.iter().find(|(o, _)| *o == words[i]) else {
+                break;
+            };
+            let mut taken = 0;
+            while taken < most
+                && i + 1 + taken < end
+                && (taken == 0 || words[i + 1 + taken].parse::<f64>().is_ok())
+            {
+                taken += 1;
             }
-        } else {
-            ignored.push(
-                format!("{option} {}", arguments.join(" "))
-                    .trim()
-                    .to_string(),
-            );
+            let arguments = &words[i + 1..i + 1 + taken];
+            if option == "-clamp" {
+                if arguments.first() == Some(&"on") {
+                    wrap = WrapMode::ClampToEdge;
+                }
+            } else {
+                ignored.push(
+                    format!("{option} {}", arguments.join(" "))
+                        .trim()
+                        .to_string(),
+                );
+            }
+            i += 1 + taken;
         }
-        i += 1 + taken;
+        i
+    };
+    // Options before the file name (its last word kept for it), the file name (spaces
+    // and all) up to the next option word, and options after it, which
+    // tinyobjloader reads too (its issue 85: `bump.jpg -bm 1.5`).
+    let first = options(0, words.len() - 1);
+    let is_option = |word: &str| OPTIONS.iter().any(|(o, _)| *o == word);
+    let last = (first + 1..words.len())
+        .find(|&j| is_option(words[j]))
+        .unwrap_or(words.len());
+    let stop = options(last, words.len());
+    if stop < words.len() {
+        ignored.push(words[stop..].join(" "));
     }
-    (words[i.min(words.len())..].join(" "), wrap, ignored)
+    (words[first.min(words.len())..last].join(" "), wrap, ignored)
 }
 
 #[cfg(test)]
@@ -827,6 +894,22 @@ mod tests {
                 "a.png".into(),
                 WrapMode::ClampToEdge,
                 vec!["-s 2 2 1".to_string()]
+            )
+        );
+        assert_eq!(
+            texture_options("-imfchan r bumpmap2.jpg -bm 1.5"),
+            (
+                "bumpmap2.jpg".into(),
+                WrapMode::Repeat,
+                vec!["-imfchan r".to_string(), "-bm 1.5".to_string()]
+            )
+        );
+        assert_eq!(
+            texture_options("this dissolve texture has spaces.jpg -clamp on"),
+            (
+                "this dissolve texture has spaces.jpg".into(),
+                WrapMode::ClampToEdge,
+                vec![]
             )
         );
         assert_eq!(
