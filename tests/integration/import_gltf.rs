@@ -1355,7 +1355,7 @@ fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
                 1,
             )
             .into_bytes(),
-            "the file requires the extension KHR_draco_mesh_compression, which is not supported (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_mesh_quantization, KHR_texture_transform). Its meshes are Draco-compressed (KHR_draco_mesh_compression), and Draco mesh compression is not supported: decompress the file first, e.g. with `gltf-transform cp IN OUT`",
+            "the file requires the extension KHR_draco_mesh_compression, which is not supported (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_materials_unlit, KHR_mesh_quantization, KHR_texture_transform). Its meshes are Draco-compressed (KHR_draco_mesh_compression), and Draco mesh compression is not supported: decompress the file first, e.g. with `gltf-transform cp IN OUT`",
         ),
         (
             "meshopt required",
@@ -1365,17 +1365,17 @@ fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
                 1,
             )
             .into_bytes(),
-            "requires the extension EXT_meshopt_compression, which is not supported (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_mesh_quantization, KHR_texture_transform). Its buffers are meshopt-compressed (EXT_meshopt_compression), and meshopt compression is not supported: decompress the file first, e.g. with `gltfpack -i IN -o OUT`",
+            "requires the extension EXT_meshopt_compression, which is not supported (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_materials_unlit, KHR_mesh_quantization, KHR_texture_transform). Its buffers are meshopt-compressed (EXT_meshopt_compression), and meshopt compression is not supported: decompress the file first, e.g. with `gltfpack -i IN -o OUT`",
         ),
         (
             "several required extensions",
             ok.replacen(
                 '{',
-                r#"{"extensionsRequired":["KHR_materials_sheen","KHR_lights_punctual","KHR_materials_unlit","EXT_meshopt_compression"],"#,
+                r#"{"extensionsRequired":["KHR_materials_sheen","KHR_lights_punctual","KHR_materials_clearcoat","EXT_meshopt_compression"],"#,
                 1,
             )
             .into_bytes(),
-            "the file requires 3 extensions that are not supported: KHR_materials_sheen, KHR_materials_unlit, EXT_meshopt_compression (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_mesh_quantization, KHR_texture_transform). Its buffers are meshopt-compressed (EXT_meshopt_compression)",
+            "the file requires 3 extensions that are not supported: KHR_materials_sheen, KHR_materials_clearcoat, EXT_meshopt_compression (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_materials_unlit, KHR_mesh_quantization, KHR_texture_transform). Its buffers are meshopt-compressed (EXT_meshopt_compression)",
         ),
         (
             // As gltf-transform's BoxDraco.gltf: Draco used, not required, and no
@@ -1873,4 +1873,62 @@ fn a_normal_map_s_texture_transform_turns_its_axes() {
             .contains("bad.gltf: material 0: normalTexture: KHR_texture_transform: invalid type"),
         "{message}"
     );
+}
+
+/// `KHR_materials_unlit` (required): the base colour, texture included, unshaded: an
+/// emitter of that radiance that reflects nothing, so a pixel on it shows exactly its
+/// base colour, whatever the lights (Whitted), on both backends.
+#[test]
+fn unlit_materials_show_their_base_colour_unshaded() {
+    let (doc, body) = normal_mapped_quad_with(true, &[[255, 255, 255, 255]], "");
+    let body = body.replace(
+        r#""materials":[{"normalTexture":{"index":0,"scale":0.8},"pbrMetallicRoughness":{"metallicFactor":0}}]"#,
+        r#""materials":[{"name":"flat","pbrMetallicRoughness":{"baseColorFactor":[0.5,0.25,1,1],"baseColorTexture":{"index":0}},"extensions":{"KHR_materials_unlit":{}}}],
+           "extensionsUsed":["KHR_materials_unlit"],"extensionsRequired":["KHR_materials_unlit"]"#,
+    );
+    assert!(
+        body.contains("KHR_materials_unlit"),
+        "the material is replaced"
+    );
+    let model = imported("unlit.gltf", doc.embedded(&body).as_bytes());
+    let material = &model.materials[0];
+    assert_eq!(material.material.kind, MaterialKind::Emissive);
+    assert_eq!(material.material.emission, DVec3::new(0.5, 0.25, 1.0));
+    assert!(material.emissive_texture.is_some());
+    assert_eq!(material.emissive_texture, material.base_color_texture);
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    assert!(
+        model.warnings[0].contains(
+            "material 0 ('flat'): KHR_materials_unlit: read as an emitter of its base colour"
+        ),
+        "{:?}",
+        model.warnings
+    );
+    let settings = gpu_render::scene::RenderSettings {
+        width: 32,
+        height: 24,
+        ..Default::default()
+    };
+    let mut scene = model.into_scene(settings);
+    scene.camera.eye = DVec3::new(0.0, 0.0, 4.0);
+    scene.camera.look_at = DVec3::ZERO;
+    assert!(
+        !scene.lights.is_empty(),
+        "lit, to show the lights change nothing"
+    );
+    let image = gpu_render::cpu::render(&scene, None).image;
+    let centre = image.pixels[(12 * 32 + 16) as usize];
+    for (c, expected) in [0.5, 0.25, 1.0].into_iter().enumerate() {
+        assert!((centre[c] - expected).abs() < 1e-6, "{centre:?}");
+    }
+    if let Some(gpu) = crate::support::gpu::headless_gpu() {
+        let renderer = crate::support::gpu::renderer(&gpu);
+        crate::support::twins::assert_backends_agree(
+            &gpu,
+            &renderer,
+            "gltf-unlit",
+            &scene,
+            crate::support::twins::TWIN_TOLERANCE,
+        );
+    }
 }

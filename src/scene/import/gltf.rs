@@ -43,6 +43,7 @@ const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
     "KHR_materials_transmission",
+    "KHR_materials_unlit",
     "KHR_mesh_quantization",
     "KHR_texture_transform",
 ];
@@ -932,6 +933,15 @@ impl Importer<'_> {
             None
         };
         let colors = self.colors(primitive, name, count);
+        // Emissive materials come from KHR_materials_unlit alone here; their colour is
+        // the emission, which vertex colours do not multiply.
+        let unlit =
+            self.model.materials[uses.index as usize].material.kind == MaterialKind::Emissive;
+        if unlit && colors.is_some() {
+            self.warn(format!(
+                "{name}: COLOR_0 does not multiply the colour of its unlit material; ignored"
+            ));
+        }
         let indices: Vec<u32> = match primitive.indices() {
             Some(accessor) => read(
                 &accessor,
@@ -1295,7 +1305,18 @@ impl Importer<'_> {
             .transmission()
             .map_or(0.0, |t| f64::from(t.transmission_factor()));
         let ior = material.ior().map(f64::from);
-        let ours = if transmission > 0.0 && metallic < 1.0 {
+        let ours = if material.unlit() {
+            // KHR_materials_unlit: the base colour, unshaded. An emitter of that radiance
+            // that reflects nothing shows it exactly (Whitted); the path integrator also
+            // lets it light its surroundings, which an unlit surface does not do.
+            self.warn(format!(
+                "{name}: KHR_materials_unlit: read as an emitter of its base colour that reflects nothing; under the path integrator it also lights its surroundings"
+            ));
+            Material {
+                emission: base,
+                ..Material::blank(MaterialKind::Emissive)
+            }
+        } else if transmission > 0.0 && metallic < 1.0 {
             let ior = match ior {
                 Some(ior) if ior.is_finite() && ior >= 1.0 => ior,
                 Some(ior) => {
@@ -1359,6 +1380,8 @@ impl Importer<'_> {
             None => None,
         };
         let emissive_texture = match material.emissive_texture() {
+            // An unlit material's colour is its base colour, texture included.
+            _ if material.unlit() => base_color_texture,
             Some(info) => Some(self.texture(&info, Encoding::Color, &name, "emissiveTexture")?),
             None => None,
         };
