@@ -389,6 +389,51 @@ fn the_texture_settings_test_shows_no_red_x() {
     gpu_agrees("texture-settings-test", &scene);
 }
 
+/// Khronos' UnlitTest (`KHR_materials_unlit`, required): its README asks for two boxes
+/// of flat orange and blue, "with no shading", under any lights. At one sample per
+/// pixel every pixel is the background or exactly one of the two base colours.
+#[test]
+fn the_unlit_test_shows_two_flat_boxes() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(
+        "../shared/realworld/draco/testdata/KhronosSampleModels/UnlitTest/glTF/UnlitTest.gltf",
+    );
+    if !path.exists() {
+        eprintln!("{} is absent; skipped", path.display());
+        return;
+    }
+    let model = gpu_render::scene::import::import_model(&path).expect("imports");
+    let scene = model.into_scene(RenderSettings {
+        width: 160,
+        height: 100,
+        samples_per_pixel: 1,
+        ..RenderSettings::default()
+    });
+    assert!(!scene.lights.is_empty(), "lit, so that shading would show");
+    let image = gpu_render::cpu::render(&scene, None).image;
+    let background = scene.environment.background.as_vec3();
+    let orange = glam::Vec3::new(1.0, 0.217_637_64, 0.0);
+    let blue = glam::Vec3::new(0.0, 0.217_637_64, 1.0);
+    let (mut on_orange, mut on_blue) = (0, 0);
+    for p in &image.pixels {
+        let c = glam::Vec3::new(p[0], p[1], p[2]);
+        if (c - orange).abs().max_element() < 1e-6 {
+            on_orange += 1;
+        } else if (c - blue).abs().max_element() < 1e-6 {
+            on_blue += 1;
+        } else {
+            assert!(
+                (c - background).abs().max_element() < 1e-6,
+                "a shaded pixel {c} (neither box colour nor the background {background})"
+            );
+        }
+    }
+    assert!(
+        on_orange > 500 && on_blue > 500,
+        "{on_orange} orange and {on_blue} blue pixels"
+    );
+    gpu_agrees("unlit-test", &scene);
+}
+
 /// A spot light 2 above a white floor, pointing down, its cones 0.2 and 0.4 rad
 /// (`KHR_lights_punctual`'s spot), of intensity π W/sr: the floor's radiance is
 /// `h / d³` times the cone's attenuation.
