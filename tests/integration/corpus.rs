@@ -38,11 +38,27 @@ const EXPECTED: &str = "tests/fixtures/corpus/expected.tsv";
 const WIDTH: u32 = 16;
 const HEIGHT: u32 = 12;
 
-fn corpus_root() -> PathBuf {
+/// The corpus folder: `GPU_RENDER_CORPUS`, else `../shared/realworld`.
+pub(crate) fn corpus_root() -> PathBuf {
     match std::env::var_os("GPU_RENDER_CORPUS") {
         Some(dir) => PathBuf::from(dir),
         None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realworld"),
     }
+}
+
+/// The corpus file at `relative` (to [`corpus_root`]) imported, for tests that judge
+/// one model as its own README says; `None`, with a notice, where the corpus is absent,
+/// unless `GPU_RENDER_REQUIRE_CORPUS` is set (then a failure, as for the conformance
+/// test).
+pub(crate) fn corpus_model(relative: &str) -> Option<gpu_render::scene::import::ImportedModel> {
+    let path = corpus_root().join(relative);
+    if !path.exists() {
+        let notice = format!("{} is absent", path.display());
+        assert!(!flag("GPU_RENDER_REQUIRE_CORPUS"), "{notice}");
+        eprintln!("note: {notice}; skipped");
+        return None;
+    }
+    Some(import_model(&path).unwrap_or_else(|e| panic!("{relative}: {e}")))
 }
 
 fn flag(name: &str) -> bool {

@@ -466,13 +466,11 @@ fn the_path_tracer_s_stochastic_blend_converges_to_the_whitted_blend() {
 /// the image differs from the same scene with the material opaque, and only there.
 #[test]
 fn the_corpus_clear_coat_test_s_partial_coating_renders_blended() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/realworld/assimp/test/models/glTF2/ClearCoat-glTF/ClearCoatTest.gltf");
-    if !path.exists() {
-        eprintln!("{} is absent; skipped", path.display());
+    let Some(model) =
+        crate::corpus::corpus_model("assimp/test/models/glTF2/ClearCoat-glTF/ClearCoatTest.gltf")
+    else {
         return;
-    }
-    let model = gpu_render::scene::import::import_model(&path).expect("imports");
+    };
     assert!(
         model.warnings.iter().all(|w| !w.contains("alphaMode")),
         "{:?}",

@@ -252,13 +252,11 @@ fn every_texture_of_a_material_follows_its_own_transform_on_both_backends() {
 /// colour is white): rendered as its colours say, not white.
 #[test]
 fn the_corpus_vertex_coloured_box_renders_in_colour() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/realworld/gltf-transform/packages/core/test/in/BoxVertexColors.glb");
-    if !path.exists() {
-        eprintln!("{} is absent; skipped", path.display());
+    let Some(model) =
+        crate::corpus::corpus_model("gltf-transform/packages/core/test/in/BoxVertexColors.glb")
+    else {
         return;
-    }
-    let model = gpu_render::scene::import::import_model(&path).expect("imports");
+    };
     assert!(model.meshes.iter().all(|m| m.colors.is_some()));
     let scene = model.into_scene(RenderSettings {
         width: 48,
@@ -353,14 +351,11 @@ fn camera_rays_pass_through_single_sided_back_faces_which_still_cast_shadows() {
 /// of a single-sided quad, which a viewer that culls back faces never shows.
 #[test]
 fn the_texture_settings_test_shows_no_red_x() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(
-        "../shared/realworld/draco/testdata/KhronosSampleModels/TextureSettingsTest/glTF/TextureSettingsTest.gltf",
-    );
-    if !path.exists() {
-        eprintln!("{} is absent; skipped", path.display());
+    let Some(model) = crate::corpus::corpus_model(
+        "draco/testdata/KhronosSampleModels/TextureSettingsTest/glTF/TextureSettingsTest.gltf",
+    ) else {
         return;
-    }
-    let model = gpu_render::scene::import::import_model(&path).expect("imports");
+    };
     let scene = model.into_scene(RenderSettings {
         width: 160,
         height: 120,
@@ -394,14 +389,11 @@ fn the_texture_settings_test_shows_no_red_x() {
 /// pixel every pixel is the background or exactly one of the two base colours.
 #[test]
 fn the_unlit_test_shows_two_flat_boxes() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(
-        "../shared/realworld/draco/testdata/KhronosSampleModels/UnlitTest/glTF/UnlitTest.gltf",
-    );
-    if !path.exists() {
-        eprintln!("{} is absent; skipped", path.display());
+    let Some(model) = crate::corpus::corpus_model(
+        "draco/testdata/KhronosSampleModels/UnlitTest/glTF/UnlitTest.gltf",
+    ) else {
         return;
-    }
-    let model = gpu_render::scene::import::import_model(&path).expect("imports");
+    };
     let scene = model.into_scene(RenderSettings {
         width: 160,
         height: 100,
