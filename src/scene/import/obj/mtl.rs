@@ -875,7 +875,14 @@ pub(super) fn texture_options(spec: &str) -> (String, WrapMode, Vec<String>) {
     if stop < words.len() {
         ignored.push(words[stop..].join(" "));
     }
-    (words[first.min(words.len())..last].join(" "), wrap, ignored)
+    // The file name as written between its first and last word (runs of spaces kept).
+    let offset = |word: &str| word.as_ptr() as usize - spec.as_ptr() as usize;
+    let file = match words.get(first..last) {
+        Some([start, .., end]) => &spec[offset(start)..offset(end) + end.len()],
+        Some([only]) => only,
+        _ => "",
+    };
+    (file.to_string(), wrap, ignored)
 }
 
 #[cfg(test)]
@@ -903,6 +910,18 @@ mod tests {
                 WrapMode::Repeat,
                 vec!["-imfchan r".to_string(), "-bm 1.5".to_string()]
             )
+        );
+        assert_eq!(
+            texture_options("-o 1 two  spaces.png"),
+            (
+                "two  spaces.png".into(),
+                WrapMode::Repeat,
+                vec!["-o 1".to_string()]
+            )
+        );
+        assert_eq!(
+            texture_options("-clamp on"),
+            ("on".into(), WrapMode::Repeat, vec![])
         );
         assert_eq!(
             texture_options("this dissolve texture has spaces.jpg -clamp on"),
