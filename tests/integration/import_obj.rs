@@ -1481,3 +1481,61 @@ fn norm_and_normal_map_bumps_map_normals_and_height_maps_are_warned_about() {
         bare.warnings
     );
 }
+
+/// The PBR extension's `map_Pr` and `map_Pm` (as tinyobjloader reads them) become one
+/// metallic/roughness texture laid out as glTF's (green roughness, blue metalness) at
+/// the larger map's size, its values multiplying `Pr` and `Pm`; the maps alone make
+/// the material metal/roughness; `-imfchan` picks a channel, luminance otherwise.
+#[test]
+fn map_pr_and_map_pm_make_a_metallic_roughness_texture() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    write_png(
+        &dir.path().join("rough.png"),
+        2,
+        1,
+        &[[51, 51, 51, 255], [204, 204, 204, 255]],
+    );
+    write_png(&dir.path().join("metal.png"), 1, 1, &[[0, 0, 128, 255]]);
+    std::fs::write(
+        dir.path().join("pbr.mtl"),
+        "newmtl pbr\nKd 0.8 0.8 0.8\nPr 0.5\nmap_Pr rough.png\nmap_Pm -imfchan b metal.png\n\
+         newmtl maps_only\nKd 0.8 0.8 0.8\nmap_Pm metal.png\n",
+    )
+    .expect("mtl");
+    std::fs::write(
+        dir.path().join("pbr.obj"),
+        format!("mtllib pbr.mtl\nusemtl pbr\n{QUAD}usemtl maps_only\nf 1/1/1 2/2/1 3/3/1\n"),
+    )
+    .expect("obj");
+    let model = import_obj(&dir.path().join("pbr.obj")).expect("imports");
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let find = |name: &str| {
+        model
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .unwrap_or_else(|| panic!("material {name}"))
+    };
+    let pbr = find("pbr");
+    assert_eq!(pbr.material.kind, MaterialKind::Pbr);
+    assert_eq!(pbr.material.roughness, 0.5);
+    assert_eq!(pbr.material.metallic, 0.0, "Pm absent: 0, whatever the map");
+    let texture = pbr.metallic_roughness_texture.expect("a texture");
+    let image = &model.images[texture.image as usize];
+    assert_eq!((image.width, image.height), (2, 1));
+    let metal = 128.0 / 255.0;
+    for (x, rough) in [(0, 51.0 / 255.0), (1, 204.0 / 255.0)] {
+        let t = image.texel(x, 0);
+        assert!(
+            (t[1] - rough).abs() < 1e-6 && (t[2] - metal).abs() < 1e-6,
+            "{t:?}"
+        );
+    }
+    // Only map_Pm: a metal/roughness material (Pr 1, Pm 0 as for Pr/Pm), the texture's
+    // green 1 (no roughness map) and blue the map's luminance.
+    let only = find("maps_only");
+    assert_eq!(only.material.kind, MaterialKind::Pbr);
+    let image = &model.images[only.metallic_roughness_texture.expect("a texture").image as usize];
+    assert_eq!(image.texel(0, 0)[1], 1.0);
+    assert!((image.texel(0, 0)[2] - 0.0722 * metal).abs() < 1e-6);
+}

@@ -15,10 +15,10 @@
 //! missing library or texture, an empty `usemtl`, normal indices in a file without
 //! `vn`, and a number followed by junk (`3.1+e2`) are warnings, never errors.
 
-mod dissolve;
 mod face;
 mod mtl;
 mod normal_map;
+mod scalar_maps;
 
 use std::borrow::Cow;
 use std::collections::{HashMap, HashSet};

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use glam::{DVec2, DVec3};
 
-use super::dissolve::{CoverageChannel, coverage_size, with_coverage};
 use super::normal_map::{BumpImage, bump_multiplier, classify};
+use super::scalar_maps::{CoverageChannel, coverage_size, metallic_roughness, with_coverage};
 use super::{DEFAULT_OBJ_ALBEDO, Notes, at, decode_text, finite, is_integer, strip_comment, words};
 use crate::echo::{echo, echo_path, short, short3};
 use crate::input::{InputError, read_input};
@@ -46,6 +46,10 @@ pub(super) struct SourceMaterial {
     norm_at: Option<(usize, usize)>,
     /// `bump` (or `map_Bump`, `map_bump`) line and column, when it has one.
     bump_at: Option<(usize, usize)>,
+    /// `map_Pr` line and column, when it has one.
+    map_pr_at: Option<(usize, usize)>,
+    /// `map_Pm` line and column, when it has one.
+    map_pm_at: Option<(usize, usize)>,
 }
 
 /// The material libraries an OBJ file names.
@@ -155,6 +159,8 @@ impl Libraries {
                 map_d_at,
                 norm_at,
                 bump_at,
+                map_pr_at,
+                map_pm_at,
             },
         ) in materials.into_iter().zip(lines)
         {
@@ -170,6 +176,8 @@ impl Libraries {
                 map_d_at,
                 norm_at,
                 bump_at,
+                map_pr_at,
+                map_pm_at,
             });
         }
         Ok(())
@@ -231,6 +239,8 @@ struct MtlLines {
     map_d_at: Option<(usize, usize)>,
     norm_at: Option<(usize, usize)>,
     bump_at: Option<(usize, usize)>,
+    map_pr_at: Option<(usize, usize)>,
+    map_pm_at: Option<(usize, usize)>,
 }
 
 /// Checks every line of an MTL library and returns the text for `tobj` (colours with one
@@ -273,6 +283,8 @@ fn scan_mtl(
                 map_d_at: None,
                 norm_at: None,
                 bump_at: None,
+                map_pr_at: None,
+                map_pm_at: None,
             });
         } else if MTL_COLOURS.contains(&keyword) {
             if values
@@ -356,13 +368,23 @@ fn scan_mtl(
             }
             if matches!(
                 keyword,
-                "map_Kd" | "map_Ke" | "map_d" | "norm" | "bump" | "map_Bump" | "map_bump"
+                "map_Kd"
+                    | "map_Ke"
+                    | "map_d"
+                    | "norm"
+                    | "bump"
+                    | "map_Bump"
+                    | "map_bump"
+                    | "map_Pr"
+                    | "map_Pm"
             ) {
                 match lines.last_mut() {
                     Some(last) if keyword == "map_Kd" => last.map_kd_at = Some((n, column)),
                     Some(last) if keyword == "map_Ke" => last.map_ke_at = Some((n, column)),
                     Some(last) if keyword == "map_d" => last.map_d_at = Some((n, column)),
                     Some(last) if keyword == "norm" => last.norm_at = Some((n, column)),
+                    Some(last) if keyword == "map_Pr" => last.map_pr_at = Some((n, column)),
+                    Some(last) if keyword == "map_Pm" => last.map_pm_at = Some((n, column)),
                     Some(last) => last.bump_at = Some((n, column)),
                     None => kept.clear(),
                 }
@@ -427,7 +449,7 @@ pub(super) fn map_material(
         };
         let (file, wrap, mut ignored) = texture_options(spec);
         let handled = match key {
-            "map_d" => "-imfchan ",
+            "map_d" | "map_Pr" | "map_Pm" => "-imfchan ",
             "norm" | "bump" => "-bm ",
             _ => "",
         };
@@ -503,6 +525,14 @@ pub(super) fn map_material(
         None => ("bump", m.normal_texture.as_ref(), source.bump_at),
     };
     let normal_texture = load_texture(normal_key, normal_spec, normal_at, Encoding::Data)?;
+    // The PBR extension's scalar maps, each with the channel its -imfchan names.
+    let mut scalar_map = |key: &str, at_line| -> Result<_, SceneError> {
+        let spec = m.unknown_param.get(key);
+        let texture = load_texture(key, spec, at_line, Encoding::Data)?;
+        Ok(texture.map(|t| (t, spec.map(String::as_str).and_then(imfchan))))
+    };
+    let roughness_map = scalar_map("map_Pr", source.map_pr_at)?;
+    let metallic_map = scalar_map("map_Pm", source.map_pm_at)?;
     let coverage_channel = match m.dissolve_texture.as_deref().and_then(imfchan) {
         None => CoverageChannel::Auto,
         Some(letter) => CoverageChannel::from_imfchan(&letter).unwrap_or_else(|| {
@@ -526,7 +556,7 @@ pub(super) fn map_material(
         .unknown_param
         .keys()
         .filter(|k| {
-            (k.starts_with("map_") && k.as_str() != "map_Ke")
+            (k.starts_with("map_") && !matches!(k.as_str(), "map_Ke" | "map_Pr" | "map_Pm"))
                 || matches!(k.as_str(), "disp" | "decal" | "refl")
         })
         .collect();
@@ -616,7 +646,11 @@ pub(super) fn map_material(
             emission,
             ..Material::blank(MaterialKind::Dielectric)
         }
-    } else if pr.is_some() || pm.is_some() {
+    } else if pr.is_some()
+        || pm.is_some()
+        || m.unknown_param.contains_key("map_Pr")
+        || m.unknown_param.contains_key("map_Pm")
+    {
         if matches!(illum, 3 | 5 | 8) {
             warn(format!(
                 "illum {illum} (coat) is ignored: Pr/Pm make it a metal/roughness material"
@@ -752,11 +786,92 @@ pub(super) fn map_material(
     if normal_texture.is_some() {
         material.normal_scale = normal_scale;
     }
+    // map_Pr and map_Pm as one metallic/roughness texture (made once per pair).
+    let mut metallic_roughness_texture = None;
+    if material.kind != MaterialKind::Pbr && (roughness_map.is_some() || metallic_map.is_some()) {
+        warn(
+            "map_Pr and map_Pm are read by metal/roughness materials only; ignored on glass".into(),
+        );
+    } else if roughness_map.is_some() || metallic_map.is_some() {
+        let mut channel = |map: &Option<(TextureRef, Option<String>)>, key: &str| {
+            let letter = map.as_ref().and_then(|(_, letter)| letter.clone());
+            match letter.as_deref().map(CoverageChannel::from_imfchan) {
+                None => CoverageChannel::Luminance,
+                Some(Some(channel)) => channel,
+                Some(None) => {
+                    warn(format!(
+                        "{key} -imfchan {} is not supported (r, g, b, m or l are); its luminance is read",
+                        echo(letter.as_deref().unwrap_or_default())
+                    ));
+                    CoverageChannel::Luminance
+                }
+            }
+        };
+        let (rough_channel, metal_channel) = (
+            channel(&roughness_map, "map_Pr"),
+            channel(&metallic_map, "map_Pm"),
+        );
+        let (rough, metal) = (roughness_map.map(|(t, _)| t), metallic_map.map(|(t, _)| t));
+        if let (Some(r), Some(m)) = (rough, metal)
+            && (r.transform != m.transform || r.wrap_u != m.wrap_u)
+        {
+            warn(
+                "map_Pm's -s, -o or -clamp differ from map_Pr's; it is placed as map_Pr is".into(),
+            );
+        }
+        let placed = rough.or(metal).expect("one of the two maps");
+        let size = {
+            let pixels = |t: Option<TextureRef>| {
+                t.map(|t| {
+                    let i = &textures.images[t.image as usize];
+                    (
+                        u64::from(i.width) * u64::from(i.height),
+                        (i.width, i.height),
+                    )
+                })
+            };
+            match (pixels(rough), pixels(metal)) {
+                (Some(r), Some(m)) if m.0 > r.0 => m.1,
+                (Some(r), _) => r.1,
+                (None, Some(m)) => m.1,
+                (None, None) => (1, 1),
+            }
+        };
+        let key = format!(
+            "{:?} {rough_channel:?} {:?} {metal_channel:?}",
+            rough.map(|t| t.image),
+            metal.map(|t| t.image)
+        );
+        let image = textures
+            .derived(
+                key,
+                size,
+                |images| {
+                    let map = |t: Option<TextureRef>, c| t.map(|t| (&images[t.image as usize], c));
+                    metallic_roughness(map(rough, rough_channel), map(metal, metal_channel))
+                        .expect("one of the two maps")
+                },
+                budget,
+            )
+            .map_err(|e| {
+                let (line, column) = source
+                    .map_pr_at
+                    .or(source.map_pm_at)
+                    .unwrap_or((source.line, 1));
+                at(
+                    &source.library,
+                    line,
+                    column,
+                    format!("material '{}': map_Pr/map_Pm: {e}", echo(&m.name)),
+                )
+            })?;
+        metallic_roughness_texture = Some(TextureRef { image, ..placed });
+    }
     Ok(ImportedMaterial {
         name: m.name.clone(),
         material,
         base_color_texture,
-        metallic_roughness_texture: None,
+        metallic_roughness_texture,
         emissive_texture,
         normal_texture,
     })

@@ -1,7 +1,11 @@
-//! OBJ's dissolve texture (`map_d`) as coverage: the texture's values become the alpha
-//! of the material's albedo texture (our materials read coverage there, as glTF's do),
-//! as tinyobjloader (`alpha_texname`), assimp (`aiTextureType_OPACITY`) and three.js's
-//! MTLLoader (`alphaMap`) read it.
+//! OBJ's scalar textures folded into the textures our materials read. The dissolve
+//! texture (`map_d`) is coverage: its values become the alpha of the material's albedo
+//! texture (our materials read coverage there, as glTF's do), as tinyobjloader
+//! (`alpha_texname`), assimp (`aiTextureType_OPACITY`) and three.js's MTLLoader
+//! (`alphaMap`) read it. The PBR extension's roughness and metalness textures
+//! (`map_Pr`, `map_Pm`, as tinyobjloader reads them) become one metallic/roughness
+//! texture laid out as glTF's (green roughness, blue metalness), whose values multiply
+//! `Pr` and `Pm`.
 
 use crate::scene::Image;
 
@@ -76,24 +80,10 @@ pub(super) fn coverage_size(base: Option<&Image>, mask: &Image) -> (u32, u32) {
 pub(super) fn with_coverage(base: Option<&Image>, mask: &Image, channel: CoverageChannel) -> Image {
     let channel = channel.resolved(mask);
     let (width, height) = coverage_size(base, mask);
-    // Mask texels [start, end) along one axis under target texel `i` of `n`.
-    let span = |i: u32, n: u32, m: u32| {
-        let start = u64::from(i) * u64::from(m) / u64::from(n);
-        let end = (u64::from(i + 1) * u64::from(m) / u64::from(n)).max(start + 1);
-        (start as u32, (end as u32).min(m))
-    };
     let mut texels = Vec::with_capacity(width as usize * height as usize);
     for y in 0..height {
-        let (y0, y1) = span(y, height, mask.height);
         for x in 0..width {
-            let (x0, x1) = span(x, width, mask.width);
-            let mut sum = 0.0f64;
-            for my in y0..y1 {
-                for mx in x0..x1 {
-                    sum += f64::from(channel.of(mask.texel(mx, my)));
-                }
-            }
-            let coverage = (sum / f64::from((x1 - x0) * (y1 - y0))) as f32;
+            let coverage = mean_under(mask, channel, (x, y), (width, height));
             let [r, g, b, a] = base.map_or([1.0; 4], |b| b.texel(x, y));
             texels.push([r, g, b, a * coverage]);
         }
@@ -112,6 +102,84 @@ pub(super) fn with_coverage(base: Option<&Image>, mask: &Image, channel: Coverag
         height,
         texels,
     }
+}
+
+/// The mean of `image`'s values through `channel` (resolved) over the texels whose
+/// centres fall in texel `(x, y)` of a `width × height` grid over the same square (the
+/// nearest one where none do: a smaller image).
+fn mean_under(
+    image: &Image,
+    channel: CoverageChannel,
+    (x, y): (u32, u32),
+    (width, height): (u32, u32),
+) -> f32 {
+    // Image texels [start, end) along one axis under target texel `i` of `n`.
+    let span = |i: u32, n: u32, m: u32| {
+        let start = u64::from(i) * u64::from(m) / u64::from(n);
+        let end = (u64::from(i + 1) * u64::from(m) / u64::from(n)).max(start + 1);
+        (start as u32, (end as u32).min(m))
+    };
+    let (x0, x1) = span(x, width, image.width);
+    let (y0, y1) = span(y, height, image.height);
+    let mut sum = 0.0f64;
+    for iy in y0..y1 {
+        for ix in x0..x1 {
+            sum += f64::from(channel.of(image.texel(ix, iy)));
+        }
+    }
+    (sum / f64::from((x1 - x0) * (y1 - y0))) as f32
+}
+
+/// The metallic/roughness texture of `roughness` and `metallic` (`map_Pr`, `map_Pm`:
+/// each an image and the channel its `-imfchan` names, luminance without one), at the
+/// larger one's size (in texels): green the roughness, blue the metalness, 1 where a
+/// map is missing (the factor alone), red 0 and alpha 1. `None` without either map.
+pub(super) fn metallic_roughness(
+    roughness: Option<(&Image, CoverageChannel)>,
+    metallic: Option<(&Image, CoverageChannel)>,
+) -> Option<Image> {
+    let size = |map: Option<(&Image, CoverageChannel)>| map.map(|(i, _)| (i.width, i.height));
+    let (width, height) = match (size(roughness), size(metallic)) {
+        (Some(r), Some(m)) => {
+            if u64::from(m.0) * u64::from(m.1) > u64::from(r.0) * u64::from(r.1) {
+                m
+            } else {
+                r
+            }
+        }
+        (Some(only), None) | (None, Some(only)) => only,
+        (None, None) => return None,
+    };
+    let value = |map: Option<(&Image, CoverageChannel)>, x, y| match map {
+        Some((image, channel)) => {
+            let channel = match channel {
+                CoverageChannel::Auto => CoverageChannel::Luminance,
+                other => other,
+            };
+            mean_under(image, channel, (x, y), (width, height))
+        }
+        None => 1.0,
+    };
+    let mut texels = Vec::with_capacity(width as usize * height as usize);
+    for y in 0..height {
+        for x in 0..width {
+            texels.push([0.0, value(roughness, x, y), value(metallic, x, y), 1.0]);
+        }
+    }
+    let name = |map: Option<(&Image, CoverageChannel)>| {
+        map.map_or("none".to_string(), |(i, _)| i.path.display().to_string())
+    };
+    Some(Image {
+        path: format!(
+            "roughness {} and metalness {}",
+            name(roughness),
+            name(metallic)
+        )
+        .into(),
+        width,
+        height,
+        texels,
+    })
 }
 
 #[cfg(test)]
@@ -161,6 +229,31 @@ mod tests {
             Some(CoverageChannel::Matte)
         );
         assert_eq!(CoverageChannel::from_imfchan("z"), None);
+    }
+
+    #[test]
+    fn roughness_and_metalness_maps_make_one_texture_at_the_larger_size() {
+        let rough = image(2, 1, vec![[0.2, 0.2, 0.2, 1.0], [0.8, 0.8, 0.8, 1.0]]);
+        let metal = image(1, 1, vec![[0.0, 0.0, 0.5, 1.0]]);
+        let both = metallic_roughness(
+            Some((&rough, CoverageChannel::Auto)),
+            Some((&metal, CoverageChannel::Colour(2))),
+        )
+        .expect("a texture");
+        assert_eq!((both.width, both.height), (2, 1));
+        assert_eq!(
+            both.texels,
+            vec![[0.0, 0.2, 0.5, 1.0], [0.0, 0.8, 0.5, 1.0]]
+        );
+        let alone =
+            metallic_roughness(None, Some((&metal, CoverageChannel::Auto))).expect("a texture");
+        let luminance = 0.0722 * 0.5;
+        assert!((alone.texels[0][2] - luminance).abs() < 1e-7);
+        assert_eq!(
+            alone.texels[0][1], 1.0,
+            "no roughness map: the factor alone"
+        );
+        assert!(metallic_roughness(None, None).is_none());
     }
 
     #[test]
