@@ -1484,8 +1484,9 @@ fn norm_and_normal_map_bumps_map_normals_and_height_maps_are_warned_about() {
 
 /// The PBR extension's `map_Pr` and `map_Pm` (as tinyobjloader reads them) become one
 /// metallic/roughness texture laid out as glTF's (green roughness, blue metalness) at
-/// the larger map's size, its values multiplying `Pr` and `Pm`; the maps alone make
-/// the material metal/roughness; `-imfchan` picks a channel, luminance otherwise.
+/// the larger map's size; a map replaces its factor (as Blender's importer reads it);
+/// the maps alone make the material metal/roughness; `-imfchan` picks a channel,
+/// luminance otherwise.
 #[test]
 fn map_pr_and_map_pm_make_a_metallic_roughness_texture() {
     let dir = tempfile::tempdir().expect("temporary directory");
@@ -1518,8 +1519,8 @@ fn map_pr_and_map_pm_make_a_metallic_roughness_texture() {
     };
     let pbr = find("pbr");
     assert_eq!(pbr.material.kind, MaterialKind::Pbr);
-    assert_eq!(pbr.material.roughness, 0.5);
-    assert_eq!(pbr.material.metallic, 0.0, "Pm absent: 0, whatever the map");
+    assert_eq!(pbr.material.roughness, 1.0, "the map replaces Pr 0.5");
+    assert_eq!(pbr.material.metallic, 1.0, "the map gives the metalness");
     let texture = pbr.metallic_roughness_texture.expect("a texture");
     let image = &model.images[texture.image as usize];
     assert_eq!((image.width, image.height), (2, 1));
@@ -1531,10 +1532,14 @@ fn map_pr_and_map_pm_make_a_metallic_roughness_texture() {
             "{t:?}"
         );
     }
-    // Only map_Pm: a metal/roughness material (Pr 1, Pm 0 as for Pr/Pm), the texture's
-    // green 1 (no roughness map) and blue the map's luminance.
+    // Only map_Pm: a metal/roughness material (roughness 1 as without Pr), the
+    // texture's green 1 (no roughness map) and blue the map's luminance.
     let only = find("maps_only");
     assert_eq!(only.material.kind, MaterialKind::Pbr);
+    assert_eq!(
+        (only.material.roughness, only.material.metallic),
+        (1.0, 1.0)
+    );
     let image = &model.images[only.metallic_roughness_texture.expect("a texture").image as usize];
     assert_eq!(image.texel(0, 0)[1], 1.0);
     assert!((image.texel(0, 0)[2] - 0.0722 * metal).abs() < 1e-6);

@@ -866,6 +866,14 @@ pub(super) fn map_material(
                 )
             })?;
         metallic_roughness_texture = Some(TextureRef { image, ..placed });
+        // A map replaces its factor, as Blender's importer reads it (it links the map
+        // in the factor's place).
+        if rough.is_some() {
+            material.roughness = 1.0;
+        }
+        if metal.is_some() {
+            material.metallic = 1.0;
+        }
     }
     Ok(ImportedMaterial {
         name: m.name.clone(),

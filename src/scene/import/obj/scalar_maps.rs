@@ -4,8 +4,8 @@
 //! (`alpha_texname`), assimp (`aiTextureType_OPACITY`) and three.js's MTLLoader
 //! (`alphaMap`) read it. The PBR extension's roughness and metalness textures
 //! (`map_Pr`, `map_Pm`, as tinyobjloader reads them) become one metallic/roughness
-//! texture laid out as glTF's (green roughness, blue metalness), whose values multiply
-//! `Pr` and `Pm`.
+//! texture laid out as glTF's (green roughness, blue metalness), whose values replace
+//! `Pr` and `Pm` (the caller sets those factors to 1).
 
 use crate::scene::Image;
 
