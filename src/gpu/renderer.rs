@@ -24,7 +24,7 @@ use super::film::Film;
 use super::gpu_scene::GpuScene;
 use super::limits::{check_limits, required_limits};
 use super::pipelines::{Pipelines, TracePipelines};
-use super::scene_buffers::{UploadOptions, hardware_plan, upload_scene};
+use super::scene_buffers::{HardwarePlan, UploadOptions, hardware_plan, upload_scene};
 use super::wavefront::{Schedule, default_schedule, iteration_budget_for, warm_up};
 use super::{RenderError, ShaderFeatures, Traversal};
 use crate::accel::{BuildMethod, SceneGeometry};
@@ -297,10 +297,11 @@ impl Renderer {
         // The hardware traversal walks a tree of the analytic shapes alone: the
         // scene's tree (over every triangle) is built only for the software walk.
         let mut geometry = SceneGeometry::without_scene_tree(scene, BuildMethod::Sah);
-        if hardware_plan(self.options.traversal, device, &geometry)?.is_none() {
+        let plan = hardware_plan(self.options.traversal, device, &geometry)?;
+        if plan.is_none() {
             geometry.build_scene_tree(BuildMethod::Sah);
         }
-        self.upload_with_geometry(device, queue, scene, &geometry)
+        self.upload_planned(device, queue, scene, &geometry, plan)
     }
 
     /// [`Renderer::upload`] with geometry already built from `scene` (for example the
@@ -311,6 +312,20 @@ impl Renderer {
         queue: &wgpu::Queue,
         scene: &Scene,
         geometry: &SceneGeometry,
+    ) -> Result<GpuScene, RenderError> {
+        let plan = hardware_plan(self.options.traversal, device, geometry)?;
+        self.upload_planned(device, queue, scene, geometry, plan)
+    }
+
+    /// The uploads of [`Renderer::upload`] and [`Renderer::upload_with_geometry`],
+    /// with the traversal planned ([`hardware_plan`]).
+    fn upload_planned(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        geometry: &SceneGeometry,
+        plan: Option<HardwarePlan>,
     ) -> Result<GpuScene, RenderError> {
         let prepared = upload_scene(
             device,
@@ -323,8 +338,8 @@ impl Renderer {
                 allow_refill_lanes: self.options.refill_lanes,
                 allow_unrolled: self.options.unrolled,
                 aov: self.options.aov,
-                traversal: self.options.traversal,
             },
+            plan,
         )?;
         let cached = self.pipelines.has_trace(&prepared.features, self.schedule);
         let started = Instant::now();

@@ -134,18 +134,12 @@ pub(crate) struct UploadOptions {
     /// The module records the auxiliary passes ([`ShaderFeatures::aov`]; the general
     /// module always can).
     pub aov: bool,
-    /// How the triangles are found ([`super::RendererOptions::traversal`]).
-    pub traversal: Traversal,
 }
 
-/// Uploads `scene` (as loaded: it is converted to its lighting space here) with its
-/// `geometry` (built from the lighting-space-independent shapes). With
-/// `allow_uniform_records`, a scene whose records fit is bound with uniform records
-/// where the device prefers them (see `super::cpu_device::uniform_records`). With
-/// `allow_refill_lanes`, the trace module gives way to finished lanes
-/// ([`ShaderFeatures::refill_lanes`]) where the device has subgroup operations. With
-/// `allow_unrolled`, a small scene's closest-hit test is unrolled
-/// ([`ShaderFeatures::unrolled`]) where the device prefers it.
+/// The hardware traversal's software part: the tree of the analytic shapes and where
+/// the instances' records go after it ([`hardware_plan`]).
+pub(crate) type HardwarePlan = (Bvh, InstanceLayout);
+
 /// The hardware traversal's plan for `geometry` on `device` where `traversal` takes
 /// it: the tree of the analytic shapes the software walk keeps (the structures hold
 /// the triangles and instances) and where the instances' records go after it; `None`
@@ -156,7 +150,7 @@ pub(crate) fn hardware_plan(
     traversal: Traversal,
     device: &wgpu::Device,
     geometry: &SceneGeometry,
-) -> Result<Option<(Bvh, InstanceLayout)>, RenderError> {
+) -> Result<Option<HardwarePlan>, RenderError> {
     if !wants_hardware(traversal, device, geometry)? {
         return Ok(None);
     }
@@ -165,12 +159,23 @@ pub(crate) fn hardware_plan(
     Ok(fits_hardware(traversal, geometry, &layout, &device.limits())?.then_some((tree, layout)))
 }
 
+/// Uploads `scene` (as loaded: it is converted to its lighting space here) with its
+/// `geometry` (built from the lighting-space-independent shapes). With
+/// `allow_uniform_records`, a scene whose records fit is bound with uniform records
+/// where the device prefers them (see `super::cpu_device::uniform_records`). With
+/// `allow_refill_lanes`, the trace module gives way to finished lanes
+/// ([`ShaderFeatures::refill_lanes`]) where the device has subgroup operations. With
+/// `allow_unrolled`, a small scene's closest-hit test is unrolled
+/// ([`ShaderFeatures::unrolled`]) where the device prefers it.
+/// `analytic` is the hardware traversal's plan ([`hardware_plan`]), `None` for the
+/// software walk of `geometry`'s tree.
 pub(crate) fn upload_scene(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     scene: &Scene,
     geometry: &SceneGeometry,
     options: UploadOptions,
+    analytic: Option<HardwarePlan>,
 ) -> Result<DeviceScene, RenderError> {
     let UploadOptions {
         specialise,
@@ -178,7 +183,6 @@ pub(crate) fn upload_scene(
         allow_refill_lanes,
         allow_unrolled,
         aov,
-        traversal,
     } = options;
     scene.render.check().map_err(RenderError::InvalidSettings)?;
     if geometry.planes.len() > MAX_PLANES {
@@ -190,7 +194,6 @@ pub(crate) fn upload_scene(
     }
     let shaded = scene.in_lighting_space();
     let scene_features = ShaderFeatures::for_scene(scene);
-    let analytic = hardware_plan(traversal, device, geometry)?;
     let hardware = analytic.is_some();
     // Geometry made without its tree (Renderer::upload, for the hardware path) that
     // the software walk traced would find nothing: a bug, not a user's error.
