@@ -9,7 +9,9 @@ use std::path::{Path, PathBuf};
 use glam::{DVec2, DVec3};
 
 use super::normal_map::{BumpImage, bump_multiplier, classify};
-use super::scalar_maps::{CoverageChannel, coverage_size, metallic_roughness, with_coverage};
+use super::scalar_maps::{
+    CoverageChannel, coverage_size, metallic_roughness, metallic_roughness_size, with_coverage,
+};
 use super::{DEFAULT_OBJ_ALBEDO, Notes, at, decode_text, finite, is_integer, strip_comment, words};
 use crate::echo::{echo, echo_path, short, short3};
 use crate::input::{InputError, read_input};
@@ -436,14 +438,14 @@ pub(super) fn map_material(
     let mut warn = |message: String| warnings.push(format!("{place}: {message}"));
     let colour = |c: Option<[f64; 3]>| c.map(|[r, g, b]| DVec3::new(r, g, b));
 
-    // A texture statement (`map_Kd`, `map_Ke`, `map_d`, `norm`, `bump`) at `at`, loaded
-    // relative to the library's directory (`map_d`'s `-imfchan` and the normal map's
-    // `-bm` are read by the caller).
+    // A texture statement (`map_Kd`, `map_Ke`, `map_d`, `norm`, `bump`, `map_Pr`,
+    // `map_Pm`) at `at`, loaded relative to the library's directory, with the argument of
+    // the option the caller reads (the scalar maps' `-imfchan`, the normal map's `-bm`).
     let mut load_texture = |key: &str,
                             spec: Option<&String>,
                             at_line: Option<(usize, usize)>,
                             encoding: Encoding|
-     -> Result<Option<TextureRef>, SceneError> {
+     -> Result<Option<(TextureRef, Option<String>)>, SceneError> {
         let (Some(spec), Some((line, column))) = (spec, at_line) else {
             return Ok(None);
         };
@@ -453,8 +455,15 @@ pub(super) fn map_material(
             "norm" | "bump" => "-bm ",
             _ => "",
         };
+        let mut argument = None;
         if !handled.is_empty() {
-            ignored.retain(|option| !option.starts_with(handled));
+            ignored.retain(|option| match option.strip_prefix(handled) {
+                Some(value) => {
+                    argument = Some(value.to_string());
+                    false
+                }
+                None => true,
+            });
         }
         let transform = scale_and_offset(&mut ignored).unwrap_or_else(|text| {
             warn(format!(
@@ -492,25 +501,28 @@ pub(super) fn map_material(
                 format!("material '{}': {key}: {e}", echo(&m.name)),
             )
         })?;
-        Ok(Some(TextureRef {
+        let texture = TextureRef {
             image,
             wrap_u: wrap,
             wrap_v: wrap,
             transform,
-        }))
+        };
+        Ok(Some((texture, argument)))
     };
     let mut base_color_texture = load_texture(
         "map_Kd",
         m.diffuse_texture.as_ref(),
         source.map_kd_at,
         Encoding::Color,
-    )?;
+    )?
+    .map(|(texture, _)| texture);
     let emissive_texture = load_texture(
         "map_Ke",
         m.unknown_param.get("map_Ke"),
         source.map_ke_at,
         Encoding::Color,
-    )?;
+    )?
+    .map(|(texture, _)| texture);
     // A scalar texture: the file's values, not linearised.
     let dissolve_texture = load_texture(
         "map_d",
@@ -525,24 +537,46 @@ pub(super) fn map_material(
         None => ("bump", m.normal_texture.as_ref(), source.bump_at),
     };
     let normal_texture = load_texture(normal_key, normal_spec, normal_at, Encoding::Data)?;
-    // The PBR extension's scalar maps, each with the channel its -imfchan names.
-    let mut scalar_map = |key: &str, at_line| -> Result<_, SceneError> {
-        let spec = m.unknown_param.get(key);
-        let texture = load_texture(key, spec, at_line, Encoding::Data)?;
-        Ok(texture.map(|t| (t, spec.map(String::as_str).and_then(imfchan))))
-    };
-    let roughness_map = scalar_map("map_Pr", source.map_pr_at)?;
-    let metallic_map = scalar_map("map_Pm", source.map_pm_at)?;
-    let coverage_channel = match m.dissolve_texture.as_deref().and_then(imfchan) {
-        None => CoverageChannel::Auto,
-        Some(letter) => CoverageChannel::from_imfchan(&letter).unwrap_or_else(|| {
-            warn(format!(
-                "map_d -imfchan {} is not supported (r, g, b, m or l are); its alpha, or else its luminance, is the coverage",
-                echo(&letter)
-            ));
-            CoverageChannel::Auto
-        }),
-    };
+    // The PBR extension's scalar maps.
+    let roughness_map = load_texture(
+        "map_Pr",
+        m.unknown_param.get("map_Pr"),
+        source.map_pr_at,
+        Encoding::Data,
+    )?;
+    let metallic_map = load_texture(
+        "map_Pm",
+        m.unknown_param.get("map_Pm"),
+        source.map_pm_at,
+        Encoding::Data,
+    )?;
+    // The channel a scalar map's -imfchan names, `fallback` without one (or, with a
+    // warning, with one MTL does not define).
+    let mut channel =
+        |map: &Option<(TextureRef, Option<String>)>, key: &str, fallback: CoverageChannel| {
+            let Some(letter) = map.as_ref().and_then(|(_, letter)| letter.as_deref()) else {
+                return fallback;
+            };
+            CoverageChannel::from_imfchan(letter).unwrap_or_else(|| {
+                warn(format!(
+                    "{key} -imfchan {} is not supported (r, g, b, m or l are); {} is read",
+                    echo(letter),
+                    match fallback {
+                        CoverageChannel::Auto => "its alpha, or else its luminance,",
+                        _ => "its luminance",
+                    }
+                ));
+                fallback
+            })
+        };
+    let coverage_channel = channel(&dissolve_texture, "map_d", CoverageChannel::Auto);
+    let rough_channel = channel(&roughness_map, "map_Pr", CoverageChannel::Luminance);
+    let metal_channel = channel(&metallic_map, "map_Pm", CoverageChannel::Luminance);
+    let dissolve_texture = dissolve_texture.map(|(texture, _)| texture);
+    let (rough, metal) = (
+        roughness_map.map(|(texture, _)| texture),
+        metallic_map.map(|(texture, _)| texture),
+    );
     for (key, present) in [
         ("map_Ks", m.specular_texture.is_some()),
         ("map_Ka", m.ambient_texture.is_some()),
@@ -567,30 +601,40 @@ pub(super) fn map_material(
     if norm.is_some() && m.normal_texture.is_some() {
         warn("bump is ignored: norm gives the normal map".into());
     }
-    let normal_texture = normal_texture.and_then(|texture| {
-        let image = &textures.images[texture.image as usize];
-        let why = match classify(image) {
-            BumpImage::NormalMap => return Some(texture),
-            BumpImage::HeightMap => "is grey, a height map: bump mapping is not supported (tangent-space normal maps are)",
-            BumpImage::Unclear => "is not a tangent-space normal map (its blue channel, the normal's z, averages below one half)",
-        };
-        warn(format!(
-            "{normal_key}: the image {} {why}; ignored",
-            echo_path(&image.path)
-        ));
-        None
-    });
-    let normal_scale = match normal_spec.and_then(|spec| bump_multiplier(&texture_options(spec).2))
-    {
-        Some(Ok(scale)) => scale,
-        Some(Err(text)) => {
-            warn(format!(
-                "{normal_key} -bm {} is not a finite number; the normal map's strength is 1",
-                echo(&text)
-            ));
-            1.0
+    // The normal map where its image is one, and its strength (`-bm`).
+    let (normal_texture, normal_scale) = match normal_texture {
+        Some((texture, multiplier)) => {
+            let image = &textures.images[texture.image as usize];
+            let why = match classify(image) {
+                BumpImage::NormalMap => "",
+                BumpImage::HeightMap => {
+                    "is grey, a height map: bump mapping is not supported (tangent-space normal maps are)"
+                }
+                BumpImage::Unclear => {
+                    "is not a tangent-space normal map (its blue channel, the normal's z, averages below one half)"
+                }
+            };
+            if why.is_empty() {
+                let scale = match multiplier.as_deref() {
+                    None => 1.0,
+                    Some(text) => bump_multiplier(text).unwrap_or_else(|| {
+                        warn(format!(
+                            "{normal_key} -bm {} is not a finite number; the normal map's strength is 1",
+                            echo(text)
+                        ));
+                        1.0
+                    }),
+                };
+                (Some(texture), scale)
+            } else {
+                warn(format!(
+                    "{normal_key}: the image {} {why}; ignored",
+                    echo_path(&image.path)
+                ));
+                (None, 1.0)
+            }
         }
-        None => 1.0,
+        None => (None, 1.0),
     };
 
     let default_albedo = if base_color_texture.is_some() {
@@ -788,30 +832,17 @@ pub(super) fn map_material(
     }
     // map_Pr and map_Pm as one metallic/roughness texture (made once per pair).
     let mut metallic_roughness_texture = None;
-    if material.kind != MaterialKind::Pbr && (roughness_map.is_some() || metallic_map.is_some()) {
+    if (rough.is_some() || metal.is_some()) && material.kind != MaterialKind::Pbr {
         warn(
             "map_Pr and map_Pm are read by metal/roughness materials only; ignored on glass".into(),
         );
-    } else if roughness_map.is_some() || metallic_map.is_some() {
-        let mut channel = |map: &Option<(TextureRef, Option<String>)>, key: &str| {
-            let letter = map.as_ref().and_then(|(_, letter)| letter.clone());
-            match letter.as_deref().map(CoverageChannel::from_imfchan) {
-                None => CoverageChannel::Luminance,
-                Some(Some(channel)) => channel,
-                Some(None) => {
-                    warn(format!(
-                        "{key} -imfchan {} is not supported (r, g, b, m or l are); its luminance is read",
-                        echo(letter.as_deref().unwrap_or_default())
-                    ));
-                    CoverageChannel::Luminance
-                }
-            }
-        };
-        let (rough_channel, metal_channel) = (
-            channel(&roughness_map, "map_Pr"),
-            channel(&metallic_map, "map_Pm"),
-        );
-        let (rough, metal) = (roughness_map.map(|(t, _)| t), metallic_map.map(|(t, _)| t));
+    } else if let (Some(placed), Some(size)) = (
+        rough.or(metal),
+        metallic_roughness_size(
+            rough.map(|t| &textures.images[t.image as usize]),
+            metal.map(|t| &textures.images[t.image as usize]),
+        ),
+    ) {
         if let (Some(r), Some(m)) = (rough, metal)
             && (r.transform != m.transform || r.wrap_u != m.wrap_u)
         {
@@ -819,24 +850,6 @@ pub(super) fn map_material(
                 "map_Pm's -s, -o or -clamp differ from map_Pr's; it is placed as map_Pr is".into(),
             );
         }
-        let placed = rough.or(metal).expect("one of the two maps");
-        let size = {
-            let pixels = |t: Option<TextureRef>| {
-                t.map(|t| {
-                    let i = &textures.images[t.image as usize];
-                    (
-                        u64::from(i.width) * u64::from(i.height),
-                        (i.width, i.height),
-                    )
-                })
-            };
-            match (pixels(rough), pixels(metal)) {
-                (Some(r), Some(m)) if m.0 > r.0 => m.1,
-                (Some(r), _) => r.1,
-                (None, Some(m)) => m.1,
-                (None, None) => (1, 1),
-            }
-        };
         let key = format!(
             "{:?} {rough_channel:?} {:?} {metal_channel:?}",
             rough.map(|t| t.image),
@@ -919,15 +932,6 @@ fn scale_and_offset(options: &mut Vec<String>) -> Result<TextureTransform, Strin
     Ok(TextureTransform::offset_rotation_scale(
         0, offset, 0.0, scale,
     ))
-}
-
-/// The argument of a texture statement's `-imfchan` option, if it has one.
-fn imfchan(spec: &str) -> Option<String> {
-    let (_, _, options) = texture_options(spec);
-    options
-        .iter()
-        .find_map(|option| option.strip_prefix("-imfchan "))
-        .map(str::to_string)
 }
 
 /// Splits a texture statement (`-clamp on -s 2 2 file name.png`) into the file name, the

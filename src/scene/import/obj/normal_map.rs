@@ -35,17 +35,10 @@ pub(super) fn classify(image: &Image) -> BumpImage {
     }
 }
 
-/// The `-bm` (bump multiplier) of a texture statement's unsupported options as
-/// `texture_options` lists them, if it has one: its number, or `Err` with the text.
-pub(super) fn bump_multiplier(options: &[String]) -> Option<Result<f64, String>> {
-    let argument = options.iter().find_map(|o| o.strip_prefix("-bm "))?;
-    Some(
-        argument
-            .parse::<f64>()
-            .ok()
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| argument.to_string()),
-    )
+/// The value of a `-bm` (bump multiplier) option's argument: a finite number, else
+/// `None`.
+pub(super) fn bump_multiplier(argument: &str) -> Option<f64> {
+    argument.parse::<f64>().ok().filter(|v| v.is_finite())
 }
 
 #[cfg(test)]
@@ -72,16 +65,9 @@ mod tests {
     }
 
     #[test]
-    fn the_bump_multiplier_is_read_from_the_options() {
-        let options = |o: &[&str]| o.iter().map(|s| (*s).to_string()).collect::<Vec<_>>();
-        assert_eq!(
-            bump_multiplier(&options(&["-s 2 2", "-bm 0.5"])),
-            Some(Ok(0.5))
-        );
-        assert_eq!(bump_multiplier(&options(&["-s 2 2"])), None);
-        assert_eq!(
-            bump_multiplier(&options(&["-bm inf"])),
-            Some(Err("inf".into()))
-        );
+    fn the_bump_multiplier_is_a_finite_number() {
+        assert_eq!(bump_multiplier("0.5"), Some(0.5));
+        assert_eq!(bump_multiplier("inf"), None);
+        assert_eq!(bump_multiplier("strong"), None);
     }
 }

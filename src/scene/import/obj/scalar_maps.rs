@@ -130,6 +130,21 @@ fn mean_under(
     (sum / f64::from((x1 - x0) * (y1 - y0))) as f32
 }
 
+/// The size of [`metallic_roughness`]'s texture: the larger map's (in texels; the
+/// roughness map's on a tie), `None` without either.
+pub(super) fn metallic_roughness_size(
+    roughness: Option<&Image>,
+    metallic: Option<&Image>,
+) -> Option<(u32, u32)> {
+    let texels = |i: &Image| u64::from(i.width) * u64::from(i.height);
+    let larger = match (roughness, metallic) {
+        (Some(r), Some(m)) if texels(m) > texels(r) => m,
+        (Some(only), _) | (None, Some(only)) => only,
+        (None, None) => return None,
+    };
+    Some((larger.width, larger.height))
+}
+
 /// The metallic/roughness texture of `roughness` and `metallic` (`map_Pr`, `map_Pm`:
 /// each an image and the channel its `-imfchan` names, luminance without one), at the
 /// larger one's size (in texels): green the roughness, blue the metalness, 1 where a
@@ -138,18 +153,8 @@ pub(super) fn metallic_roughness(
     roughness: Option<(&Image, CoverageChannel)>,
     metallic: Option<(&Image, CoverageChannel)>,
 ) -> Option<Image> {
-    let size = |map: Option<(&Image, CoverageChannel)>| map.map(|(i, _)| (i.width, i.height));
-    let (width, height) = match (size(roughness), size(metallic)) {
-        (Some(r), Some(m)) => {
-            if u64::from(m.0) * u64::from(m.1) > u64::from(r.0) * u64::from(r.1) {
-                m
-            } else {
-                r
-            }
-        }
-        (Some(only), None) | (None, Some(only)) => only,
-        (None, None) => return None,
-    };
+    let (width, height) =
+        metallic_roughness_size(roughness.map(|(i, _)| i), metallic.map(|(i, _)| i))?;
     let value = |map: Option<(&Image, CoverageChannel)>, x, y| match map {
         Some((image, channel)) => {
             let channel = match channel {
