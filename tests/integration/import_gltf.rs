@@ -15,6 +15,9 @@ use gpu_render::scene::import::{
 };
 use gpu_render::scene::{AlphaMode, Light, MaterialKind, TextureTransform};
 
+use crate::support::compare::max_channel_difference;
+use crate::support::models::{assert_tangents, small_scene};
+
 /// A glTF document under construction: one binary buffer and its views and accessors.
 #[derive(Default)]
 struct Doc {
@@ -1151,12 +1154,7 @@ fn occlusion_textures_are_left_to_the_path_tracer_and_normal_maps_get_flat_norma
     assert!(model.materials[0].normal_texture.is_some());
     let mesh = &model.meshes[0];
     assert_eq!(mesh.normals.as_deref(), Some(&[DVec3::Z; 3][..]));
-    for tangent in mesh.tangents.as_ref().expect("tangents") {
-        assert!(
-            (*tangent - DVec4::new(1.0, 0.0, 0.0, -1.0)).length() < 1e-6,
-            "{tangent}"
-        );
-    }
+    assert_tangents(mesh.tangents.as_ref(), DVec4::new(1.0, 0.0, 0.0, -1.0));
     // Without texture coordinates no tangents can be made: a warning.
     let bare = body
         .replace(r#","TEXCOORD_0":2,"TEXCOORD_1":3"#, "")
@@ -1738,36 +1736,28 @@ fn generated_tangents_give_the_image_given_ones_give() {
     assert!(given.warnings.is_empty(), "{:?}", given.warnings);
     assert!(generated.warnings.is_empty(), "{:?}", generated.warnings);
     // MikkTSpace's tangents are the given ones: +x, handedness +1.
-    for tangent in generated.meshes[0].tangents.as_ref().expect("generated") {
-        assert!(
-            (*tangent - glam::DVec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-6,
-            "{tangent}"
-        );
-    }
+    assert_tangents(
+        generated.meshes[0].tangents.as_ref(),
+        DVec4::new(1.0, 0.0, 0.0, 1.0),
+    );
     assert_eq!(given.materials[0].material.normal_scale, f64::from(0.8f32));
     // Rendered, the same image; and a different one without the normal map.
-    let settings = gpu_render::scene::RenderSettings {
-        width: 32,
-        height: 24,
-        ..Default::default()
-    };
     let render = |model: &ImportedModel| {
-        let mut scene = model.into_scene(settings);
-        scene.camera.eye = DVec3::new(0.0, 0.0, 4.0);
-        scene.camera.look_at = DVec3::ZERO;
-        gpu_render::cpu::render(&scene, None).image.pixels
+        let scene = small_scene(model, DVec3::new(0.0, 0.0, 4.0), DVec3::ZERO);
+        gpu_render::cpu::render(&scene, None).image
     };
     let (a, b) = (render(&given), render(&generated));
-    let largest = a
-        .iter()
-        .zip(&b)
-        .map(|(p, q)| (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0f32, f32::max))
-        .fold(0.0, f32::max);
+    let largest = max_channel_difference(&a, &b);
     assert!(largest < 1e-5, "images differ by {largest}");
     let mut flat = given.clone();
     flat.materials[0].normal_texture = None;
     let c = render(&flat);
-    assert!(a.iter().zip(&c).any(|(p, q)| (p[0] - q[0]).abs() > 1e-2));
+    assert!(
+        a.pixels
+            .iter()
+            .zip(&c.pixels)
+            .any(|(p, q)| (p[0] - q[0]).abs() > 1e-2)
+    );
 }
 
 /// A normal map whose `KHR_texture_transform` turns it a quarter: its axes turn with
@@ -1802,28 +1792,14 @@ fn a_normal_map_s_texture_transform_turns_its_axes() {
     // u' = v, v' = −u: the map's +x runs along increasing v, down the quad (−y); its
     // +y (decreasing v') along +u (+x): a right-handed frame.
     for model in [&given, &generated] {
-        for tangent in model.meshes[0].tangents.as_ref().expect("tangents") {
-            assert!(
-                (*tangent - DVec4::new(0.0, -1.0, 0.0, 1.0)).length() < 1e-6,
-                "{tangent}"
-            );
-        }
+        assert_tangents(
+            model.meshes[0].tangents.as_ref(),
+            DVec4::new(0.0, -1.0, 0.0, 1.0),
+        );
     }
-    let settings = gpu_render::scene::RenderSettings {
-        width: 32,
-        height: 24,
-        ..Default::default()
-    };
-    let scene = |model: &ImportedModel| {
-        let mut scene = model.into_scene(settings);
-        scene.camera.eye = DVec3::new(0.0, 0.0, 4.0);
-        scene.camera.look_at = DVec3::ZERO;
-        scene
-    };
+    let scene = |model: &ImportedModel| small_scene(model, DVec3::new(0.0, 0.0, 4.0), DVec3::ZERO);
     let render = |model: &ImportedModel| gpu_render::cpu::render(&scene(model), None).image;
-    let largest = |a: &gpu_render::film::LinearImage, b: &gpu_render::film::LinearImage| {
-        crate::support::compare::max_channel_difference(a, b)
-    };
+    let largest = max_channel_difference;
     let reference = render(&turned_by_hand);
     for (what, model) in [("given", &given), ("generated", &generated)] {
         let difference = largest(&render(model), &reference);
@@ -1904,14 +1880,7 @@ fn unlit_materials_show_their_base_colour_unshaded() {
         "{:?}",
         model.warnings
     );
-    let settings = gpu_render::scene::RenderSettings {
-        width: 32,
-        height: 24,
-        ..Default::default()
-    };
-    let mut scene = model.into_scene(settings);
-    scene.camera.eye = DVec3::new(0.0, 0.0, 4.0);
-    scene.camera.look_at = DVec3::ZERO;
+    let scene = small_scene(&model, DVec3::new(0.0, 0.0, 4.0), DVec3::ZERO);
     assert!(
         !scene.lights.is_empty(),
         "lit, to show the lights change nothing"

@@ -1419,25 +1419,18 @@ fn norm_and_normal_map_bumps_map_normals_and_height_maps_are_warned_about() {
         model.warnings
     );
     // MikkTSpace's tangents: along +u (+x), handedness +1 (v runs up +y in OBJ).
-    let tangents = model.meshes[0].tangents.as_ref().expect("tangents");
-    for tangent in tangents {
-        assert!(
-            (*tangent - DVec4::new(1.0, 0.0, 0.0, 1.0)).length() < 1e-6,
-            "{tangent}"
-        );
-    }
+    crate::support::models::assert_tangents(
+        model.meshes[0].tangents.as_ref(),
+        DVec4::new(1.0, 0.0, 0.0, 1.0),
+    );
 
     // Rendered: the tilt shows against the plain quad, on both backends.
-    let settings = gpu_render::scene::RenderSettings {
-        width: 32,
-        height: 24,
-        ..Default::default()
-    };
     let scene = |model: &ImportedModel| {
-        let mut scene = model.into_scene(settings);
-        scene.camera.eye = DVec3::new(1.0, 0.5, 4.0);
-        scene.camera.look_at = DVec3::new(1.0, 0.5, 0.0);
-        scene
+        crate::support::models::small_scene(
+            model,
+            DVec3::new(1.0, 0.5, 4.0),
+            DVec3::new(1.0, 0.5, 0.0),
+        )
     };
     let mapped = scene(&model);
     let plain = scene(&import_with("plain"));

@@ -3,6 +3,7 @@
 pub mod compare;
 pub mod geometry;
 pub mod gpu;
+pub mod models;
 pub mod pipeline;
 pub mod process;
 pub mod quads;
