@@ -10,7 +10,7 @@ use glam::{DVec2, DVec3};
 
 use super::normal_map::{BumpImage, bump_multiplier, classify};
 use super::scalar_maps::{
-    CoverageChannel, coverage_size, metallic_roughness, metallic_roughness_size, with_coverage,
+    ScalarChannel, coverage_size, metallic_roughness, metallic_roughness_size, with_coverage,
 };
 use super::{DEFAULT_OBJ_ALBEDO, Notes, at, decode_text, finite, is_integer, strip_comment, words};
 use crate::echo::{echo, echo_path, short, short3};
@@ -553,25 +553,25 @@ pub(super) fn map_material(
     // The channel a scalar map's -imfchan names, `fallback` without one (or, with a
     // warning, with one MTL does not define).
     let mut channel =
-        |map: &Option<(TextureRef, Option<String>)>, key: &str, fallback: CoverageChannel| {
+        |map: &Option<(TextureRef, Option<String>)>, key: &str, fallback: ScalarChannel| {
             let Some(letter) = map.as_ref().and_then(|(_, letter)| letter.as_deref()) else {
                 return fallback;
             };
-            CoverageChannel::from_imfchan(letter).unwrap_or_else(|| {
+            ScalarChannel::from_imfchan(letter).unwrap_or_else(|| {
                 warn(format!(
                     "{key} -imfchan {} is not supported (r, g, b, m or l are); {} is read",
                     echo(letter),
                     match fallback {
-                        CoverageChannel::Auto => "its alpha, or else its luminance,",
+                        ScalarChannel::Auto => "its alpha, or else its luminance,",
                         _ => "its luminance",
                     }
                 ));
                 fallback
             })
         };
-    let coverage_channel = channel(&dissolve_texture, "map_d", CoverageChannel::Auto);
-    let rough_channel = channel(&roughness_map, "map_Pr", CoverageChannel::Luminance);
-    let metal_channel = channel(&metallic_map, "map_Pm", CoverageChannel::Luminance);
+    let coverage_channel = channel(&dissolve_texture, "map_d", ScalarChannel::Auto);
+    let rough_channel = channel(&roughness_map, "map_Pr", ScalarChannel::Luminance);
+    let metal_channel = channel(&metallic_map, "map_Pm", ScalarChannel::Luminance);
     let dissolve_texture = dissolve_texture.map(|(texture, _)| texture);
     let (rough, metal) = (
         roughness_map.map(|(texture, _)| texture),

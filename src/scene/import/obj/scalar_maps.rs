@@ -9,12 +9,13 @@
 
 use crate::scene::Image;
 
-/// Which channel of a `map_d` image is its coverage: its `-imfchan` option (MTL:
-/// `r`, `g`, `b`, `m` the matte, i.e. alpha, `l` the luminance), or, without one, the
-/// alpha where the image has any texel below 1 (an RGBA cut-out) and else the
-/// luminance (a grey mask: the MTL default of scalar textures).
+/// Which channel of a scalar map's image holds its values: its `-imfchan` option
+/// (MTL: `r`, `g`, `b`, `m` the matte, i.e. alpha, `l` the luminance), or, without one,
+/// for `map_d` the alpha where the image has any texel below 1 (an RGBA cut-out) and
+/// else the luminance (a grey mask), for the PBR maps the luminance (MTL's default for
+/// scalar textures).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub(super) enum CoverageChannel {
+pub(super) enum ScalarChannel {
     /// One colour channel: 0 red, 1 green, 2 blue.
     Colour(usize),
     /// The alpha channel (MTL's "matte").
@@ -25,7 +26,7 @@ pub(super) enum CoverageChannel {
     Auto,
 }
 
-impl CoverageChannel {
+impl ScalarChannel {
     /// The channel `-imfchan` names, `None` for a letter MTL does not define (`z`, the
     /// depth channel, included: our images have none).
     pub(super) fn from_imfchan(letter: &str) -> Option<Self> {
@@ -40,7 +41,7 @@ impl CoverageChannel {
     }
 
     /// The coverage of `texel` (file values, not linearised) by this channel, with
-    /// `Auto` already resolved by [`CoverageChannel::resolved`], clamped to [0, 1].
+    /// `Auto` already resolved by [`ScalarChannel::resolved`], clamped to [0, 1].
     fn of(self, texel: [f32; 4]) -> f32 {
         let value = match self {
             Self::Colour(c) => texel[c],
@@ -77,7 +78,7 @@ pub(super) fn coverage_size(base: Option<&Image>, mask: &Image) -> (u32, u32) {
 /// coverage through `channel`. Where the sizes differ, each texel takes the mean
 /// coverage of the mask texels whose centres fall in it (the nearest one where none
 /// do: a smaller mask).
-pub(super) fn with_coverage(base: Option<&Image>, mask: &Image, channel: CoverageChannel) -> Image {
+pub(super) fn with_coverage(base: Option<&Image>, mask: &Image, channel: ScalarChannel) -> Image {
     let channel = channel.resolved(mask);
     let (width, height) = coverage_size(base, mask);
     let mut texels = Vec::with_capacity(width as usize * height as usize);
@@ -109,7 +110,7 @@ pub(super) fn with_coverage(base: Option<&Image>, mask: &Image, channel: Coverag
 /// nearest one where none do: a smaller image).
 fn mean_under(
     image: &Image,
-    channel: CoverageChannel,
+    channel: ScalarChannel,
     (x, y): (u32, u32),
     (width, height): (u32, u32),
 ) -> f32 {
@@ -150,15 +151,15 @@ pub(super) fn metallic_roughness_size(
 /// larger one's size (in texels): green the roughness, blue the metalness, 1 where a
 /// map is missing (the factor alone), red 0 and alpha 1. `None` without either map.
 pub(super) fn metallic_roughness(
-    roughness: Option<(&Image, CoverageChannel)>,
-    metallic: Option<(&Image, CoverageChannel)>,
+    roughness: Option<(&Image, ScalarChannel)>,
+    metallic: Option<(&Image, ScalarChannel)>,
 ) -> Option<Image> {
     let (width, height) =
         metallic_roughness_size(roughness.map(|(i, _)| i), metallic.map(|(i, _)| i))?;
-    let value = |map: Option<(&Image, CoverageChannel)>, x, y| match map {
+    let value = |map: Option<(&Image, ScalarChannel)>, x, y| match map {
         Some((image, channel)) => {
             let channel = match channel {
-                CoverageChannel::Auto => CoverageChannel::Luminance,
+                ScalarChannel::Auto => ScalarChannel::Luminance,
                 other => other,
             };
             mean_under(image, channel, (x, y), (width, height))
@@ -171,7 +172,7 @@ pub(super) fn metallic_roughness(
             texels.push([0.0, value(roughness, x, y), value(metallic, x, y), 1.0]);
         }
     }
-    let name = |map: Option<(&Image, CoverageChannel)>| {
+    let name = |map: Option<(&Image, ScalarChannel)>| {
         map.map_or("none".to_string(), |(i, _)| i.path.display().to_string())
     };
     Some(Image {
@@ -204,13 +205,13 @@ mod tests {
     fn a_grey_mask_becomes_the_alpha_of_the_colour_texture() {
         let base = image(2, 1, vec![[0.5, 0.25, 0.125, 1.0], [1.0, 0.0, 0.0, 0.5]]);
         let mask = image(2, 1, vec![[0.0, 0.0, 0.0, 1.0], [1.0, 1.0, 1.0, 1.0]]);
-        let merged = with_coverage(Some(&base), &mask, CoverageChannel::Auto);
+        let merged = with_coverage(Some(&base), &mask, ScalarChannel::Auto);
         assert_eq!(
             merged.texels,
             vec![[0.5, 0.25, 0.125, 0.0], [1.0, 0.0, 0.0, 0.5]]
         );
         // Without a colour texture: white, the coverage in alpha.
-        let alone = with_coverage(None, &mask, CoverageChannel::Auto);
+        let alone = with_coverage(None, &mask, ScalarChannel::Auto);
         assert_eq!(alone.texels, vec![[1.0, 1.0, 1.0, 0.0], [1.0; 4]]);
     }
 
@@ -224,16 +225,13 @@ mod tests {
                 .map(|t| t[3])
                 .collect::<Vec<_>>()
         };
-        assert_eq!(alpha(CoverageChannel::Auto), vec![0.0, 1.0]);
-        assert_eq!(alpha(CoverageChannel::Colour(1)), vec![0.2, 0.6]);
-        assert_eq!(alpha(CoverageChannel::Colour(0)), vec![1.0, 1.0]);
-        let luminance = alpha(CoverageChannel::Luminance);
+        assert_eq!(alpha(ScalarChannel::Auto), vec![0.0, 1.0]);
+        assert_eq!(alpha(ScalarChannel::Colour(1)), vec![0.2, 0.6]);
+        assert_eq!(alpha(ScalarChannel::Colour(0)), vec![1.0, 1.0]);
+        let luminance = alpha(ScalarChannel::Luminance);
         assert!((luminance[0] - (0.2126 + 0.7152 * 0.2)).abs() < 1e-6);
-        assert_eq!(
-            CoverageChannel::from_imfchan("m"),
-            Some(CoverageChannel::Matte)
-        );
-        assert_eq!(CoverageChannel::from_imfchan("z"), None);
+        assert_eq!(ScalarChannel::from_imfchan("m"), Some(ScalarChannel::Matte));
+        assert_eq!(ScalarChannel::from_imfchan("z"), None);
     }
 
     #[test]
@@ -241,8 +239,8 @@ mod tests {
         let rough = image(2, 1, vec![[0.2, 0.2, 0.2, 1.0], [0.8, 0.8, 0.8, 1.0]]);
         let metal = image(1, 1, vec![[0.0, 0.0, 0.5, 1.0]]);
         let both = metallic_roughness(
-            Some((&rough, CoverageChannel::Auto)),
-            Some((&metal, CoverageChannel::Colour(2))),
+            Some((&rough, ScalarChannel::Auto)),
+            Some((&metal, ScalarChannel::Colour(2))),
         )
         .expect("a texture");
         assert_eq!((both.width, both.height), (2, 1));
@@ -251,7 +249,7 @@ mod tests {
             vec![[0.0, 0.2, 0.5, 1.0], [0.0, 0.8, 0.5, 1.0]]
         );
         let alone =
-            metallic_roughness(None, Some((&metal, CoverageChannel::Auto))).expect("a texture");
+            metallic_roughness(None, Some((&metal, ScalarChannel::Auto))).expect("a texture");
         let luminance = 0.0722 * 0.5;
         assert!((alone.texels[0][2] - luminance).abs() < 1e-7);
         assert_eq!(
@@ -266,12 +264,12 @@ mod tests {
         let base = image(2, 1, vec![[1.0; 4]; 2]);
         // Four mask texels across: two under each base texel, averaged.
         let fine = image(4, 1, [0.0, 1.0, 1.0, 1.0].map(|v| [v, v, v, 1.0]).to_vec());
-        let merged = with_coverage(Some(&base), &fine, CoverageChannel::Luminance);
+        let merged = with_coverage(Some(&base), &fine, ScalarChannel::Luminance);
         assert!((merged.texels[0][3] - 0.5).abs() < 1e-6);
         assert!((merged.texels[1][3] - 1.0).abs() < 1e-6);
         // One mask texel for a 2 x 1 base: both take it.
         let coarse = image(1, 1, vec![[0.25, 0.25, 0.25, 1.0]]);
-        let merged = with_coverage(Some(&base), &coarse, CoverageChannel::Luminance);
+        let merged = with_coverage(Some(&base), &coarse, ScalarChannel::Luminance);
         assert_eq!((merged.width, merged.height), (2, 1));
         assert!(merged.texels.iter().all(|t| (t[3] - 0.25).abs() < 1e-6));
     }
