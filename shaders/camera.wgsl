@@ -1,26 +1,47 @@
 // The pinhole camera (with an optional thin lens) and the pixel sample pattern. CPU
-// twin: src/camera.rs (strata_grid, jitter_seed, sample_offset, lens_sample,
-// CameraFrame::camera_ray, CameraFrame::ray_direction -> camera_ray_direction); the
-// hash is sample.wgsl's. The lattice generator of the
-// sample count is computed once on the host (camera::lattice_generator) and arrives in
-// frame.lattice_generator.
+// twin: src/camera.rs (sobol_second, owen_scramble, sample_seed, sample_offset,
+// lens_sample, CameraFrame::camera_ray, CameraFrame::ray_direction ->
+// camera_ray_direction); the hash is sample.wgsl's.
 
 #import types
 #import bindings
 #import sample
 #import intersect
 
-// n columns and n rows of elementary strata for n samples; sample_offset puts exactly
-// one sample in every column and every row.
-fn strata_grid(samples_per_pixel: u32) -> vec2<u32> {
-    let n = max(samples_per_pixel, 1u);
-    return vec2<u32>(n, n);
+// The second coordinate of Sobol's (0,2)-sequence as 32 fraction bits: the XOR of the
+// direction numbers v_k of the set bits of `index`, v_0 = 1/2, v_k = v_{k-1} ^
+// (v_{k-1} >> 1) (Sobol, USSR Comp. Math. 1967; the first coordinate is van der
+// Corput's, reverseBits). Twin of sobol_second.
+fn sobol_second(index: u32) -> u32 {
+    var bits = 0u;
+    var direction = 0x80000000u;
+    var rest = index;
+    while rest != 0u {
+        if (rest & 1u) == 1u {
+            bits ^= direction;
+        }
+        direction ^= direction >> 1u;
+        rest >>= 1u;
+    }
+    return bits;
 }
 
-// The hash that jitters sample `index` inside its cell: the pattern's samples hash
-// pixel_index * spp + index; later rounds through the same strata (index >= spp)
-// hash that seed again mixed with the round. Twin of jitter_seed (src/camera.rs).
-fn jitter_seed(pixel_index: u32, spp: u32, index: u32) -> u32 {
+// Nested uniform (Owen) scramble of 32 fraction bits: Laine and Karras's hash on the
+// reversed bits, the constants of Burley, "Practical Hash-based Owen Scrambling",
+// JCGT 9(4), 2020, listing 3. Twin of owen_scramble.
+fn owen_scramble(bits: u32, seed: u32) -> u32 {
+    var x = reverseBits(bits) + seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return reverseBits(x);
+}
+
+// The hash of sample `index` of a pixel that seeds its lens point: the pattern's
+// samples hash pixel_index * spp + index; later rounds (index >= spp) hash that seed
+// again mixed with the round. Twin of sample_seed (src/camera.rs).
+fn sample_seed(pixel_index: u32, spp: u32, index: u32) -> u32 {
     let round = index / spp;
     let first = pcg_hash(pixel_index * spp + index % spp);
     if round == 0u {
@@ -30,34 +51,29 @@ fn jitter_seed(pixel_index: u32, spp: u32, index: u32) -> u32 {
 }
 
 // Offset in [0, 1)^2 of sample `index` inside pixel (px, py): the pixel centre for one
-// sample; otherwise column `index` and row (index * g + shift) mod n of the n x n strata
-// (one sample per column and per row, on a Fibonacci lattice of generator g =
-// frame.lattice_generator, shifted by a hash of the pixel), jittered inside the cell by a hash of pixel and sample index.
+// sample; otherwise point `index` of Sobol's (0,2)-sequence, each coordinate
+// Owen-scrambled by a hash of the pixel (pbrt-v4's ZSobolSampler construction, §8.7).
+// Twin of sample_offset.
 fn sample_offset(px: u32, py: u32, index: u32) -> vec2<f32> {
-    let spp = frame.samples_per_pixel;
-    if spp <= 1u {
+    if frame.samples_per_pixel <= 1u {
         return vec2<f32>(0.5, 0.5);
     }
-    let grid = strata_grid(spp);
-    let pixel_index = py * frame.width + px;
-    let shift = pcg_hash(pixel_index) % grid.y;
-    let column = index % grid.x;
-    // column * g + shift < 65535 * 65535 + 65536 < 2^32: no overflow for n <= 65536.
-    let row = (column * frame.lattice_generator + shift) % grid.y;
-    let seed = jitter_seed(pixel_index, spp, index);
-    let jitter = vec2<f32>(unit_from_hash(seed), unit_from_hash(pcg_hash(seed)));
-    let cell = vec2<f32>(f32(column), f32(row));
-    return (cell + jitter) / vec2<f32>(grid);
+    let seed_x = pcg_hash(py * frame.width + px);
+    let seed_y = pcg_hash(seed_x);
+    return vec2<f32>(
+        unit_from_hash(owen_scramble(reverseBits(index), seed_x)),
+        unit_from_hash(owen_scramble(sobol_second(index), seed_y)),
+    );
 }
 
-// The 32-bit golden ratio, XORed into a sample's jitter seed for its lens point.
+// The 32-bit golden ratio, XORed into a sample's seed for its lens point.
 // CPU twin: LENS_SALT.
 const LENS_SALT: u32 = 0x9e3779b9u;
 
 // The point of the unit square that picks the lens point of sample `index` of pixel
-// `pixel_index`: a hash of its jitter seed salted apart from the jitter.
+// `pixel_index`: a hash of its sample seed, salted apart.
 fn lens_sample(pixel_index: u32, spp: u32, index: u32) -> vec2<f32> {
-    let seed = pcg_hash(jitter_seed(pixel_index, max(spp, 1u), index) ^ LENS_SALT);
+    let seed = pcg_hash(sample_seed(pixel_index, max(spp, 1u), index) ^ LENS_SALT);
     return vec2<f32>(unit_from_hash(seed), unit_from_hash(pcg_hash(seed)));
 }
 

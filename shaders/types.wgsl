@@ -34,7 +34,6 @@ struct FrameUniforms {
     flags: u32,
     offset_scale: f32,
     min_ray_weight: f32,
-    lattice_generator: u32,
     static_pixels: u32,
     // The camera's thin lens (camera_ray): its radius, 0 for a pinhole, and the
     // distance of the plane in focus along `forward`.
@@ -45,6 +44,7 @@ struct FrameUniforms {
     // CameraFrame::pixel_cone); both 0 without texture filtering.
     cone_width: f32,
     cone_spread: f32,
+    _pad: u32,
 }
 
 // FrameUniforms.flags: also store each finished pixel's sample sum and luminance m2 in

@@ -142,7 +142,7 @@ fn pop_ray(slot: u32, path: ptr<function, PathState>, trace: ptr<function, Trace
     return true;
 }
 
-// Starts the camera ray of the path's current sample (jittered stratified, box
+// Starts the camera ray of the path's current sample (Owen-scrambled Sobol, box
 // filter), inside the dielectrics around the camera.
 fn start_sample(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) {
     let xy = image_position(path);

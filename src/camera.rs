@@ -164,73 +164,49 @@ pub struct PixelCone {
     pub spread: f64,
 }
 
-/// The stratum grid of `samples_per_pixel` samples: `n` columns and `n` rows of
-/// elementary strata, each `1/n` of the pixel wide and high. [`sample_offset`] puts
-/// exactly one sample in every column and exactly one in every row (a Latin square),
-/// so the grid is always covered uniformly, whatever `n` is. One sample is `(1, 1)`.
-pub fn strata_grid(samples_per_pixel: u32) -> (u32, u32) {
-    let n = samples_per_pixel.max(1);
-    (n, n)
-}
-
-/// Candidates [`lattice_generator`] weighs: the integer nearest `n/φ` and the 8 on
-/// each side of it.
-pub const LATTICE_CANDIDATES: u32 = 17;
-
-/// The generator `g` of the rank-1 lattice of `n` points `(i/n, (i·g mod n)/n)`: of the
-/// integers near `n/φ` (golden ratio φ: a Fibonacci lattice) that are coprime with `n`,
-/// so that `i ↦ i·g mod n` is a permutation of the rows, the one whose continued
-/// fraction `n/g` has the smallest largest partial quotient (Zaremba's figure of merit:
-/// small quotients mean no two points close together), the nearest to `n/φ` on a tie.
-/// Integer arithmetic only (`40503 = round(2^16/φ)`; exact for `n <= 65536`), so both
-/// backends agree bit for bit.
-///
-/// Rank-1 lattices for pixel sampling: Dammertz and Keller, "Image Synthesis by Rank-1
-/// Lattices", Monte Carlo and Quasi-Monte Carlo Methods 2006 (Springer, 2008); the
-/// figure of merit: Niederreiter, "Random Number Generation and Quasi-Monte Carlo
-/// Methods" (SIAM, 1992), §5.
-pub fn lattice_generator(n: u32) -> u32 {
-    let nearest = (n.wrapping_mul(40_503).wrapping_add(32_768)) >> 16;
-    let mut best = (u32::MAX, 1);
-    for k in 0..LATTICE_CANDIDATES {
-        let step = k.div_ceil(2);
-        let g = if k % 2 == 1 {
-            nearest.wrapping_add(step)
-        } else {
-            nearest.wrapping_sub(step)
-        };
-        if g == 0 || g >= n {
-            continue;
+/// The second coordinate of Sobol's sequence in base 2 as 32 fraction bits: the XOR of
+/// the direction numbers `v_k` of the set bits `k` of `index`, `v_0 = 2⁻¹` and `v_k =
+/// v_{k−1} ⊕ (v_{k−1} >> 1)` (the primitive polynomial `x + 1`: the generator matrix
+/// is Pascal's triangle mod 2). With the van der Corput first coordinate
+/// (`index.reverse_bits()`) it makes the (0,2)-sequence: every aligned block of `2^k`
+/// points is a (0,k,2)-net, one point in each of the `2^k` equal dyadic boxes of every
+/// shape (Sobol, "On the distribution of points in a cube", USSR Comp. Math. 1967;
+/// Niederreiter 1992, §4). Twin of `sobol_second` in `shaders/camera.wgsl`.
+pub fn sobol_second(index: u32) -> u32 {
+    let (mut bits, mut direction, mut rest) = (0u32, 0x8000_0000u32, index);
+    while rest != 0 {
+        if rest & 1 == 1 {
+            bits ^= direction;
         }
-        let quality = largest_partial_quotient(n, g);
-        if quality < best.0 {
-            best = (quality, g);
-        }
+        direction ^= direction >> 1;
+        rest >>= 1;
     }
-    best.1
+    bits
 }
 
-/// The largest partial quotient of the continued fraction of `n/g` (Euclid's
-/// algorithm), or `u32::MAX` when `n` and `g` are not coprime.
-fn largest_partial_quotient(n: u32, g: u32) -> u32 {
-    let (mut a, mut b, mut largest) = (n, g, 0);
-    while b != 0 {
-        largest = largest.max(a / b);
-        (a, b) = (b, a % b);
-    }
-    if a == 1 { largest } else { u32::MAX }
+/// A nested uniform (Owen) scramble of the 32 fraction bits `bits` seeded by `seed`:
+/// each bit is flipped by a hash of the bits above it, so that every dyadic interval
+/// maps onto one of the same length: a (0,k,2)-net stays one, and every point becomes
+/// uniform on [0, 1). The hash is Laine and Karras's, on the reversed bits, with the
+/// constants of Burley, "Practical Hash-based Owen Scrambling", JCGT 9(4), 2020,
+/// listing 3 (`nested_uniform_scramble`). Twin of `owen_scramble`.
+pub fn owen_scramble(bits: u32, seed: u32) -> u32 {
+    let mut x = bits.reverse_bits().wrapping_add(seed);
+    x ^= x.wrapping_mul(0x6c50_b47c);
+    x ^= x.wrapping_mul(0xb82f_1e52);
+    x ^= x.wrapping_mul(0xc7af_e638);
+    x ^= x.wrapping_mul(0x8d22_f6e6);
+    x.reverse_bits()
 }
 
-/// The sample pattern of one render: [`sample_offset`] with the lattice generator of
-/// its sample count computed once (the GPU receives it in its frame constants).
+/// The sample pattern of one render: [`sample_offset`] for its image width and
+/// sample count.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SamplePattern {
     /// Image width (the pixel index is `y · width + x`).
     pub width: u32,
     /// Samples per pixel.
     pub samples_per_pixel: u32,
-    /// [`lattice_generator`] of `samples_per_pixel`.
-    pub lattice_generator: u32,
 }
 
 impl SamplePattern {
@@ -239,40 +215,31 @@ impl SamplePattern {
         Self {
             width: settings.width,
             samples_per_pixel: settings.samples_per_pixel,
-            lattice_generator: lattice_generator(settings.samples_per_pixel),
         }
     }
 
     /// [`sample_offset`] of sample `index` of pixel (`px`, `py`).
     pub fn offset(&self, px: u32, py: u32, index: u32) -> (f64, f64) {
-        let spp = self.samples_per_pixel;
-        if spp <= 1 {
+        if self.samples_per_pixel <= 1 {
             return (0.5, 0.5);
         }
-        let (columns, rows) = strata_grid(spp);
         let pixel_index = py.wrapping_mul(self.width).wrapping_add(px);
-        let shift = pcg_hash(pixel_index) % rows;
-        let column = index % columns;
-        // In u64 for safety; the WGSL twin's u32 cannot overflow either for n <= 65536.
-        let row = ((u64::from(column) * u64::from(self.lattice_generator) + u64::from(shift))
-            % u64::from(rows)) as u32;
-        let seed = jitter_seed(pixel_index, spp, index);
-        let jitter_x = unit_from_hash(seed);
-        let jitter_y = unit_from_hash(pcg_hash(seed));
+        let seed_x = pcg_hash(pixel_index);
+        let seed_y = pcg_hash(seed_x);
         (
-            (f64::from(column) + jitter_x) / f64::from(columns),
-            (f64::from(row) + jitter_y) / f64::from(rows),
+            unit_from_hash(owen_scramble(index.reverse_bits(), seed_x)),
+            unit_from_hash(owen_scramble(sobol_second(index), seed_y)),
         )
     }
 }
 
-/// The hash that jitters sample `index` of pixel `pixel_index` inside its cell. The
-/// samples of the pattern (`index < spp`) hash `pixel_index · spp + index`, one number
-/// per sample of the image. A progressive render's later rounds through the same
-/// strata (`index ≥ spp`, round `r = index / spp`) hash that first-round seed again
-/// mixed with the round, so that they repeat neither their own first round's jitter
-/// nor a neighbour's (`pixel_index · spp + index` would be the next pixel's).
-pub fn jitter_seed(pixel_index: u32, spp: u32, index: u32) -> u32 {
+/// The hash of sample `index` of pixel `pixel_index` that seeds its lens point
+/// ([`lens_sample`]). The samples of the pattern (`index < spp`) hash `pixel_index ·
+/// spp + index`, one number per sample of the image. A progressive render's later
+/// rounds (`index ≥ spp`, round `r = index / spp`) hash that first-round seed again
+/// mixed with the round, so that they repeat neither their own first round's lens
+/// points nor a neighbour's (`pixel_index · spp + index` would be the next pixel's).
+pub fn sample_seed(pixel_index: u32, spp: u32, index: u32) -> u32 {
     let round = index / spp;
     let first = pcg_hash(pixel_index.wrapping_mul(spp).wrapping_add(index % spp));
     if round == 0 {
@@ -283,26 +250,31 @@ pub fn jitter_seed(pixel_index: u32, spp: u32, index: u32) -> u32 {
 }
 
 /// The point of the unit square that picks the lens point of sample `index` of pixel
-/// `pixel_index` ([`CameraFrame::camera_ray`]): a hash of the sample's jitter seed
-/// ([`jitter_seed`]) salted apart from the jitter itself, so that the lens point and
+/// `pixel_index` ([`CameraFrame::camera_ray`]): a hash of the sample's seed
+/// ([`sample_seed`]) salted apart from other uses of it, so that the lens point and
 /// the image position vary independently. Both backends pick the same points.
 pub fn lens_sample(pixel_index: u32, spp: u32, index: u32) -> DVec2 {
-    let seed = pcg_hash(jitter_seed(pixel_index, spp.max(1), index) ^ LENS_SALT);
+    let seed = pcg_hash(sample_seed(pixel_index, spp.max(1), index) ^ LENS_SALT);
     DVec2::new(unit_from_hash(seed), unit_from_hash(pcg_hash(seed)))
 }
 
-/// XORed into a sample's jitter seed for its lens point ([`lens_sample`]): the
-/// 32-bit golden ratio, any constant that separates the two streams would do.
+/// XORed into a sample's seed for its lens point ([`lens_sample`]): the 32-bit
+/// golden ratio, any constant that separates the two streams would do.
 pub const LENS_SALT: u32 = 0x9e37_79b9;
 
 /// The offset inside pixel (`px`, `py`) of sample `index`, in [0, 1)². One sample goes
-/// through the pixel centre (as in the lecture). With `n > 1` samples, sample `i` lies
-/// in column `i` and row `(i·g + s) mod n` of the `n × n` [`strata_grid`], where `g` is
-/// the [`lattice_generator`] of `n` and `s` a hash of the pixel: every column and every
-/// row holds exactly one sample (so the mean offset is within `1/(2n)` of the pixel
-/// centre in each axis, for every `n`), and the points lie on a Fibonacci lattice, so
-/// they are spread in 2D too. Each sample is jittered inside its cell by a hash of the
-/// pixel and sample index, so both backends pick identical positions.
+/// through the pixel centre (as in the lecture). With `n > 1` samples, sample `i` is
+/// point `i` of Sobol's (0,2)-sequence (van der Corput's radical inverse, then
+/// [`sobol_second`]), each coordinate Owen-scrambled ([`owen_scramble`]) by a hash of
+/// the pixel: for `n = 2^k` the pixel's samples are a (0,k,2)-net (exactly one in every
+/// column and every row of `n`, one in every cell of a `√n × √n` grid, and in every
+/// other dyadic box of area `1/n`), any `n` samples lie in distinct columns and rows of
+/// the next power of two, every sample is uniform over the pixel (so the box-filter
+/// mean is unbiased), and a progressive render's later samples go on with the same
+/// sequence, so each further aligned block of `2^k` is a net too and together they
+/// make finer ones. pbrt-v4's default sampler is the same construction
+/// (`ZSobolSampler`; Pharr, Jakob and Humphreys, 4th ed., §8.7). Integer arithmetic
+/// and the same 24 bits of each coordinate on both backends: identical positions.
 pub fn sample_offset(px: u32, py: u32, index: u32, settings: &RenderSettings) -> (f64, f64) {
     SamplePattern::new(settings).offset(px, py, index)
 }
@@ -362,69 +334,109 @@ mod tests {
         assert_eq!((cone.width, cone.spread), (6.0 / 480.0, 0.0));
     }
 
-    #[test]
-    fn every_column_and_row_holds_exactly_one_sample() {
-        for n in 1..=300 {
-            let (columns, rows) = strata_grid(n);
-            assert_eq!((columns, rows), (n, n));
-            for (px, py) in [(0, 0), (7, 3), (639, 479)] {
-                let mut column_hits = vec![0u32; columns as usize];
-                let mut row_hits = vec![0u32; rows as usize];
-                for index in 0..n {
-                    let (x, y) = sample_offset(px, py, index, &settings(640, n));
-                    assert!((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y));
-                    column_hits[(x * f64::from(columns)) as usize] += 1;
-                    row_hits[(y * f64::from(rows)) as usize] += 1;
-                }
-                assert!(
-                    column_hits.iter().all(|&h| h == 1),
-                    "n={n}: {column_hits:?}"
-                );
-                assert!(row_hits.iter().all(|&h| h == 1), "n={n}: {row_hits:?}");
+    /// Whether `points` (in [0, 1)²) hold exactly one point in each of the `2^k` dyadic
+    /// boxes of every shape `2^-a × 2^-(k-a)`, `2^k` being their number.
+    fn is_net(points: &[(f64, f64)]) -> bool {
+        let n = points.len();
+        let k = n.trailing_zeros();
+        (0..=k).all(|a| {
+            let (columns, rows) = (1usize << a, 1usize << (k - a));
+            let mut hits = vec![0u32; n];
+            for &(x, y) in points {
+                let cell = (y * rows as f64) as usize * columns + (x * columns as f64) as usize;
+                hits[cell] += 1;
             }
-        }
+            hits.iter().all(|&h| h == 1)
+        })
     }
 
     #[test]
-    fn mean_offset_is_the_pixel_centre_for_every_sample_count() {
-        // One sample per column and per row, each jittered inside a cell 1/n wide: the
-        // mean lies within 1/(2n) of 0.5. The old ceil(sqrt(n)) grid left cells of its
-        // last row empty (32 samples: 4 of 36), a bias of 0.05 in y.
-        for n in 1..=300 {
-            let bound = 0.5 / f64::from(n);
-            for (px, py) in [(0, 0), (5, 2), (31, 23), (1000, 1000)] {
-                let (sum_x, sum_y) = (0..n)
-                    .map(|i| sample_offset(px, py, i, &settings(1920, n)))
-                    .fold((0.0, 0.0), |(sx, sy), (x, y)| (sx + x, sy + y));
-                let mean = (sum_x / f64::from(n), sum_y / f64::from(n));
-                assert!(
-                    (mean.0 - 0.5).abs() <= bound && (mean.1 - 0.5).abs() <= bound,
-                    "n={n} pixel ({px}, {py}): mean offset {mean:?}, bound {bound}"
-                );
-            }
-        }
-    }
-
-    #[test]
-    fn lattice_generator_permutes_the_rows() {
-        for n in 2..=65_536u32 {
-            let g = lattice_generator(n);
-            assert!(g >= 1 && g < n, "n={n} g={g}");
-            assert_ne!(
-                largest_partial_quotient(n, g),
-                u32::MAX,
-                "n={n} g={g}: not coprime"
+    fn the_sobol_sequence_is_the_published_one() {
+        // Unscrambled: (0, 0), (1/2, 1/2), (1/4, 3/4), (3/4, 1/4), (1/8, 5/8),
+        // (5/8, 1/8), (3/8, 3/8), (7/8, 7/8) (Sobol 1967; Joe and Kuo's table).
+        let expected = [0.0, 0.5, 0.75, 0.25, 0.625, 0.125, 0.375, 0.875];
+        for (i, y) in expected.into_iter().enumerate() {
+            assert_eq!(
+                f64::from(sobol_second(i as u32)) / 2f64.powi(32),
+                y,
+                "i={i}"
             );
-            // Some candidate is coprime: never the diagonal fallback g = 1.
-            assert!(n <= 3 || g > 1, "n={n}");
         }
-        // Fibonacci numbers get the Fibonacci lattice: 89 points, generator 55.
-        assert_eq!(lattice_generator(89), 55);
-        // 32 points: 21 is nearest 32/φ, but 32/21 = [1; 1, 1, 10]; 25 gives [1; 3, 1, 1, 3].
-        assert_eq!(lattice_generator(32), 25);
-        for n in 2..=300 {
-            let quality = largest_partial_quotient(n, lattice_generator(n));
-            assert!(quality <= 8, "n={n}: largest partial quotient {quality}");
+        let points: Vec<(f64, f64)> = (0..1024u32)
+            .map(|i| {
+                let unit = |bits: u32| f64::from(bits) / 2f64.powi(32);
+                (unit(i.reverse_bits()), unit(sobol_second(i)))
+            })
+            .collect();
+        for k in 0..=10 {
+            assert!(is_net(&points[..1 << k]), "first {} points", 1 << k);
+        }
+    }
+
+    #[test]
+    fn owen_scrambling_maps_dyadic_intervals_onto_dyadic_intervals() {
+        // The top k bits of the result depend on the top k bits of the input only, and
+        // the scramble is a bijection (of 16-bit prefixes here).
+        for seed in [0u32, 1, 0xdead_beef, pcg_hash(7)] {
+            let mut seen = vec![false; 1 << 16];
+            for top in 0..(1u32 << 16) {
+                let a = owen_scramble(top << 16, seed);
+                let b = owen_scramble((top << 16) | pcg_hash(top) >> 16, seed);
+                assert_eq!(a >> 16, b >> 16, "seed {seed} prefix {top}");
+                assert!(!std::mem::replace(&mut seen[(a >> 16) as usize], true));
+            }
+        }
+    }
+
+    #[test]
+    fn powers_of_two_fill_every_dyadic_box_and_other_counts_distinct_strata() {
+        for n in 2..=300u32 {
+            let strata = n.next_power_of_two();
+            for (px, py) in [(0, 0), (7, 3), (639, 479)] {
+                let points: Vec<(f64, f64)> = (0..n)
+                    .map(|i| sample_offset(px, py, i, &settings(640, n)))
+                    .collect();
+                assert!(
+                    points
+                        .iter()
+                        .all(|&(x, y)| (0.0..1.0).contains(&x) && (0.0..1.0).contains(&y))
+                );
+                if n.is_power_of_two() {
+                    assert!(is_net(&points), "n={n} pixel ({px}, {py}): {points:?}");
+                }
+                // Any count: no two samples share a column or a row of the next power of
+                // two (a prefix of a net).
+                let mut columns = vec![0u32; strata as usize];
+                let mut rows = vec![0u32; strata as usize];
+                for &(x, y) in &points {
+                    columns[(x * f64::from(strata)) as usize] += 1;
+                    rows[(y * f64::from(strata)) as usize] += 1;
+                }
+                assert!(columns.iter().chain(&rows).all(|&h| h <= 1), "n={n}");
+            }
+        }
+    }
+
+    #[test]
+    fn every_sample_is_uniform_over_the_pixel() {
+        // Owen scrambling makes each sample uniform on the pixel, so the box-filter mean
+        // is unbiased for every count: over 65,536 pixels, the mean of sample i's
+        // offset is 1/2 and its variance 1/12, within 5 standard errors.
+        let pixels = 65_536u32;
+        for (n, index) in [(3, 2), (5, 4), (32, 17), (100, 99)] {
+            let pattern = SamplePattern::new(&settings(256, n));
+            let (mut sum, mut square) = (DVec2::ZERO, DVec2::ZERO);
+            for p in 0..pixels {
+                let (x, y) = pattern.offset(p % 256, p / 256, index);
+                let v = DVec2::new(x, y);
+                sum += v;
+                square += v * v;
+            }
+            let mean = sum / f64::from(pixels);
+            let variance = square / f64::from(pixels) - mean * mean;
+            let error = 5.0 * (1.0f64 / 12.0 / f64::from(pixels)).sqrt();
+            assert!((mean - 0.5).abs().max_element() < error, "n={n}: {mean:?}");
+            assert!((variance - 1.0 / 12.0).abs().max_element() < 0.002, "n={n}");
         }
     }
 
@@ -462,24 +474,23 @@ mod tests {
     }
 
     #[test]
-    fn later_rounds_jitter_afresh_and_never_as_the_next_pixel() {
-        // The position inside its cell of each sample: with n samples the cell is 1/n
-        // wide, so the jitter is the fractional part of offset × n.
-        let jitter = |px: u32, index: u32, n: u32| {
-            let (x, y) = sample_offset(px, 0, index, &settings(64, n));
-            ((x * f64::from(n)).fract(), (y * f64::from(n)).fract())
-        };
-        for n in [2, 3, 16] {
-            for px in 0..8 {
-                for index in 0..n {
-                    let later = jitter(px, n + index, n);
-                    assert_ne!(later, jitter(px + 1, index, n), "n={n} pixel {px} {index}");
-                    assert_ne!(later, jitter(px, index, n), "n={n} pixel {px} {index}");
-                    assert_ne!(later, jitter(px, 2 * n + index, n), "n={n} pixel {px}");
-                }
+    fn later_rounds_go_on_with_the_sequence() {
+        // A progressive render's rounds past the pattern: each round of a power of two
+        // is a net of its own, unlike the rounds before it, and the rounds together
+        // make a finer net (4 rounds of 4: one of 16).
+        for (px, py) in [(0, 0), (9, 2)] {
+            let points: Vec<(f64, f64)> = (0..16)
+                .map(|i| sample_offset(px, py, i, &settings(64, 4)))
+                .collect();
+            assert!(is_net(&points));
+            for round in points.chunks(4) {
+                assert!(is_net(round));
             }
+            assert_ne!(points[..4], points[4..8]);
         }
-        // The first round is the pattern as it always was.
-        assert_eq!(jitter_seed(7, 16, 3), pcg_hash(7 * 16 + 3));
+        // The lens point's seed: the first round is the pattern's own sample index.
+        assert_eq!(sample_seed(7, 16, 3), pcg_hash(7 * 16 + 3));
+        assert_ne!(sample_seed(7, 16, 19), sample_seed(7, 16, 3));
+        assert_ne!(sample_seed(7, 16, 19), sample_seed(8, 16, 3));
     }
 }

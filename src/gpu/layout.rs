@@ -77,9 +77,6 @@ pub struct FrameUniforms {
     pub offset_scale: f32,
     /// Branches whose weight is not above this are not traced.
     pub min_ray_weight: f32,
-    /// The sample pattern's lattice generator (`crate::camera::lattice_generator` of
-    /// the samples per pixel).
-    pub lattice_generator: u32,
     /// Region pixels below this go to slots in a fixed order, the rest from the shared
     /// counter ([`static_pixels_for`]; set where a trace starts).
     pub static_pixels: u32,
@@ -94,6 +91,8 @@ pub struct FrameUniforms {
     /// A camera ray's cone width growth per unit distance, `2·tan(α/2)`
     /// ([`crate::camera::CameraFrame::pixel_cone`]); 0 without texture filtering.
     pub cone_spread: f32,
+    /// Padding to the record's 16-byte alignment.
+    pub _pad: u32,
 }
 
 /// Most rounds of pixels handed out in a fixed order ([`static_pixels_for`]).

@@ -749,12 +749,12 @@ pub fn frame_uniforms(scene: &Scene, geometry: &SceneGeometry) -> FrameUniforms 
         flags: projection_flag | filtering_flag,
         offset_scale: geometry.offset_scale as f32,
         min_ray_weight: settings.min_ray_weight as f32,
-        lattice_generator: crate::camera::lattice_generator(settings.samples_per_pixel),
         static_pixels: 0,
         lens_radius: camera.lens_radius as f32,
         focus_distance: camera.focus_distance as f32,
         cone_width: cone.width as f32,
         cone_spread: cone.spread as f32,
+        _pad: 0,
     }
 }
 

@@ -68,12 +68,12 @@ fn rust_twins() -> BTreeMap<&'static str, Twin> {
                 flags,
                 offset_scale,
                 min_ray_weight,
-                lattice_generator,
                 static_pixels,
                 lens_radius,
                 focus_distance,
                 cone_width,
                 cone_spread,
+                _pad,
             }),
         ),
         (
