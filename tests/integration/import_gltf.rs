@@ -16,7 +16,7 @@ use gpu_render::scene::import::{
 use gpu_render::scene::{AlphaMode, Light, MaterialKind, TextureTransform};
 
 use crate::support::compare::max_channel_difference;
-use crate::support::models::{assert_tangents, small_scene};
+use crate::support::models::{assert_tangents, material_named, small_scene};
 
 /// A glTF document under construction: one binary buffer and its views and accessors.
 #[derive(Default)]
@@ -828,13 +828,7 @@ fn alpha_modes_cutoffs_and_the_base_colour_s_alpha_are_read() {
         primitive(3)
     );
     let model = imported("alpha.gltf", doc.embedded(&body).as_bytes());
-    let material = |name: &str| {
-        model
-            .materials
-            .iter()
-            .find(|m| m.name == name)
-            .unwrap_or_else(|| panic!("material {name}"))
-    };
+    let material = |name: &str| material_named(&model, name);
     let leaf = material("leaf");
     assert_eq!(leaf.material.alpha_mode, AlphaMode::Mask { cutoff: 0.5 });
     assert!((leaf.material.alpha - 0.8).abs() < 1e-7);

@@ -9,6 +9,8 @@ use gpu_render::low_level::color::srgb_decode;
 use gpu_render::scene::import::{ImportedModel, WrapMode, import_model, import_obj, parse_obj};
 use gpu_render::scene::{AlphaMode, MaterialKind, SceneError};
 
+use crate::support::models::material_named;
+
 /// Writes `files` (name, contents) into a fresh directory and imports the first.
 fn import(files: &[(&str, &str)]) -> (tempfile::TempDir, Result<ImportedModel, SceneError>) {
     let dir = tempfile::tempdir().expect("temporary directory");
@@ -242,14 +244,7 @@ fn mtl_illumination_models_map_as_documented() {
         obj.push_str(&format!("usemtl {name}\nf 1 2 3\n"));
     }
     let model = imported(&[("all.obj", &obj), ("all.mtl", MATERIALS)]);
-    let material = |name: &str| {
-        model
-            .materials
-            .iter()
-            .find(|m| m.name == name)
-            .unwrap_or_else(|| panic!("no material {name}"))
-            .material
-    };
+    let material = |name: &str| material_named(&model, name).material;
     let flat = material("flat");
     assert_eq!(flat.kind, MaterialKind::Lambert, "illum 1 ignores Ks");
     assert_eq!(flat.diffuse, DVec3::new(0.5, 0.4, 0.3));
@@ -381,12 +376,9 @@ f 1/1/1 2/2/1 3/3/1
     .expect("obj");
     let model = import_obj(&dir.path().join("t.obj")).expect("imports");
     let transform = |name: &str| {
-        model
-            .materials
-            .iter()
-            .find(|m| m.name == name)
-            .and_then(|m| m.base_color_texture)
-            .unwrap_or_else(|| panic!("material {name}"))
+        material_named(&model, name)
+            .base_color_texture
+            .unwrap_or_else(|| panic!("material {name} has no texture"))
             .transform
     };
     // An OBJ texture coordinate (u, v_obj) lands at (3u + 0.25, 0.5 v_obj + 0.5) of the
@@ -1251,14 +1243,7 @@ fn dissolve_makes_a_blended_material_of_that_alpha() {
         obj.push_str(&format!("usemtl {name}\nf 1 2 3\n"));
     }
     let model = imported(&[("d.obj", &obj), ("d.mtl", mtl)]);
-    let material = |name: &str| {
-        &model
-            .materials
-            .iter()
-            .find(|m| m.name == name)
-            .unwrap_or_else(|| panic!("no material {name}"))
-            .material
-    };
+    let material = |name: &str| &material_named(&model, name).material;
     for name in ["quarter", "tr"] {
         assert_eq!(material(name).alpha_mode, AlphaMode::Blend, "{name}");
         assert_eq!(material(name).alpha, 0.25, "{name}");
@@ -1322,13 +1307,7 @@ fn map_d_is_coverage_in_the_albedo_texture_s_alpha() {
     )
     .expect("obj");
     let model = import_obj(&dir.path().join("leaf.obj")).expect("imports");
-    let material = |name: &str| {
-        model
-            .materials
-            .iter()
-            .find(|m| m.name == name)
-            .unwrap_or_else(|| panic!("material {name}"))
-    };
+    let material = |name: &str| material_named(&model, name);
     let texels = |name: &str| {
         let texture = material(name).base_color_texture.expect("a texture");
         let image = &model.images[texture.image as usize];
@@ -1396,14 +1375,7 @@ fn norm_and_normal_map_bumps_map_normals_and_height_maps_are_warned_about() {
         std::fs::write(dir.path().join("quad.obj"), obj(material)).expect("obj");
         import_obj(&dir.path().join("quad.obj")).expect("imports")
     };
-    let find = |model: &ImportedModel, name: &str| {
-        model
-            .materials
-            .iter()
-            .find(|m| m.name == name)
-            .unwrap_or_else(|| panic!("material {name}"))
-            .clone()
-    };
+    let find = |model: &ImportedModel, name: &str| material_named(model, name).clone();
 
     let model = import_with("norm");
     assert!(find(&model, "norm").normal_texture.is_some());
@@ -1503,13 +1475,7 @@ fn map_pr_and_map_pm_make_a_metallic_roughness_texture() {
     .expect("obj");
     let model = import_obj(&dir.path().join("pbr.obj")).expect("imports");
     assert!(model.warnings.is_empty(), "{:?}", model.warnings);
-    let find = |name: &str| {
-        model
-            .materials
-            .iter()
-            .find(|m| m.name == name)
-            .unwrap_or_else(|| panic!("material {name}"))
-    };
+    let find = |name: &str| material_named(&model, name);
     let pbr = find("pbr");
     assert_eq!(pbr.material.kind, MaterialKind::Pbr);
     assert_eq!(pbr.material.roughness, 1.0, "the map replaces Pr 0.5");

@@ -2,7 +2,7 @@
 
 use glam::{DVec3, DVec4};
 use gpu_render::scene::Scene;
-use gpu_render::scene::import::ImportedModel;
+use gpu_render::scene::import::{ImportedMaterial, ImportedModel};
 
 /// `model` as a 32 x 24 scene (its lights, or the default ones) seen from `eye`
 /// towards `look_at`.
@@ -26,4 +26,13 @@ pub fn assert_tangents(tangents: Option<&Vec<DVec4>>, expected: DVec4) {
             "{tangent} against {expected}"
         );
     }
+}
+
+/// The material of `model` named `name`; panics naming it when there is none.
+pub fn material_named<'a>(model: &'a ImportedModel, name: &str) -> &'a ImportedMaterial {
+    model
+        .materials
+        .iter()
+        .find(|m| m.name == name)
+        .unwrap_or_else(|| panic!("no material {name}"))
 }
