@@ -1,8 +1,8 @@
 //! The WGSL sample pattern (`shaders/camera.wgsl`) against its CPU twin
 //! (`src/camera.rs`): a test kernel calls `sample_offset` for two rounds of every sample
 //! (the pattern and the progressive samples past it) of a few
-//! pixels at every sample count 1..=300 and at large counts (sample indices past
-//! 2^16 and 2^17, where the Sobol sequence's higher direction numbers come in), and
+//! pixels at every sample count 1..=300 and at large counts (sample indices up to
+//! 2^17 − 1, where the Sobol sequence's higher direction numbers come in), and
 //! each offset must equal the CPU's exactly: both take the same 24 bits of the same
 //! integers, which f32 holds exactly. That the CPU pattern covers the pixel uniformly
 //! (a (0,k,2)-net for power-of-two counts) is tested in `src/camera.rs`.
