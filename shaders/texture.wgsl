@@ -195,7 +195,8 @@ fn sample_texture_lod(layer: u32, width: u32, height: u32, uv: vec2<f32>, wrap: 
 
 // How a lookup covers a footprint (twin of TexelFootprint in src/texture.rs): `probes`
 // trilinear lookups at level `lod`, spread evenly along `axis` (texture coordinates,
-// the footprint's whole long axis) around the looked-up point.
+// the probes' span: PROBE_SPAN times the footprint's long axis) around the looked-up
+// point.
 struct TexelFootprint {
     lod: f32,
     axis: vec2<f32>,
@@ -207,9 +208,10 @@ struct TexelFootprint {
 // probe at texture_lod. Anisotropic: the footprint is L = w/|n·d| long along
 // footprint.axis and w wide; in texels its long axis is a = J·axis·L (J: planar
 // mapping's (axis·t, axis·b)/scale or the triangle's uv_axis, then the transform's
-// linear part; times W × H) and its width b = w·L·W·H·ρ/|a|; N = round(|a|/b) probes
-// clamped to [1, max_probes], spaced a/N apart, each at level log2(max(|a|/N, b))
-// clamped to [0, last level] (Feline: McCormack et al., "Fast Elliptical Lines for
+// linear part; times W × H) and its width b = w·L·W·H·ρ/|a|; the probes span √2·a
+// (PROBE_SPAN), tapered by probe_weight: N = round(√2·|a|/b) probes clamped to [1,
+// max_probes], spaced √2·a/N apart, each at level log2(max(√2·|a|/N, b)) clamped to
+// [0, last level] (Feline: McCormack et al., "Fast Elliptical Lines for
 // Anisotropic Texture Mapping", SIGGRAPH 1999; the ray cone's ellipse from
 // Akenine-Möller et al., JCGT 10(1), 2021). Twin of texel_footprint.
 fn texel_footprint(material: Material, slot: u32, width: u32, height: u32, footprint: ConeFootprint) -> TexelFootprint {
@@ -238,28 +240,44 @@ fn texel_footprint(material: Material, slot: u32, width: u32, height: u32, footp
     let length_along = footprint.width / footprint.cosine;
     let axis = vec2<f32>(r0.x * along.x + r0.y * along.y, r1.x * along.x + r1.y * along.y) * length_along;
     let size = vec2<f32>(f32(width), f32(height));
-    let major = length(axis * size);
-    let minor = footprint.width * length_along * size.x * size.y * density / major;
+    let minor = footprint.width * length_along * size.x * size.y * density / length(axis * size);
+    let probe_axis = axis * PROBE_SPAN;
+    let span = length(probe_axis * size);
     // Positive and finite (not NaN), else the isotropic lookup, which clamps such cases.
-    if !(major > 0.0 && major <= 3.4028235e38 && minor > 0.0 && minor <= 3.4028235e38) {
+    if !(span > 0.0 && span <= 3.4028235e38 && minor > 0.0 && minor <= 3.4028235e38) {
         return isotropic;
     }
-    let probes = u32(clamp(round(major / minor), 1.0, f32(footprint.max_probes)));
-    let lod = log2(max(major / f32(probes), minor));
-    return TexelFootprint(clamp(lod, 0.0, f32(last)), select(vec2<f32>(0.0), axis, probes > 1u), probes);
+    let probes = u32(clamp(round(span / minor), 1.0, f32(footprint.max_probes)));
+    let lod = log2(max(span / f32(probes), minor));
+    return TexelFootprint(clamp(lod, 0.0, f32(last)), select(vec2<f32>(0.0), probe_axis, probes > 1u), probes);
 }
 
-// The lookup `footprint` (texel_footprint) at `uv`: the mean of its probes' trilinear
-// lookups (sample_texture_lod) at uv + axis·((i + ½)/N − ½), i in [0, N). Twin of
-// sample_texture_footprint.
+// How far the probes of an anisotropic lookup reach along the footprint's long axis, in
+// footprint lengths: √2 (twin of PROBE_SPAN in src/texture.rs, which says why).
+const PROBE_SPAN: f32 = 1.4142135;
+
+// The weight of the probe at r in (−1, 1) along the probes' span: e^(−2r²), the
+// Gaussian of the elliptical weighted average (Heckbert, "Fundamentals of Texture
+// Mapping and Image Warping", 1989, §3.5.8; pbrt-v4's MIPMap::EWA, α = 2). Twin of
+// probe_weight.
+fn probe_weight(r: f32) -> f32 {
+    return exp(-2.0 * r * r);
+}
+
+// The lookup `footprint` (texel_footprint) at `uv`: its probes' trilinear lookups
+// (sample_texture_lod) at uv + axis·r_i/2, r_i = 2·((i + ½)/N − ½) for i in [0, N),
+// averaged with the weights probe_weight(r_i). Twin of sample_texture_footprint.
 fn sample_texture_footprint(layer: u32, width: u32, height: u32, uv: vec2<f32>, wrap: vec2<u32>, footprint: TexelFootprint) -> vec3<f32> {
     let n = max(footprint.probes, 1u);
     var sum = vec3<f32>(0.0);
+    var total = 0.0;
     for (var i = 0u; i < n; i++) {
-        let offset = (f32(i) + 0.5) / f32(n) - 0.5;
-        sum += sample_texture_lod(layer, width, height, uv + footprint.axis * offset, wrap, footprint.lod);
+        let r = 2.0 * ((f32(i) + 0.5) / f32(n) - 0.5);
+        let weight = probe_weight(r);
+        sum += sample_texture_lod(layer, width, height, uv + footprint.axis * (0.5 * r), wrap, footprint.lod) * weight;
+        total += weight;
     }
-    return sum / f32(n);
+    return sum / total;
 }
 
 // The filtered lookup of the texture in `slot` of `material` at the hit's footprint.

@@ -277,12 +277,14 @@ pub fn texture_lod(
 
 /// How a lookup covers a footprint in a texture ([`texel_footprint`]): `probes`
 /// trilinear lookups at level of detail `lod`, spread evenly along `axis` (in texture
-/// coordinates: the footprint's whole long axis) and centred on the looked-up point.
+/// coordinates: the span of the probes, [`PROBE_SPAN`] times the footprint's long
+/// axis) and centred on the looked-up point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TexelFootprint {
     /// The level of detail of every probe, in `[0, last_level]`.
     pub lod: f64,
-    /// The footprint's long axis in texture coordinates (zero for one probe).
+    /// The span of the probes in texture coordinates, [`PROBE_SPAN`] times the
+    /// footprint's long axis (zero for one probe).
     pub axis: DVec2,
     /// How many probes, in `[1, max_probes]`.
     pub probes: u32,
@@ -296,12 +298,14 @@ pub struct TexelFootprint {
 /// world distance: planar mapping's `(axis·t, axis·b)/scale`, a mesh triangle's
 /// [`ConeFootprint::uv_axis`], then the transform's linear part; times `W × H`) and
 /// its width `b = w·L·W·H·ρ / |a|` (the area over the length, `ρ` as in
-/// [`texture_lod`]). It takes `N = round(|a|/b)` probes, clamped to `[1, max_probes]`,
-/// spaced `a/N` apart, each at level `log2(max(|a|/N, b))` (clamped to `[0,
-/// last_level]`): probes along the major axis, each filtering its share of it, as
-/// Feline does (McCormack et al., "Feline: Fast Elliptical Lines for Anisotropic
-/// Texture Mapping", SIGGRAPH 1999; the ray cone's ellipse from Akenine-Möller et
-/// al., JCGT 10(1), 2021). Twin of `texel_footprint` in `shaders/texture.wgsl`.
+/// [`texture_lod`]). The probes cover `√2·a` ([`PROBE_SPAN`]), which their Gaussian
+/// weights ([`sample_texture_footprint`]) taper: `N = round(√2·|a|/b)` probes, clamped
+/// to `[1, max_probes]`, spaced `√2·a/N` apart, each at level `log2(max(√2·|a|/N, b))`
+/// (clamped to `[0, last_level]`): probes along the major axis, each filtering its
+/// share of it, as Feline does (McCormack et al., "Feline: Fast Elliptical Lines for
+/// Anisotropic Texture Mapping", SIGGRAPH 1999; the ray cone's ellipse from
+/// Akenine-Möller et al., JCGT 10(1), 2021). Twin of `texel_footprint` in
+/// `shaders/texture.wgsl`.
 pub fn texel_footprint(
     material: &Material,
     transform: &TextureTransform,
@@ -340,17 +344,19 @@ pub fn texel_footprint(
         r1.x * along.x + r1.y * along.y,
     ) * length;
     let (w, h) = (f64::from(image.width), f64::from(image.height));
-    let major = DVec2::new(axis.x * w, axis.y * h).length();
-    let minor = footprint.width * length * w * h * density / major;
+    let minor =
+        footprint.width * length * w * h * density / DVec2::new(axis.x * w, axis.y * h).length();
+    let axis = axis * PROBE_SPAN;
+    let span = DVec2::new(axis.x * w, axis.y * h).length();
     // Not finite or not positive (a grazing ray, a degenerate mapping, NaN): the
     // isotropic lookup, which clamps such cases.
-    if !(major > 0.0 && major.is_finite() && minor > 0.0 && minor.is_finite()) {
+    if !(span > 0.0 && span.is_finite() && minor > 0.0 && minor.is_finite()) {
         return isotropic;
     }
-    let probes = (major / minor)
+    let probes = (span / minor)
         .round()
         .clamp(1.0, f64::from(footprint.max_probes)) as u32;
-    let lod = (major / f64::from(probes)).max(minor).log2();
+    let lod = (span / f64::from(probes)).max(minor).log2();
     TexelFootprint {
         lod: if lod > 0.0 {
             lod.min(last_level as f64)
@@ -362,9 +368,30 @@ pub fn texel_footprint(
     }
 }
 
-/// The anisotropic lookup of `footprint` ([`texel_footprint`]) at `(u, v)`: the mean
-/// of its probes' trilinear lookups ([`sample_texture_lod`]) at `(u, v) + axis·((i +
-/// ½)/N − ½)`, `i` in `[0, N)`. Twin of `sample_texture_footprint`.
+/// How far the probes of an anisotropic lookup reach along the footprint's long axis,
+/// in footprint lengths: `√2` ([`texel_footprint`]), tapered by the Gaussian of
+/// [`probe_weight`]. Measured, not derived: with the probes evenly weighted over the
+/// footprint's length (a box along the axis, whose sharp ends alias) the whole-image
+/// error of `scenes/bench/horizon-checker.toml` was 0.338 of the unfiltered one; with
+/// the Gaussian over `√2·L` it is 0.324, and lower on `horizon-photo.toml` and
+/// `horizon-fabric.toml` too (BENCHMARKS.md, "Filtered textures", with the other spans
+/// and widths tried).
+pub const PROBE_SPAN: f64 = std::f64::consts::SQRT_2;
+
+/// The weight of the probe at `r ∈ (−1, 1)` along the span of an anisotropic lookup
+/// (`r = ±1` at its ends): `e^{−2r²}`, the Gaussian of the elliptical weighted average
+/// (Heckbert, "Fundamentals of Texture Mapping and Image Warping", 1989, §3.5.8;
+/// pbrt-v4's `MIPMap::EWA`, α = 2), which falls to `e^{−2}` at the span's ends: a
+/// standard deviation of `√2·L/4 = L/√8` for a footprint `L` long. Twin of
+/// `probe_weight`.
+pub fn probe_weight(r: f64) -> f64 {
+    (-2.0 * r * r).exp()
+}
+
+/// The anisotropic lookup of `footprint` ([`texel_footprint`]) at `(u, v)`: its
+/// probes' trilinear lookups ([`sample_texture_lod`]) at `(u, v) + axis·r_i/2`, `r_i =
+/// 2·((i + ½)/N − ½)` for `i` in `[0, N)`, averaged with the weights
+/// [`probe_weight`]`(r_i)`. Twin of `sample_texture_footprint`.
 pub fn sample_texture_footprint(
     image: &Image,
     levels: &[Image],
@@ -374,13 +401,15 @@ pub fn sample_texture_footprint(
     footprint: &TexelFootprint,
 ) -> DVec3 {
     let n = footprint.probes.max(1);
-    let mut sum = DVec3::ZERO;
+    let (mut sum, mut total) = (DVec3::ZERO, 0.0);
     for i in 0..n {
-        let offset = (f64::from(i) + 0.5) / f64::from(n) - 0.5;
-        let at = DVec2::new(u, v) + footprint.axis * offset;
-        sum += sample_texture_lod(image, levels, at.x, at.y, wrap, footprint.lod);
+        let r = 2.0 * ((f64::from(i) + 0.5) / f64::from(n) - 0.5);
+        let weight = probe_weight(r);
+        let at = DVec2::new(u, v) + footprint.axis * (0.5 * r);
+        sum += sample_texture_lod(image, levels, at.x, at.y, wrap, footprint.lod) * weight;
+        total += weight;
     }
-    sum / f64::from(n)
+    sum / total
 }
 
 /// Trilinear lookup at `(u, v)` and level of detail `lod` (in `[0, levels.len()]`,
@@ -912,21 +941,22 @@ mod tests {
                     .with_max_probes(max_probes);
             texel_footprint(&material, &transform, &image, 6, &footprint)
         };
-        // 4 texels wide, 8 long: 2 probes, each at the level of 4 texels, 8 texels
-        // apart in all along v (planar v is p·b with b = t × n = -z... its sign is
-        // the frame's), none along u.
+        // 4 texels wide, 8 long: the probes span 8√2 = 11.3 texels along v (planar v
+        // is p·b with b = t × n = -z... its sign is the frame's), none along u: 3
+        // probes (11.3/4 rounded), each at the level of 4 texels (their spacing, 3.8
+        // texels, is less).
         let anisotropic = at(4.0 * texel, MAX_TEXTURE_PROBES);
-        assert_eq!(anisotropic.probes, 2);
+        assert_eq!(anisotropic.probes, 3);
         assert!((anisotropic.lod - 2.0).abs() < 1e-12, "{anisotropic:?}");
         assert!(anisotropic.axis.x.abs() < 1e-12);
-        assert!((anisotropic.axis.y.abs() * 64.0 - 8.0).abs() < 1e-9);
+        assert!((anisotropic.axis.y.abs() * 64.0 - 8.0 * PROBE_SPAN).abs() < 1e-9);
         // Isotropic: one probe at the long axis's level, as texture_lod says.
         let isotropic = at(4.0 * texel, 1);
         assert_eq!(isotropic.probes, 1);
         assert!((isotropic.lod - 3.0).abs() < 1e-12);
-        // Magnified: level 0, still two probes across the footprint's length.
+        // Magnified: level 0, still three probes across the footprint's length.
         let magnified = at(0.25 * texel, MAX_TEXTURE_PROBES);
-        assert_eq!((magnified.lod, magnified.probes), (0.0, 2));
+        assert_eq!((magnified.lod, magnified.probes), (0.0, 3));
         // Head-on: round, one probe, the isotropic level.
         let head_on =
             ConeFootprint::new(4.0 * texel, -DVec3::Y, DVec3::Y, [0.0; 2], [DVec2::ZERO; 2])
@@ -934,7 +964,7 @@ mod tests {
         let round = texel_footprint(&material, &transform, &image, 6, &head_on);
         assert_eq!((round.lod, round.probes, round.axis), (2.0, 1, DVec2::ZERO));
         // Grazing (cos 0.01): 100 to 1, capped at 16 probes whose level covers their
-        // share (a 16th of the length), not the width.
+        // share (a 16th of the span, √2 times the length), not the width.
         let grazing_direction = DVec3::new(0.0, -0.01, (1.0f64 - 1e-4).sqrt());
         let grazing = ConeFootprint::new(
             texel,
@@ -947,9 +977,30 @@ mod tests {
         let capped = texel_footprint(&material, &transform, &image, 6, &grazing);
         assert_eq!(capped.probes, MAX_TEXTURE_PROBES);
         assert!(
-            (capped.lod - (100.0f64 / 16.0).log2()).abs() < 1e-6,
+            (capped.lod - (100.0 * PROBE_SPAN / 16.0).log2()).abs() < 1e-6,
             "{capped:?}"
         );
+    }
+
+    #[test]
+    fn anisotropic_probes_are_weighted_by_a_gaussian() {
+        // Three probes one texel apart on texel centres of level 0 (r = -2/3, 0, 2/3),
+        // only the last texel lit: its probe weighs e^{-2·(2/3)²} against the centre
+        // probe's 1 (evenly weighted probes would give a third).
+        let row = image(6, 1, |x, _| f32::from(x == 3));
+        let levels = mip_levels(&row);
+        let footprint = TexelFootprint {
+            lod: 0.0,
+            axis: DVec2::new(0.5, 0.0),
+            probes: 3,
+        };
+        let wrap = [TextureWrap::Repeat; 2];
+        let got = sample_texture_footprint(&row, &levels, 2.5 / 6.0, 0.5, wrap, &footprint).x;
+        let outer = (-2.0f64 * 4.0 / 9.0).exp();
+        assert!((got - outer / (1.0 + 2.0 * outer)).abs() < 1e-12, "{got}");
+        assert_eq!(probe_weight(0.0), 1.0);
+        assert!((probe_weight(1.0) - (-2.0f64).exp()).abs() < 1e-15);
+        assert_eq!(probe_weight(-0.5), probe_weight(0.5));
     }
 
     #[test]

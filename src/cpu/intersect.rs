@@ -1021,10 +1021,11 @@ mod tests {
         let along = DVec3::new(0.5f64.sqrt(), -0.5f64.sqrt(), 0.0);
         let x = footprint(along);
         // Along x: the long axis √2/256 world units = 4·√2/256 of u = √2 texels, the
-        // width 1/256 along z = 1/4 texel... ratio 4√2: 6 probes (rounded).
+        // width 1/256 along z = 1/4 texel... ratio 4√2; the probes span √2 times the
+        // long axis (PROBE_SPAN): 2 texels, 8 probes.
         assert!(x.axis.y.abs() < 1e-12 && x.axis.x > 0.0, "{x:?}");
-        assert!((x.axis.x * 64.0 - 2.0f64.sqrt() * 4.0 * 64.0 / 256.0).abs() < 1e-9);
-        assert_eq!(x.probes, 6);
+        assert!((x.axis.x * 64.0 - 2.0 * 4.0 * 64.0 / 256.0).abs() < 1e-9);
+        assert_eq!(x.probes, 8);
         let z = footprint(DVec3::new(0.0, -0.5f64.sqrt(), 0.5f64.sqrt()));
         // Along z: √2/256 of v (0.35 texel) long, 1 texel wide: the width rules.
         assert_eq!(z.probes, 1);

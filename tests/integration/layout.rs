@@ -576,6 +576,10 @@ fn wgsl_constants_equal_their_rust_twins() {
         gpu_render::low_level::cpu::path::ROULETTE_DEPTH
     );
     assert!(path.lines().any(|l| l == roulette), "{roulette}");
+    assert_eq!(
+        wgsl_f32_const(module("texture"), "PROBE_SPAN"),
+        gpu_render::low_level::texture::PROBE_SPAN as f32
+    );
     let probes = format!(
         "const MAX_TEXTURE_PROBES: u32 = {}u;",
         gpu_render::scene::MAX_TEXTURE_PROBES
