@@ -240,9 +240,10 @@ fn texel_footprint(material: Material, slot: u32, width: u32, height: u32, footp
     let length_along = footprint.width / footprint.cosine;
     let axis = vec2<f32>(r0.x * along.x + r0.y * along.y, r1.x * along.x + r1.y * along.y) * length_along;
     let size = vec2<f32>(f32(width), f32(height));
-    let minor = footprint.width * length_along * size.x * size.y * density / length(axis * size);
+    let major = length(axis * size);
+    let minor = footprint.width * length_along * size.x * size.y * density / major;
     let probe_axis = axis * PROBE_SPAN;
-    let span = length(probe_axis * size);
+    let span = major * PROBE_SPAN;
     // Positive and finite (not NaN), else the isotropic lookup, which clamps such cases.
     if !(span > 0.0 && span <= 3.4028235e38 && minor > 0.0 && minor <= 3.4028235e38) {
         return isotropic;

@@ -344,10 +344,9 @@ pub fn texel_footprint(
         r1.x * along.x + r1.y * along.y,
     ) * length;
     let (w, h) = (f64::from(image.width), f64::from(image.height));
-    let minor =
-        footprint.width * length * w * h * density / DVec2::new(axis.x * w, axis.y * h).length();
-    let axis = axis * PROBE_SPAN;
-    let span = DVec2::new(axis.x * w, axis.y * h).length();
+    let major = DVec2::new(axis.x * w, axis.y * h).length();
+    let minor = footprint.width * length * w * h * density / major;
+    let (axis, span) = (axis * PROBE_SPAN, major * PROBE_SPAN);
     // Not finite or not positive (a grazing ray, a degenerate mapping, NaN): the
     // isotropic lookup, which clamps such cases.
     if !(span > 0.0 && span.is_finite() && minor > 0.0 && minor.is_finite()) {
