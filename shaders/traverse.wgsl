@@ -328,9 +328,20 @@ struct StackedChild {
     entry: f32,
 }
 
-// The stack's top child is kept in `held` while it is not in traversal_stack
-// (held.word == EMPTY_CHILD when level stack_len - 1, if any, is in memory): a child
-// pushed and popped with no push between never goes through memory.
+// The stack's top STACK_WINDOW children are kept in registers (StackWindow), the
+// newest in component 0, and only the levels below them in traversal_stack: a child
+// pushed and popped while fewer than STACK_WINDOW others were pushed above it never
+// goes through memory. llvmpipe keeps a vector's components in registers of their
+// own, so shifting the window is register renaming, where a storage access costs a
+// branch per lane.
+const STACK_WINDOW: u32 = 4u;
+
+struct StackWindow {
+    words: vec4<u32>,
+    entries: vec4<f32>,
+    // Children in the window: the top `len` levels of the stack.
+    len: u32,
+}
 
 // Writes `child` to level `level` of slot `slot`'s stack.
 fn store_stacked(slot: u32, level: u32, child: StackedChild) {
@@ -338,31 +349,57 @@ fn store_stacked(slot: u32, level: u32, child: StackedChild) {
     traversal_stack[traversal_stack_index(slot, level, 1u)] = bitcast<u32>(child.entry);
 }
 
-// Pushes `child`: the held child goes to memory and `child` is held.
-fn push_child(slot: u32, trace: ptr<function, TraceRay>, held: ptr<function, StackedChild>, child: StackedChild) {
+// Pushes `child` on the window; a full window first sends its oldest child to memory.
+fn push_child(slot: u32, trace: ptr<function, TraceRay>, window: ptr<function, StackWindow>, child: StackedChild) {
     if (*trace).stack_len >= MAX_TRAVERSAL_STACK {
         atomicOr(&counters.errors, ERROR_TRAVERSAL_STACK);
         return;
     }
-    if (*held).word != EMPTY_CHILD {
-        store_stacked(slot, (*trace).stack_len - 1u, *held);
+    if (*window).len == STACK_WINDOW {
+        store_stacked(slot, (*trace).stack_len - STACK_WINDOW,
+                      StackedChild((*window).words.w, (*window).entries.w));
+        (*window).len -= 1u;
     }
-    *held = child;
+    (*window).words = vec4<u32>(child.word, (*window).words.xyz);
+    (*window).entries = vec4<f32>(child.entry, (*window).entries.xyz);
+    (*window).len += 1u;
     (*trace).stack_len += 1u;
+}
+
+// Writes the window's children to their levels in memory (before a suspended call
+// returns) and empties it.
+fn spill_window(slot: u32, trace: TraceRay, window: ptr<function, StackWindow>) {
+    let w = *window;
+    if w.len > 0u {
+        store_stacked(slot, trace.stack_len - 1u, StackedChild(w.words.x, w.entries.x));
+    }
+    if w.len > 1u {
+        store_stacked(slot, trace.stack_len - 2u, StackedChild(w.words.y, w.entries.y));
+    }
+    if w.len > 2u {
+        store_stacked(slot, trace.stack_len - 3u, StackedChild(w.words.z, w.entries.z));
+    }
+    if w.len > 3u {
+        store_stacked(slot, trace.stack_len - 4u, StackedChild(w.words.w, w.entries.w));
+    }
+    (*window).len = 0u;
 }
 
 // Pops the stack's top child and goes to it if the ray enters its box no farther
 // than the best hit (times Ize's factor, as the slab test's far distance): a child
 // pushed earlier may lie beyond a hit found since. Twin of the pop in Query::walk.
-fn pop_child(slot: u32, trace: ptr<function, TraceRay>, held: ptr<function, StackedChild>) {
+fn pop_child(slot: u32, trace: ptr<function, TraceRay>, window: ptr<function, StackWindow>) {
     (*trace).stack_len -= 1u;
-    var child = *held;
-    if child.word == EMPTY_CHILD {
+    var child = StackedChild((*window).words.x, (*window).entries.x);
+    if (*window).len == 0u {
         child = StackedChild(
             traversal_stack[traversal_stack_index(slot, (*trace).stack_len, 0u)],
             bitcast<f32>(traversal_stack[traversal_stack_index(slot, (*trace).stack_len, 1u)]));
+    } else {
+        (*window).words = vec4<u32>((*window).words.yzw, EMPTY_CHILD);
+        (*window).entries = vec4<f32>((*window).entries.yzw, 0.0);
+        (*window).len -= 1u;
     }
-    (*held).word = EMPTY_CHILD;
     if child.entry <= (*trace).best_t * FAR_SLAB_SCALE {
         enter_child(trace, child.word);
     }
@@ -382,7 +419,7 @@ fn sort_pair(entries: ptr<function, vec4<f32>>, words: ptr<function, vec4<u32>>,
 // Visits the current wide node: tests its four children's boxes, goes to the child the
 // ray enters nearest, and stacks the others it enters, the farthest deepest. Twin of
 // the node visit in Query::walk.
-fn visit_wide_node(slot: u32, trace: ptr<function, TraceRay>, held: ptr<function, StackedChild>, slab: SlabRay) {
+fn visit_wide_node(slot: u32, trace: ptr<function, TraceRay>, window: ptr<function, StackWindow>, slab: SlabRay) {
     let node = bvh_nodes[(*trace).node];
     var entries = child_entries(slab, node, (*trace).best_t);
     var words = select(node.children, vec4<u32>(EMPTY_CHILD), entries == vec4<f32>(MISSED_CHILD));
@@ -393,13 +430,13 @@ fn visit_wide_node(slot: u32, trace: ptr<function, TraceRay>, held: ptr<function
     sort_pair(&entries, &words, 1u, 3u);
     sort_pair(&entries, &words, 1u, 2u);
     if words[3] != EMPTY_CHILD {
-        push_child(slot, trace, held, StackedChild(words[3], entries[3]));
+        push_child(slot, trace, window, StackedChild(words[3], entries[3]));
     }
     if words[2] != EMPTY_CHILD {
-        push_child(slot, trace, held, StackedChild(words[2], entries[2]));
+        push_child(slot, trace, window, StackedChild(words[2], entries[2]));
     }
     if words[1] != EMPTY_CHILD {
-        push_child(slot, trace, held, StackedChild(words[1], entries[1]));
+        push_child(slot, trace, window, StackedChild(words[1], entries[1]));
     }
     (*trace).node = NO_NODE;
     if words[0] != EMPTY_CHILD {
@@ -409,11 +446,11 @@ fn visit_wide_node(slot: u32, trace: ptr<function, TraceRay>, held: ptr<function
 
 // One node step: a pop when no node is current, else a visit of the current node; a
 // leaf it reaches is opened in the same step.
-fn node_step(slot: u32, trace: ptr<function, TraceRay>, held: ptr<function, StackedChild>, slab: SlabRay) {
+fn node_step(slot: u32, trace: ptr<function, TraceRay>, window: ptr<function, StackWindow>, slab: SlabRay) {
     if (*trace).node == NO_NODE {
-        pop_child(slot, trace, held);
+        pop_child(slot, trace, window);
     } else {
-        visit_wide_node(slot, trace, held, slab);
+        visit_wide_node(slot, trace, window, slab);
     }
 }
 
@@ -451,9 +488,9 @@ fn traverse(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) -> u32 {
     }
     var finished = false;
     var exited = false;
-    // The stack's top (see StackedChild), written back before a suspended call
+    // The stack's top (see StackWindow), written back before a suspended call
     // returns.
-    var held = StackedChild(EMPTY_CHILD, 0.0);
+    var window = StackWindow(vec4<u32>(EMPTY_CHILD), vec4<f32>(0.0), 0u);
     loop {
         // The test switch: a driver that cuts the loop after its first step (even
         // one that would have ended it).
@@ -470,10 +507,13 @@ fn traverse(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) -> u32 {
             break;
         }
         //#if REFILL_LANES
-        // The lanes still here vote (subgroupAdd over the active lanes); the test is
-        // the same for all of them, so they leave together. The exit is charged, as it
-        // costs the loop's last iteration.
-        if give_way && steps > 0u && REFILL_FRACTION * subgroupAdd(1u) <= traversing {
+        // The lanes still here vote (subgroupAdd over the active lanes) every fourth
+        // step: llvmpipe adds the lanes up one by one, which cost 3-5% of the bunny's
+        // trace when they voted at every step (BENCHMARKS.md, "The compressed 4-wide
+        // BVH"). `steps` is the same in every lane still here (they began the loop
+        // together), so the test is the same for all of them and they leave together.
+        // The exit is charged, as it costs the loop's last iteration.
+        if give_way && steps > 0u && (steps & 3u) == 0u && REFILL_FRACTION * subgroupAdd(1u) <= traversing {
             iterations += 1u;
             gave_way = true;
             exited = true;
@@ -492,13 +532,13 @@ fn traverse(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) -> u32 {
             continue;
         }
         //#endif
-        node_step(slot, trace, &held, ray.slab);
+        node_step(slot, trace, &window, ray.slab);
     }
     if !exited {
         atomicOr(&counters.errors, ERROR_LOOP_CUT);
     }
-    if !finished && held.word != EMPTY_CHILD {
-        store_stacked(slot, (*trace).stack_len - 1u, held);
+    if !finished {
+        spill_window(slot, *trace, &window);
     }
     if finished {
         return TRAVERSAL_FINISHED;

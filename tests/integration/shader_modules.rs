@@ -387,6 +387,7 @@ const WITHOUT_RUST_TWIN: &[(&str, &[&str], &str)] = &[
             "traversal_stack_index",
             "store_stacked",
             "push_child",
+            "spill_window",
             "pop_child",
             "visit_wide_node",
             "node_step",
