@@ -32,8 +32,16 @@ use super::wide::{WideNode, collapse};
 /// ([`super::wide::MAX_TRAVERSAL_STACK`]).
 pub const MAX_BVH_DEPTH: u32 = 64;
 
-/// Most primitives in one leaf.
-pub const MAX_LEAF_PRIMITIVES: u32 = 4;
+/// Most primitives in one leaf. Two: on lavapipe a triangle test costs about as much
+/// as a wide node's visit (each reads its records lane by lane), and the bunny's trace
+/// was 8% shorter with leaves of two than of four, the million-triangle terrain's 7%
+/// (BENCHMARKS.md, "The compressed 4-wide BVH").
+pub const MAX_LEAF_PRIMITIVES: u32 = 2;
+
+/// Nodes of at most this many primitives are split at their median on the longest
+/// axis instead of by binned SAH: for so few the bins cost more than the choice gains
+/// (the builder's speed with leaves of two, BENCHMARKS.md).
+const SMALL_NODE: usize = 4;
 
 /// One node of the tree as both tracers read it (`BvhNode` in `shaders/types.wgsl`).
 #[repr(C)]
@@ -413,6 +421,7 @@ fn split(
         )
     };
     if method == BuildMethod::MedianSplit
+        || prims.len() <= SMALL_NODE
         || depth >= MEDIAN_SPLIT_DEPTH
         || extent[axis].is_nan()
         || extent[axis] <= 0.0
