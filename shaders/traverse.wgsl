@@ -367,20 +367,21 @@ fn push_child(slot: u32, trace: ptr<function, TraceRay>, window: ptr<function, S
 }
 
 // Writes the window's children to their levels in memory (before a suspended call
-// returns) and empties it.
-fn spill_window(slot: u32, trace: TraceRay, window: ptr<function, StackWindow>) {
+// returns; `stack_len` is the stack's whole depth) and empties it. Unrolled: a loop
+// would count towards llvmpipe's loop limit (budget.wgsl).
+fn spill_window(slot: u32, stack_len: u32, window: ptr<function, StackWindow>) {
     let w = *window;
     if w.len > 0u {
-        store_stacked(slot, trace.stack_len - 1u, StackedChild(w.words.x, w.entries.x));
+        store_stacked(slot, stack_len - 1u, StackedChild(w.words.x, w.entries.x));
     }
     if w.len > 1u {
-        store_stacked(slot, trace.stack_len - 2u, StackedChild(w.words.y, w.entries.y));
+        store_stacked(slot, stack_len - 2u, StackedChild(w.words.y, w.entries.y));
     }
     if w.len > 2u {
-        store_stacked(slot, trace.stack_len - 3u, StackedChild(w.words.z, w.entries.z));
+        store_stacked(slot, stack_len - 3u, StackedChild(w.words.z, w.entries.z));
     }
     if w.len > 3u {
-        store_stacked(slot, trace.stack_len - 4u, StackedChild(w.words.w, w.entries.w));
+        store_stacked(slot, stack_len - 4u, StackedChild(w.words.w, w.entries.w));
     }
     (*window).len = 0u;
 }
@@ -538,7 +539,7 @@ fn traverse(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) -> u32 {
         atomicOr(&counters.errors, ERROR_LOOP_CUT);
     }
     if !finished {
-        spill_window(slot, *trace, &window);
+        spill_window(slot, (*trace).stack_len, &window);
     }
     if finished {
         return TRAVERSAL_FINISHED;

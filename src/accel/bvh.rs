@@ -34,14 +34,14 @@ pub const MAX_BVH_DEPTH: u32 = 64;
 
 /// Most primitives in one leaf. Two: on lavapipe a triangle test costs about as much
 /// as a wide node's visit (each reads its records lane by lane), and the bunny's trace
-/// was 8% shorter with leaves of two than of four, the million-triangle terrain's 7%
+/// was 11% shorter with leaves of two than of four, the million-triangle terrain's 9%
 /// (BENCHMARKS.md, "The compressed 4-wide BVH").
 pub const MAX_LEAF_PRIMITIVES: u32 = 2;
 
-/// Nodes of at most this many primitives are split at their median on the longest
-/// axis instead of by binned SAH: for so few the bins cost more than the choice gains
-/// (the builder's speed with leaves of two, BENCHMARKS.md).
-const SMALL_NODE: usize = 4;
+/// Nodes that a median split turns into two leaves are split at their median on the
+/// longest axis instead of by binned SAH: for so few primitives the bins cost more
+/// than the choice gains (the builder's speed with leaves of two, BENCHMARKS.md).
+const SMALL_NODE: usize = 2 * MAX_LEAF_PRIMITIVES as usize;
 
 /// One node of the tree as both tracers read it (`BvhNode` in `shaders/types.wgsl`).
 #[repr(C)]
