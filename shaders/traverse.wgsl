@@ -6,9 +6,10 @@
 // the Rust constants (the module `limits`, src/gpu/shaders.rs). Every step is charged
 // to the invocation's budget (budget.wgsl).
 //
-// The traversal runs in steps (`traverse`): a primitive test while a leaf is open,
-// else a node step (pop, or visit a wide node and descend into the child it enters
-// first), so that a lane never waits for the others to finish a phase of their own.
+// The traversal runs in steps (`traverse`): where no leaf is open a node step (a pop,
+// a visit of a wide node that descends into the child it enters first, or both), then
+// where a leaf is open (still, or just reached) its next primitive's test, so that a
+// lane never waits for the others to finish a phase of their own.
 // Its state between steps and between dispatches is its TraceRay.
 
 // Unrolled scenes: a scene of a few primitives (src/gpu/cpu_device/unrolled.rs says which) gets
@@ -445,12 +446,14 @@ fn visit_wide_node(slot: u32, trace: ptr<function, TraceRay>, window: ptr<functi
     }
 }
 
-// One node step: a pop when no node is current, else a visit of the current node; a
-// leaf it reaches is opened in the same step.
+// One node step: a pop when no node is current, then a visit of the current node
+// (the one just popped, or the one a visit entered before); a leaf either reaches is
+// opened in the same step.
 fn node_step(slot: u32, trace: ptr<function, TraceRay>, window: ptr<function, StackWindow>, slab: SlabRay) {
     if (*trace).node == NO_NODE {
         pop_child(slot, trace, window);
-    } else {
+    }
+    if (*trace).node != NO_NODE {
         visit_wide_node(slot, trace, window, slab);
     }
 }
@@ -466,8 +469,17 @@ fn node_step(slot: u32, trace: ptr<function, TraceRay>, window: ptr<function, St
 // PRIM_INSTANCE is entered as one step (enter_instance); when the mesh's tree is done,
 // one more step moves the ray back and resumes the leaf (leave_instance).
 //
-// One loop whose every step is a primitive test or a node step measured 2-4% faster
-// on llvmpipe than "while-while" (Aila and Laine, "Understanding the Efficiency of Ray
+// One loop whose every step is a node step where no leaf is open (a pop, a visit, or
+// a pop and the visit of the node popped), then a primitive test where a leaf is
+// open (the one the node step opened, or one still open): the operations of the walk
+// in their order, as few iterations as there are node visits and primitive tests.
+// llvmpipe (Mesa 25.0's gallivm) runs both sides of every `if` for the whole vector,
+// its lanes masked ("gallivm doesn't generally jump when exec_mask is 0",
+// lp_bld_nir_soa.c): an iteration costs its pop, its visit and its primitive test
+// whichever each lane needs, and fewer iterations cost less. The step that did one
+// of the three traced the bunny 8% slower and the million-triangle terrain 10% slower
+// (BENCHMARKS.md, "The compressed 4-wide BVH"). Such a loop measured 2-4% faster on
+// llvmpipe than "while-while" (Aila and Laine, "Understanding the Efficiency of Ray
 // Traversal on GPUs", HPG 2009: a descent loop, then a leaf loop), where lanes that
 // reached a leaf wait for the rest (BENCHMARKS.md, "Uniform records").
 fn traverse(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) -> u32 {
@@ -523,17 +535,19 @@ fn traverse(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) -> u32 {
         //#endif
         steps += 1u;
         iterations += 1u;
+        // The node step where no leaf is open, then the open leaf's next primitive.
+        if (*trace).cursor >= (*trace).leaf_end {
+            //#if INSTANCES
+            if (*trace).node == NO_NODE && (*trace).stack_len == (*trace).stack_base {
+                ray = leave_instance(trace, world_ray);
+                continue;
+            }
+            //#endif
+            node_step(slot, trace, &window, ray.slab);
+        }
         if (*trace).cursor < (*trace).leaf_end {
             next_leaf_prim(trace, &ray, world_ray);
-            continue;
         }
-        //#if INSTANCES
-        if (*trace).node == NO_NODE && (*trace).stack_len == (*trace).stack_base {
-            ray = leave_instance(trace, world_ray);
-            continue;
-        }
-        //#endif
-        node_step(slot, trace, &window, ray.slab);
     }
     if !exited {
         atomicOr(&counters.errors, ERROR_LOOP_CUT);
