@@ -35,3 +35,7 @@
 @group(0) @binding(18) var<storage, read> triangle_attributes: array<TriangleAttributes>;
 // binding 19: `emitters`, declared by area_lights.wgsl.
 // binding 20: `environment`, declared by environment.wgsl.
+// binding 21: `scene_tlas`, declared by ray_query.wgsl.
+// binding 22: `node_texels`, the BVH nodes as texels where the scene's features have
+// node_texture, read by load_wide_node(i) (which reads `bvh_nodes` otherwise);
+// declared by src/gpu/cpu_device/node_texture.rs.

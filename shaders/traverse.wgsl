@@ -422,7 +422,7 @@ fn sort_pair(entries: ptr<function, vec4<f32>>, words: ptr<function, vec4<u32>>,
 // ray enters nearest, and stacks the others it enters, the farthest deepest. Twin of
 // the node visit in Query::walk.
 fn visit_wide_node(slot: u32, trace: ptr<function, TraceRay>, window: ptr<function, StackWindow>, slab: SlabRay) {
-    let node = bvh_nodes[(*trace).node];
+    let node = load_wide_node((*trace).node);
     var entries = child_entries(slab, node, (*trace).best_t);
     var words = select(node.children, vec4<u32>(EMPTY_CHILD), entries == vec4<f32>(MISSED_CHILD));
     // A sorting network of four (Knuth, TAOCP vol. 3, §5.3.4): the nearest first.

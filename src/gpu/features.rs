@@ -69,6 +69,13 @@ pub struct ShaderFeatures {
     /// `src/gpu/cpu_device/uniform_records.rs`), never by [`ShaderFeatures::for_scene`]. Not a
     /// directive: the bindings' declarations differ, not the code.
     pub uniform_records: bool,
+    /// The wide BVH nodes are read from the texels of a texture (`load_wide_node` of
+    /// `src/gpu/cpu_device/node_texture.rs`) rather than from their storage buffer:
+    /// chosen at upload on CPU devices for scenes whose records do not fit uniform
+    /// arrays ([`ShaderFeatures::uniform_records`]), never by
+    /// [`ShaderFeatures::for_scene`]. Not a directive either: only the declarations
+    /// differ. The image does not depend on it.
+    pub node_texture: bool,
     /// The fused kernel's Whitted traversals give way once few lanes of their subgroup
     /// still traverse, so that the lanes whose rays finished shade and start their
     /// next rays (`REFILL_LANES`; Aila and Laine's "replacing terminated rays", see
@@ -119,6 +126,7 @@ impl ShaderFeatures {
         alpha: false,
         aov: true,
         uniform_records: false,
+        node_texture: false,
         refill_lanes: false,
         unrolled: None,
         hardware_traversal: false,
@@ -166,6 +174,7 @@ impl ShaderFeatures {
             alpha: scene.materials.iter().any(Material::uses_alpha),
             aov: false,
             uniform_records: false,
+            node_texture: false,
             refill_lanes: false,
             unrolled: None,
             hardware_traversal: false,
@@ -189,6 +198,9 @@ impl ShaderFeatures {
             .collect();
         if self.uniform_records {
             on.push("uniform_records".into());
+        }
+        if self.node_texture {
+            on.push("node_texture".into());
         }
         if on.is_empty() {
             "none".into()

@@ -27,7 +27,8 @@ pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// 14–17 path states, bounce stacks, traces, traversal stacks; 18 mesh triangles'
 /// vertex normals and texture coordinates; 19 the path integrator's emitters; 20 the
 /// environment map and its sampling tables; 21 the hardware traversal's top-level
-/// acceleration structure (only in its layout).
+/// acceleration structure (only in its layout); 22 the BVH nodes as texels (read only
+/// by modules with [`ShaderFeatures::node_texture`], bound in every layout).
 pub(crate) mod binding {
     pub const FRAME: u32 = 0;
     pub const SPHERES: u32 = 1;
@@ -51,6 +52,7 @@ pub(crate) mod binding {
     pub const EMITTERS: u32 = 19;
     pub const ENVIRONMENT: u32 = 20;
     pub const SCENE_TLAS: u32 = 21;
+    pub const NODE_TEXELS: u32 = 22;
 }
 
 /// Storage buffers the trace kernels bind in one stage.
@@ -139,6 +141,14 @@ impl TraceLayout {
             storage_entry(TRIANGLE_ATTRIBUTES, true),
             storage_entry(EMITTERS, true),
             storage_entry(ENVIRONMENT, true),
+            compute_entry(
+                NODE_TEXELS,
+                wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Uint,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+            ),
         ];
         if acceleration_structure {
             entries.push(compute_entry(

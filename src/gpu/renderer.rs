@@ -79,8 +79,9 @@ pub struct RendererOptions {
     /// to compile) or the general shader.
     pub specialise: bool,
     /// On CPU devices, bind the records of scenes small enough as uniform buffers
-    /// (`true`, faster there; see [`ShaderFeatures::uniform_records`]) or always as
-    /// storage buffers.
+    /// (see [`ShaderFeatures::uniform_records`]) and read the BVH nodes of larger
+    /// ones from a texture (see [`ShaderFeatures::node_texture`]) (`true`, faster
+    /// there), or always read the records from storage buffers.
     pub uniform_records: bool,
     /// Where the device has subgroup operations, let the fused kernel's traversals
     /// give way to lanes whose rays finished (`true`, faster on lavapipe; see

@@ -4,8 +4,8 @@
 
 use super::RenderError;
 use super::area_lights::{EMITTER_NONE, FLAG_PATH, GpuEmitter, emitter_records};
-use super::cpu_device::uniform_records;
 use super::cpu_device::unrolled::{self, UnrolledPrimitives};
+use super::cpu_device::{node_texture, uniform_records};
 use super::environment::environment_buffer;
 use super::features::ShaderFeatures;
 use super::layout::FrameUniforms;
@@ -53,6 +53,9 @@ pub(crate) struct DeviceScene {
     pub(crate) buffers: SceneBuffers,
     /// Albedo textures and BRDF maps, one layer each (see [`image_layers`]).
     pub(crate) images: wgpu::TextureView,
+    /// The BVH nodes as texels ([`ShaderFeatures::node_texture`]), else a one-texel
+    /// placeholder.
+    pub(crate) node_texels: wgpu::TextureView,
     /// The acceleration structures of the hardware traversal
     /// ([`ShaderFeatures::hardware_traversal`]), if it is used.
     pub(crate) acceleration: Option<Acceleration>,
@@ -106,8 +109,9 @@ impl DeviceScene {
         &self.bvh
     }
 
-    /// Bytes of the scene's storage buffers on the device (primitives, BVH,
-    /// materials, lights; not the images or the per-trace slots).
+    /// Bytes of the scene's buffers on the device (primitives, BVH, materials,
+    /// lights, and the BVH nodes' texture where there is one; not the images or the
+    /// per-trace slots).
     pub fn scene_bytes(&self) -> u64 {
         self.scene_bytes
     }
@@ -124,7 +128,8 @@ impl DeviceScene {
 pub(crate) struct UploadOptions {
     /// Only the features the scene uses ([`ShaderFeatures::for_scene`]), else all.
     pub specialise: bool,
-    /// Records in uniform buffers where the device prefers them and they fit.
+    /// Records in uniform buffers where the device prefers them and they fit, else
+    /// the BVH nodes in a texture where it prefers that and they fit.
     pub allow_uniform_records: bool,
     /// Traversals that give way, where the device has subgroup operations.
     pub allow_refill_lanes: bool,
@@ -251,6 +256,12 @@ pub(crate) fn upload_scene(
         && !hardware
         && uniform_records::preferred(&device.adapter_info())
         && uniform_records::fits(&padded, &limits);
+    // Too large for uniform arrays: the nodes in a texture, where it fits.
+    let node_texture = allow_uniform_records
+        && !uniform_records
+        && !hardware
+        && uniform_records::preferred(&device.adapter_info())
+        && node_texture::fits(padded.bvh_nodes.len(), &limits);
     let mut scene_bytes = 0;
     let mut upload =
         |what: &str, binding: u32, bytes: &[u8]| -> Result<wgpu::Buffer, RenderError> {
@@ -371,6 +382,13 @@ pub(crate) fn upload_scene(
         None => None,
     };
     let (images, image_bytes) = upload_images(device, queue, &shaded, &limits)?;
+    let node_texels = if node_texture {
+        let (view, bytes) = node_texture::upload(device, queue, &padded.bvh_nodes)?;
+        scene_bytes += bytes;
+        view
+    } else {
+        node_texture::placeholder(device)
+    };
     Ok(DeviceScene {
         frame,
         // A path keeps its one continuation on the bounce stack.
@@ -381,6 +399,7 @@ pub(crate) fn upload_scene(
         },
         features: ShaderFeatures {
             uniform_records,
+            node_texture,
             refill_lanes: allow_refill_lanes
                 && device.features().contains(wgpu::Features::SUBGROUP),
             unrolled,
@@ -399,6 +418,7 @@ pub(crate) fn upload_scene(
         encode_srgb: scene.display_encodes_srgb(),
         buffers,
         images,
+        node_texels,
         acceleration,
         bvh: match &analytic {
             Some((tree, _)) => tree.stats,

@@ -104,7 +104,10 @@ pub fn host_module(name: &str, features: &ShaderFeatures) -> Option<String> {
         )),
         "records" => Some(format!(
             "#import types\n{}",
-            super::cpu_device::uniform_records::declarations(features.uniform_records)
+            super::cpu_device::uniform_records::declarations(
+                features.uniform_records,
+                features.node_texture
+            )
         )),
         "unrolled_scene" => features.unrolled.as_ref().map(|unrolled| unrolled.wgsl()),
         _ => None,

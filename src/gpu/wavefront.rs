@@ -385,6 +385,10 @@ impl SlotBuffers {
             buffer(binding::TRIANGLE_ATTRIBUTES, &s.triangle_attributes),
             buffer(binding::EMITTERS, &s.emitters),
             buffer(binding::ENVIRONMENT, &s.environment),
+            wgpu::BindGroupEntry {
+                binding: binding::NODE_TEXELS,
+                resource: wgpu::BindingResource::TextureView(&scene.node_texels),
+            },
         ];
         if let Some(acceleration) = &scene.acceleration {
             entries.push(wgpu::BindGroupEntry {

@@ -120,6 +120,7 @@ fn feature_sets() -> Vec<ShaderFeatures> {
         alpha: false,
         aov: false,
         uniform_records: false,
+        node_texture: false,
         refill_lanes: false,
         unrolled: None,
         hardware_traversal: false,

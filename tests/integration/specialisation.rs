@@ -166,6 +166,7 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         alpha: false,
         aov: false,
         uniform_records: false,
+        node_texture: false,
         refill_lanes: false,
         unrolled: None,
         hardware_traversal: false,

@@ -5,6 +5,8 @@
 //! - `uniform_records`: the scene records every traversal step reads bound as
 //!   uniform arrays instead of storage buffers (llvmpipe gathers uniform elements
 //!   without a branch per lane);
+//! - `node_texture`: for scenes too large for that, the wide BVH nodes as the texels
+//!   of a texture (llvmpipe gathers texels without a branch per lane either);
 //! - [`unrolled`]: the closest-hit test of a scene of a few primitives as straight-line
 //!   WGSL instead of a walk of the BVH.
 //!
@@ -12,5 +14,6 @@
 //! ([`crate::gpu::ShaderFeatures::refill_lanes`]), is a shader feature decided with the
 //! device's loop limits in `gpu::limits`.
 
+pub(crate) mod node_texture;
 pub(crate) mod uniform_records;
 pub mod unrolled;

@@ -182,9 +182,16 @@ pub(crate) fn padded_bytes(binding: u32) -> Option<u64> {
 }
 
 /// The WGSL declarations of the record bindings: storage arrays, or with `uniform`
-/// uniform arrays of their capacity; and the accessors of the packed ones,
-/// `polygon_point(i)` and `prim_ref(i)`.
-pub(crate) fn declarations(uniform: bool) -> String {
+/// uniform arrays of their capacity; the accessors of the packed ones,
+/// `polygon_point(i)` and `prim_ref(i)`; and `load_wide_node(i)`, which reads the
+/// node from `bvh_nodes`, or with `node_texture` (and storage arrays) from the
+/// texture of `super::node_texture`.
+pub(crate) fn declarations(uniform: bool, node_texture: bool) -> String {
+    let node_reader = if node_texture && !uniform {
+        super::node_texture::WGSL
+    } else {
+        "fn load_wide_node(i: u32) -> WideNode { return bvh_nodes[i]; }\n"
+    };
     let packed = PACKED.iter().map(|p| {
         if uniform {
             format!(
@@ -219,6 +226,7 @@ pub(crate) fn declarations(uniform: bool) -> String {
             }
         })
         .chain(packed)
+        .chain(std::iter::once(node_reader.to_string()))
         .collect()
 }
 
@@ -262,12 +270,12 @@ mod tests {
     #[test]
     fn declarations_give_the_address_space_and_the_capacity() {
         assert!(
-            declarations(false).contains(
+            declarations(false, false).contains(
                 "@group(0) @binding(12) var<storage, read> bvh_nodes: array<WideNode>;\n"
             )
         );
         assert!(
-            declarations(true).contains(
+            declarations(true, false).contains(
                 "@group(0) @binding(12) var<uniform> bvh_nodes: array<WideNode, 1024>;\n"
             )
         );
@@ -275,14 +283,23 @@ mod tests {
 
     #[test]
     fn declarations_name_each_record_binding_once() {
-        for uniform in [false, true] {
-            let text = declarations(uniform);
+        for (uniform, node_texture) in [(false, false), (true, false), (false, true)] {
+            let text = declarations(uniform, node_texture);
             let bindings = RECORDS.iter().map(|r| r.binding);
             for binding in bindings.chain(PACKED.iter().map(|p| p.binding)) {
                 assert_eq!(text.matches(&format!("@binding({binding}) ")).count(), 1);
             }
             assert!(text.contains("fn prim_ref(i: u32) -> u32 {"));
             assert!(text.contains("fn polygon_point(i: u32) -> vec2<f32> {"));
+            assert_eq!(
+                text.matches("fn load_wide_node(i: u32) -> WideNode {")
+                    .count(),
+                1
+            );
+            assert_eq!(
+                text.contains("var node_texels: texture_2d<u32>"),
+                node_texture
+            );
         }
     }
 }

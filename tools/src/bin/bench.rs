@@ -59,7 +59,8 @@ struct Args {
     #[arg(long)]
     schedule: Option<String>,
     /// Keep the scene records in storage buffers, not in uniform buffers where they
-    /// fit on a CPU device (`Renderer::with_uniform_records(false)`).
+    /// fit on a CPU device nor the BVH nodes in a texture where they do not
+    /// (`Renderer::with_uniform_records(false)`).
     #[arg(long)]
     storage_records: bool,
     /// Traversals never give way to finished lanes
@@ -452,7 +453,7 @@ fn main() -> Result<()> {
     let primitives = gpu_render::low_level::accel::SceneGeometry::new(&scene).bounded_count();
     println!(
         "GPU scene buffers: {} bytes for {primitives} bounded primitives ({:.1} bytes each, \
-         BVH included); BVH built in {:.1} ms; records in {} buffers; closest hit {}; \
+         BVH included); BVH built in {:.1} ms; records in {} buffers{}; closest hit {}; \
          triangles by {}",
         prepared.scene_bytes(),
         prepared.scene_bytes() as f64 / primitives.max(1) as f64,
@@ -461,6 +462,11 @@ fn main() -> Result<()> {
             "uniform"
         } else {
             "storage"
+        },
+        if prepared.features().node_texture {
+            ", BVH nodes in a texture"
+        } else {
+            ""
         },
         if prepared.features().unrolled.is_some() {
             "unrolled"
