@@ -476,9 +476,9 @@ fn node_step(slot: u32, trace: ptr<function, TraceRay>, window: ptr<function, St
 // llvmpipe (Mesa 25.0's gallivm) runs both sides of every `if` for the whole vector,
 // its lanes masked ("gallivm doesn't generally jump when exec_mask is 0",
 // lp_bld_nir_soa.c): an iteration costs its pop, its visit and its primitive test
-// whichever each lane needs, and fewer iterations cost less. The step that did one
-// of the three traced the bunny 8% slower and the million-triangle terrain 10% slower
-// (BENCHMARKS.md, "The compressed 4-wide BVH"). Such a loop measured 2-4% faster on
+// whichever each lane needs, and fewer iterations cost less. With the step that did
+// one of the three, the bunny's trace took 10% longer at 32 spp (20% at 256) and the
+// million-triangle terrain's 15% (BENCHMARKS.md, "The compressed 4-wide BVH"). Such a loop measured 2-4% faster on
 // llvmpipe than "while-while" (Aila and Laine, "Understanding the Efficiency of Ray
 // Traversal on GPUs", HPG 2009: a descent loop, then a leaf loop), where lanes that
 // reached a leaf wait for the rest (BENCHMARKS.md, "Uniform records").

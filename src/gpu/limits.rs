@@ -7,9 +7,11 @@ use super::RenderError;
 use super::pipelines::TRACE_STORAGE_BUFFERS;
 use super::shaders::{SLOT_WORKGROUP_SIZE, WORKGROUP_SIZE};
 
-/// Bindings in the trace kernels' bind group (`shaders/trace.wgsl`, 0 to 18,
-/// `shaders/path.wgsl`'s 19 and `shaders/environment.wgsl`'s 20).
-const TRACE_BINDINGS: u32 = 21;
+/// Bindings in the trace kernels' bind group, counted to the highest index
+/// (`shaders/trace.wgsl`, 0 to 18, `shaders/path.wgsl`'s 19,
+/// `shaders/environment.wgsl`'s 20, the hardware traversal's 21 and the BVH node
+/// texture's 22, `src/gpu/pipelines.rs`).
+const TRACE_BINDINGS: u32 = 23;
 
 /// One limit the renderer needs at least: the field of [`wgpu::Limits`] by name and
 /// by accessor, and the minimum.
@@ -35,7 +37,8 @@ const NEEDS: [Need; 9] = [
     Need {
         limit: "max_sampled_textures_per_shader_stage",
         field: |l| &mut l.max_sampled_textures_per_shader_stage,
-        needed: 1,
+        // The images and the BVH node texture (a placeholder where unused).
+        needed: 2,
     },
     Need {
         limit: "max_uniform_buffers_per_shader_stage",
