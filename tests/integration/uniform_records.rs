@@ -1,7 +1,9 @@
 //! On CPU devices, a scene whose records fit is bound with its BVH nodes, spheres,
 //! polygons, triangles, materials and lights in uniform buffers
-//! (`src/gpu/cpu_device/uniform_records.rs`): the same pixels and the same rays as with storage
-//! buffers, and scenes too large for them keep storage buffers.
+//! (`src/gpu/cpu_device/uniform_records.rs`), and a larger one reads its BVH nodes
+//! from a texture (`src/gpu/cpu_device/node_texture.rs`): the same pixels and the same
+//! rays as with storage buffers, and scenes too large for uniform buffers keep
+//! storage buffers for their records.
 
 use glam::DVec3;
 use gpu_render::gpu::Renderer;
@@ -46,18 +48,17 @@ fn shipped_scenes_render_the_same_with_uniform_and_storage_records() {
         let prepared = uniform
             .upload(&gpu.device, &gpu.queue, &scene)
             .expect("prepare");
-        assert!(
-            !storage
-                .upload(&gpu.device, &gpu.queue, &scene)
-                .expect("prepare")
-                .features()
-                .uniform_records
-        );
+        let stored = storage
+            .upload(&gpu.device, &gpu.queue, &scene)
+            .expect("prepare");
+        assert!(!stored.features().uniform_records && !stored.features().node_texture);
         if !cpu_device(&gpu) {
             // Real GPUs keep storage buffers: nothing to compare.
-            assert!(!prepared.features().uniform_records);
+            assert!(!prepared.features().uniform_records && !prepared.features().node_texture);
             continue;
         }
+        // One or the other where the records do not fit uniform buffers.
+        assert!(prepared.features().uniform_records != prepared.features().node_texture);
         uniform_scenes += usize::from(prepared.features().uniform_records);
         // The same code reading the same values; only where they are bound differs.
         let what = format!("{path}, uniform and storage records");
@@ -107,4 +108,50 @@ fn records_beyond_one_uniform_binding_stay_in_storage_buffers() {
         )
         .expect("prepare");
     assert!(!beyond.features().uniform_records);
+    // Its nodes (a few) go to the texture instead, on CPU devices only.
+    assert_eq!(beyond.features().node_texture, cpu_device(&gpu));
+    assert!(!fits.features().node_texture);
+}
+
+#[test]
+fn a_scene_too_large_for_uniform_records_reads_its_nodes_from_a_texture_with_the_same_pixels() {
+    let Some(gpu) = crate::support::gpu::headless_gpu() else {
+        return;
+    };
+    let texture = crate::support::gpu::renderer(&gpu);
+    let storage = Renderer::new(
+        &gpu.device,
+        RendererOptions {
+            uniform_records: false,
+            ..RendererOptions::default()
+        },
+    )
+    .expect("renderer");
+    let mut scene = crate::support::scenes::reduced(
+        crate::support::scenes::shipped("showcase.toml"),
+        48,
+        RenderOverrides::default(),
+    );
+    // 9,400 triangles: beyond the 1,365 of one uniform binding, and thousands of nodes.
+    scene.meshes.push(gpu_render::scene::Mesh {
+        instances: vec![glam::DMat4::IDENTITY],
+        ..crate::support::geometry::blob(60, 80)
+    });
+    let prepared = texture
+        .upload(&gpu.device, &gpu.queue, &scene)
+        .expect("prepare");
+    assert!(!prepared.features().uniform_records);
+    assert_eq!(prepared.features().node_texture, cpu_device(&gpu));
+    let stored = storage
+        .upload(&gpu.device, &gpu.queue, &scene)
+        .expect("prepare");
+    assert!(!stored.features().node_texture);
+    // The same walk reading the same nodes; only where they are bound differs.
+    crate::support::gpu::assert_renders_identical(
+        &gpu,
+        &texture,
+        &storage,
+        &scene,
+        "the showcase and a blob, nodes from the texture and from storage",
+    );
 }
