@@ -478,10 +478,11 @@ fn node_step(slot: u32, trace: ptr<function, TraceRay>, window: ptr<function, St
 // lp_bld_nir_soa.c): an iteration costs its pop, its visit and its primitive test
 // whichever each lane needs, and fewer iterations cost less. With the step that did
 // one of the three, the bunny's trace took 10% longer at 32 spp (20% at 256) and the
-// million-triangle terrain's 15% (BENCHMARKS.md, "The compressed 4-wide BVH"). Such a loop measured 2-4% faster on
-// llvmpipe than "while-while" (Aila and Laine, "Understanding the Efficiency of Ray
-// Traversal on GPUs", HPG 2009: a descent loop, then a leaf loop), where lanes that
-// reached a leaf wait for the rest (BENCHMARKS.md, "Uniform records").
+// million-triangle terrain's 15% (BENCHMARKS.md, "The compressed 4-wide BVH"). Such
+// a loop measured 2-4% faster on llvmpipe than "while-while" (Aila and Laine,
+// "Understanding the Efficiency of Ray Traversal on GPUs", HPG 2009: a descent loop,
+// then a leaf loop), where lanes that reached a leaf wait for the rest (BENCHMARKS.md,
+// "Uniform records").
 fn traverse(slot: u32, trace: ptr<function, TraceRay>, give_way: bool) -> u32 {
     //#if REFILL_LANES
     // The lanes of this subgroup that run this call together (counted only where they

@@ -252,16 +252,12 @@ pub(crate) fn upload_scene(
     let padded = records.padded();
     // The hardware traversal's triangle buffer is the structures' vertex buffer: a
     // storage buffer.
-    let uniform_records = allow_uniform_records
-        && !hardware
-        && uniform_records::preferred(&device.adapter_info())
-        && uniform_records::fits(&padded, &limits);
+    let cpu_records =
+        allow_uniform_records && !hardware && uniform_records::preferred(&device.adapter_info());
+    let uniform_records = cpu_records && uniform_records::fits(&padded, &limits);
     // Too large for uniform arrays: the nodes in a texture, where it fits.
-    let node_texture = allow_uniform_records
-        && !uniform_records
-        && !hardware
-        && uniform_records::preferred(&device.adapter_info())
-        && node_texture::fits(padded.bvh_nodes.len(), &limits);
+    let node_texture =
+        cpu_records && !uniform_records && node_texture::fits(padded.bvh_nodes.len(), &limits);
     let mut scene_bytes = 0;
     let mut upload =
         |what: &str, binding: u32, bytes: &[u8]| -> Result<wgpu::Buffer, RenderError> {

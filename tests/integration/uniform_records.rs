@@ -15,20 +15,25 @@ fn cpu_device(gpu: &gpu_render::gpu::HeadlessGpu) -> bool {
     gpu.adapter_info().device_type == wgpu::DeviceType::Cpu
 }
 
-#[test]
-fn shipped_scenes_render_the_same_with_uniform_and_storage_records() {
-    let Some(gpu) = crate::support::gpu::headless_gpu() else {
-        return;
-    };
-    let uniform = crate::support::gpu::renderer(&gpu);
-    let storage = Renderer::new(
+/// A renderer that keeps every record in storage buffers.
+fn storage_renderer(gpu: &gpu_render::gpu::HeadlessGpu) -> Renderer {
+    Renderer::new(
         &gpu.device,
         RendererOptions {
             uniform_records: false,
             ..RendererOptions::default()
         },
     )
-    .expect("renderer");
+    .expect("renderer")
+}
+
+#[test]
+fn shipped_scenes_render_the_same_with_uniform_and_storage_records() {
+    let Some(gpu) = crate::support::gpu::headless_gpu() else {
+        return;
+    };
+    let uniform = crate::support::gpu::renderer(&gpu);
+    let storage = storage_renderer(&gpu);
     let mut uniform_scenes = 0;
     // Whitted with polygons, triangles and glass; the path integrator; meshes and
     // textures; tabulated BRDFs; an environment map.
@@ -119,14 +124,7 @@ fn a_scene_too_large_for_uniform_records_reads_its_nodes_from_a_texture_with_the
         return;
     };
     let texture = crate::support::gpu::renderer(&gpu);
-    let storage = Renderer::new(
-        &gpu.device,
-        RendererOptions {
-            uniform_records: false,
-            ..RendererOptions::default()
-        },
-    )
-    .expect("renderer");
+    let storage = storage_renderer(&gpu);
     let mut scene = crate::support::scenes::reduced(
         crate::support::scenes::shipped("showcase.toml"),
         48,

@@ -16,10 +16,11 @@
 //! Layout: node `i`'s four 16-byte quarters, in their [`WideNode`] order, are the
 //! texels `(4 · (i mod NODES_PER_ROW) + k, i / NODES_PER_ROW)`, `k = 0..4`, of an
 //! `Rgba32Uint` texture [`ROW_TEXELS`] wide (read by `load_wide_node` of
-//! [`WGSL`]).
+//! [`wgsl`]).
 
 use crate::accel::WideNode;
 use crate::gpu::RenderError;
+use crate::gpu::pipelines::binding;
 use crate::gpu::readback::{Caught, capture};
 
 /// Nodes in one texture row.
@@ -31,17 +32,23 @@ pub const TEXELS_PER_NODE: u32 = 4;
 /// The texture's width in texels (within the 8,192 every WebGPU device allows).
 pub const ROW_TEXELS: u32 = NODES_PER_ROW * TEXELS_PER_NODE;
 
-/// The WGSL declaration of the texture (binding 22, `binding::NODE_TEXELS` in
-/// `src/gpu/pipelines.rs`) and of `load_wide_node(i)`, which reads node `i` from it.
-pub(crate) const WGSL: &str = "@group(0) @binding(22) var node_texels: texture_2d<u32>;\n\
-fn load_wide_node(i: u32) -> WideNode {\n\
-    let at = vec2<i32>(i32((i % 1024u) * 4u), i32(i / 1024u));\n\
-    let a = textureLoad(node_texels, at, 0);\n\
-    let b = textureLoad(node_texels, at + vec2<i32>(1, 0), 0);\n\
-    let c = textureLoad(node_texels, at + vec2<i32>(2, 0), 0);\n\
-    let d = textureLoad(node_texels, at + vec2<i32>(3, 0), 0);\n\
-    return WideNode(bitcast<vec3<f32>>(a.xyz), a.w, b.xyz, b.w, c.xyz, c.w, d);\n\
-}\n";
+/// The WGSL declaration of the texture (`binding::NODE_TEXELS` in
+/// `src/gpu/pipelines.rs`) and of `load_wide_node(i)`, which reads node `i` from it,
+/// written from this module's constants.
+pub(crate) fn wgsl() -> String {
+    format!(
+        "@group(0) @binding({binding}) var node_texels: texture_2d<u32>;\n\
+         fn load_wide_node(i: u32) -> WideNode {{\n\
+             let at = vec2<i32>(i32((i % {NODES_PER_ROW}u) * {TEXELS_PER_NODE}u), i32(i / {NODES_PER_ROW}u));\n\
+             let a = textureLoad(node_texels, at, 0);\n\
+             let b = textureLoad(node_texels, at + vec2<i32>(1, 0), 0);\n\
+             let c = textureLoad(node_texels, at + vec2<i32>(2, 0), 0);\n\
+             let d = textureLoad(node_texels, at + vec2<i32>(3, 0), 0);\n\
+             return WideNode(bitcast<vec3<f32>>(a.xyz), a.w, b.xyz, b.w, c.xyz, c.w, d);\n\
+         }}\n",
+        binding = binding::NODE_TEXELS,
+    )
+}
 
 /// The texture's rows for `nodes` nodes (at least one).
 fn rows(nodes: usize) -> u64 {
@@ -63,7 +70,7 @@ pub(crate) fn texel_words(nodes: &[WideNode]) -> Vec<u32> {
     words
 }
 
-/// Uploads `nodes` as the texture [`WGSL`] reads (the caller checked [`fits`]), and
+/// Uploads `nodes` as the texture [`wgsl`] reads (the caller checked [`fits`]), and
 /// its bytes.
 pub(crate) fn upload(
     device: &wgpu::Device,
@@ -143,7 +150,9 @@ mod tests {
 
     #[test]
     fn every_node_is_read_back_whole_from_the_texels_the_shader_reads() {
-        assert!(WGSL.contains("(i % 1024u) * 4u), i32(i / 1024u)"));
+        let wgsl = wgsl();
+        assert!(wgsl.contains("@group(0) @binding(22) var node_texels: texture_2d<u32>;"));
+        assert!(wgsl.contains("(i % 1024u) * 4u), i32(i / 1024u)"));
         assert_eq!(NODES_PER_ROW, 1024);
         let nodes: Vec<WideNode> = (0..2500).map(node).collect();
         let words = texel_words(&nodes);

@@ -188,9 +188,9 @@ pub(crate) fn padded_bytes(binding: u32) -> Option<u64> {
 /// texture of `super::node_texture`.
 pub(crate) fn declarations(uniform: bool, node_texture: bool) -> String {
     let node_reader = if node_texture && !uniform {
-        super::node_texture::WGSL
+        super::node_texture::wgsl()
     } else {
-        "fn load_wide_node(i: u32) -> WideNode { return bvh_nodes[i]; }\n"
+        "fn load_wide_node(i: u32) -> WideNode { return bvh_nodes[i]; }\n".to_string()
     };
     let packed = PACKED.iter().map(|p| {
         if uniform {
@@ -226,7 +226,7 @@ pub(crate) fn declarations(uniform: bool, node_texture: bool) -> String {
             }
         })
         .chain(packed)
-        .chain(std::iter::once(node_reader.to_string()))
+        .chain(std::iter::once(node_reader))
         .collect()
 }
 
