@@ -5,6 +5,7 @@ use std::collections::HashMap;
 use std::sync::{Mutex, PoisonError};
 
 use super::RenderError;
+use super::cpu_device::node_texture;
 use super::cpu_device::uniform_records::{UNIFORM_BUFFERS, device_allows, is_uniform_record};
 use super::features::ShaderFeatures;
 use super::ray_query::{RAY_QUERY_FEATURE, hardware_traversal_available};
@@ -198,6 +199,9 @@ pub(crate) struct Pipelines {
     trace: Mutex<HashMap<(ShaderFeatures, Schedule), TracePipelines>>,
     /// The driver's cache of compiled pipelines every pipeline goes through, if any.
     cache: Option<wgpu::PipelineCache>,
+    /// The one-texel texture bound where a scene's BVH nodes are not in a texture
+    /// (every trace layout has the binding), one for all the device's scenes.
+    pub node_texels_placeholder: wgpu::TextureView,
 }
 
 fn compute_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
@@ -309,6 +313,7 @@ impl Pipelines {
             display,
             trace: Mutex::new(HashMap::new()),
             cache,
+            node_texels_placeholder: node_texture::placeholder(device),
         })
     }
 

@@ -341,6 +341,7 @@ impl Renderer {
                 aov: self.options.aov,
             },
             plan,
+            &self.pipelines.node_texels_placeholder,
         )?;
         let cached = self.pipelines.has_trace(&prepared.features, self.schedule);
         let started = Instant::now();

@@ -53,8 +53,8 @@ pub(crate) struct DeviceScene {
     pub(crate) buffers: SceneBuffers,
     /// Albedo textures and BRDF maps, one layer each (see [`image_layers`]).
     pub(crate) images: wgpu::TextureView,
-    /// The BVH nodes as texels ([`ShaderFeatures::node_texture`]), else a one-texel
-    /// placeholder.
+    /// The BVH nodes as texels ([`ShaderFeatures::node_texture`]), else the
+    /// renderer's one-texel placeholder.
     pub(crate) node_texels: wgpu::TextureView,
     /// The acceleration structures of the hardware traversal
     /// ([`ShaderFeatures::hardware_traversal`]), if it is used.
@@ -181,6 +181,7 @@ pub(crate) fn upload_scene(
     geometry: &SceneGeometry,
     options: UploadOptions,
     analytic: Option<HardwarePlan>,
+    node_texels_placeholder: &wgpu::TextureView,
 ) -> Result<DeviceScene, RenderError> {
     let UploadOptions {
         specialise,
@@ -383,7 +384,7 @@ pub(crate) fn upload_scene(
         scene_bytes += bytes;
         view
     } else {
-        node_texture::placeholder(device)
+        node_texels_placeholder.clone()
     };
     Ok(DeviceScene {
         frame,
