@@ -86,14 +86,28 @@ pub fn iteration_budget_for(adapter: &wgpu::AdapterInfo) -> u32 {
 pub const TRAVERSAL_STACK_BYTES_PER_SLOT: u64 = MAX_TRAVERSAL_STACK as u64 * 2 * 4;
 
 /// The number of path slots a trace uses on `adapter` when the caller does not choose:
-/// 16,384 on CPU devices (enough for every SIMD lane of every core, small enough for
-/// the slots' state to stay in cache) and 131,072 elsewhere.
+/// on CPU devices [`CPU_SLOTS_PER_THREAD`] for each of the host's threads (at least
+/// two, which llvmpipe runs one per core), 131,072 elsewhere.
 pub fn default_slot_count(adapter: &wgpu::AdapterInfo) -> u32 {
     if adapter.device_type == wgpu::DeviceType::Cpu {
-        1 << 14
+        cpu_slot_count(std::thread::available_parallelism().map_or(1, usize::from))
     } else {
         1 << 17
     }
+}
+
+/// Path slots per CPU thread on CPU devices: eight workgroups of 256 for each thread
+/// to balance, and about 2 MiB of slot state (path, trace and traversal stack, about
+/// 1 KiB a slot) per core, which stays in its caches. On the 2-core machine the bunny
+/// (`scenes/bench/bunny.toml`, 32 spp) traced 8% faster with 4,096 slots than with the
+/// 16,384 used before, the million-triangle terrain 1% and `glass.toml` 2%; the
+/// showcase at 1920x1080 the same (BENCHMARKS.md, "Path slots on CPU devices").
+pub const CPU_SLOTS_PER_THREAD: u32 = 2048;
+
+/// The CPU-device slot count for `threads` host threads ([`default_slot_count`]).
+fn cpu_slot_count(threads: usize) -> u32 {
+    let threads = u32::try_from(threads).unwrap_or(u32::MAX).max(2);
+    threads.saturating_mul(CPU_SLOTS_PER_THREAD).min(1 << 17)
 }
 
 /// How the trace kernels are dispatched (`docs/model.md`, "Bounded work"). Both run the
@@ -600,6 +614,15 @@ pub(crate) fn check_errors(errors: u32) -> Result<(), RenderError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cpu_devices_get_slots_per_host_thread_from_two_threads_up_to_the_gpu_count() {
+        assert_eq!(cpu_slot_count(1), 2 * CPU_SLOTS_PER_THREAD);
+        assert_eq!(cpu_slot_count(2), 4096);
+        assert_eq!(cpu_slot_count(8), 16384);
+        assert_eq!(cpu_slot_count(1000), 1 << 17);
+        assert_eq!(cpu_slot_count(usize::MAX), 1 << 17);
+    }
 
     fn llvmpipe(driver_info: &str) -> wgpu::AdapterInfo {
         wgpu::AdapterInfo {
