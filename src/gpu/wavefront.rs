@@ -86,8 +86,9 @@ pub fn iteration_budget_for(adapter: &wgpu::AdapterInfo) -> u32 {
 pub const TRAVERSAL_STACK_BYTES_PER_SLOT: u64 = MAX_TRAVERSAL_STACK as u64 * 2 * 4;
 
 /// The number of path slots a trace uses on `adapter` when the caller does not choose:
-/// on CPU devices [`CPU_SLOTS_PER_THREAD`] for each of the host's threads (at least
-/// two, which llvmpipe runs one per core), 131,072 elsewhere.
+/// on CPU devices [`CPU_SLOTS_PER_THREAD`] for each of the host's threads (llvmpipe
+/// runs one per core; counted as at least two, the whole at most 131,072), 131,072
+/// elsewhere.
 pub fn default_slot_count(adapter: &wgpu::AdapterInfo) -> u32 {
     if adapter.device_type == wgpu::DeviceType::Cpu {
         cpu_slot_count(std::thread::available_parallelism().map_or(1, usize::from))
@@ -98,10 +99,11 @@ pub fn default_slot_count(adapter: &wgpu::AdapterInfo) -> u32 {
 
 /// Path slots per CPU thread on CPU devices: eight workgroups of 256 for each thread
 /// to balance, and about 2 MiB of slot state (path, trace and traversal stack, about
-/// 1 KiB a slot) per core, which stays in its caches. On the 2-core machine the bunny
-/// (`scenes/bench/bunny.toml`, 32 spp) traced 8% faster with 4,096 slots than with the
-/// 16,384 used before, the million-triangle terrain 1% and `glass.toml` 2%; the
-/// showcase at 1920x1080 the same (BENCHMARKS.md, "Path slots on CPU devices").
+/// 1 KiB a slot) per core, where the 16,384 slots used before gave each of two cores
+/// 8 MiB. On the 2-core machine the bunny (`scenes/bench/bunny.toml`, 32 spp) traced
+/// 8% faster with 4,096 slots than with 16,384, the million-triangle terrain 1% and
+/// `glass.toml` 3%; the showcase took the same time (BENCHMARKS.md, "Path slots on
+/// CPU devices").
 pub const CPU_SLOTS_PER_THREAD: u32 = 2048;
 
 /// The CPU-device slot count for `threads` host threads ([`default_slot_count`]).
