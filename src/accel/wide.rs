@@ -350,8 +350,8 @@ impl WideNode {
 /// `first + 1`) collapsed into wide nodes, node 0 the root. A binary leaf keeps its
 /// primitive range, so the wide tree shares the binary tree's primitive order.
 ///
-/// Two passes: [`plan`] walks the tree once, choosing each wide node's children and
-/// numbering the wide nodes; [`encode`] then quantizes every node on its own, which
+/// Two passes: `plan` walks the tree once, choosing each wide node's children and
+/// numbering the wide nodes; `encode` then quantizes every node on its own, which
 /// splits across threads without changing a byte.
 pub fn collapse(nodes: &[BvhNode]) -> Vec<WideNode> {
     if nodes.is_empty() {
