@@ -72,7 +72,11 @@ const TRAVERSAL_GAVE_WAY: u32 = 2u;
 // costs more than it wins: on lavapipe (8 lanes) with the Whitted integrator,
 // glass.toml traced 1.077 s without it, 1.098 s giving way at 1/2, 1.569 s at 3/4,
 // 0.979 s at 1/3 and 0.986 s at 1/5; the 1920x1080 showcase 5.953 s without, 4.753 s
-// at 1/3 (BENCHMARKS.md, "Replacing finished rays").
+// at 1/3 (BENCHMARKS.md, "Replacing finished rays"). The kernel has changed since
+// (fused node and primitive steps, nodes in a texture, fewer slots): on it lavapipe
+// traced meshes 10-15% faster without giving way, so the renderer leaves it off
+// unless asked (RendererOptions::refill_lanes; BENCHMARKS.md, "Lane refill off by
+// default").
 const REFILL_FRACTION: u32 = 3u;
 //#endif
 

@@ -80,9 +80,9 @@ pub struct ShaderFeatures {
     /// still traverse, so that the lanes whose rays finished shade and start their
     /// next rays (`REFILL_LANES`; Aila and Laine's "replacing terminated rays", see
     /// `shaders/traverse.wgsl`). Needs [`wgpu::Features::SUBGROUP`], so it is chosen
-    /// at upload from the device (see `super::scene_buffers`), never by
-    /// [`ShaderFeatures::for_scene`], and [`ShaderFeatures::ALL`] leaves it out. The
-    /// image does not depend on it.
+    /// at upload from the device where [`super::RendererOptions::refill_lanes`] asks
+    /// for it (see `super::scene_buffers`), never by [`ShaderFeatures::for_scene`],
+    /// and [`ShaderFeatures::ALL`] leaves it out. The image does not depend on it.
     pub refill_lanes: bool,
     /// The closest-hit test of a small scene as straight-line code over its primitives
     /// (`UNROLLED`; see [`super::cpu_device::unrolled`]), instead of the BVH's walk: chosen at

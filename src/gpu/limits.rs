@@ -112,10 +112,9 @@ pub fn required_limits(adapter_limits: &wgpu::Limits) -> wgpu::Limits {
 /// will use; it runs without them, only slower or with less to report:
 /// [`wgpu::Features::TIMESTAMP_QUERY`] times the trace passes on the GPU
 /// ([`crate::film::RenderStats::gpu_time`]), and [`wgpu::Features::SUBGROUP`] lets the
-/// fused kernel's traversals give way to finished lanes
-/// ([`super::ShaderFeatures::refill_lanes`]; the 1920x1080 showcase traced 17-20%
-/// faster with it on lavapipe), and [`wgpu::Features::PIPELINE_CACHE`] lets an
-/// application keep compiled kernels between runs
+/// fused kernel's traversals give way to finished lanes where asked
+/// ([`super::RendererOptions::refill_lanes`]), and [`wgpu::Features::PIPELINE_CACHE`]
+/// lets an application keep compiled kernels between runs
 /// ([`super::RendererOptions::pipeline_cache`]).
 pub fn optional_features(adapter_features: wgpu::Features) -> wgpu::Features {
     adapter_features

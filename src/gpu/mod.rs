@@ -17,7 +17,8 @@
 //!   [`crate::low_level::gpu`]).
 //! - `cpu_device`: for CPU devices (lavapipe), the strategies that only pay there:
 //!   the scene records in uniform buffers, small scenes' closest-hit test without the
-//!   tree, and lanes that give way to finished ones ([`ShaderFeatures::refill_lanes`]).
+//!   tree, and the BVH nodes of larger scenes in a texture. (Lanes that give way to
+//!   finished ones, [`ShaderFeatures::refill_lanes`], are off unless asked for.)
 //!
 //! ```no_run
 //! use gpu_render::gpu::{AdapterChoice, HeadlessGpu, Renderer, RendererOptions};

@@ -84,8 +84,10 @@ pub struct RendererOptions {
     /// there), or always read the records from storage buffers.
     pub uniform_records: bool,
     /// Where the device has subgroup operations, let the fused kernel's traversals
-    /// give way to lanes whose rays finished (`true`, faster on lavapipe; see
-    /// [`ShaderFeatures::refill_lanes`]).
+    /// give way to lanes whose rays finished (see [`ShaderFeatures::refill_lanes`]).
+    /// `false` by default: on lavapipe the kernel without it traced meshes 10-15%
+    /// faster and the unrolled showcase 5% faster (`BENCHMARKS.md`, "Lane refill
+    /// off by default"); GPUs' default schedule, the wavefront, never gives way.
     pub refill_lanes: bool,
     /// On CPU devices, test the primitives of scenes small enough unrolled instead of
     /// walking their BVH (`true`, faster there; see [`ShaderFeatures::unrolled`]).
@@ -126,7 +128,7 @@ impl Default for RendererOptions {
             aov: false,
             specialise: true,
             uniform_records: true,
-            refill_lanes: true,
+            refill_lanes: false,
             unrolled: true,
             traversal: Traversal::Auto,
             simulate_loop_cut: false,

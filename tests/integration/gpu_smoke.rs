@@ -192,9 +192,10 @@ fn regions_slots_and_budgets_do_not_change_the_image() {
 
     // Three uneven bands of rows, each traced into its place in one target.
     let prepared = renderer.upload(device, queue, &scene).expect("prepare");
-    // The reference gives way to finished lanes wherever the device can (lavapipe can).
+    // The reference does not give way to finished lanes (off by default); the
+    // "lane refill" variant below does wherever the device can (lavapipe can).
+    assert!(!prepared.features().refill_lanes);
     let subgroups = device.features().contains(wgpu::Features::SUBGROUP);
-    assert_eq!(prepared.features().refill_lanes, subgroups);
     if gpu.adapter.get_info().name.contains("llvmpipe") {
         assert!(subgroups, "lavapipe offers subgroup operations");
     }
@@ -239,11 +240,11 @@ fn regions_slots_and_budgets_do_not_change_the_image() {
             ),
         ),
         (
-            "no lane refill",
+            "lane refill",
             crate::support::gpu::renderer_with(
                 &gpu,
                 RendererOptions {
-                    refill_lanes: false,
+                    refill_lanes: true,
                     ..RendererOptions::default()
                 },
             ),
@@ -272,23 +273,25 @@ fn regions_slots_and_budgets_do_not_change_the_image() {
         // The smallest budgets: a budget of 1 once made no progress at all in the
         // fused kernel (its shading step spent the one iteration on nothing).
         (
-            "fused schedule, budget 1",
+            "fused schedule, budget 1, lane refill",
             crate::support::gpu::renderer_with(
                 &gpu,
                 RendererOptions {
                     schedule: Some(Schedule::Fused),
                     iteration_budget: Some(1),
+                    refill_lanes: true,
                     ..RendererOptions::default()
                 },
             ),
         ),
         (
-            "fused schedule, budget 2",
+            "fused schedule, budget 2, lane refill",
             crate::support::gpu::renderer_with(
                 &gpu,
                 RendererOptions {
                     schedule: Some(Schedule::Fused),
                     iteration_budget: Some(2),
+                    refill_lanes: true,
                     ..RendererOptions::default()
                 },
             ),
@@ -305,6 +308,16 @@ fn regions_slots_and_budgets_do_not_change_the_image() {
             ),
         ),
     ] {
+        if label.contains("lane refill") {
+            let features = variant
+                .upload(device, queue, &scene)
+                .expect("prepare")
+                .features();
+            assert_eq!(
+                features.refill_lanes, subgroups,
+                "{label} gives way where it can"
+            );
+        }
         let target = linear_target(device);
         let view = target.create_view(&Default::default());
         let traced = variant
@@ -328,6 +341,7 @@ fn giving_way_to_finished_lanes_does_not_change_the_image() {
         &gpu,
         RendererOptions {
             schedule: Some(Schedule::Fused),
+            refill_lanes: true,
             ..RendererOptions::default()
         },
     );
@@ -335,7 +349,6 @@ fn giving_way_to_finished_lanes_does_not_change_the_image() {
         &gpu,
         RendererOptions {
             schedule: Some(Schedule::Fused),
-            refill_lanes: false,
             ..RendererOptions::default()
         },
     );

@@ -397,8 +397,8 @@ impl Backend {
 /// (whose loops have no limit, `gpu::driver_loop_limit`) on Whitted scenes without
 /// meshes, that is without models loaded from files (loose triangles are fine): the
 /// 1920x1080 showcase 1.10x, the direct-light scene 2.5x, the Whitted caustic and
-/// Cornell box 1.4x-1.6x, with lanes refilled (`gpu::ShaderFeatures::refill_lanes`),
-/// and `glass.toml` 1.6x with its primitives unrolled (`gpu::cpu_device::unrolled`); and on
+/// Cornell box 1.4x-1.6x, with lanes refilled then (`gpu::ShaderFeatures::refill_lanes`,
+/// off by default since, as lavapipe became faster without it), and `glass.toml` 1.6x with its primitives unrolled (`gpu::cpu_device::unrolled`); and on
 /// path-traced scenes of at most `gpu::cpu_device::unrolled::MAX_UNROLLED_PRIMITIVES` primitives
 /// without meshes, unrolled (the Cornell box 1.8x, the caustic and the environment-lit
 /// materials 1.1x). Meshes make it slower (`models.toml`, OBJ and glTF tori and vases,

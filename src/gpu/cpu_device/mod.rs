@@ -10,9 +10,11 @@
 //! - [`unrolled`]: the closest-hit test of a scene of a few primitives as straight-line
 //!   WGSL instead of a walk of the BVH.
 //!
-//! A third, refilling finished lanes inside the trace kernel
-//! ([`crate::gpu::ShaderFeatures::refill_lanes`]), is a shader feature decided with the
-//! device's loop limits in `gpu::limits`.
+//! A fourth, refilling finished lanes inside the trace kernel
+//! ([`crate::gpu::ShaderFeatures::refill_lanes`]), is a shader feature that needs
+//! subgroup operations (`gpu::limits`); it is off unless asked for
+//! ([`crate::gpu::RendererOptions::refill_lanes`]), since lavapipe now traces faster
+//! without it.
 
 pub(crate) mod node_texture;
 pub(crate) mod uniform_records;

@@ -60,14 +60,14 @@ struct Args {
     schedule: Option<String>,
     /// Keep the scene records in storage buffers, not in uniform buffers where they
     /// fit on a CPU device nor the BVH nodes in a texture where they do not
-    /// (`Renderer::with_uniform_records(false)`).
+    /// (`RendererOptions::uniform_records` false).
     #[arg(long)]
     storage_records: bool,
-    /// Traversals never give way to finished lanes
-    /// (`Renderer::with_refill_lanes(false)`).
+    /// The fused kernel's traversals give way to finished lanes where the device has
+    /// subgroup operations (`RendererOptions::refill_lanes`, off by default).
     #[arg(long)]
-    no_refill: bool,
-    /// Small scenes walk their BVH too (`Renderer::with_unrolled_primitives(false)`).
+    refill: bool,
+    /// Small scenes walk their BVH too (`RendererOptions::unrolled` false).
     #[arg(long)]
     no_unrolled: bool,
     /// Path slots of the GPU trace (default: the adapter's, `default_slot_count`).
@@ -421,7 +421,7 @@ fn main() -> Result<()> {
         &gpu.device,
         RendererOptions {
             uniform_records: !args.storage_records,
-            refill_lanes: !args.no_refill,
+            refill_lanes: args.refill,
             unrolled: !args.no_unrolled,
             slot_count: args.slots,
             schedule,
