@@ -32,13 +32,14 @@ const NEEDS: [Need; 9] = [
     Need {
         limit: "max_storage_textures_per_shader_stage",
         field: |l| &mut l.max_storage_textures_per_shader_stage,
-        needed: 1,
+        // The linear output and the BVH node texture (a placeholder where unused).
+        needed: 2,
     },
     Need {
         limit: "max_sampled_textures_per_shader_stage",
         field: |l| &mut l.max_sampled_textures_per_shader_stage,
-        // The images and the BVH node texture (a placeholder where unused).
-        needed: 2,
+        // The images.
+        needed: 1,
     },
     Need {
         limit: "max_uniform_buffers_per_shader_stage",

@@ -6,7 +6,9 @@ use std::sync::{Mutex, PoisonError};
 
 use super::RenderError;
 use super::cpu_device::node_texture;
-use super::cpu_device::uniform_records::{UNIFORM_BUFFERS, device_allows, is_uniform_record};
+use super::cpu_device::uniform_records::{
+    SMALL_UNIFORM_BUFFERS, UNIFORM_BUFFERS, UniformRecords, device_allows, device_allows_small,
+};
 use super::features::ShaderFeatures;
 use super::ray_query::{RAY_QUERY_FEATURE, hardware_traversal_available};
 use super::readback::{Caught, capture};
@@ -95,8 +97,9 @@ impl TracePipelines {
 }
 
 /// The bind group and pipeline layout of the trace modules of one kind of record
-/// binding (see [`ShaderFeatures::uniform_records`]), with or without the hardware
-/// traversal's acceleration structure ([`ShaderFeatures::hardware_traversal`]).
+/// binding ([`UniformRecords`]: see [`ShaderFeatures::uniform_records`] and
+/// [`ShaderFeatures::node_texture`]), with or without the hardware traversal's
+/// acceleration structure ([`ShaderFeatures::hardware_traversal`]).
 #[derive(Debug)]
 struct TraceLayout {
     bind_group: wgpu::BindGroupLayout,
@@ -106,13 +109,13 @@ struct TraceLayout {
 impl TraceLayout {
     fn new(
         device: &wgpu::Device,
-        uniform_records: bool,
+        records: UniformRecords,
         acceleration_structure: bool,
     ) -> Result<Self, RenderError> {
         use binding::*;
         // The records every traversal step reads: storage or uniform arrays.
         let record = |binding: u32| {
-            if uniform_records && is_uniform_record(binding) {
+            if records.binds_uniform(binding) {
                 uniform_entry(binding)
             } else {
                 storage_entry(binding, true)
@@ -144,10 +147,10 @@ impl TraceLayout {
             storage_entry(ENVIRONMENT, true),
             compute_entry(
                 NODE_TEXELS,
-                wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Uint,
+                wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::ReadOnly,
+                    format: node_texture::NODE_TEXEL_FORMAT,
                     view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
                 },
             ),
         ];
@@ -161,10 +164,15 @@ impl TraceLayout {
         }
         let bind_group = capture(device, "trace bind group layout", Caught::Resource, || {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(match (uniform_records, acceleration_structure) {
-                    (true, _) => "gpu-render trace bindings (uniform records)",
-                    (false, true) => "gpu-render trace bindings (acceleration structure)",
-                    (false, false) => "gpu-render trace bindings",
+                label: Some(match (records, acceleration_structure) {
+                    (UniformRecords::All, _) => "gpu-render trace bindings (uniform records)",
+                    (UniformRecords::Small, _) => {
+                        "gpu-render trace bindings (small uniform records, node texture)"
+                    }
+                    (UniformRecords::None, true) => {
+                        "gpu-render trace bindings (acceleration structure)"
+                    }
+                    (UniformRecords::None, false) => "gpu-render trace bindings",
                 }),
                 entries: &entries,
             })
@@ -189,6 +197,9 @@ pub(crate) struct Pipelines {
     /// With uniform records, where the device binds enough uniform buffers
     /// (`uniform_records::device_allows`).
     uniform_layout: Option<TraceLayout>,
+    /// With the small records uniform and the BVH nodes in a texture, where the
+    /// device binds enough uniform buffers (`uniform_records::device_allows_small`).
+    node_texture_layout: Option<TraceLayout>,
     /// With storage records and the hardware traversal's acceleration structure,
     /// where the device has ray queries
     /// ([`super::ray_query::hardware_traversal_available`]).
@@ -270,14 +281,19 @@ impl Pipelines {
         device: &wgpu::Device,
         cache: Option<wgpu::PipelineCache>,
     ) -> Result<Self, RenderError> {
-        let storage_layout = TraceLayout::new(device, false, false)?;
+        let storage_layout = TraceLayout::new(device, UniformRecords::None, false)?;
         let uniform_layout = if device_allows(&device.limits()) {
-            Some(TraceLayout::new(device, true, false)?)
+            Some(TraceLayout::new(device, UniformRecords::All, false)?)
+        } else {
+            None
+        };
+        let node_texture_layout = if device_allows_small(&device.limits()) {
+            Some(TraceLayout::new(device, UniformRecords::Small, false)?)
         } else {
             None
         };
         let hardware_layout = if hardware_traversal_available(device) {
-            Some(TraceLayout::new(device, false, true)?)
+            Some(TraceLayout::new(device, UniformRecords::None, true)?)
         } else {
             None
         };
@@ -308,6 +324,7 @@ impl Pipelines {
         Ok(Self {
             storage_layout,
             uniform_layout,
+            node_texture_layout,
             hardware_layout,
             display_bind_group_layout,
             display,
@@ -369,8 +386,9 @@ impl Pipelines {
     /// The layouts of the trace modules for `features` (their record bindings are
     /// storage or uniform buffers).
     ///
-    /// Errors: [`RenderError::Limit`] for uniform records on a device that binds too
-    /// few uniform buffers, [`RenderError::MissingFeature`] for the hardware traversal
+    /// Errors: [`RenderError::Limit`] for uniform records (all or the small ones) on a
+    /// device that binds too few uniform buffers, [`RenderError::MissingFeature`] for
+    /// the hardware traversal
     /// on a device without ray queries (an upload never chooses them there).
     fn trace_layout(
         &self,
@@ -387,31 +405,32 @@ impl Pipelines {
                     hint: "",
                 });
         }
-        if !features.uniform_records {
-            return Ok(&self.storage_layout);
-        }
-        self.uniform_layout
-            .as_ref()
-            .ok_or_else(|| RenderError::Limit {
-                limit: "max_uniform_buffers_per_shader_stage",
-                needed: u64::from(UNIFORM_BUFFERS),
-                available: u64::from(device.limits().max_uniform_buffers_per_shader_stage),
-            })
+        let (layout, needed) = match UniformRecords::of(features) {
+            UniformRecords::None => return Ok(&self.storage_layout),
+            UniformRecords::All => (&self.uniform_layout, UNIFORM_BUFFERS),
+            UniformRecords::Small => (&self.node_texture_layout, SMALL_UNIFORM_BUFFERS),
+        };
+        layout.as_ref().ok_or_else(|| RenderError::Limit {
+            limit: "max_uniform_buffers_per_shader_stage",
+            needed: u64::from(needed),
+            available: u64::from(device.limits().max_uniform_buffers_per_shader_stage),
+        })
     }
 
     /// The bind group layout of the trace modules for a prepared scene's `features`
-    /// (uploads choose uniform records only where the device has their layout).
+    /// (uploads choose uniform records, all or the small ones, only where the device
+    /// has their layout).
     pub fn trace_bind_group_layout(&self, features: &ShaderFeatures) -> &wgpu::BindGroupLayout {
-        match (
-            &self.uniform_layout,
-            &self.hardware_layout,
-            features.uniform_records,
-            features.hardware_traversal,
-        ) {
-            (_, Some(hardware), _, true) => &hardware.bind_group,
-            (Some(uniform), _, true, _) => &uniform.bind_group,
-            _ => &self.storage_layout.bind_group,
-        }
+        let layout = if features.hardware_traversal {
+            self.hardware_layout.as_ref()
+        } else {
+            match UniformRecords::of(features) {
+                UniformRecords::None => None,
+                UniformRecords::All => self.uniform_layout.as_ref(),
+                UniformRecords::Small => self.node_texture_layout.as_ref(),
+            }
+        };
+        &layout.unwrap_or(&self.storage_layout).bind_group
     }
 
     /// How many trace modules have been built so far.

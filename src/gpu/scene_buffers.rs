@@ -4,6 +4,7 @@
 
 use super::RenderError;
 use super::area_lights::{EMITTER_NONE, FLAG_PATH, GpuEmitter, emitter_records};
+use super::cpu_device::uniform_records::UniformRecords;
 use super::cpu_device::unrolled::{self, UnrolledPrimitives};
 use super::cpu_device::{node_texture, uniform_records};
 use super::environment::environment_buffer;
@@ -256,18 +257,28 @@ pub(crate) fn upload_scene(
     let cpu_records =
         allow_uniform_records && !hardware && uniform_records::preferred(&device.adapter_info());
     let uniform_records = cpu_records && uniform_records::fits(&padded, &limits);
-    // Too large for uniform arrays: the nodes in a texture, where it fits.
-    let node_texture =
-        cpu_records && !uniform_records && node_texture::fits(padded.bvh_nodes.len(), &limits);
+    // Too large for uniform arrays: the nodes in a texture and the small records
+    // uniform, where they fit.
+    let node_texture = cpu_records
+        && !uniform_records
+        && node_texture::fits(padded.bvh_nodes.len(), &limits)
+        && uniform_records::small_records_fit(&padded, &limits);
+    let record_bindings = UniformRecords::of(&ShaderFeatures {
+        uniform_records,
+        node_texture,
+        ..ShaderFeatures::ALL
+    });
     let mut scene_bytes = 0;
     let mut upload =
         |what: &str, binding: u32, bytes: &[u8]| -> Result<wgpu::Buffer, RenderError> {
             // A uniform record array is bound whole: its buffer has the array's length.
-            let uniform_bytes = uniform_records
+            let uniform_bytes = record_bindings
+                .binds_uniform(binding)
                 .then(|| uniform_records::padded_bytes(binding))
                 .flatten();
             let size = uniform_bytes.unwrap_or(bytes.len() as u64);
-            // A uniform record array fits its binding (`uniform_records::fits`).
+            // A uniform record array fits its binding (`uniform_records::fits`,
+            // `uniform_records::small_records_fit`).
             if uniform_bytes.is_none() && size > max_binding {
                 return Err(RenderError::SceneTooLarge {
                     what: format!("{what} buffer bytes"),

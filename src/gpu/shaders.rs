@@ -105,8 +105,7 @@ pub fn host_module(name: &str, features: &ShaderFeatures) -> Option<String> {
         "records" => Some(format!(
             "#import types\n{}",
             super::cpu_device::uniform_records::declarations(
-                features.uniform_records,
-                features.node_texture
+                super::cpu_device::uniform_records::UniformRecords::of(features)
             )
         )),
         "unrolled_scene" => features.unrolled.as_ref().map(|unrolled| unrolled.wgsl()),

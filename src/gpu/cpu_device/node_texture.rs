@@ -1,21 +1,26 @@
-//! The wide BVH nodes as the texels of a texture, on CPU devices, for scenes whose
-//! records do not fit uniform buffers (`super::uniform_records`).
+//! The wide BVH nodes as the texels of a read-only storage texture, on CPU devices,
+//! for scenes whose records do not fit uniform buffers (`super::uniform_records`).
 //!
 //! llvmpipe (Mesa 25.0) reads a storage-buffer element whose index differs from lane
 //! to lane one lane at a time, each lane behind a branch on its execution mask and
 //! each component behind another on the buffer's bounds (`emit_load_mem` in gallivm's
-//! `lp_bld_nir_soa.c`). A texel fetch (`textureLoad`) it gathers without branches:
-//! one 16-byte texel per lane, its coordinates clamped as a vector. A node visit reads
-//! a 64-byte node, four texels here: the bunny of `scenes/bench/bunny.toml` (69,451
-//! triangles) traced 8% faster on lavapipe with its nodes in a texture, the
-//! million-triangle terrain no faster (BENCHMARKS.md, "The compressed 4-wide BVH").
-//! The triangles did not gain from the same (three texels each, slower than their
-//! storage reads), so only the nodes go to the texture; the storage buffer of nodes
-//! stays bound too, for the instance records it holds (`shaders/instance.wgsl`).
+//! `lp_bld_nir_soa.c`). A texel load it gathers without branches: one 16-byte texel
+//! per lane, its coordinates checked as a vector. A node visit reads a 64-byte node,
+//! four texels here. With a sampled texture (`texture_2d<u32>`) the bunny of
+//! `scenes/bench/bunny.toml` (69,451 triangles) traced 8% faster on lavapipe than
+//! from storage; a storage texture (`texture_storage_2d<rgba32uint, read>`) is faster
+//! still, the bunny 15% and the million-triangle terrain 16%: lavapipe's image load
+//! is a 48-instruction function, its sampled texel fetch 156, which looks up the mip
+//! level's size and offset lane by lane although there is one level (BENCHMARKS.md,
+//! "The compressed 4-wide BVH" and "Small records in uniform buffers, nodes in a
+//! storage texture"). The triangles did not gain from a sampled texture (three texels
+//! each, slower than their storage reads), so only the nodes go to the texture; the
+//! storage buffer of nodes stays bound too, for the instance records it holds
+//! (`shaders/instance.wgsl`).
 //!
 //! Layout: node `i`'s four 16-byte quarters, in their [`WideNode`] order, are the
 //! texels `(4 · (i mod NODES_PER_ROW) + k, i / NODES_PER_ROW)`, `k = 0..4`, of an
-//! `Rgba32Uint` texture [`ROW_TEXELS`] wide (read by `load_wide_node` of
+//! [`NODE_TEXEL_FORMAT`] texture [`ROW_TEXELS`] wide (read by `load_wide_node` of
 //! [`wgsl`]).
 
 use crate::accel::WideNode;
@@ -26,7 +31,10 @@ use crate::gpu::readback::{Caught, capture};
 /// Nodes in one texture row.
 pub const NODES_PER_ROW: u32 = 1024;
 
-/// Texels of one node: its 64 bytes as four `Rgba32Uint` texels.
+/// The texture's format: a texel holds four of a node's words.
+pub const NODE_TEXEL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
+
+/// Texels of one node: its 64 bytes as four [`NODE_TEXEL_FORMAT`] texels.
 pub const TEXELS_PER_NODE: u32 = 4;
 
 /// The texture's width in texels (within the 8,192 every WebGPU device allows).
@@ -37,13 +45,13 @@ pub const ROW_TEXELS: u32 = NODES_PER_ROW * TEXELS_PER_NODE;
 /// written from this module's constants.
 pub(crate) fn wgsl() -> String {
     format!(
-        "@group(0) @binding({binding}) var node_texels: texture_2d<u32>;\n\
+        "@group(0) @binding({binding}) var node_texels: texture_storage_2d<rgba32uint, read>;\n\
          fn load_wide_node(i: u32) -> WideNode {{\n\
              let at = vec2<i32>(i32((i % {NODES_PER_ROW}u) * {TEXELS_PER_NODE}u), i32(i / {NODES_PER_ROW}u));\n\
-             let a = textureLoad(node_texels, at, 0);\n\
-             let b = textureLoad(node_texels, at + vec2<i32>(1, 0), 0);\n\
-             let c = textureLoad(node_texels, at + vec2<i32>(2, 0), 0);\n\
-             let d = textureLoad(node_texels, at + vec2<i32>(3, 0), 0);\n\
+             let a = textureLoad(node_texels, at);\n\
+             let b = textureLoad(node_texels, at + vec2<i32>(1, 0));\n\
+             let c = textureLoad(node_texels, at + vec2<i32>(2, 0));\n\
+             let d = textureLoad(node_texels, at + vec2<i32>(3, 0));\n\
              return WideNode(bitcast<vec3<f32>>(a.xyz), a.w, b.xyz, b.w, c.xyz, c.w, d);\n\
          }}\n",
         binding = binding::NODE_TEXELS,
@@ -120,8 +128,8 @@ fn descriptor(label: &str, size: wgpu::Extent3d) -> wgpu::TextureDescriptor<'_> 
         mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba32Uint,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        format: NODE_TEXEL_FORMAT,
+        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     }
 }
@@ -151,7 +159,9 @@ mod tests {
     #[test]
     fn every_node_is_read_back_whole_from_the_texels_the_shader_reads() {
         let wgsl = wgsl();
-        assert!(wgsl.contains("@group(0) @binding(22) var node_texels: texture_2d<u32>;"));
+        assert!(wgsl.contains(
+            "@group(0) @binding(22) var node_texels: texture_storage_2d<rgba32uint, read>;"
+        ));
         assert!(wgsl.contains("(i % 1024u) * 4u), i32(i / 1024u)"));
         assert_eq!(NODES_PER_ROW, 1024);
         let nodes: Vec<WideNode> = (0..2500).map(node).collect();

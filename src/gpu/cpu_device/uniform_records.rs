@@ -22,6 +22,7 @@
 use std::mem::size_of;
 
 use crate::accel::WideNode;
+use crate::gpu::features::ShaderFeatures;
 use crate::gpu::layout::{GpuLight, GpuMaterial, GpuPlane, GpuPolygon, GpuSphere, GpuTriangle};
 use crate::gpu::pipelines::binding;
 use crate::gpu::upload::SceneRecords;
@@ -145,11 +146,66 @@ const PACKED: [PackedBinding; 2] = [
 /// frame's and one per record array.
 pub(crate) const UNIFORM_BUFFERS: u32 = 1 + (RECORDS.len() + PACKED.len()) as u32;
 
+/// The record arrays that scenes too large for uniform records still bind as uniform
+/// arrays where they fit, beside their BVH nodes in a texture
+/// ([`UniformRecords::Small`]): the planes every ray tests, and the materials and
+/// lights every shading step reads, which real scenes have few of. The bunny of
+/// `scenes/bench/bunny.toml` traced 11% faster with them uniform (BENCHMARKS.md,
+/// "Small records in uniform buffers, nodes in a storage texture").
+const SMALL_RECORDS: [u32; 3] = [binding::PLANES, binding::MATERIALS, binding::LIGHTS];
+
+/// The uniform buffers the trace kernels bind in one stage with
+/// [`UniformRecords::Small`]: the frame's and the small records'.
+pub(crate) const SMALL_UNIFORM_BUFFERS: u32 = 1 + SMALL_RECORDS.len() as u32;
+
+/// Which record bindings a trace module and its layout bind as uniform arrays.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum UniformRecords {
+    /// None: every record array is a storage buffer.
+    None,
+    /// Every record array ([`is_uniform_record`]): a small scene on a CPU device
+    /// ([`crate::gpu::ShaderFeatures::uniform_records`]).
+    All,
+    /// The small record arrays ([`SMALL_RECORDS`]), the others storage buffers and the
+    /// BVH nodes in a texture: a larger scene on a CPU device
+    /// ([`crate::gpu::ShaderFeatures::node_texture`]).
+    Small,
+}
+
+impl UniformRecords {
+    /// The record bindings of a module with `features`.
+    pub(crate) fn of(features: &ShaderFeatures) -> Self {
+        if features.uniform_records {
+            Self::All
+        } else if features.node_texture {
+            Self::Small
+        } else {
+            Self::None
+        }
+    }
+
+    /// Whether record binding `binding` is a uniform array.
+    pub(crate) fn binds_uniform(self, binding: u32) -> bool {
+        match self {
+            Self::None => false,
+            Self::All => is_uniform_record(binding),
+            Self::Small => SMALL_RECORDS.contains(&binding),
+        }
+    }
+}
+
 /// Whether a device with `limits` can bind the records as uniform buffers at all
 /// (the trace layout with uniform records is built only then).
 pub(crate) fn device_allows(limits: &wgpu::Limits) -> bool {
     limits.max_uniform_buffer_binding_size >= UNIFORM_RECORD_BYTES
         && limits.max_uniform_buffers_per_shader_stage >= UNIFORM_BUFFERS
+}
+
+/// Whether a device with `limits` can bind the small records as uniform buffers (the
+/// trace layout of [`UniformRecords::Small`] is built only then).
+pub(crate) fn device_allows_small(limits: &wgpu::Limits) -> bool {
+    limits.max_uniform_buffer_binding_size >= UNIFORM_RECORD_BYTES
+        && limits.max_uniform_buffers_per_shader_stage >= SMALL_UNIFORM_BUFFERS
 }
 
 /// How many records of `stride` bytes one uniform binding holds.
@@ -181,19 +237,19 @@ pub(crate) fn padded_bytes(binding: u32) -> Option<u64> {
         })
 }
 
-/// The WGSL declarations of the record bindings: storage arrays, or with `uniform`
-/// uniform arrays of their capacity; the accessors of the packed ones,
-/// `polygon_point(i)` and `prim_ref(i)`; and `load_wide_node(i)`, which reads the
-/// node from `bvh_nodes`, or with `node_texture` (and storage arrays) from the
-/// texture of `super::node_texture`.
-pub(crate) fn declarations(uniform: bool, node_texture: bool) -> String {
-    let node_reader = if node_texture && !uniform {
+/// The WGSL declarations of the record bindings: storage arrays, or where `records`
+/// binds them uniform, uniform arrays of their capacity; the accessors of the packed
+/// ones, `polygon_point(i)` and `prim_ref(i)`; and `load_wide_node(i)`, which reads
+/// the node from `bvh_nodes`, or with [`UniformRecords::Small`] from the texture of
+/// `super::node_texture`.
+pub(crate) fn declarations(records: UniformRecords) -> String {
+    let node_reader = if records == UniformRecords::Small {
         super::node_texture::wgsl()
     } else {
         "fn load_wide_node(i: u32) -> WideNode { return bvh_nodes[i]; }\n".to_string()
     };
     let packed = PACKED.iter().map(|p| {
-        if uniform {
+        if records.binds_uniform(p.binding) {
             format!(
                 "@group(0) @binding({}) var<uniform> {}: array<{}, {}>;\n\
                  fn {}(i: u32) -> {} {{ {} }}\n",
@@ -210,7 +266,7 @@ pub(crate) fn declarations(uniform: bool, node_texture: bool) -> String {
     RECORDS
         .iter()
         .map(|r| {
-            if uniform {
+            if records.binds_uniform(r.binding) {
                 format!(
                     "@group(0) @binding({}) var<uniform> {}: array<{}, {}>;\n",
                     r.binding,
@@ -242,6 +298,16 @@ pub(crate) fn fits(records: &SceneRecords, limits: &wgpu::Limits) -> bool {
             .all(|p| (p.length)(records) <= PACKED_VEC4S * p.per_vec4)
 }
 
+/// Whether the small record arrays of `records` ([`SMALL_RECORDS`]) fit their uniform
+/// bindings on a device with `limits`.
+pub(crate) fn small_records_fit(records: &SceneRecords, limits: &wgpu::Limits) -> bool {
+    device_allows_small(limits)
+        && RECORDS
+            .iter()
+            .filter(|r| SMALL_RECORDS.contains(&r.binding))
+            .all(|r| (r.length)(records) <= capacity(r.stride))
+}
+
 /// Whether a scene whose records [`fits`] binds them as uniform arrays on the device
 /// `info` describes: on CPU devices only (see the module's documentation).
 pub(crate) fn preferred(info: &wgpu::AdapterInfo) -> bool {
@@ -270,21 +336,65 @@ mod tests {
     #[test]
     fn declarations_give_the_address_space_and_the_capacity() {
         assert!(
-            declarations(false, false).contains(
+            declarations(UniformRecords::None).contains(
                 "@group(0) @binding(12) var<storage, read> bvh_nodes: array<WideNode>;\n"
             )
         );
         assert!(
-            declarations(true, false).contains(
+            declarations(UniformRecords::All).contains(
                 "@group(0) @binding(12) var<uniform> bvh_nodes: array<WideNode, 1024>;\n"
+            )
+        );
+        // The small records uniform, the rest storage, beside the node texture.
+        let small = declarations(UniformRecords::Small);
+        assert!(small.contains("@group(0) @binding(6) var<uniform> materials: array<Material, "));
+        assert!(small.contains("@group(0) @binding(7) var<uniform> lights: array<Light, "));
+        assert!(small.contains("@group(0) @binding(2) var<uniform> planes: array<Plane, "));
+        assert!(
+            small
+                .contains("@group(0) @binding(5) var<storage, read> triangles: array<Triangle>;\n")
+        );
+        assert!(
+            small.contains(
+                "@group(0) @binding(12) var<storage, read> bvh_nodes: array<WideNode>;\n"
             )
         );
     }
 
     #[test]
+    fn small_records_fit_where_the_device_and_their_counts_allow() {
+        let limits = wgpu::Limits {
+            max_uniform_buffer_binding_size: UNIFORM_RECORD_BYTES,
+            max_uniform_buffers_per_shader_stage: SMALL_UNIFORM_BUFFERS,
+            ..wgpu::Limits::default()
+        };
+        let mut records = SceneRecords {
+            triangles: vec![bytemuck::Zeroable::zeroed(); 100_000],
+            ..SceneRecords::default()
+        };
+        assert!(!fits(&records, &limits));
+        assert!(small_records_fit(&records, &limits));
+        let materials = capacity(size_of::<GpuMaterial>());
+        records.materials = vec![bytemuck::Zeroable::zeroed(); materials];
+        assert!(small_records_fit(&records, &limits));
+        records.materials.push(bytemuck::Zeroable::zeroed());
+        assert!(!small_records_fit(&records, &limits));
+        records.materials.clear();
+        let few = wgpu::Limits {
+            max_uniform_buffers_per_shader_stage: SMALL_UNIFORM_BUFFERS - 1,
+            ..limits
+        };
+        assert!(!small_records_fit(&records, &few));
+    }
+
+    #[test]
     fn declarations_name_each_record_binding_once() {
-        for (uniform, node_texture) in [(false, false), (true, false), (false, true)] {
-            let text = declarations(uniform, node_texture);
+        for records in [
+            UniformRecords::None,
+            UniformRecords::All,
+            UniformRecords::Small,
+        ] {
+            let text = declarations(records);
             let bindings = RECORDS.iter().map(|r| r.binding);
             for binding in bindings.chain(PACKED.iter().map(|p| p.binding)) {
                 assert_eq!(text.matches(&format!("@binding({binding}) ")).count(), 1);
@@ -297,8 +407,8 @@ mod tests {
                 1
             );
             assert_eq!(
-                text.contains("var node_texels: texture_2d<u32>"),
-                node_texture
+                text.contains("var node_texels: texture_storage_2d<rgba32uint, read>"),
+                records == UniformRecords::Small
             );
         }
     }

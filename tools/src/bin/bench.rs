@@ -59,7 +59,8 @@ struct Args {
     #[arg(long)]
     schedule: Option<String>,
     /// Keep the scene records in storage buffers, not in uniform buffers where they
-    /// fit on a CPU device nor the BVH nodes in a texture where they do not
+    /// fit on a CPU device nor the BVH nodes in a texture (and the small records in
+    /// uniform buffers) where they do not
     /// (`RendererOptions::uniform_records` false).
     #[arg(long)]
     storage_records: bool,
@@ -464,7 +465,7 @@ fn main() -> Result<()> {
             "storage"
         },
         if prepared.features().node_texture {
-            ", BVH nodes in a texture"
+            " (planes, materials and lights uniform), BVH nodes in a storage texture"
         } else {
             ""
         },
