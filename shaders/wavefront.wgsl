@@ -245,8 +245,10 @@ fn fetch_pixel(slot: u32, path: ptr<function, PathState>) {
 // next pixel, the next camera ray) until a new traversal starts, the slot runs out of
 // pixels, or the budget is spent (the path then stays in its phase and the next step
 // continues there). Straight-line code, so that each phase's code runs once per step
-// on SIMD devices that execute every branch (llvmpipe).
-fn shade_step(slot: u32, path: ptr<function, PathState>, trace: ptr<function, TraceRay>) {
+// on SIMD devices that execute every branch (llvmpipe). Without `may_start` a path
+// that reaches its next sample waits there (see trace_paths, LOCKSTEP_SAMPLES).
+fn shade_step(slot: u32, path: ptr<function, PathState>, trace: ptr<function, TraceRay>,
+              may_start: bool) {
     if (*trace).status == TRACE_DONE {
         (*trace).status = TRACE_IDLE;
         if (*path).phase == PHASE_CLOSEST {
@@ -300,7 +302,7 @@ fn shade_step(slot: u32, path: ptr<function, PathState>, trace: ptr<function, Tr
     if (*path).phase == PHASE_FETCH_PIXEL || (*path).phase == PHASE_FIRST_PIXEL {
         fetch_pixel(slot, path);
     }
-    if (*path).phase == PHASE_START_SAMPLE {
+    if (*path).phase == PHASE_START_SAMPLE && may_start {
         start_sample(path, trace);
     }
 }
@@ -321,7 +323,7 @@ fn shade_paths(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     iterations = 0u;
-    shade_step(slot, &path, &trace);
+    shade_step(slot, &path, &trace, true);
     paths[slot] = path;
     traces[slot] = trace;
 }
@@ -365,6 +367,22 @@ fn trace_paths(@builtin(global_invocation_id) id: vec3<u32>) {
     // integrator's do not, as its heavier shading step made that 3-4% slower on a
     // Cornell box (BENCHMARKS.md, "Replacing finished rays").
     let give_way = (frame.flags & FLAG_PATH) == 0u;
+    //#if LOCKSTEP_SAMPLES
+    // Whitted samples start in lockstep: a lane whose sample is done waits until every
+    // lane of its subgroup still here is done with theirs, and they start their next
+    // samples (or pixels) together. So the rays that a vector traverses at once are
+    // all camera rays or all shadow rays of the same light, from neighbouring pixels,
+    // and walk the same nodes; before, lanes whose pixels take fewer rays per sample
+    // (the background's one against a lit hit's two) drifted into other phases and
+    // other pixels, and a vector walked the union of unrelated rays' nodes. Waiting
+    // costs little on SIMD devices, where an iteration costs the same for one lane as
+    // for all of them (traverse.wgsl), and a Whitted pixel's samples take nearly the
+    // same rays. On lavapipe it traced the bunny 17% faster, the showcase 36%, and
+    // glass.toml, the Cornell box and models.toml 16-24% (BENCHMARKS.md, "Samples in
+    // lockstep"). Not for the path integrator: its paths end at random depths, so
+    // lanes wait for the longest, and a path-traced Cornell box took 30% longer.
+    let lockstep = (frame.flags & FLAG_PATH) == 0u;
+    //#endif
     var exited = false;
     loop {
         if trace_in_flight(trace) {
@@ -381,10 +399,18 @@ fn trace_paths(@builtin(global_invocation_id) id: vec3<u32>) {
             exited = true;
             break;
         }
+        var may_start = true;
+        //#if LOCKSTEP_SAMPLES
+        // The vote is over the lanes still in the loop (those whose budget is spent
+        // have left, and vote again in the next dispatch).
+        if lockstep {
+            may_start = subgroupAll(path.phase == PHASE_START_SAMPLE);
+        }
+        //#endif
         // A lane whose traversal gave way resumes it in the next pass.
         if !trace_in_flight(trace) {
             iterations += 1u;
-            shade_step(slot, &path, &trace);
+            shade_step(slot, &path, &trace, may_start);
         }
     }
     if !exited {

@@ -84,6 +84,16 @@ pub struct ShaderFeatures {
     /// for it (see `super::scene_buffers`), never by [`ShaderFeatures::for_scene`],
     /// and [`ShaderFeatures::ALL`] leaves it out. The image does not depend on it.
     pub refill_lanes: bool,
+    /// The fused kernel's Whitted samples start in lockstep: a lane whose sample is
+    /// done waits for the other lanes of its subgroup to finish theirs, so that the
+    /// rays a SIMD vector traverses together are all camera rays, or all shadow rays
+    /// of one light, of neighbouring pixels (`LOCKSTEP_SAMPLES`, see
+    /// `shaders/wavefront.wgsl`). Needs [`wgpu::Features::SUBGROUP`], so it is chosen
+    /// at upload from the device where [`super::RendererOptions::lockstep_samples`]
+    /// asks for it (see `super::scene_buffers`), never by
+    /// [`ShaderFeatures::for_scene`], and [`ShaderFeatures::ALL`] leaves it out. The
+    /// image does not depend on it.
+    pub lockstep_samples: bool,
     /// The closest-hit test of a small scene as straight-line code over its primitives
     /// (`UNROLLED`; see [`super::cpu_device::unrolled`]), instead of the BVH's walk: chosen at
     /// upload for small scenes on CPU devices, never by [`ShaderFeatures::for_scene`],
@@ -128,6 +138,7 @@ impl ShaderFeatures {
         uniform_records: false,
         node_texture: false,
         refill_lanes: false,
+        lockstep_samples: false,
         unrolled: None,
         hardware_traversal: false,
     };
@@ -176,6 +187,7 @@ impl ShaderFeatures {
             uniform_records: false,
             node_texture: false,
             refill_lanes: false,
+            lockstep_samples: false,
             unrolled: None,
             hardware_traversal: false,
         }
@@ -214,7 +226,7 @@ impl ShaderFeatures {
 type FeatureFlag = fn(&ShaderFeatures) -> bool;
 
 /// The name of each feature in the WGSL directives, with the flag it reads.
-const FEATURE_NAMES: [(&str, FeatureFlag); 20] = [
+const FEATURE_NAMES: [(&str, FeatureFlag); 21] = [
     ("SPHERES", |f| f.spheres),
     ("PLANES", |f| f.planes),
     ("POLYGONS", |f| f.polygons),
@@ -233,6 +245,7 @@ const FEATURE_NAMES: [(&str, FeatureFlag); 20] = [
     ("ALPHA", |f| f.alpha),
     ("AOV", |f| f.aov),
     ("REFILL_LANES", |f| f.refill_lanes),
+    ("LOCKSTEP_SAMPLES", |f| f.lockstep_samples),
     ("UNROLLED", |f| f.unrolled.is_some()),
     ("HARDWARE_TRAVERSAL", |f| f.hardware_traversal),
 ];

@@ -18,7 +18,10 @@
 //! - `cpu_device`: for CPU devices (lavapipe), the strategies that only pay there:
 //!   the scene records in uniform buffers, small scenes' closest-hit test without the
 //!   tree, and the BVH nodes of larger scenes in a texture. (Lanes that give way to
-//!   finished ones, [`ShaderFeatures::refill_lanes`], are off unless asked for.)
+//!   finished ones, [`ShaderFeatures::refill_lanes`], are off unless asked for;
+//!   Whitted samples that start in lockstep across a subgroup,
+//!   [`ShaderFeatures::lockstep_samples`], are on wherever the device has subgroup
+//!   operations.)
 //!
 //! ```no_run
 //! use gpu_render::gpu::{AdapterChoice, HeadlessGpu, Renderer, RendererOptions};

@@ -89,6 +89,12 @@ pub struct RendererOptions {
     /// faster and the unrolled showcase 5% faster (`BENCHMARKS.md`, "Lane refill
     /// off by default"); GPUs' default schedule, the wavefront, never gives way.
     pub refill_lanes: bool,
+    /// Where the device has subgroup operations, let the fused kernel's Whitted
+    /// samples start in lockstep across a subgroup (see
+    /// [`ShaderFeatures::lockstep_samples`]). `true` by default: on lavapipe it traced
+    /// the bunny 17% faster and the showcase 36% (`BENCHMARKS.md`, "Samples in
+    /// lockstep"); the image is the same either way.
+    pub lockstep_samples: bool,
     /// On CPU devices, test the primitives of scenes small enough unrolled instead of
     /// walking their BVH (`true`, faster there; see [`ShaderFeatures::unrolled`]).
     pub unrolled: bool,
@@ -129,6 +135,7 @@ impl Default for RendererOptions {
             specialise: true,
             uniform_records: true,
             refill_lanes: false,
+            lockstep_samples: true,
             unrolled: true,
             traversal: Traversal::Auto,
             simulate_loop_cut: false,
@@ -339,6 +346,7 @@ impl Renderer {
                 specialise: self.options.specialise,
                 allow_uniform_records: self.options.uniform_records,
                 allow_refill_lanes: self.options.refill_lanes,
+                allow_lockstep_samples: self.options.lockstep_samples,
                 allow_unrolled: self.options.unrolled,
                 aov: self.options.aov,
             },

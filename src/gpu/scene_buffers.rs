@@ -134,6 +134,9 @@ pub(crate) struct UploadOptions {
     pub allow_uniform_records: bool,
     /// Traversals that give way, where the device has subgroup operations.
     pub allow_refill_lanes: bool,
+    /// Whitted samples that start in lockstep, where the device has subgroup
+    /// operations.
+    pub allow_lockstep_samples: bool,
     /// A small scene's closest-hit test unrolled, where the device prefers it
     /// ([`super::unrolled`]).
     pub allow_unrolled: bool,
@@ -170,7 +173,9 @@ pub(crate) fn hardware_plan(
 /// `allow_uniform_records`, a scene whose records fit is bound with uniform records
 /// where the device prefers them (see `super::cpu_device::uniform_records`). With
 /// `allow_refill_lanes`, the trace module gives way to finished lanes
-/// ([`ShaderFeatures::refill_lanes`]) where the device has subgroup operations. With
+/// ([`ShaderFeatures::refill_lanes`]) where the device has subgroup operations, and
+/// with `allow_lockstep_samples` its Whitted samples start in lockstep there
+/// ([`ShaderFeatures::lockstep_samples`]). With
 /// `allow_unrolled`, a small scene's closest-hit test is unrolled
 /// ([`ShaderFeatures::unrolled`]) where the device prefers it.
 /// `analytic` is the hardware traversal's plan ([`hardware_plan`]), `None` for the
@@ -188,6 +193,7 @@ pub(crate) fn upload_scene(
         specialise,
         allow_uniform_records,
         allow_refill_lanes,
+        allow_lockstep_samples,
         allow_unrolled,
         aov,
     } = options;
@@ -409,6 +415,8 @@ pub(crate) fn upload_scene(
             uniform_records,
             node_texture,
             refill_lanes: allow_refill_lanes
+                && device.features().contains(wgpu::Features::SUBGROUP),
+            lockstep_samples: allow_lockstep_samples
                 && device.features().contains(wgpu::Features::SUBGROUP),
             unrolled,
             hardware_traversal: hardware,

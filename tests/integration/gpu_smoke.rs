@@ -196,6 +196,9 @@ fn regions_slots_and_budgets_do_not_change_the_image() {
     // "lane refill" variant below does wherever the device can (lavapipe can).
     assert!(!prepared.features().refill_lanes);
     let subgroups = device.features().contains(wgpu::Features::SUBGROUP);
+    // Samples start in lockstep by default wherever the device can; the "samples not
+    // in lockstep" variant below turns it off.
+    assert_eq!(prepared.features().lockstep_samples, subgroups);
     if gpu.adapter.get_info().name.contains("llvmpipe") {
         assert!(subgroups, "lavapipe offers subgroup operations");
     }
@@ -245,6 +248,16 @@ fn regions_slots_and_budgets_do_not_change_the_image() {
                 &gpu,
                 RendererOptions {
                     refill_lanes: true,
+                    ..RendererOptions::default()
+                },
+            ),
+        ),
+        (
+            "samples not in lockstep",
+            crate::support::gpu::renderer_with(
+                &gpu,
+                RendererOptions {
+                    lockstep_samples: false,
                     ..RendererOptions::default()
                 },
             ),
@@ -363,6 +376,57 @@ fn giving_way_to_finished_lanes_does_not_change_the_image() {
         );
         let what = format!("{path}, lanes refilled and not");
         crate::support::gpu::assert_renders_identical(&gpu, &refill, &plain, &scene, &what);
+    }
+}
+
+/// Samples that start in lockstep across a subgroup wait for one another, within and
+/// across dispatches, but trace the same rays: shipped Whitted scenes (polygons and
+/// glass, meshes and instances, deep refraction) and a path-traced one (which does
+/// not wait) render the same pixels from the same rays with and without it, with the
+/// default budget and with a budget of 3 iterations per dispatch.
+#[test]
+fn samples_in_lockstep_do_not_change_the_image() {
+    let Some(gpu) = crate::support::gpu::headless_gpu() else {
+        return;
+    };
+    let subgroups = gpu.device.features().contains(wgpu::Features::SUBGROUP);
+    for budget in [None, Some(3)] {
+        let renderer = |lockstep_samples| {
+            crate::support::gpu::renderer_with(
+                &gpu,
+                RendererOptions {
+                    schedule: Some(Schedule::Fused),
+                    iteration_budget: budget,
+                    lockstep_samples,
+                    ..RendererOptions::default()
+                },
+            )
+        };
+        let lockstep = renderer(true);
+        let free = renderer(false);
+        for path in [
+            "showcase.toml",
+            "glass.toml",
+            "models.toml",
+            "cornell-box.toml",
+        ] {
+            let scene = crate::support::scenes::reduced(
+                crate::support::scenes::shipped(path),
+                64,
+                RenderOverrides {
+                    samples_per_pixel: Some(4),
+                    max_depth: Some(16),
+                    ..RenderOverrides::default()
+                },
+            );
+            let features = lockstep
+                .upload(&gpu.device, &gpu.queue, &scene)
+                .expect("prepare")
+                .features();
+            assert_eq!(features.lockstep_samples, subgroups, "{path}: where it can");
+            let what = format!("{path}, budget {budget:?}, samples in lockstep and not");
+            crate::support::gpu::assert_renders_identical(&gpu, &lockstep, &free, &scene, &what);
+        }
     }
 }
 

@@ -122,6 +122,7 @@ fn feature_sets() -> Vec<ShaderFeatures> {
         uniform_records: false,
         node_texture: false,
         refill_lanes: false,
+        lockstep_samples: false,
         unrolled: None,
         hardware_traversal: false,
     };
@@ -158,6 +159,7 @@ fn feature_sets() -> Vec<ShaderFeatures> {
         ShaderFeatures {
             uniform_records: true,
             refill_lanes: true,
+            lockstep_samples: true,
             unrolled,
             ..ShaderFeatures::ALL
         },

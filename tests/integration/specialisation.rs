@@ -17,14 +17,17 @@ fn function_names(features: &ShaderFeatures) -> BTreeSet<String> {
     let source = trace_shader_source(features).expect("well-formed directives");
     let module = naga::front::wgsl::parse_str(&source)
         .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
-    let mut validator = if features.refill_lanes {
+    let mut validator = if features.refill_lanes || features.lockstep_samples {
         let mut validator = naga::valid::Validator::new(
             naga::valid::ValidationFlags::all(),
             naga::valid::Capabilities::SUBGROUP,
         );
         validator
             .subgroup_stages(naga::valid::ShaderStages::COMPUTE)
-            .subgroup_operations(naga::valid::SubgroupOperationSet::ARITHMETIC);
+            .subgroup_operations(
+                naga::valid::SubgroupOperationSet::ARITHMETIC
+                    | naga::valid::SubgroupOperationSet::VOTE,
+            );
         validator
     } else {
         naga::valid::Validator::new(
@@ -103,21 +106,22 @@ fn only_a_scene_with_an_environment_map_gets_its_code() {
     }
 }
 
-/// Only a module with `refill_lanes` uses subgroup operations (a device without
-/// wgpu::Features::SUBGROUP could not build the others otherwise), and it validates.
+/// Only a module with `refill_lanes` or `lockstep_samples` uses subgroup operations
+/// (a device without wgpu::Features::SUBGROUP could not build the others otherwise),
+/// and it validates.
 #[test]
-fn only_modules_that_refill_lanes_use_subgroup_operations() {
+fn only_modules_that_ask_for_them_use_subgroup_operations() {
     for features in [
         ShaderFeatures::ALL,
         ShaderFeatures::for_scene(&scene("showcase.toml")),
         ShaderFeatures::for_scene(&scene("cornell-box.toml")),
     ] {
         assert!(
-            !features.refill_lanes,
+            !features.refill_lanes && !features.lockstep_samples,
             "chosen from the device, not the scene"
         );
         let without = trace_shader_source(&features).expect("well-formed directives");
-        assert!(!without.contains("subgroupAdd("));
+        assert!(!without.contains("subgroupAdd(") && !without.contains("subgroupAll("));
         let refill = ShaderFeatures {
             refill_lanes: true,
             ..features
@@ -125,6 +129,15 @@ fn only_modules_that_refill_lanes_use_subgroup_operations() {
         assert_eq!(function_names(&refill), function_names(&features));
         let with = trace_shader_source(&refill).expect("well-formed directives");
         assert!(with.contains("subgroupAdd(1u)"));
+        assert!(!with.contains("subgroupAll("));
+        let lockstep = ShaderFeatures {
+            lockstep_samples: true,
+            ..features
+        };
+        assert_eq!(function_names(&lockstep), function_names(&features));
+        let with = trace_shader_source(&lockstep).expect("well-formed directives");
+        assert!(with.contains("subgroupAll(path.phase == PHASE_START_SAMPLE)"));
+        assert!(!with.contains("subgroupAdd("));
     }
 }
 
@@ -168,6 +181,7 @@ fn every_feature_alone_and_every_feature_left_out_validates() {
         uniform_records: false,
         node_texture: false,
         refill_lanes: false,
+        lockstep_samples: false,
         unrolled: None,
         hardware_traversal: false,
     };

@@ -68,6 +68,10 @@ struct Args {
     /// subgroup operations (`RendererOptions::refill_lanes`, off by default).
     #[arg(long)]
     refill: bool,
+    /// The fused kernel's Whitted samples do not start in lockstep
+    /// (`RendererOptions::lockstep_samples` false).
+    #[arg(long)]
+    no_lockstep: bool,
     /// Small scenes walk their BVH too (`RendererOptions::unrolled` false).
     #[arg(long)]
     no_unrolled: bool,
@@ -423,6 +427,7 @@ fn main() -> Result<()> {
         RendererOptions {
             uniform_records: !args.storage_records,
             refill_lanes: args.refill,
+            lockstep_samples: !args.no_lockstep,
             unrolled: !args.no_unrolled,
             slot_count: args.slots,
             schedule,
