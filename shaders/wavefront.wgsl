@@ -377,10 +377,11 @@ fn trace_paths(@builtin(global_invocation_id) id: vec3<u32>) {
     // other pixels, and a vector walked the union of unrelated rays' nodes. Waiting
     // costs little on SIMD devices, where an iteration costs the same for one lane as
     // for all of them (traverse.wgsl), and a Whitted pixel's samples take nearly the
-    // same rays. On lavapipe it traced the bunny 17% faster, the showcase 36%, and
-    // glass.toml, the Cornell box and models.toml 16-24% (BENCHMARKS.md, "Samples in
-    // lockstep"). Not for the path integrator: its paths end at random depths, so
-    // lanes wait for the longest, and a path-traced Cornell box took 30% longer.
+    // same rays. On lavapipe it traced the bunny 20% faster, the million-triangle
+    // terrain 15%, models.toml 20%, glass.toml 32% and the showcase 9%
+    // (BENCHMARKS.md, "Samples in lockstep"). Not for the path integrator: its paths
+    // end at random depths, so lanes wait for the longest, and a path-traced Cornell
+    // box took 30% longer in lockstep.
     let lockstep = (frame.flags & FLAG_PATH) == 0u;
     //#endif
     var exited = false;

@@ -92,7 +92,7 @@ pub struct RendererOptions {
     /// Where the device has subgroup operations, let the fused kernel's Whitted
     /// samples start in lockstep across a subgroup (see
     /// [`ShaderFeatures::lockstep_samples`]). `true` by default: on lavapipe it traced
-    /// the bunny 17% faster and the showcase 36% (`BENCHMARKS.md`, "Samples in
+    /// the bunny 20% faster and the showcase 9% (`BENCHMARKS.md`, "Samples in
     /// lockstep"); the image is the same either way.
     pub lockstep_samples: bool,
     /// On CPU devices, test the primitives of scenes small enough unrolled instead of
