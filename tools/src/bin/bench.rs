@@ -448,7 +448,7 @@ fn main() -> Result<()> {
         std::thread::available_parallelism().map_or(1, usize::from)
     );
     if args.specialisation {
-        return compare_specialisation(&gpu, &scene, args.runs);
+        return compare_specialisation(&gpu, &scene, args.runs, !args.no_lockstep);
     }
     if args.schedules {
         return compare_schedules(&gpu, &scene, args.runs);
@@ -548,11 +548,13 @@ fn main() -> Result<()> {
     Ok(())
 }
 
-/// Times the specialised and the general trace pipeline on `scene`.
+/// Times the specialised and the general trace pipeline on `scene`, with Whitted
+/// samples in lockstep where the device can or not (`lockstep_samples`).
 fn compare_specialisation(
     gpu: &HeadlessGpu,
     scene: &gpu_render::scene::Scene,
     runs: usize,
+    lockstep_samples: bool,
 ) -> Result<()> {
     let features = gpu_render::gpu::ShaderFeatures::for_scene(scene);
     println!("scene features: {}", features.label());
@@ -574,6 +576,7 @@ fn compare_specialisation(
             &gpu.device,
             RendererOptions {
                 specialise,
+                lockstep_samples,
                 ..RendererOptions::default()
             },
         )?;
