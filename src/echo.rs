@@ -263,3 +263,34 @@ mod tests {
         assert_eq!(short(-0.5f32).to_string(), "-0.5");
     }
 }
+
+/// A count of bytes as a message shows it: in GiB, MiB or KiB with two decimals,
+/// whichever is the largest unit of which there is at least one, else in bytes
+/// (`50.00 MiB`, not `0.05 GiB`; `5.12 MiB`, not `0.00 GiB`).
+///
+/// ```
+/// use gpu_render::low_level::echo::bytes;
+/// assert_eq!(bytes(3 << 30).to_string(), "3.00 GiB");
+/// assert_eq!(bytes(5 << 20).to_string(), "5.00 MiB");
+/// assert_eq!(bytes(1536).to_string(), "1.50 KiB");
+/// assert_eq!(bytes(12).to_string(), "12 bytes");
+/// ```
+pub fn bytes(count: u64) -> Bytes {
+    Bytes(count)
+}
+
+/// A count of bytes, shown by [`bytes`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Bytes(pub u64);
+
+impl fmt::Display for Bytes {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        const UNITS: [(&str, u32); 3] = [("GiB", 30), ("MiB", 20), ("KiB", 10)];
+        for (unit, shift) in UNITS {
+            if self.0 >= 1 << shift {
+                return write!(f, "{:.2} {unit}", self.0 as f64 / (1u64 << shift) as f64);
+            }
+        }
+        write!(f, "{} bytes", self.0)
+    }
+}

@@ -12,10 +12,17 @@
 //! `RESOLVE_BENEATH`, so that the confinement and the open are one step; elsewhere on
 //! Unix, and where `openat2` is not allowed, component by component with
 //! `O_NOFOLLOW`, which refuses every symbolic link).
+//!
+//! Every file opened here is noted, by its identity on disk (device and inode, taken
+//! from the open descriptor), for whoever asked with [`record_inputs`]: a program
+//! refuses an output that is one of them, whatever name led to it and however the
+//! loader used it (a material library, a buffer, a texture merged into another or read
+//! and dropped).
 
+use std::cell::RefCell;
 use std::fs::File;
 use std::io::{self, Read};
-use std::path::{Component, Path};
+use std::path::{Component, Path, PathBuf};
 
 /// Why an input file cannot be read. The messages are the reason alone, without the
 /// file's path, which the caller names with the file's role: "cannot read the model
@@ -56,7 +63,7 @@ pub enum InputError {
 /// without reading from it.
 pub fn open_input(path: &Path) -> Result<File, InputError> {
     let file = open_nonblocking(path).map_err(InputError::Io)?;
-    check_regular(file)
+    check_regular(file, path)
 }
 
 /// Reads the whole regular file at `path`, refusing one larger than `limit` bytes
@@ -81,7 +88,7 @@ pub fn open_confined(dir: &Path, relative: &Path) -> Result<File, InputError> {
         return Err(InputError::OutsideFolder { how: "" });
     }
     let file = confined::open(dir, relative)?;
-    check_regular(file)
+    check_regular(file, &dir.join(relative))
 }
 
 /// Reads the whole file `relative` inside `dir` as [`open_confined`] opens it,
@@ -114,13 +121,113 @@ fn read_limited(file: File, limit: u64) -> Result<Vec<u8>, InputError> {
     Ok(bytes)
 }
 
-/// `file` if the open descriptor is a regular file (`fstat`, so no later swap counts).
-fn check_regular(file: File) -> Result<File, InputError> {
+/// `file` (opened as `path`) if the open descriptor is a regular file (`fstat`, so no
+/// later swap counts), noted for [`record_inputs`].
+fn check_regular(file: File, path: &Path) -> Result<File, InputError> {
     let metadata = file.metadata().map_err(InputError::Io)?;
     match not_a_regular_file(&metadata) {
-        None => Ok(file),
+        None => {
+            note_input(path, &metadata);
+            Ok(file)
+        }
         Some(kind) => Err(InputError::NotARegularFile { kind }),
     }
+}
+
+/// A file that was opened as an input: the name it was opened by and its identity on
+/// disk when it was opened.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct InputFile {
+    /// The path it was opened by (as the scene or model named it, joined to its folder).
+    pub path: PathBuf,
+    /// Its identity: device and inode on Unix, the resolved path elsewhere.
+    pub identity: FileIdentity,
+}
+
+/// Which file on disk a path reaches, whatever links or spellings lead to it.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct FileIdentity(IdentityKey);
+
+#[cfg(unix)]
+type IdentityKey = (u64, u64);
+#[cfg(not(unix))]
+type IdentityKey = PathBuf;
+
+impl FileIdentity {
+    /// The identity of the file `metadata` describes (reached as `path`).
+    #[cfg(unix)]
+    pub fn of(metadata: &std::fs::Metadata, _path: &Path) -> Self {
+        use std::os::unix::fs::MetadataExt;
+        Self((metadata.dev(), metadata.ino()))
+    }
+
+    /// The identity of the file `metadata` describes (reached as `path`).
+    #[cfg(not(unix))]
+    pub fn of(_metadata: &std::fs::Metadata, path: &Path) -> Self {
+        Self(path.canonicalize().unwrap_or_else(|_| path.to_path_buf()))
+    }
+
+    /// The identity of the file at `path` now (links followed), if it exists.
+    pub fn at(path: &Path) -> Option<Self> {
+        std::fs::metadata(path)
+            .ok()
+            .map(|metadata| Self::of(&metadata, path))
+    }
+}
+
+thread_local! {
+    /// The inputs opened on this thread, one list per [`record_inputs`] call in progress
+    /// (innermost last).
+    static RECORDINGS: RefCell<Vec<Vec<InputFile>>> = const { RefCell::new(Vec::new()) };
+}
+
+/// Runs `load` and returns, with its result, every input file it opened on this thread
+/// through this module (scene files, images, models, material libraries, buffers,
+/// tiles), each once, in the order first opened: files that failed to load count too,
+/// as long as they were opened. Calls may nest; an inner call's files are the outer
+/// call's too.
+pub fn record_inputs<T>(load: impl FnOnce() -> T) -> (T, Vec<InputFile>) {
+    RECORDINGS.with(|recordings| recordings.borrow_mut().push(Vec::new()));
+    /// Pops this call's list even if `load` panics, so no later call sees it.
+    struct Pop;
+    impl Drop for Pop {
+        fn drop(&mut self) {
+            RECORDINGS.with(|recordings| {
+                let mut recordings = recordings.borrow_mut();
+                if let Some(inner) = recordings.pop()
+                    && let Some(outer) = recordings.last_mut()
+                {
+                    for file in inner {
+                        if !outer.contains(&file) {
+                            outer.push(file);
+                        }
+                    }
+                }
+            });
+        }
+    }
+    let pop = Pop;
+    let result = load();
+    let files =
+        RECORDINGS.with(|recordings| recordings.borrow().last().cloned().unwrap_or_default());
+    drop(pop);
+    (result, files)
+}
+
+/// Notes the input `path` (described by `metadata`) for the [`record_inputs`] calls in
+/// progress on this thread.
+fn note_input(path: &Path, metadata: &std::fs::Metadata) {
+    RECORDINGS.with(|recordings| {
+        if let Some(files) = recordings.borrow_mut().last_mut() {
+            let file = InputFile {
+                path: path.to_path_buf(),
+                identity: FileIdentity::of(metadata, path),
+            };
+            if !files.contains(&file) {
+                files.push(file);
+            }
+        }
+    });
 }
 
 #[cfg(unix)]

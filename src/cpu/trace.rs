@@ -88,7 +88,7 @@ impl PreparedScene {
         } else {
             (Vec::new(), PixelCone::default())
         };
-        Self {
+        let mut prepared = Self {
             settings: scene.render,
             camera,
             samples: SamplePattern::new(&scene.render),
@@ -103,12 +103,18 @@ impl PreparedScene {
             lights: scene.lights.clone(),
             geometry,
             camera_medium: MediumStack::from_outermost_first(&scene.camera_medium()),
-            images: scene.images,
+            images: Vec::new(),
             image_levels,
             cone,
             area_lights,
             brdf_map_cdfs,
-        }
+        };
+        // The lighting space's own copy of the images is moved, not copied again.
+        prepared.images = match scene {
+            std::borrow::Cow::Owned(scene) => scene.images,
+            std::borrow::Cow::Borrowed(scene) => scene.images.clone(),
+        };
+        prepared
     }
 
     /// The scene's textures looked up at `footprint` (filtered as the scene's

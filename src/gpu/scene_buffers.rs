@@ -16,12 +16,13 @@ use super::ray_query::{
 };
 use super::readback::{Caught, capture};
 use super::upload::{
-    InstanceLayout, SceneRecords, frame_uniforms, image_layer_levels, image_layers,
+    InstanceLayout, SceneRecords, frame_uniforms, image_array_levels, image_array_size,
+    image_layer, image_layer_level,
 };
 use crate::accel::{
     BrdfMapCdfs, BuildMethod, Bvh, BvhStats, EnvironmentLight, MAX_PLANES, SceneGeometry,
 };
-use crate::scene::{Image, Integrator, Scene};
+use crate::scene::{Integrator, Scene};
 use crate::texture::mip_levels;
 
 /// The storage buffers of an uploaded scene.
@@ -52,7 +53,7 @@ pub(crate) struct DeviceScene {
     pub(crate) features: ShaderFeatures,
     pub(crate) encode_srgb: bool,
     pub(crate) buffers: SceneBuffers,
-    /// Albedo textures and BRDF maps, one layer each (see [`image_layers`]).
+    /// Albedo textures and BRDF maps, one layer each (see [`super::upload::image_layers`]).
     pub(crate) images: wgpu::TextureView,
     /// The BVH nodes as texels ([`ShaderFeatures::node_texture`]), else the
     /// renderer's one-texel placeholder.
@@ -446,8 +447,12 @@ pub(crate) fn upload_scene(
 }
 
 /// Uploads the scene's images as one `Rgba32Float` 2D array texture (one layer per
-/// image, see [`image_layers`]), with its mip chain where the scene filters textures
-/// ([`image_layer_levels`]), and returns its view and its bytes (every level's).
+/// image, see [`super::upload::image_layers`]), with its mip chain where the scene filters textures
+/// ([`super::upload::image_layer_levels`]), and returns its view and its bytes (every level's).
+///
+/// One layer at a time: its level 0 and its mip chain are made, written and submitted
+/// before the next, so that the host holds one layer's copies (and wgpu one layer's
+/// staging) at a time, not the whole array's twice (`docs/reliability.md`, "Memory").
 fn upload_images(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -455,7 +460,7 @@ fn upload_images(
     limits: &wgpu::Limits,
 ) -> Result<(wgpu::TextureView, u64), RenderError> {
     let cdfs = BrdfMapCdfs::new(&scene.images, &scene.materials);
-    let (width, height, layers, texels) = image_layers(&scene.images, &cdfs);
+    let (width, height, layers) = image_array_size(&scene.images);
     if layers > limits.max_texture_array_layers {
         return Err(RenderError::SceneTooLarge {
             what: "images (texture array layers)".to_string(),
@@ -470,17 +475,17 @@ fn upload_images(
     };
     // With texture filtering, the array's mip chain: level k of every image in level k
     // of its layer (the CPU reference's PreparedScene::image_levels).
-    let mip_chain = if scene.render.texture_filtering.filters() {
-        let levels: Vec<Vec<Image>> = scene.images.iter().map(mip_levels).collect();
-        image_layer_levels(&levels, width, height, layers)
+    let filters = scene.render.texture_filtering.filters();
+    let extra_levels = if filters {
+        image_array_levels(width, height)
     } else {
-        Vec::new()
+        0
     };
     let texture = capture(device, "image array", Caught::Resource, || {
         device.create_texture(&wgpu::TextureDescriptor {
             label: Some("gpu-render images"),
             size,
-            mip_level_count: 1 + mip_chain.len() as u32,
+            mip_level_count: 1 + extra_levels,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: wgpu::TextureFormat::Rgba32Float,
@@ -488,38 +493,52 @@ fn upload_images(
             view_formats: &[],
         })
     })?;
-    queue.write_texture(
-        texture.as_image_copy(),
-        bytemuck::cast_slice(&texels),
-        wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(width * 16),
-            rows_per_image: Some(height),
-        },
-        size,
-    );
-    let mut bytes = std::mem::size_of_val(texels.as_slice()) as u64;
-    for (level, (w, h, texels)) in mip_chain.iter().enumerate() {
+    let write_layer = |layer: u32, level: u32, w: u32, h: u32, texels: &[[f32; 4]]| {
         queue.write_texture(
             wgpu::TexelCopyTextureInfo {
                 texture: &texture,
-                mip_level: level as u32 + 1,
-                origin: wgpu::Origin3d::ZERO,
+                mip_level: level,
+                origin: wgpu::Origin3d {
+                    x: 0,
+                    y: 0,
+                    z: layer,
+                },
                 aspect: wgpu::TextureAspect::All,
             },
             bytemuck::cast_slice(texels),
             wgpu::TexelCopyBufferLayout {
                 offset: 0,
                 bytes_per_row: Some(w * 16),
-                rows_per_image: Some(*h),
+                rows_per_image: Some(h),
             },
             wgpu::Extent3d {
-                width: *w,
-                height: *h,
-                depth_or_array_layers: layers,
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
             },
         );
-        bytes += std::mem::size_of_val(texels.as_slice()) as u64;
+        std::mem::size_of_val(texels) as u64
+    };
+    let mut bytes = 0;
+    if scene.images.is_empty() {
+        bytes += write_layer(0, 0, width, height, &[[0.0; 4]]);
+        for k in 1..=extra_levels {
+            bytes += write_layer(0, k, 1, 1, &[[0.0; 4]]);
+        }
+    }
+    for (layer, image) in scene.images.iter().enumerate() {
+        let layer_texels = image_layer(image, cdfs.of_image(layer), width, height);
+        bytes += write_layer(layer as u32, 0, width, height, &layer_texels);
+        drop(layer_texels);
+        if filters {
+            let chain = mip_levels(image);
+            for k in 1..=extra_levels {
+                let (w, h, texels) = image_layer_level(&chain, k, width, height);
+                bytes += write_layer(layer as u32, k, w, h, &texels);
+            }
+        }
+        // The staging copies of this layer go to the device now, not with the next.
+        queue.submit([]);
     }
     let view = texture.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2Array),

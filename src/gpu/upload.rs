@@ -16,8 +16,8 @@ use super::layout::{
     WRAP_CLAMP_TO_EDGE, WRAP_MIRRORED_REPEAT, WRAP_REPEAT,
 };
 use crate::accel::{
-    BrdfMapCdfs, Bvh, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry, TriangleAttributes,
-    TriangleShape, WideNode,
+    BrdfMapCdf, BrdfMapCdfs, Bvh, Instance, PolygonShape, PrimKind, PrimRef, SceneGeometry,
+    TriangleAttributes, TriangleShape, WideNode,
 };
 use crate::camera::{CameraFrame, PixelCone};
 use crate::scene::{
@@ -594,23 +594,44 @@ pub fn triangle_attributes_record(
 /// Returns `(width, height, layers, texels)` with texels layer by layer, row-major; a
 /// scene without images gets one 1×1 zero layer (WGSL needs a bound texture).
 pub fn image_layers(images: &[Image], cdfs: &BrdfMapCdfs) -> (u32, u32, u32, Vec<[f32; 4]>) {
+    let (width, height, layers) = image_array_size(images);
+    let mut texels = Vec::with_capacity(width as usize * height as usize * layers as usize);
+    for (layer, image) in images.iter().enumerate() {
+        texels.extend(image_layer(image, cdfs.of_image(layer), width, height));
+    }
+    texels.resize(width as usize * height as usize * layers as usize, [0.0; 4]);
+    (width, height, layers, texels)
+}
+
+/// The size of the scene's image array ([`image_layers`]): the largest width, the
+/// largest height and the number of layers (at least 1 each).
+pub fn image_array_size(images: &[Image]) -> (u32, u32, u32) {
     let width = images.iter().map(|i| i.width).max().unwrap_or(1);
     let height = images.iter().map(|i| i.height).max().unwrap_or(1);
-    let layers = images.len().max(1);
-    let mut texels = vec![[0.0; 4]; width as usize * height as usize * layers];
-    for (layer, image) in images.iter().enumerate() {
-        for y in 0..image.height as usize {
-            let row = &image.texels[y * image.width as usize..(y + 1) * image.width as usize];
-            let start = (layer * height as usize + y) * width as usize;
-            texels[start..start + row.len()].copy_from_slice(row);
-            if let Some(cdf) = cdfs.of_image(layer) {
-                for (x, texel) in texels[start..start + row.len()].iter_mut().enumerate() {
-                    texel[3] = cdf.value(x as u32, y as u32);
-                }
+    (width, height, images.len().max(1) as u32)
+}
+
+/// One layer of [`image_layers`]: `image` in the top-left corner of `width × height`
+/// texels, the rest zero, its alpha replaced by the inverse-CDF table `cdf` where the
+/// image is a BRDF map the path integrator samples.
+pub fn image_layer(
+    image: &Image,
+    cdf: Option<&BrdfMapCdf>,
+    width: u32,
+    height: u32,
+) -> Vec<[f32; 4]> {
+    let mut texels = vec![[0.0; 4]; width as usize * height as usize];
+    for y in 0..image.height.min(height) as usize {
+        let row = &image.texels[y * image.width as usize..][..image.width.min(width) as usize];
+        let start = y * width as usize;
+        texels[start..start + row.len()].copy_from_slice(row);
+        if let Some(cdf) = cdf {
+            for (x, texel) in texels[start..start + row.len()].iter_mut().enumerate() {
+                texel[3] = cdf.value(x as u32, y as u32);
             }
         }
     }
-    (width, height, layers as u32, texels)
+    texels
 }
 
 /// Levels 1 and up of the image array's mip chain (level 0 is [`image_layers`]): the
@@ -629,25 +650,44 @@ pub fn image_layer_levels(
     height: u32,
     layers: u32,
 ) -> Vec<(u32, u32, Vec<[f32; 4]>)> {
-    let count = width.max(height).max(1).ilog2();
-    (1..=count)
+    (1..=image_array_levels(width, height))
         .map(|k| {
             let (w, h) = ((width >> k).max(1), (height >> k).max(1));
-            let mut texels = vec![[0.0; 4]; w as usize * h as usize * layers as usize];
-            for (layer, chain) in levels.iter().enumerate() {
-                let Some(image) = chain.get(k as usize - 1).or(chain.last()) else {
-                    continue;
-                };
-                for y in 0..image.height.min(h) as usize {
-                    let row =
-                        &image.texels[y * image.width as usize..][..image.width.min(w) as usize];
-                    let start = (layer * h as usize + y) * w as usize;
-                    texels[start..start + row.len()].copy_from_slice(row);
-                }
+            let mut texels = Vec::with_capacity(w as usize * h as usize * layers as usize);
+            for chain in levels {
+                texels.extend(image_layer_level(chain, k, width, height).2);
             }
+            texels.resize(w as usize * h as usize * layers as usize, [0.0; 4]);
             (w, h, texels)
         })
         .collect()
+}
+
+/// The number of mip levels beyond 0 of an image array whose level 0 is `width ×
+/// height`: `⌊log2(max(width, height))⌋`.
+pub fn image_array_levels(width: u32, height: u32) -> u32 {
+    width.max(height).max(1).ilog2()
+}
+
+/// One layer of level `k` (at least 1) of [`image_layer_levels`]: level `k` of the
+/// image's chain `chain` (or its last level, if the chain is shorter) in the top-left
+/// corner of the array's level size, the rest zero. Returns `(width, height, texels)`.
+pub fn image_layer_level(
+    chain: &[Image],
+    k: u32,
+    width: u32,
+    height: u32,
+) -> (u32, u32, Vec<[f32; 4]>) {
+    let (w, h) = ((width >> k).max(1), (height >> k).max(1));
+    let mut texels = vec![[0.0; 4]; w as usize * h as usize];
+    if let Some(image) = chain.get(k as usize - 1).or(chain.last()) {
+        for y in 0..image.height.min(h) as usize {
+            let row = &image.texels[y * image.width as usize..][..image.width.min(w) as usize];
+            let start = y * w as usize;
+            texels[start..start + row.len()].copy_from_slice(row);
+        }
+    }
+    (w, h, texels)
 }
 
 /// The record of one light.

@@ -25,6 +25,7 @@ use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder, Rgb};
 
 use crate::film::LinearImage;
+use crate::input::{FileIdentity, InputFile};
 
 mod layers;
 mod temporary;
@@ -145,6 +146,23 @@ pub enum OutputError {
         input: PathBuf,
         /// What the input is ("scene file", "texture").
         what: String,
+    },
+    /// Two outputs of one command name the same file (`-o img.exr` with
+    /// `--standard-error ./img.exr`): the second would replace the first.
+    #[error(
+        "{}: the {what} is the same file as the {other_what} {}; name another file for each",
+        .path.display(),
+        .other.display()
+    )]
+    SameOutput {
+        /// The later output.
+        path: PathBuf,
+        /// What it is ("--standard-error").
+        what: String,
+        /// The earlier output it collides with.
+        other: PathBuf,
+        /// What that is ("image (-o)").
+        other_what: String,
     },
     /// The image and the buffers handed to the writer disagree in size.
     #[error("{}: cannot write the image: {message}", .path.display())]
@@ -287,14 +305,11 @@ pub fn check_not_an_input<'a, 'b>(
     path: &Path,
     inputs: impl IntoIterator<Item = (&'a Path, &'b str)>,
 ) -> Result<(), OutputError> {
-    let Ok(output) = std::fs::metadata(path) else {
+    let Some(output) = FileIdentity::at(path) else {
         return Ok(());
     };
     for (input, what) in inputs {
-        let Ok(metadata) = std::fs::metadata(input) else {
-            continue;
-        };
-        if same_file(&output, &metadata, path, input) {
+        if FileIdentity::at(input).as_ref() == Some(&output) {
             return Err(OutputError::OverwritesInput {
                 path: path.to_path_buf(),
                 input: input.to_path_buf(),
@@ -305,17 +320,59 @@ pub fn check_not_an_input<'a, 'b>(
     Ok(())
 }
 
-#[cfg(unix)]
-fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata, _: &Path, _: &Path) -> bool {
-    use std::os::unix::fs::MetadataExt;
-    (a.dev(), a.ino()) == (b.dev(), b.ino())
+/// Refuses an output path that is one of the files a load read
+/// ([`crate::input::record_inputs`]): the file it names now is compared with each
+/// input's identity when it was read, and with what the input's path reaches now, so
+/// that neither a link nor another spelling of the name gets past.
+pub fn check_not_read(path: &Path, inputs: &[InputFile]) -> Result<(), OutputError> {
+    let Some(output) = FileIdentity::at(path) else {
+        return Ok(());
+    };
+    for input in inputs {
+        if input.identity == output || FileIdentity::at(&input.path).as_ref() == Some(&output) {
+            return Err(OutputError::OverwritesInput {
+                path: path.to_path_buf(),
+                input: input.path.clone(),
+                what: "input".to_owned(),
+            });
+        }
+    }
+    Ok(())
 }
 
-#[cfg(not(unix))]
-fn same_file(_: &std::fs::Metadata, _: &std::fs::Metadata, a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
+/// Refuses two outputs of one command that would land in the same file: `outputs` pairs
+/// each path with what it is ("image (-o)", "--standard-error"). Paths are compared as
+/// files, not as text: an existing file by device and inode (so links count), a new one
+/// by its resolved folder and name (`./img.exr` and `img.exr` are one file). Each
+/// path's folder must exist ([`check_output_path`] checks that first).
+pub fn check_distinct_outputs(outputs: &[(&Path, &str)]) -> Result<(), OutputError> {
+    for (i, &(first, first_what)) in outputs.iter().enumerate() {
+        for &(second, second_what) in &outputs[i + 1..] {
+            if same_destination(first, second) {
+                return Err(OutputError::SameOutput {
+                    path: second.to_path_buf(),
+                    what: second_what.to_owned(),
+                    other: first.to_path_buf(),
+                    other_what: first_what.to_owned(),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Whether writing `a` and writing `b` would replace the same file.
+fn same_destination(a: &Path, b: &Path) -> bool {
+    if let (Some(a), Some(b)) = (FileIdentity::at(a), FileIdentity::at(b)) {
+        return a == b;
+    }
+    let resolved = |path: &Path| {
+        let dir = parent_dir(path).canonicalize().ok()?;
+        Some((dir, path.file_name()?.to_owned()))
+    };
+    match (resolved(a), resolved(b)) {
+        (Some(a), Some(b)) => a == b,
+        _ => a == b,
     }
 }
 

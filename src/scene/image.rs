@@ -1,7 +1,7 @@
 //! Reading image files for albedo textures and tabulated BRDF maps.
 
 use std::io::Cursor;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use image::{DynamicImage, ImageFormat, ImageReader};
@@ -76,6 +76,81 @@ pub const MAX_IMAGE_SIDE: u32 = 2048;
 /// file without compression is 64 MiB, so this leaves room for any real encoding.
 pub const MAX_IMAGE_FILE_BYTES: u64 = 256 * 1024 * 1024;
 
+/// Bytes a decoded image holds for each texel: linear RGBA `f32`.
+pub const DECODED_BYTES_PER_TEXEL: u64 = 16;
+
+/// The most bytes decoding holds for each texel besides the file's own bytes: the
+/// decoder's image (at most RGB(A) `f32`, 16 bytes, while a 3-channel image is widened
+/// to 4: 12 + 16) and the linear texels made from it (16). An upper bound, used to
+/// refuse an image before it is decoded ([`EncodedImage::decoding_peak_bytes`]).
+pub const DECODING_BYTES_PER_TEXEL: u64 = 44;
+
+/// An image file read but not decoded: its bytes and the size its header declares
+/// (checked as [`load_image`] checks it), so that a caller can count the memory the
+/// image will take before it takes it.
+#[derive(Debug, Clone)]
+pub struct EncodedImage {
+    path: PathBuf,
+    bytes: Vec<u8>,
+    width: u32,
+    height: u32,
+}
+
+impl EncodedImage {
+    /// Reads the image file at `path` and its header ([`crate::input`]'s rules).
+    pub fn read(path: &Path) -> Result<Self, ImageError> {
+        let bytes =
+            read_input(path, MAX_IMAGE_FILE_BYTES).map_err(|e| ImageError::Read(Arc::new(e)))?;
+        Self::from_bytes(path, bytes)
+    }
+
+    /// Reads the file `file` that a sandboxed scene in folder `dir` names: opened
+    /// beneath `dir` so that no symbolic link, nor a swap of one while the file is
+    /// opened, reaches outside it ([`crate::input::open_confined`]). The image's path
+    /// is `dir/file`.
+    pub fn read_confined(dir: &Path, file: &Path) -> Result<Self, ImageError> {
+        let bytes = read_confined(dir, file, MAX_IMAGE_FILE_BYTES)
+            .map_err(|e| ImageError::Read(Arc::new(e)))?;
+        Self::from_bytes(&dir.join(file), bytes)
+    }
+
+    /// The image file `bytes`, read from or named `path`, with its header checked.
+    pub fn from_bytes(path: &Path, bytes: Vec<u8>) -> Result<Self, ImageError> {
+        let (width, height) = image_dimensions(path, &bytes)?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            bytes,
+            width,
+            height,
+        })
+    }
+
+    /// The width and height its header declares.
+    pub fn dimensions(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// The bytes the decoded image holds ([`DECODED_BYTES_PER_TEXEL`] a texel).
+    pub fn decoded_bytes(&self) -> u64 {
+        texel_count(self.width, self.height) * DECODED_BYTES_PER_TEXEL
+    }
+
+    /// The most bytes held while it is decoded: the file's bytes and
+    /// [`DECODING_BYTES_PER_TEXEL`] a texel.
+    pub fn decoding_peak_bytes(&self) -> u64 {
+        self.bytes.len() as u64 + texel_count(self.width, self.height) * DECODING_BYTES_PER_TEXEL
+    }
+
+    /// Decodes it as [`load_image`] does.
+    pub fn decode(self) -> Result<Image, ImageError> {
+        decode_image(&self.path, &self.bytes)
+    }
+}
+
+fn texel_count(width: u32, height: u32) -> u64 {
+    u64::from(width) * u64::from(height)
+}
+
 /// Reads the image at `path` into linear RGBA `f32`: 8- and 16-bit files (PNG) are
 /// taken as sRGB-encoded and linearised with the exact sRGB curve (IEC 61966-2-1);
 /// 32-bit float files (OpenEXR, Radiance HDR) are taken as linear. Fails with a
@@ -85,19 +160,13 @@ pub const MAX_IMAGE_FILE_BYTES: u64 = 256 * 1024 * 1024;
 /// [`MAX_IMAGE_SIDE`], or holds a non-finite value. Texels outside [0, 1] are kept as
 /// they are: a scene's materials check their range.
 pub fn load_image(path: &Path) -> Result<Image, ImageError> {
-    let bytes =
-        read_input(path, MAX_IMAGE_FILE_BYTES).map_err(|e| ImageError::Read(Arc::new(e)))?;
-    decode_image(path, &bytes)
+    EncodedImage::read(path)?.decode()
 }
 
-/// [`load_image`] for the file `file` that a sandboxed scene in folder `dir` names:
-/// opened beneath `dir` so that no symbolic link, nor a swap of one while the file is
-/// opened, reaches outside it ([`crate::input::open_confined`]). The image's path is
-/// `dir/file`.
+/// [`load_image`] for the file `file` that a sandboxed scene in folder `dir` names
+/// ([`EncodedImage::read_confined`]). The image's path is `dir/file`.
 pub fn load_confined_image(dir: &Path, file: &Path) -> Result<Image, ImageError> {
-    let bytes = read_confined(dir, file, MAX_IMAGE_FILE_BYTES)
-        .map_err(|e| ImageError::Read(Arc::new(e)))?;
-    decode_image(&dir.join(file), &bytes)
+    EncodedImage::read_confined(dir, file)?.decode()
 }
 
 /// The width and height the image file `bytes` (read from or named `path`) declares in
@@ -145,33 +214,46 @@ pub fn decode_image(path: &Path, bytes: &[u8]) -> Result<Image, ImageError> {
         });
     }
     let (width, height) = (decoded.width(), decoded.height());
-    let texels: Vec<[f32; 4]> = match &decoded {
+    // Each conversion consumes the decoder's image, so that at most it and one
+    // converted copy are held at once (DECODING_BYTES_PER_TEXEL).
+    let texels: Vec<[f32; 4]> = match decoded {
         DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_) => {
-            decoded.to_rgba32f().pixels().map(|p| p.0).collect()
+            let values = decoded.into_rgba32f().into_raw();
+            match bytemuck::allocation::try_cast_vec(values) {
+                Ok(texels) => texels,
+                Err((_, values)) => values
+                    .chunks_exact(4)
+                    .map(|t| [t[0], t[1], t[2], t[3]])
+                    .collect(),
+            }
         }
         DynamicImage::ImageLuma16(_)
         | DynamicImage::ImageLumaA16(_)
         | DynamicImage::ImageRgb16(_)
         | DynamicImage::ImageRgba16(_) => decoded
-            .to_rgba16()
+            .into_rgba16()
             .pixels()
             .map(|p| {
                 let c = |v: u16| srgb_decode(f64::from(v) / 65535.0) as f32;
                 [c(p.0[0]), c(p.0[1]), c(p.0[2]), f32::from(p.0[3]) / 65535.0]
             })
             .collect(),
-        _ => {
+        decoded => {
             let table: Vec<f32> = (0..=255u8)
                 .map(|v| srgb_decode(f64::from(v) / 255.0) as f32)
                 .collect();
-            decoded
-                .to_rgba8()
-                .pixels()
-                .map(|p| {
-                    let c = |v: u8| table[usize::from(v)];
-                    [c(p.0[0]), c(p.0[1]), c(p.0[2]), f32::from(p.0[3]) / 255.0]
-                })
-                .collect()
+            let c = |v: u8| table[usize::from(v)];
+            match decoded {
+                DynamicImage::ImageRgb8(rgb) => rgb
+                    .pixels()
+                    .map(|p| [c(p.0[0]), c(p.0[1]), c(p.0[2]), 1.0])
+                    .collect(),
+                decoded => decoded
+                    .into_rgba8()
+                    .pixels()
+                    .map(|p| [c(p.0[0]), c(p.0[1]), c(p.0[2]), f32::from(p.0[3]) / 255.0])
+                    .collect(),
+            }
         }
     };
     if let Some(index) = texels.iter().position(|t| t.iter().any(|c| !c.is_finite())) {

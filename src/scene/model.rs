@@ -868,9 +868,11 @@ impl Scene {
     /// so that shading happens on gamma-encoded values as in the lecture's wrong
     /// example. Light intensities are physical quantities and stay as they are, as do
     /// images (textures, BRDF maps and the environment map).
-    pub fn in_lighting_space(&self) -> Scene {
-        let mut scene = self.clone();
+    ///
+    /// Borrowed in [`LightingSpace::Linear`]: no copy of the images is made.
+    pub fn in_lighting_space(&self) -> std::borrow::Cow<'_, Scene> {
         if self.render.lighting_space == LightingSpace::NaiveGamma {
+            let mut scene = self.clone();
             let encode = |c: DVec3| {
                 DVec3::new(
                     crate::color::srgb_encode_extended(c.x),
@@ -887,8 +889,9 @@ impl Scene {
             }
             scene.environment.background = encode(scene.environment.background);
             scene.environment.ambient = encode(scene.environment.ambient);
+            return std::borrow::Cow::Owned(scene);
         }
-        scene
+        std::borrow::Cow::Borrowed(self)
     }
 
     /// The indices of refraction of the dielectric spheres that contain the camera,

@@ -29,11 +29,14 @@ mod gpu_vs_cpu;
 mod import_fuzz;
 mod import_gltf;
 mod import_obj;
+mod inputs_kept;
 mod instancing;
 mod layering;
 mod layout;
 mod load_time;
 mod material_errors;
+#[cfg(target_os = "linux")]
+mod memory_cap;
 mod model_alpha;
 mod model_shading;
 mod noise;

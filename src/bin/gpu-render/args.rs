@@ -100,7 +100,7 @@ pub enum Command {
 /// The arguments of `gpu-render tradeoff`.
 #[derive(Debug, Args)]
 pub struct TradeoffArgs {
-    /// The scene file (TOML).
+    /// The scene file (TOML), or a model file (OBJ, glTF, GLB) framed as a scene of its own.
     #[arg(value_name = "SCENE")]
     pub scene: PathBuf,
 
@@ -579,7 +579,7 @@ fn parse_seconds(text: &str) -> Result<std::time::Duration, String> {
 }
 
 /// The render settings that override the scene's.
-#[derive(Debug, Clone, Args)]
+#[derive(Debug, Clone, Default, Args)]
 pub struct SettingsArgs {
     /// Image width in pixels [default: the scene's].
     #[arg(

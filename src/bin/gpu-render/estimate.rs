@@ -16,7 +16,6 @@
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow, bail};
-use gpu_render::scene::{RenderSettings, import};
 use gpu_render::tiles::{PixelWindow, tile_window};
 
 use crate::args::{BackendArg, EstimateArgs};
@@ -33,17 +32,17 @@ pub fn run(args: &EstimateArgs) -> Result<()> {
     crate::apply_overrides(&args.settings, crate::minimal_settings(), None)?;
     let started = Instant::now();
     // A model file is framed as a scene of its own, as the render command frames it.
-    let (mut scene, camera_path) = if import::is_model_path(&args.scene) {
-        let render =
-            crate::apply_overrides(&args.settings, RenderSettings::default(), Some(&args.scene))?;
-        let scene = crate::load_model(&args.scene, render, args.sandbox, false, None)?;
-        (scene, None)
-    } else {
-        let file = crate::load(&args.scene, args.sandbox, false, None)?;
-        (file.scene, file.camera_path)
-    };
+    let loaded = crate::loading::load_any(
+        &args.scene,
+        &crate::loading::LoadArgs {
+            settings: &args.settings,
+            sandbox: args.sandbox,
+            quiet: false,
+            max_memory: None,
+        },
+    )?;
+    let (scene, camera_path) = (loaded.scene, loaded.camera_path);
     let load_time = started.elapsed();
-    scene.render = crate::apply_overrides(&args.settings, scene.render, Some(&args.scene))?;
     let (width, height) = (scene.render.width, scene.render.height);
     tile_window(0, args.tiles, width, height)
         .map_err(|e| anyhow!("--tiles {}: {e}", args.tiles))?;

@@ -11,6 +11,7 @@ mod args;
 mod backend;
 mod compare;
 mod estimate;
+mod loading;
 mod memory;
 mod merge;
 mod naming;
@@ -30,17 +31,16 @@ use std::time::Instant;
 use anyhow::{Context, Result, anyhow, bail};
 use clap::{CommandFactory, Parser, error::ErrorKind};
 use gpu_render::output::{self, HDR_MAX, OutputFormat, Written};
-use gpu_render::scene::{
-    self, Integrator, LightingSpace, LoadOptions, LoadProgress, RenderSettings, Scene, SceneFile,
-    SceneWarning,
-};
+use gpu_render::scene::{self, Integrator, LightingSpace, RenderSettings, Scene};
 use gpu_render::tiles::{Fingerprint, PixelWindow, Tile, TileInfo, tile_window};
 
 use crate::args::{AdapterArg, AovList, BackendArg, Cli, DenoiserArg, RenderArgs, SettingsArgs};
 use crate::backend::{Backend, Denoiser, Frame, GpuOptions};
+use crate::loading::{LoadArgs, Loaded};
 use crate::memory::{BackendKind, Estimate};
 use crate::progress::Progress;
 use crate::summary::Summary;
+use gpu_render::low_level::input::InputFile;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -185,15 +185,20 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
     // A model is refused while it is read once it would hold more than --max-memory.
     let cap = Some((args.max_memory * f64::from(1u32 << 30)) as u64);
 
-    let (mut scene, camera_path) = if scene::import::is_model_path(scene_path) {
-        let render = apply_overrides(&args.settings, RenderSettings::default(), Some(scene_path))?;
-        let scene = load_model(scene_path, render, args.sandbox, args.quiet, cap)?;
-        (scene, None)
-    } else {
-        let file = load(scene_path, args.sandbox, args.quiet, cap)?;
-        (file.scene, file.camera_path)
-    };
-    scene.render = apply_overrides(&args.settings, scene.render, Some(scene_path))?;
+    let loaded = loading::load_any(
+        scene_path,
+        &LoadArgs {
+            settings: &args.settings,
+            sandbox: args.sandbox,
+            quiet: args.quiet,
+            max_memory: cap,
+        },
+    )?;
+    let Loaded {
+        mut scene,
+        camera_path,
+        inputs,
+    } = loaded;
     let frame = match args.frame {
         None => None,
         Some(frame) => {
@@ -222,9 +227,19 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
     let standard_error_path = args
         .standard_error
         .as_deref()
-        .map(|pattern| standard_error_path(pattern, frame, tile, &output_path, scene_path, &scene))
+        .map(|pattern| {
+            standard_error_path(
+                pattern,
+                frame,
+                tile,
+                &output_path,
+                scene_path,
+                &scene,
+                &inputs,
+            )
+        })
         .transpose()?;
-    check_inputs_survive(&output_path, scene_path, &scene)?;
+    loading::check_inputs_survive(&output_path, scene_path, &scene, &inputs)?;
     if args.denoise.is_some() && scene.render.integrator == Integrator::Whitted {
         bail!(
             "{}: --denoise removes the noise of path tracing, and the scene uses the Whitted integrator, whose images have none; render with integrator = \"path\" (or --integrator path), or without --denoise",
@@ -248,7 +263,7 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
         &gpu_options,
         args.quiet,
     )?;
-    check_memory(
+    let estimate = check_memory(
         &scene,
         &backend,
         format,
@@ -360,6 +375,7 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
                 .noise
                 .as_ref()
                 .filter(|_| standard_error_path.is_some()),
+            memory: memory::peak_resident_bytes().map(|peak| (peak, estimate.total)),
         };
         eprintln!("{summary}");
     }
@@ -387,90 +403,6 @@ fn piece_window(args: &RenderArgs, settings: &RenderSettings) -> Result<Option<P
     }
 }
 
-/// Loads the scene file (and its camera path, if it has one), with progress after a
-/// second and warnings on stderr (unless `quiet`), confined to its folder with
-/// `sandbox`, each model it places refused once importing it would hold more than
-/// `max_memory` bytes.
-pub fn load(
-    scene_path: &Path,
-    sandbox: bool,
-    quiet: bool,
-    max_memory: Option<u64>,
-) -> Result<SceneFile> {
-    let warn = |warning: &SceneWarning| eprintln!("warning: {warning}");
-    let label = scene_path.display().to_string();
-    let scene = progress::while_loading(&label, !quiet, |progress| {
-        let options = LoadOptions {
-            sandbox,
-            progress: Some(progress),
-            warning: (!quiet).then_some(&warn as &(dyn Fn(&SceneWarning) + Sync)),
-            max_model_bytes: max_memory,
-        };
-        scene::load_scene_file(scene_path, &options)
-    })?;
-    Ok(scene)
-}
-
-/// Imports a model file and frames it as a scene of its own
-/// ([`gpu_render::scene::import::ImportedModel::into_scene`]) with `render`'s settings;
-/// warnings on stderr unless `quiet`, progress after a second; refused once importing
-/// it would hold more than `max_memory` bytes. A model's own references (material
-/// libraries, buffers, images) cannot be confined, so `sandbox` refuses model files.
-pub fn load_model(
-    path: &Path,
-    render: RenderSettings,
-    sandbox: bool,
-    quiet: bool,
-    max_memory: Option<u64>,
-) -> Result<Scene> {
-    if sandbox {
-        bail!(
-            "{}: --sandbox cannot render model files: the files a model names itself \
-             (material libraries, buffers, textures) are not confined",
-            path.display()
-        );
-    }
-    let label = path.display().to_string();
-    let model = progress::while_loading(&label, !quiet, |progress| {
-        let report = |done: u64, total: u64| progress(LoadProgress::Importing { done, total });
-        let options = scene::import::ImportOptions {
-            max_bytes: max_memory,
-            progress: Some(&report),
-        };
-        scene::import::import_model_with(path, &options)
-    })?;
-    let scene = model.into_scene(render);
-    if !quiet {
-        for warning in &model.warnings {
-            eprintln!(
-                "warning: {}",
-                gpu_render::low_level::echo::escape_controls(warning)
-            );
-        }
-        if model.camera.is_none() {
-            eprintln!(
-                "note: {} has no camera; framing its bounds from the front, above right",
-                path.display()
-            );
-        }
-        if model.lights.is_empty() {
-            eprintln!(
-                "note: {} has no lights; using the default three directional lights",
-                path.display()
-            );
-        }
-    }
-    Ok(scene)
-}
-
-/// Refuses an output that is the scene file or one of its images (textures, BRDF maps,
-/// the environment map).
-fn check_inputs_survive(output_path: &Path, scene_path: &Path, scene: &Scene) -> Result<()> {
-    let inputs = std::iter::once((scene_path, "scene file")).chain(scene.image_files());
-    output::check_not_an_input(output_path, inputs)?;
-    Ok(())
-}
-
 /// The path `--standard-error` names for this render (`{frame}` and `{tile}`
 /// expanded): an `.exr` that is neither the image written nor an input.
 fn standard_error_path(
@@ -480,6 +412,7 @@ fn standard_error_path(
     output_path: &Path,
     scene_path: &Path,
     scene: &Scene,
+    inputs: &[InputFile],
 ) -> Result<PathBuf> {
     let path = naming::expand(pattern, frame, tile)?;
     if output::check_output_path(&path)? != OutputFormat::Exr {
@@ -488,13 +421,8 @@ fn standard_error_path(
             path.display()
         );
     }
-    if path == output_path {
-        bail!(
-            "{}: --standard-error must name another file than the image (-o)",
-            path.display()
-        );
-    }
-    check_inputs_survive(&path, scene_path, scene)?;
+    output::check_distinct_outputs(&[(output_path, "image (-o)"), (&path, "--standard-error")])?;
+    loading::check_inputs_survive(&path, scene_path, scene, inputs)?;
     Ok(path)
 }
 
@@ -510,7 +438,7 @@ fn check_memory(
     aov: bool,
     oidn: bool,
     max_memory_gib: f64,
-) -> Result<()> {
+) -> Result<Estimate> {
     let kind = match backend {
         Backend::Gpu { .. } => BackendKind::Gpu,
         Backend::Cpu { .. } => BackendKind::Cpu,
@@ -545,7 +473,7 @@ fn check_memory(
             backend.describe()
         );
     }
-    Ok(())
+    Ok(estimate)
 }
 
 /// Warns when the format could not hold every pixel and clamped some.

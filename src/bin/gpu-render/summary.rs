@@ -4,6 +4,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use gpu_render::film::RenderStats;
+use gpu_render::low_level::echo::bytes;
 use gpu_render::low_level::noise::NoiseEstimate;
 use gpu_render::scene::RenderSettings;
 
@@ -31,6 +32,9 @@ pub struct Summary<'a> {
     pub output: &'a Path,
     /// The noise estimate, with `--standard-error`.
     pub noise: Option<&'a NoiseEstimate>,
+    /// The process's peak resident memory so far and the estimate `--max-memory` was
+    /// checked against, in bytes, where the system tells the peak.
+    pub memory: Option<(u64, u64)>,
 }
 
 impl std::fmt::Display for Summary<'_> {
@@ -59,12 +63,19 @@ impl std::fmt::Display for Summary<'_> {
             ),
             Some(None) => ", estimated noise unknown (needs 2 spp and light)".to_owned(),
         };
+        let memory = self.memory.map_or(String::new(), |(peak, estimate)| {
+            format!(
+                ", peak memory {} (estimated {})",
+                bytes(peak),
+                bytes(estimate)
+            )
+        });
         let compile = self.compile.map_or(String::new(), |compile| {
             format!(" (kernel compile {:.2} s)", compile.as_secs_f64())
         });
         write!(
             f,
-            "rendered {passes}{piece}{}x{}{frame}, {} spp, max depth {} on {} in {:.2} s{compile}: {} rays, trace {:.2} s ({source}), {:.1} Mrays/s{noise} -> {}",
+            "rendered {passes}{piece}{}x{}{frame}, {} spp, max depth {} on {} in {:.2} s{compile}: {} rays, trace {:.2} s ({source}), {:.1} Mrays/s{noise}{memory} -> {}",
             s.width,
             s.height,
             s.samples_per_pixel,
@@ -138,6 +149,7 @@ mod tests {
             },
             output: Path::new("out.png"),
             noise: None,
+            memory: None,
         };
         assert_eq!(
             summary.to_string(),

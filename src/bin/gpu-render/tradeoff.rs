@@ -30,7 +30,17 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
             args.out_dir.display()
         );
     }
-    let scene = crate::load(&args.scene, args.sandbox, false, None)?.scene;
+    // Its settings are the file's own: the sweep sets them.
+    let loaded = crate::loading::load_any(
+        &args.scene,
+        &crate::loading::LoadArgs {
+            settings: &crate::args::SettingsArgs::default(),
+            sandbox: args.sandbox,
+            quiet: false,
+            max_memory: None,
+        },
+    )?;
+    let scene = loaded.scene.clone();
     let height = (u64::from(scene.render.height) * u64::from(args.width)
         / u64::from(scene.render.width))
     .max(1) as u32;
@@ -85,9 +95,7 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
     );
     for name in &outputs {
         let path = args.out_dir.join(name);
-        let inputs =
-            std::iter::once((args.scene.as_path(), "scene file")).chain(scene.image_files());
-        gpu_render::output::check_not_an_input(&path, inputs)?;
+        loaded.check_output(&args.scene, &path)?;
     }
     std::fs::create_dir_all(&args.out_dir)
         .with_context(|| format!("cannot create {}", args.out_dir.display()))?;

@@ -6,13 +6,13 @@ use glam::DVec3;
 use toml::Spanned;
 
 use super::LoadOptions;
+use super::budget::{LoadBudget, load_scene_image};
 use super::check::{ColourRange, Item, Source};
 use super::paths::confined_path;
 use super::raw::RawMaterial;
 use crate::echo::{echo, echo_path, short, short3};
 use crate::scene::{
-    FresnelModel, Image, Material, MaterialKind, MicrofacetDistribution, SceneError,
-    TextureMapping, load_confined_image, load_image,
+    FresnelModel, Image, Material, MaterialKind, MicrofacetDistribution, SceneError, TextureMapping,
 };
 
 /// Largest accepted Blinn-Phong exponent.
@@ -114,16 +114,25 @@ pub struct ImageTable<'a> {
     /// Images loaded so far, indexed by `Material::albedo_texture` / `brdf_map`, with
     /// what each is used for.
     images: Vec<(Image, ImageRole)>,
+    /// The memory the load holds so far (the environment map's first), against the cap.
+    budget: &'a mut LoadBudget,
 }
 
 impl<'a> ImageTable<'a> {
-    /// An empty table for a scene file in directory `base`.
-    pub fn new(base: &'a Path, options: &'a LoadOptions<'a>) -> Self {
+    /// An empty table for a scene file in directory `base`, its images charged to
+    /// `budget`.
+    pub fn new(base: &'a Path, options: &'a LoadOptions<'a>, budget: &'a mut LoadBudget) -> Self {
         Self {
             base,
             options,
             images: Vec::new(),
+            budget,
         }
+    }
+
+    /// The bytes the cap leaves for the rest of the load, if there is a cap.
+    pub fn bytes_left(&self) -> Option<u64> {
+        self.budget.left()
     }
 
     /// The images, in index order.
@@ -165,22 +174,14 @@ impl<'a> ImageTable<'a> {
                 echo_path(&path)
             ))
         };
-        let mut image = if self.options.sandbox {
-            // Opened beneath the folder: the check above and the open are one step.
-            load_confined_image(self.base, Path::new(file))
-        } else {
-            load_image(&path)
-        }
-        .map_err(|e| {
-            item.fail_image(
-                format_args!(
-                    "{field} `{}` ({})",
-                    echo_path(Path::new(file)),
-                    echo_path(&path)
-                ),
-                e,
-            )
-        })?;
+        let mut image = load_scene_image(
+            item,
+            field,
+            (file, &path),
+            self.base,
+            self.options,
+            self.budget,
+        )?;
         if let Some(((x, y), channel, value)) = negative_texel(&image) {
             let why = match role {
                 ImageRole::Albedo => "a reflectance cannot be negative",

@@ -6,6 +6,7 @@
 //! and the problem.
 
 mod animation;
+mod budget;
 mod check;
 mod lights;
 mod materials;
@@ -57,10 +58,13 @@ pub struct LoadOptions<'a> {
     /// Told about each suspicious input that was accepted, and what was done about it
     /// (an albedo texel above 1, clamped to 1).
     pub warning: Option<&'a (dyn Fn(&SceneWarning) + Sync)>,
-    /// The most bytes importing each model file the scene places may hold
-    /// ([`crate::scene::import::ImportOptions::max_bytes`]): a model too large is
+    /// The most bytes the load may hold: the images the scene names (the environment
+    /// map, albedo textures, BRDF maps), each counted from its header before it is
+    /// decoded, together with what decoding it holds for a moment; and each model file
+    /// it places, within what the images leave
+    /// ([`crate::scene::import::ImportOptions::max_bytes`]). A scene too large is
     /// refused before it takes the memory. `None`: the fixed limits only.
-    pub max_model_bytes: Option<u64>,
+    pub max_bytes: Option<u64>,
 }
 
 impl std::fmt::Debug for LoadOptions<'_> {
@@ -69,7 +73,7 @@ impl std::fmt::Debug for LoadOptions<'_> {
             .field("sandbox", &self.sandbox)
             .field("progress", &self.progress.is_some())
             .field("warning", &self.warning.is_some())
-            .field("max_model_bytes", &self.max_model_bytes)
+            .field("max_bytes", &self.max_bytes)
             .finish()
     }
 }
@@ -344,11 +348,13 @@ fn build_scene(
             crate::scene::CAMERA_PRECISION_LIMIT
         )));
     }
+    let mut budget = budget::LoadBudget::new(options.max_bytes);
     let environment = settings::environment(
         source,
         raw.environment,
         source.path.parent().unwrap_or(std::path::Path::new("")),
         options,
+        &mut budget,
     )?;
     let total = (raw.materials.len() + raw.lights.len() + raw.objects.len()) as u64;
     let mut done = 0;
@@ -361,6 +367,7 @@ fn build_scene(
     let mut images = materials::ImageTable::new(
         source.path.parent().unwrap_or(std::path::Path::new("")),
         options,
+        &mut budget,
     );
     for (name, material) in raw.materials {
         materials.push(materials::material(source, &name, material, &mut images)?);
@@ -384,6 +391,11 @@ fn build_scene(
     let mut shape_items = Vec::with_capacity(raw.objects.len());
     let mut models = Vec::new();
     let mut model_cache = objects::ModelCache::new();
+    // Each model may hold what the images left of the cap.
+    let model_options = LoadOptions {
+        max_bytes: images.bytes_left(),
+        ..*options
+    };
     for (i, object) in raw.objects.into_iter().enumerate() {
         checked();
         if object.get_ref().kind.as_deref() == Some("model") {
@@ -393,7 +405,7 @@ fn build_scene(
                 i,
                 object,
                 base,
-                options,
+                &model_options,
                 &mut model_cache,
             )?);
         } else {

@@ -193,7 +193,7 @@ pub fn model(
                 options.report(crate::scene::LoadProgress::Importing { done, total });
             };
             let import = ImportOptions {
-                max_bytes: options.max_model_bytes,
+                max_bytes: options.max_bytes,
                 progress: Some(&report),
             };
             let model = import_model_with(&path, &import).map_err(|err| {

@@ -7,6 +7,7 @@ use glam::DVec3;
 use toml::Spanned;
 
 use super::LoadOptions;
+use super::budget::{LoadBudget, load_scene_image};
 use super::check::{ColourRange, Item, Source};
 use super::paths::confined_path;
 use super::raw::{
@@ -16,7 +17,7 @@ use crate::echo::{echo_path, short};
 use crate::scene::{
     Camera, Environment, EnvironmentMap, Image, Integrator, LightingSpace,
     MAX_ORTHOGRAPHIC_HALF_HEIGHT, MAX_RADIANCE, RenderSettings, SceneError, TextureFiltering,
-    ThinLens, load_confined_image, load_image,
+    ThinLens,
 };
 
 /// Default image width in pixels.
@@ -170,6 +171,7 @@ pub fn environment(
     raw: Option<Spanned<RawEnvironment>>,
     base: &Path,
     options: &LoadOptions<'_>,
+    budget: &mut LoadBudget,
 ) -> Result<Environment, SceneError> {
     let span = raw.as_ref().map(Spanned::span);
     let raw = raw.map(Spanned::into_inner).unwrap_or_default();
@@ -183,7 +185,7 @@ pub fn environment(
             }
             let rotation_degrees = item.number("rotation", raw.rotation.unwrap_or(0.0))?;
             let scale = item.colour_or("scale", raw.scale, ColourRange::Radiance, DVec3::ONE)?;
-            let image = environment_image(&item, file, base, options)?;
+            let image = environment_image(&item, file, base, options, budget)?;
             // The GPU holds radiance and the sampling tables in f32.
             let brightest = image
                 .texels
@@ -233,6 +235,7 @@ fn environment_image(
     file: &str,
     base: &Path,
     options: &LoadOptions<'_>,
+    budget: &mut LoadBudget,
 ) -> Result<Image, SceneError> {
     let path = if options.sandbox {
         confined_path(base, file).map_err(|e| item.fail(format_args!("map {e}")))?
@@ -246,22 +249,7 @@ fn environment_image(
             echo_path(&path)
         ))
     };
-    let image = if options.sandbox {
-        // Opened beneath the folder: the check above and the open are one step.
-        load_confined_image(base, Path::new(file))
-    } else {
-        load_image(&path)
-    }
-    .map_err(|e| {
-        item.fail_image(
-            format_args!(
-                "map `{}` ({})",
-                echo_path(Path::new(file)),
-                echo_path(&path)
-            ),
-            e,
-        )
-    })?;
+    let image = load_scene_image(item, "map", (file, &path), base, options, budget)?;
     for (i, texel) in image.texels.iter().enumerate() {
         for (channel, value) in ["r", "g", "b"].into_iter().zip(texel.iter().copied()) {
             if value < 0.0 {

@@ -337,6 +337,17 @@ impl Budget {
         Ok(())
     }
 
+    /// Refuses `bytes` held for a moment (a texture's decoding, beside what it keeps)
+    /// when they do not fit in what the cap leaves; counts nothing.
+    pub fn check_transient(&self, bytes: u64, what: &str) -> Result<(), LimitExceeded> {
+        match self.max_bytes {
+            Some(max) if self.bytes.saturating_add(bytes) > max => Err(LimitExceeded(
+                memory_cap_message(self.bytes.saturating_add(bytes), max, what),
+            )),
+            _ => Ok(()),
+        }
+    }
+
     /// Counts a texture of `width × height` texels.
     pub fn charge_texels(&mut self, width: u32, height: u32) -> Result<(), LimitExceeded> {
         let texels = u64::from(width) * u64::from(height);
@@ -355,14 +366,11 @@ impl Budget {
 
 /// The message for an import that needs `bytes` with `what`, more than the cap `max`.
 pub(super) fn memory_cap_message(bytes: u64, max: u64, what: &str) -> String {
-    const GIB: f64 = (1u64 << 30) as f64;
     format!(
-        "reading the model with {what} needs more than {:.2} GiB of memory (at least {:.2} \
-         GiB so far), more than the {:.2} GiB allowed (--max-memory); raise the cap if the \
-         machine has the memory",
-        max as f64 / GIB,
-        bytes as f64 / GIB,
-        max as f64 / GIB
+        "reading the model with {what} needs at least {} of memory, more than the {} \
+         allowed (--max-memory); raise the cap if the machine has the memory",
+        crate::echo::bytes(bytes),
+        crate::echo::bytes(max)
     )
 }
 

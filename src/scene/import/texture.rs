@@ -6,7 +6,10 @@ use std::path::Path;
 use super::mesh::Budget;
 use crate::color::srgb_encode;
 use crate::input::read_input;
-use crate::scene::{Image, MAX_IMAGE_FILE_BYTES, decode_image, image_dimensions};
+use crate::scene::{
+    DECODED_BYTES_PER_TEXEL, DECODING_BYTES_PER_TEXEL, Image, MAX_IMAGE_FILE_BYTES, decode_image,
+    image_dimensions,
+};
 
 /// How a texture's values are meant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -101,6 +104,14 @@ impl Textures {
             image_dimensions(path, bytes).map_err(|e| TextureFailure::Decode(e.to_string()))?;
         budget
             .charge_texels(width, height)
+            .map_err(|e| TextureFailure::Budget(e.into()))?;
+        // Decoding holds the file and the decoder's image beside the texels it keeps.
+        let transient = bytes.len() as u64
+            + u64::from(width)
+                * u64::from(height)
+                * (DECODING_BYTES_PER_TEXEL - DECODED_BYTES_PER_TEXEL);
+        budget
+            .check_transient(transient, "its textures while one is decoded")
             .map_err(|e| TextureFailure::Budget(e.into()))?;
         let mut image =
             decode_image(path, bytes).map_err(|e| TextureFailure::Decode(e.to_string()))?;

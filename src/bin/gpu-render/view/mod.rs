@@ -25,7 +25,7 @@ use gpu_render::gpu::{
 };
 use gpu_render::low_level::denoise::DenoiseSettings;
 use gpu_render::output;
-use gpu_render::scene::{self, Camera, RenderSettings, Scene};
+use gpu_render::scene::Camera;
 use winit::application::ApplicationHandler;
 use winit::dpi::{PhysicalPosition, PhysicalSize};
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -33,7 +33,9 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
 
-use crate::args::ViewArgs;
+use crate::args::{SettingsArgs, ViewArgs};
+use crate::loading::{LoadArgs, Loaded};
+use gpu_render::low_level::input::InputFile;
 use watch::SceneWatcher;
 
 /// Pixels of wheel scrolling that count as one line (touchpads report pixels).
@@ -60,11 +62,9 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     crate::apply_overrides(&args.settings, crate::minimal_settings(), None)?;
     // Stamped before the load, so that an edit made while the window opens counts.
     let watcher = SceneWatcher::new(&args.scene);
-    let scene = load_view_scene(args)?;
+    let loaded = load_view_scene(args)?;
     if let Some(path) = &args.screenshot {
-        let inputs =
-            std::iter::once((args.scene.as_path(), "scene file")).chain(scene.image_files());
-        output::check_not_an_input(path, inputs)?;
+        loaded.check_output(&args.scene, path)?;
     }
     let event_loop = EventLoop::new().context(
         "cannot open a window: no display server (set DISPLAY or WAYLAND_DISPLAY, or run \
@@ -72,7 +72,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     )?;
     let mut app = App {
         args,
-        pending: Some((scene, watcher)),
+        pending: Some((loaded, watcher)),
         viewer: None,
         error: None,
     };
@@ -86,16 +86,21 @@ pub fn run(args: &ViewArgs) -> Result<()> {
 }
 
 /// Loads the scene file (or model file) with the command-line overrides.
-fn load_view_scene(args: &ViewArgs) -> Result<Scene> {
-    let path = args.scene.as_path();
-    let mut scene = if scene::import::is_model_path(path) {
-        let render = crate::apply_overrides(&args.settings, RenderSettings::default(), Some(path))?;
-        crate::load_model(path, render, args.sandbox, args.quiet, None)?
-    } else {
-        crate::load(path, args.sandbox, args.quiet, None)?.scene
-    };
-    scene.render = crate::apply_overrides(&args.settings, scene.render, Some(path))?;
-    Ok(scene)
+fn load_view_scene(args: &ViewArgs) -> Result<Loaded> {
+    crate::loading::load_any(
+        &args.scene,
+        &view_load_args(&args.settings, args.sandbox, args.quiet),
+    )
+}
+
+/// How the viewer loads: no memory cap (the window shows what fits).
+fn view_load_args(settings: &SettingsArgs, sandbox: bool, quiet: bool) -> LoadArgs<'_> {
+    LoadArgs {
+        settings,
+        sandbox,
+        quiet,
+        max_memory: None,
+    }
 }
 
 /// The winit application: the window and its GPU state once the event loop has
@@ -103,7 +108,7 @@ fn load_view_scene(args: &ViewArgs) -> Result<Scene> {
 struct App<'a> {
     args: &'a ViewArgs,
     /// The scene to open the window with, and its file's watcher.
-    pending: Option<(Scene, SceneWatcher)>,
+    pending: Option<(Loaded, SceneWatcher)>,
     viewer: Option<Viewer>,
     error: Option<anyhow::Error>,
 }
@@ -118,10 +123,10 @@ impl App<'_> {
 
 impl ApplicationHandler for App<'_> {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
-        let Some((scene, watcher)) = self.pending.take() else {
+        let Some((loaded, watcher)) = self.pending.take() else {
             return;
         };
-        match Viewer::new(event_loop, self.args, scene, watcher) {
+        match Viewer::new(event_loop, self.args, loaded, watcher) {
             Ok(viewer) => {
                 viewer.window.request_redraw();
                 self.viewer = Some(viewer);
@@ -239,6 +244,8 @@ struct Viewer {
     /// over the interactive camera).
     file_camera: Camera,
     scene_path: PathBuf,
+    /// Every file the last load read: `S` never saves over one of them.
+    inputs: Vec<InputFile>,
     settings_args: ViewArgsSettings,
     samples_per_frame: u32,
     max_samples: u32,
@@ -276,9 +283,10 @@ impl Viewer {
     fn new(
         event_loop: &ActiveEventLoop,
         args: &ViewArgs,
-        scene: Scene,
+        loaded: Loaded,
         watcher: SceneWatcher,
     ) -> Result<Self> {
+        let Loaded { scene, inputs, .. } = loaded;
         let (width, height) = (scene.render.width, scene.render.height);
         let window = Arc::new(
             event_loop
@@ -365,6 +373,7 @@ impl Viewer {
             offscreen,
             file_camera: scene.camera,
             scene_path: args.scene.clone(),
+            inputs,
             settings_args: ViewArgsSettings {
                 settings: args.settings.clone(),
                 sandbox: args.sandbox,
@@ -701,6 +710,7 @@ impl Viewer {
     /// Reads the offscreen image (what the window shows) back and writes it as an
     /// 8-bit RGBA PNG.
     fn write_shown(&mut self, path: &Path) -> Result<()> {
+        output::check_not_read(path, &self.inputs)?;
         self.wait_in_flight()?;
         let bgra = match self.config.format {
             wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb => true,
@@ -747,16 +757,13 @@ impl Viewer {
     }
 
     fn reload(&mut self) -> Result<()> {
-        let path = self.scene_path.as_path();
         let args = &self.settings_args;
-        let mut scene = if scene::import::is_model_path(path) {
-            let render =
-                crate::apply_overrides(&args.settings, RenderSettings::default(), Some(path))?;
-            crate::load_model(path, render, args.sandbox, args.quiet, None)?
-        } else {
-            crate::load(path, args.sandbox, args.quiet, None)?.scene
-        };
-        scene.render = crate::apply_overrides(&args.settings, scene.render, Some(path))?;
+        let Loaded {
+            mut scene, inputs, ..
+        } = crate::loading::load_any(
+            &self.scene_path,
+            &view_load_args(&args.settings, args.sandbox, args.quiet),
+        )?;
         let file_camera = scene.camera;
         // The interactive camera stays unless the file's camera changed.
         if file_camera == self.file_camera {
@@ -775,6 +782,7 @@ impl Viewer {
         }
         self.scene = gpu_scene;
         self.file_camera = file_camera;
+        self.inputs = inputs;
         Ok(())
     }
 }
