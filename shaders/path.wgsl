@@ -341,39 +341,28 @@ fn path_continue(path: ptr<function, PathState>, origin: vec3<f32>, direction: v
 // picks an event in proportion to its weight (dimension 0) and records the
 // continuation; for the base BRDF it samples the next direction (dimensions 1-3) and
 // starts gathering direct light (PHASE_NEXT_LIGHT), else it goes on to PHASE_POP.
-fn path_closest_hit(path: ptr<function, PathState>, trace: TraceRay) {
-    let ray = Ray((*path).origin, (*path).direction);
-    if trace.best_prim == NO_PRIM {
-        var background = frame.background;
-        //#if ENVIRONMENT_MAP
-        if environment_present() {
-            // The environment, weighted against next-event estimation where that could
-            // have found it.
-            var weight = 1.0;
-            if (*path).depth > 0u && (*path).brdf_pdf > 0.0 {
-                weight = power_heuristic((*path).brdf_pdf,
-                                         environment.header.selection * environment_pdf(ray.direction));
-            }
-            background = environment_radiance(ray.direction) * weight;
+fn path_miss(path: ptr<function, PathState>) {
+    var background = frame.background;
+    //#if ENVIRONMENT_MAP
+    if environment_present() {
+        // The environment, weighted against next-event estimation where that could
+        // have found it.
+        var weight = 1.0;
+        if (*path).depth > 0u && (*path).brdf_pdf > 0.0 {
+            weight = power_heuristic((*path).brdf_pdf,
+                                     environment.header.selection * environment_pdf((*path).direction));
         }
-        //#endif
-        add_contribution(path, (*path).weight * background);
-        (*path).phase = PHASE_POP;
-        return;
+        background = environment_radiance((*path).direction) * weight;
     }
-    let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
-    // From here on cone_width is the cone's width at the hit, where every ray spawned
-    // here starts (every bounce keeps the camera's spread, as path_radiance does).
-    (*path).cone_width += frame.cone_spread * hit.t;
-    if (*path).pass_throughs < MAX_PASS_THROUGHS
-        && culls_back_face(materials[hit.material].cull_back_faces != 0u, (*path).depth, ray.direction, hit.normal) {
-        (*path).origin = offset_ray_origin(hit.position, hit.normal, frame.offset_scale);
-        (*path).phase = PHASE_PASS_THROUGH;
-        return;
-    }
-    let footprint = cone_footprint((*path).cone_width, ray.direction, hit.normal, hit.uv_density, hit.uv_axis);
-    let texels = material_texels(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, footprint);
-    let material = shading_material(materials[hit.material], hit.color.rgb, texels);
+    //#endif
+    add_contribution(path, (*path).weight * background);
+    (*path).phase = PHASE_POP;
+}
+
+fn path_closest_hit(path: ptr<function, PathState>, trace: TraceRay, surface: Surface) {
+    let ray = Ray((*path).origin, (*path).direction);
+    let hit = surface.hit;
+    let material = surface.material;
     // Emission, weighted against next-event estimation where that could have found it;
     // shadow_origin still holds the previous hit's, where that estimation sampled from.
     if max_component(material.emission) > 0.0 && emits_towards(hit, ray.direction, material.two_sided != 0u) {
@@ -384,25 +373,13 @@ fn path_closest_hit(path: ptr<function, PathState>, trace: TraceRay) {
         }
         add_contribution(path, (*path).weight * material.emission * weight);
     }
-    let entering = dot(ray.direction, hit.normal) < 0.0;
-    let ng = select(-hit.normal, hit.normal, entering);
-    let medium = MediumStack((*path).medium_iors, (*path).medium_depth);
-    //#if REFRACTION
-    let outside_ior = medium_outside_ior(medium, entering);
-    //#else
-    let outside_ior = 1.0;
-    //#endif
-    //#if MESH_ATTRIBUTES
-    let mapped = mapped_normal(materials[hit.material], hit.normal, hit.shading_normal, hit.tangent, texels[UV_SLOT_NORMAL]);
-    let ns = select(-mapped, mapped, entering);
-    let n = shading_frame_normal(ray.direction, ng, ns);
-    let lifted = shadow_terminator_point(hit, ng);
-    //#else
-    let n = ng;
-    let lifted = hit.position;
-    //#endif
+    let entering = surface.entering;
+    let ng = surface.ng;
+    let n = surface.n;
+    let lifted = surface.lifted;
+    let medium = surface.medium;
     let wo = -ray.direction;
-    let response = surface_response(material, ray.direction, n, entering, outside_ior);
+    let response = surface.response;
     // The events and their weights; a path whose weights are NaN also ends.
     var base = 0.0;
     if has_base_brdf(material.kind) {
@@ -470,27 +447,12 @@ fn path_closest_hit(path: ptr<function, PathState>, trace: TraceRay) {
                   direction, (*path).weight * weight, next_medium);
 }
 
-// Adds the current light's f·E·cos θi, times the event's weight, if its shadow ray was
-// unblocked, and moves on to the next light. Twin of the light loop of path_radiance.
-fn path_consume_shadow_ray(path: ptr<function, PathState>, trace: TraceRay) {
-    if trace.best_prim == NO_PRIM {
-        let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal);
-        let material = lit_material(path);
-        let lit = eval_brdf(material, (*path).normal, sample.wi, -(*path).direction)
-            * sample.irradiance * sample.cos_i;
-        add_contribution(path, (*path).direct * lit);
-    }
-    (*path).light += 1u;
-    (*path).phase = PHASE_NEXT_LIGHT;
-}
-
-// After the last light: starts the shadow ray towards the emitter sample (true), or
-// moves on to the continuation when there is none (false).
-fn path_start_emitter(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) -> bool {
-    let sample = path_emitter_sample(path);
+// Starts the shadow ray towards the emitter `sample` (path_emitter_sample of the path's
+// shadow origin), or moves on to the continuation when there is none.
+fn path_start_emitter(path: ptr<function, PathState>, trace: ptr<function, TraceRay>, sample: EmitterSample) {
     if !sample.found {
         (*path).phase = PHASE_POP;
-        return false;
+        return;
     }
     (*path).rays += 1u;
     // The environment's sample is visible when its ray hits nothing: any hit will do.
@@ -500,7 +462,6 @@ fn path_start_emitter(path: ptr<function, PathState>, trace: ptr<function, Trace
     (*trace).blend_seed = path_blend_seed(path);
     //#endif
     (*path).phase = PHASE_EMITTER;
-    return true;
 }
 
 // The emitter sample is visible when the first thing its ray meets is that emitter
@@ -508,10 +469,10 @@ fn path_start_emitter(path: ptr<function, PathState>, trace: ptr<function, Trace
 // when its ray meets nothing; then it adds f·L·cos θ / pdf (L times the emission
 // texture at the shadow ray's hit, when the emitter has one), times the event's
 // weight, weighted by the power heuristic against the BRDF sampler when the path goes
-// on. The sample is drawn again from the same numbers. Twin of sample_emitter and
+// on. `sample` is the one the ray was started towards, drawn again from the same
+// numbers (the shading step's one call of path_emitter_sample). Twin of sample_emitter and
 // sample_environment.
-fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay) {
-    let sample = path_emitter_sample(path);
+fn path_consume_emitter(path: ptr<function, PathState>, trace: TraceRay, sample: EmitterSample) {
     var visible = trace.best_prim == NO_PRIM;
     if sample.emitter != ENVIRONMENT_EMITTER {
         let emitter = emitters[sample.emitter];

@@ -11,6 +11,11 @@ const FLAG_PATH: u32 = 4u;
 // emitter is being traced (next-event estimation of the area lights).
 const PHASE_EMITTER: u32 = 8u;
 
+// PathState.phase of the path integrator: the lights are done and the emitter sample
+// of next-event estimation is to be drawn and its shadow ray started (in the shading
+// step's one call of path_emitter_sample, which consuming that ray shares).
+const PHASE_START_EMITTER: u32 = 11u;
+
 // Emitter.kind.
 // A sphere, sampled by the cone of directions it subtends.
 const EMITTER_SPHERE: u32 = 0u;

@@ -7,6 +7,9 @@
 #import bindings
 #import records
 #import math
+//#if PATH
+#import path_types
+//#endif
 
 // Branches whose weight is not above the smallest normal f32 are not traced, whatever
 // the cutoff. Twin of MIN_BRANCH_WEIGHT.
@@ -72,3 +75,10 @@ fn lit_material(path: ptr<function, PathState>) -> Material {
     material.metallic = (*path).metallic;
     return material;
 }
+
+//#if PATH
+// Whether this trace uses the path integrator.
+fn path_mode() -> bool {
+    return (frame.flags & FLAG_PATH) != 0u;
+}
+//#endif

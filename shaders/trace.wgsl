@@ -142,52 +142,34 @@ fn blend_alpha(material: Material, hit: Hit) -> f32 {
 }
 //#endif
 
-// Shades the hit (or miss) of the path's current ray, as shade_hit and trace_radiance
-// do on the CPU: a miss adds the background (background_radiance: the environment map
-// or the constant); a hit pushes the refracted, then the
-// reflected branch, and either adds its emission at once or, for a surface with a base
-// BRDF, starts gathering its lights (PHASE_NEXT_LIGHT), the ambient term first.
-fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRay) {
-    let ray = Ray((*path).origin, (*path).direction);
-    if trace.best_prim == NO_PRIM {
-        add_contribution(path, (*path).weight * background_radiance(ray.direction));
-        (*path).phase = PHASE_POP;
-        return;
-    }
-    let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
-    // Every ray spawned here starts as wide as the cone is here and keeps the spread
-    // (PreparedScene::cone_width_at; the specular bounces of JCGT 10(1), 2021, §3,
-    // without the curvature term).
-    let cone_width = (*path).cone_width + frame.cone_spread * hit.t;
-    if (*path).pass_throughs < MAX_PASS_THROUGHS
-        && culls_back_face(materials[hit.material].cull_back_faces != 0u, (*path).depth, ray.direction, hit.normal) {
-        (*path).origin = offset_ray_origin(hit.position, hit.normal, frame.offset_scale);
-        (*path).cone_width = cone_width;
-        (*path).phase = PHASE_PASS_THROUGH;
-        return;
-    }
+// What both integrators shade a closest hit with, resolved once per hit so that the
+// hit record, the texture lookups, the normal map and the Fresnel weights are one
+// call site each in the shading kernel (lavapipe inlines every call, so each call
+// site is compiled again): the hit, its material with the textures applied, the
+// cone's width there, the side the ray arrives on, the shading normal, the lifted
+// point shadow rays start from, the medium and the surface's response.
+struct Surface {
+    hit: Hit,
+    material: Material,
+    cone_width: f32,
+    entering: bool,
+    ng: vec3<f32>,
+    n: vec3<f32>,
+    lifted: vec3<f32>,
+    medium: MediumStack,
+    outside_ior: f32,
+    response: SurfaceResponse,
+}
+
+// The surface of `hit` on `ray`, reached by a cone `cone_width` wide there, inside
+// `medium`. The shared part of shade_hit and of path_radiance's bounce (src/cpu).
+fn resolve_surface(hit: Hit, ray: Ray, cone_width: f32, medium: MediumStack) -> Surface {
     let footprint = cone_footprint(cone_width, ray.direction, hit.normal, hit.uv_density, hit.uv_axis);
     let texels = material_texels(materials[hit.material], hit.position, hit.normal, hit.uv, hit.uv1, footprint);
     let material = shading_material(materials[hit.material], hit.color.rgb, texels);
     let entering = dot(ray.direction, hit.normal) < 0.0;
     // Shading happens on the side the ray came from.
     let ng = select(-hit.normal, hit.normal, entering);
-    let medium = MediumStack((*path).medium_iors, (*path).medium_depth);
-    //#if ALPHA
-    // A blended surface stops the fraction alpha of the light: its shading and
-    // branches are weighted by alpha, and the ray goes on through it, unbent, with
-    // weight 1 - alpha (one bounce deeper, pushed first so it is traced last).
-    if materials[hit.material].alpha_blend != 0u {
-        let alpha = blend_alpha(materials[hit.material], hit);
-        if alpha < 1.0 && (*path).depth < frame.max_depth {
-            let beyond = select(-hit.normal, hit.normal, dot(ray.direction, hit.normal) > 0.0);
-            push_branch(slot, path, StackEntry(
-                offset_ray_origin(hit.position, beyond, frame.offset_scale), (*path).depth + 1u,
-                ray.direction, medium.depth, (*path).weight * (1.0 - alpha), cone_width, medium.iors));
-        }
-        (*path).weight *= alpha;
-    }
-    //#endif
     //#if REFRACTION
     let outside_ior = medium_outside_ior(medium, entering);
     //#else
@@ -203,7 +185,46 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
     let n = ng;
     let lifted = hit.position;
     //#endif
-    var response = surface_response(material, ray.direction, n, entering, outside_ior);
+    let response = surface_response(material, ray.direction, n, entering, outside_ior);
+    return Surface(hit, material, cone_width, entering, ng, n, lifted, medium, outside_ior, response);
+}
+
+// Shades a miss of the path's current ray: adds the background
+// (background_radiance: the environment map or the constant).
+fn consume_miss(path: ptr<function, PathState>) {
+    add_contribution(path, (*path).weight * background_radiance((*path).direction));
+    (*path).phase = PHASE_POP;
+}
+
+// Shades the hit of the path's current ray, as shade_hit and trace_radiance do on the
+// CPU: a hit pushes the refracted, then the
+// reflected branch, and either adds its emission at once or, for a surface with a base
+// BRDF, starts gathering its lights (PHASE_NEXT_LIGHT), the ambient term first.
+fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, surface: Surface) {
+    let ray = Ray((*path).origin, (*path).direction);
+    let hit = surface.hit;
+    let cone_width = surface.cone_width;
+    let material = surface.material;
+    let ng = surface.ng;
+    let n = surface.n;
+    let medium = surface.medium;
+    let entering = surface.entering;
+    //#if ALPHA
+    // A blended surface stops the fraction alpha of the light: its shading and
+    // branches are weighted by alpha, and the ray goes on through it, unbent, with
+    // weight 1 - alpha (one bounce deeper, pushed first so it is traced last).
+    if materials[hit.material].alpha_blend != 0u {
+        let alpha = blend_alpha(materials[hit.material], hit);
+        if alpha < 1.0 && (*path).depth < frame.max_depth {
+            let beyond = select(-hit.normal, hit.normal, dot(ray.direction, hit.normal) > 0.0);
+            push_branch(slot, path, StackEntry(
+                offset_ray_origin(hit.position, beyond, frame.offset_scale), (*path).depth + 1u,
+                ray.direction, medium.depth, (*path).weight * (1.0 - alpha), cone_width, medium.iors));
+        }
+        (*path).weight *= alpha;
+    }
+    //#endif
+    var response = surface.response;
     var reflected = normalize(reflect_direction(ray.direction, n));
     //#if MESH_ATTRIBUTES
     if any(n != ng) {
@@ -234,7 +255,7 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
         (*path).material = hit.material;
         (*path).normal = n;
         (*path).base = response.base;
-        (*path).shadow_origin = offset_ray_origin(lifted, ng, frame.offset_scale);
+        (*path).shadow_origin = offset_ray_origin(surface.lifted, ng, frame.offset_scale);
         (*path).light = 0u;
         (*path).phase = PHASE_NEXT_LIGHT;
     } else {
@@ -243,15 +264,35 @@ fn consume_closest_hit(slot: u32, path: ptr<function, PathState>, trace: TraceRa
     }
 }
 
-// Adds the current light's f(wi, wo)·E·cos θi times its shadow ray's transmittance
-// if the ray was unblocked, and moves on to the next light.
+// Adds the current light's f(wi, wo)·E·cos θi if its shadow ray was unblocked, and
+// moves on to the next light: Whitted's into the hit's direct light, times the
+// transmittance of the blended surfaces the shadow ray passed; the path integrator's
+// into the sample's radiance times the event's weight (held in `direct`). One
+// function for both integrators, so that the BRDF is evaluated at one call site.
 fn consume_shadow_ray(path: ptr<function, PathState>, trace: TraceRay) {
-    // Blended surfaces the shadow ray passed let through the fraction transmittance.
-    if trace.best_prim == NO_PRIM && trace.transmittance > 0.0 {
+    var visible = trace.best_prim == NO_PRIM && trace.transmittance > 0.0;
+    var transmittance = trace.transmittance;
+    //#if PATH
+    let path_integrator = path_mode();
+    if path_integrator {
+        visible = trace.best_prim == NO_PRIM;
+        transmittance = 1.0;
+    }
+    //#endif
+    if visible {
         let sample = sample_light(lights[(*path).light], (*path).shadow_origin, (*path).normal);
         let material = lit_material(path);
-        (*path).direct += eval_brdf(material, (*path).normal, sample.wi, -(*path).direction)
-            * sample.irradiance * (sample.cos_i * trace.transmittance);
+        let lit = eval_brdf(material, (*path).normal, sample.wi, -(*path).direction)
+            * sample.irradiance * (sample.cos_i * transmittance);
+        //#if PATH
+        if path_integrator {
+            add_contribution(path, (*path).direct * lit);
+        } else {
+            (*path).direct += lit;
+        }
+        //#else
+        (*path).direct += lit;
+        //#endif
     }
     (*path).light += 1u;
     (*path).phase = PHASE_NEXT_LIGHT;

@@ -30,6 +30,8 @@
 #import color
 #import camera
 #import noise
+#import intersect
+#import medium
 #import traverse
 #import slot
 #import trace
@@ -38,13 +40,6 @@
 //#endif
 //#if AOV
 #import aov
-//#endif
-
-//#if PATH
-// Whether this trace uses the path integrator.
-fn path_mode() -> bool {
-    return (frame.flags & FLAG_PATH) != 0u;
-}
 //#endif
 
 // Gives a trace of the path integrator the stochastic transparency seed of the path's
@@ -64,29 +59,52 @@ fn seed_blend(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) {
 fn consume_closest_trace(slot: u32, path: ptr<function, PathState>, trace: TraceRay) {
     //#if AOV
     // Depth 0 is the camera ray: every branch and bounce is one deeper.
-    if aov_mode() && (*path).depth == 0u {
-        add_first_hit_aov((*path).pixel, (*path).origin, (*path).direction, trace, (*path).pass_throughs,
-                          (*path).cone_width);
+    let first_hit = aov_mode() && (*path).depth == 0u;
+    //#endif
+    if trace.best_prim == NO_PRIM {
+        //#if AOV
+        if first_hit {
+            add_missed_aov((*path).pixel);
+        }
+        //#endif
+        //#if PATH
+        if path_mode() {
+            path_miss(path);
+            return;
+        }
+        //#endif
+        consume_miss(path);
+        return;
+    }
+    let ray = Ray((*path).origin, (*path).direction);
+    let hit = hit_record_keyed(trace.best_prim, trace.best_instance, ray, trace.best_t);
+    // Every ray spawned here starts as wide as the cone is here and keeps the spread
+    // (PreparedScene::cone_width_at; the specular bounces of JCGT 10(1), 2021, §3,
+    // without the curvature term).
+    let cone_width = (*path).cone_width + frame.cone_spread * hit.t;
+    if (*path).pass_throughs < MAX_PASS_THROUGHS
+        && culls_back_face(materials[hit.material].cull_back_faces != 0u, (*path).depth, ray.direction, hit.normal) {
+        (*path).origin = offset_ray_origin(hit.position, hit.normal, frame.offset_scale);
+        (*path).cone_width = cone_width;
+        (*path).phase = PHASE_PASS_THROUGH;
+        return;
+    }
+    let surface = resolve_surface(hit, ray, cone_width, MediumStack((*path).medium_iors, (*path).medium_depth));
+    //#if AOV
+    if first_hit {
+        add_first_hit_aov((*path).pixel, surface, trace.best_t);
     }
     //#endif
     //#if PATH
     if path_mode() {
-        path_closest_hit(path, trace);
+        // From here on the path's cone_width is the cone's width at the hit, where
+        // every ray spawned here starts.
+        (*path).cone_width = cone_width;
+        path_closest_hit(path, trace, surface);
         return;
     }
     //#endif
-    consume_closest_hit(slot, path, trace);
-}
-
-// Adds the light of the finished shadow ray with the trace's integrator.
-fn consume_shadow_trace(path: ptr<function, PathState>, trace: TraceRay) {
-    //#if PATH
-    if path_mode() {
-        path_consume_shadow_ray(path, trace);
-        return;
-    }
-    //#endif
-    consume_shadow_ray(path, trace);
+    consume_closest_hit(slot, path, surface);
 }
 
 // Starts the shadow ray of the next light that faces the shading point and returns
@@ -96,8 +114,10 @@ fn next_light(path: ptr<function, PathState>, trace: ptr<function, TraceRay>) ->
     if (*path).light >= frame.light_count {
         //#if PATH
         if path_mode() {
-            // The path integrator's next-event estimation of an emitter comes last.
-            return path_start_emitter(path, trace);
+            // The path integrator's next-event estimation of an emitter comes last
+            // (shade_step draws its sample).
+            (*path).phase = PHASE_START_EMITTER;
+            return false;
         }
         //#endif
         finish_lights(path);
@@ -249,16 +269,22 @@ fn fetch_pixel(slot: u32, path: ptr<function, PathState>) {
 // that reaches its next sample waits there (see trace_paths, LOCKSTEP_SAMPLES).
 fn shade_step(slot: u32, path: ptr<function, PathState>, trace: ptr<function, TraceRay>,
               may_start: bool) {
+    //#if PATH
+    // The finished emitter shadow ray, consumed below with the step's emitter sample.
+    var emitter_trace = *trace;
+    var consume_emitter = false;
+    //#endif
     if (*trace).status == TRACE_DONE {
         (*trace).status = TRACE_IDLE;
         if (*path).phase == PHASE_CLOSEST {
             consume_closest_trace(slot, path, *trace);
         } else if (*path).phase == PHASE_SHADOW {
-            consume_shadow_trace(path, *trace);
+            consume_shadow_ray(path, *trace);
         }
         //#if PATH
         if (*path).phase == PHASE_EMITTER {
-            path_consume_emitter(path, *trace);
+            consume_emitter = true;
+            emitter_trace = *trace;
         }
         //#endif
     }
@@ -293,6 +319,19 @@ fn shade_step(slot: u32, path: ptr<function, PathState>, trace: ptr<function, Tr
             atomicOr(&counters.errors, ERROR_LOOP_CUT);
         }
     }
+    //#if PATH
+    // Next-event estimation's emitter sample, drawn at one call site for the step that
+    // starts its shadow ray and the step that consumes it (the same numbers give the
+    // same sample; a step does one or the other, never both).
+    if consume_emitter || (*path).phase == PHASE_START_EMITTER {
+        let sample = path_emitter_sample(path);
+        if consume_emitter {
+            path_consume_emitter(path, emitter_trace, sample);
+        } else {
+            path_start_emitter(path, trace, sample);
+        }
+    }
+    //#endif
     if (*path).phase == PHASE_POP {
         _ = pop_ray(slot, path, trace);
     }

@@ -16,6 +16,9 @@ use crate::scene::{Image, Material};
 pub const FLAG_PATH: u32 = 4;
 /// `PathState.phase` of the path integrator's emitter shadow ray (`PHASE_EMITTER`).
 pub const PHASE_EMITTER: u32 = 8;
+/// `PathState.phase` of the path integrator once the lights are done and the emitter
+/// sample is to be drawn (`PHASE_START_EMITTER`).
+pub const PHASE_START_EMITTER: u32 = 11;
 /// [`GpuEmitter::kind`] of a sphere.
 pub const EMITTER_SPHERE: u32 = 0;
 /// [`GpuEmitter::kind`] of a triangle.

@@ -39,6 +39,8 @@ pub struct GpuScene {
     pub(crate) camera_version: u64,
     dielectric_spheres: Vec<DielectricSphere>,
     compile_time: Duration,
+    /// Each kernel's first dispatch when the upload built them ([`Self::kernel_compiles`]).
+    pub(crate) kernel_compiles: Vec<super::wavefront::KernelCompile>,
 }
 
 impl GpuScene {
@@ -68,6 +70,7 @@ impl GpuScene {
             camera_version: 0,
             dielectric_spheres,
             compile_time,
+            kernel_compiles: Vec::new(),
         }
     }
 
@@ -139,6 +142,13 @@ impl GpuScene {
     /// features.
     pub fn compile_time(&self) -> Duration {
         self.compile_time
+    }
+
+    /// Each kernel the upload built and how long its first dispatch took (the compile,
+    /// on drivers that compile there, as lavapipe does); empty when the renderer had
+    /// the kernels from an earlier scene.
+    pub fn kernel_compiles(&self) -> &[super::wavefront::KernelCompile] {
+        &self.kernel_compiles
     }
 
     /// The trace constants of the whole image at upload, before any camera move (the

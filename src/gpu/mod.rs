@@ -75,6 +75,6 @@ pub use renderer::{
     BufferWrites, FilmImage, RenderedImage, Renderer, RendererOptions, TraceRegion, image_tiles,
 };
 pub use wavefront::{
-    CPU_SLOTS_PER_THREAD, LLVMPIPE_LOOP_LIMIT, Schedule, TARGET_SUBMISSION, default_schedule,
-    default_slot_count, driver_loop_limit, iteration_budget_for,
+    CPU_SLOTS_PER_THREAD, KernelCompile, LLVMPIPE_LOOP_LIMIT, Schedule, TARGET_SUBMISSION,
+    default_schedule, default_slot_count, driver_loop_limit, iteration_budget_for,
 };

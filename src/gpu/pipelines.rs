@@ -89,9 +89,19 @@ impl TracePipelines {
 
     /// The kernels of one round, in dispatch order.
     pub(crate) fn round(&self) -> Vec<&wgpu::ComputePipeline> {
+        self.named_round()
+            .into_iter()
+            .map(|(_, pipeline)| pipeline)
+            .collect()
+    }
+
+    /// The kernels of one round with their entry points' names, in dispatch order.
+    pub(crate) fn named_round(&self) -> Vec<(&'static str, &wgpu::ComputePipeline)> {
         match self {
-            TracePipelines::Fused(fused) => vec![fused],
-            TracePipelines::Wavefront { shade, trace } => vec![shade, trace],
+            TracePipelines::Fused(fused) => vec![(FUSED_ENTRY_POINT, fused)],
+            TracePipelines::Wavefront { shade, trace } => {
+                vec![(SHADE_ENTRY_POINT, shade), (TRACE_ENTRY_POINT, trace)]
+            }
         }
     }
 }

@@ -358,9 +358,10 @@ impl Renderer {
         let pipelines = self
             .pipelines
             .trace(device, &prepared.features, self.schedule)?;
+        let mut kernels = Vec::new();
         if !cached {
             let layout = self.pipelines.trace_bind_group_layout(&prepared.features);
-            warm_up(
+            kernels = warm_up(
                 device,
                 queue,
                 &pipelines,
@@ -370,14 +371,16 @@ impl Renderer {
             )?;
         }
         let compile_time = started.elapsed();
-        Ok(GpuScene::new(
+        let mut scene = GpuScene::new(
             device,
             prepared,
             pipelines,
             compile_time,
             scene.camera,
             scene.dielectric_spheres(),
-        ))
+        );
+        scene.kernel_compiles = kernels;
+        Ok(scene)
     }
 
     /// Moves `scene`'s camera. Writes nothing to the device: the next trace pass of

@@ -553,11 +553,23 @@ pub(crate) fn encode_rounds(
     }
 }
 
-/// Runs each trace kernel of `pipelines` (those of its schedule) once over no slots (`slot_count` 0: every
-/// invocation returns at once), so that a driver that compiles a pipeline at its first
-/// dispatch rather than at its creation (lavapipe: LLVM, seconds for a trace module)
-/// compiles it now, at upload, and neither the first trace's time nor the first frame
-/// of a frame loop pays for it.
+/// How long one kernel took to compile: its entry point and the time of its first
+/// dispatch over no work ([`warm_up`]), which is the compile on drivers that compile
+/// there (lavapipe) and nearly nothing on those that compiled at creation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct KernelCompile {
+    /// The kernel's entry point (`trace_paths`, `shade_paths`, `trace_rays`).
+    pub entry_point: &'static str,
+    /// Its first dispatch's time on the host, waiting for the device.
+    pub time: Duration,
+}
+
+/// Runs each trace kernel of `pipelines` (those of its schedule) once over no slots
+/// (`slot_count` 0: every invocation returns at once), so that a driver that compiles
+/// a pipeline at its first dispatch rather than at its creation (lavapipe: LLVM,
+/// seconds for a trace module) compiles it now, at upload, and neither the first
+/// trace's time nor the first frame of a frame loop pays for it. Each kernel is
+/// submitted and waited for alone, so that each one's compile is timed.
 pub(crate) fn warm_up(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -565,7 +577,7 @@ pub(crate) fn warm_up(
     layout: &wgpu::BindGroupLayout,
     scene: &DeviceScene,
     timeout: Option<Duration>,
-) -> Result<(), RenderError> {
+) -> Result<Vec<KernelCompile>, RenderError> {
     let slots = SlotBuffers::new(device, 1, scene.stack_size, 0, false)?;
     let target = create_texture(
         device,
@@ -582,21 +594,28 @@ pub(crate) fn warm_up(
         ..scene.frame
     };
     queue.write_buffer(&slots.uniforms, 0, bytemuck::bytes_of(&frame));
-    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-        label: Some("gpu-render warm-up"),
-    });
-    {
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+    let mut compiled = Vec::new();
+    for (entry_point, pipeline) in pipelines.named_round() {
+        let started = std::time::Instant::now();
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("gpu-render warm-up"),
-            timestamp_writes: None,
         });
-        pass.set_bind_group(0, &bind_group, &[]);
-        for pipeline in pipelines.round() {
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("gpu-render warm-up"),
+                timestamp_writes: None,
+            });
+            pass.set_bind_group(0, &bind_group, &[]);
             pass.set_pipeline(pipeline);
             pass.dispatch_workgroups(1, 1, 1);
         }
+        submit_and_wait(device, queue, encoder, "warm-up dispatch", timeout)?;
+        compiled.push(KernelCompile {
+            entry_point,
+            time: started.elapsed(),
+        });
     }
-    submit_and_wait(device, queue, encoder, "warm-up dispatch", timeout)
+    Ok(compiled)
 }
 
 /// Turns the kernels' error bits into an error: an image with a cut loop or an

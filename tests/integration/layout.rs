@@ -9,7 +9,7 @@ use gpu_render::gpu::ShaderFeatures;
 use gpu_render::low_level::accel::{PrimKind, PrimRef, WideNode};
 use gpu_render::low_level::gpu::area_lights::{
     EMITTER_NONE, EMITTER_SPHERE, EMITTER_TRIANGLE, EMITTER_TWO_SIDED_TRIANGLE, FLAG_PATH,
-    GpuEmitter, PHASE_EMITTER,
+    GpuEmitter, PHASE_EMITTER, PHASE_START_EMITTER,
 };
 use gpu_render::low_level::gpu::environment::GpuEnvironmentHeader;
 use gpu_render::low_level::gpu::layout::*;
@@ -456,6 +456,7 @@ fn constants_match() {
         ("PRIM_TRIANGLE", PrimKind::Triangle as u32),
         ("FLAG_PATH", FLAG_PATH),
         ("PHASE_EMITTER", PHASE_EMITTER),
+        ("PHASE_START_EMITTER", PHASE_START_EMITTER),
         ("EMITTER_SPHERE", EMITTER_SPHERE),
         ("EMITTER_TRIANGLE", EMITTER_TRIANGLE),
         ("EMITTER_NONE", EMITTER_NONE),

@@ -408,8 +408,18 @@ const WITHOUT_RUST_TWIN: &[(&str, &[&str], &str)] = &[
     ),
     (
         "trace",
-        &["consume_closest_hit", "consume_shadow_ray", "finish_lights"],
+        &[
+            "consume_miss",
+            "consume_closest_hit",
+            "consume_shadow_ray",
+            "finish_lights",
+        ],
         "shade_hit and direct_light cut at each shadow ray into the wavefront's steps",
+    ),
+    (
+        "trace",
+        &["resolve_surface"],
+        "the part of shade_hit and of path_radiance's bounce that both integrators share          (the hit's textures, normals and Fresnel weights), gathered in one function so          that lavapipe, which inlines every call, compiles it once in the shading kernel          (issue 50: the general shading kernel 50 s -> 40 s)",
     ),
     (
         "path",
@@ -417,8 +427,8 @@ const WITHOUT_RUST_TWIN: &[(&str, &[&str], &str)] = &[
             "path_random",
             "path_emitter_sample",
             "path_continue",
+            "path_miss",
             "path_closest_hit",
-            "path_consume_shadow_ray",
             "path_start_emitter",
             "path_consume_emitter",
             "path_blend_seed",
@@ -432,6 +442,7 @@ const WITHOUT_RUST_TWIN: &[(&str, &[&str], &str)] = &[
             "aov_mode",
             "aov_index",
             "clear_pixel_aov",
+            "add_missed_aov",
             "add_first_hit_aov",
         ],
         "the passes' sums kept in the accumulation buffer between a slot's samples: the \

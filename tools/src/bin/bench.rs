@@ -55,6 +55,14 @@ struct Args {
     /// Compare the fused and the wavefront schedule of the GPU kernels.
     #[arg(long)]
     schedules: bool,
+    /// Print each trace kernel's compile (its first dispatch, at upload) and its WGSL
+    /// size, for the scene's kernels; run it with an empty driver cache
+    /// (`MESA_SHADER_CACHE_DIR`) for a cold compile.
+    #[arg(long)]
+    compile: bool,
+    /// With `--compile`: the general kernels (every feature) rather than the scene's.
+    #[arg(long)]
+    general: bool,
     /// The GPU schedule: `fused` or `wavefront` (default: the adapter's).
     #[arg(long)]
     schedule: Option<String>,
@@ -453,6 +461,18 @@ fn main() -> Result<()> {
     if args.schedules {
         return compare_schedules(&gpu, &scene, args.runs);
     }
+    if args.compile {
+        let options = RendererOptions {
+            specialise: !args.general,
+            uniform_records: !args.storage_records,
+            lockstep_samples: !args.no_lockstep,
+            unrolled: !args.no_unrolled,
+            schedule,
+            traversal,
+            ..RendererOptions::default()
+        };
+        return compile_figures(&gpu, &scene, options);
+    }
     // Warm-up: the first dispatch compiles the pipeline (lavapipe runs LLVM then).
     renderer.render(&gpu.device, &gpu.queue, &scene, None)?;
     let prepared = renderer.upload(&gpu.device, &gpu.queue, &scene)?;
@@ -615,6 +635,51 @@ fn compare_specialisation(
         specialised,
         general,
         specialised / general
+    );
+    Ok(())
+}
+
+/// Prints each trace kernel's compile time and its module's size: the upload of a
+/// tiny copy of `scene` on a new renderer builds the kernels and dispatches each once
+/// ([`gpu_render::gpu::GpuScene::kernel_compiles`]).
+fn compile_figures(
+    gpu: &HeadlessGpu,
+    scene: &gpu_render::scene::Scene,
+    options: RendererOptions,
+) -> Result<()> {
+    let renderer = Renderer::new(&gpu.device, options)?;
+    let tiny = gpu_render::scene::Scene {
+        render: scene
+            .render
+            .with_overrides(&RenderOverrides {
+                width: Some(8),
+                height: Some(8),
+                samples_per_pixel: Some(1),
+                ..RenderOverrides::default()
+            })
+            .map_err(anyhow::Error::msg)?,
+        ..scene.clone()
+    };
+    let started = Instant::now();
+    let uploaded = renderer.upload(&gpu.device, &gpu.queue, &tiny)?;
+    let upload = started.elapsed().as_secs_f64();
+    let source = gpu_render::low_level::gpu::shaders::trace_shader_source(&uploaded.features())
+        .map_err(anyhow::Error::msg)?;
+    println!(
+        "kernels ({}): {} lines of WGSL",
+        uploaded.features().label(),
+        source.lines().count()
+    );
+    for kernel in uploaded.kernel_compiles() {
+        println!(
+            "  {}: {:.2} s",
+            kernel.entry_point,
+            kernel.time.as_secs_f64()
+        );
+    }
+    println!(
+        "compile {:.2} s of an upload of {upload:.2} s",
+        uploaded.compile_time().as_secs_f64()
     );
     Ok(())
 }
