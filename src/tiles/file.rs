@@ -21,7 +21,7 @@
 //! | `gpuRender.sceneHash` | string | [`Fingerprint::scene`], 16 hex digits |
 //! | `gpuRender.settingsHash` | string | [`Fingerprint::settings`], 16 hex digits |
 //! | `gpuRender.settings` | string | the settings in words ([`super::describe_settings`]) |
-//! | `gpuRender.backend` | string | `cpu` or `gpu` |
+//! | `gpuRender.backend` | string | `cpu`, `gpu`, or `gpu-ray-query` (triangles found by ray queries) |
 //! | `gpuRender.device` | string | `CPU reference` or the GPU adapter's name |
 //! | `gpuRender.scene` | string | the scene file's name, for people |
 //! | `gpuRender.version` | string | the gpu-render version that wrote it, for people |

@@ -91,6 +91,49 @@ fn missing_scene_file() {
     ws.assert_old_output_kept();
 }
 
+/// The reason of an error is said once (issue 49, item 6: a missing scene said "No such
+/// file or directory" three times, a missing texture four, a FIFO texture three), as
+/// `docs/reliability.md` promises.
+#[test]
+fn the_reason_of_an_error_is_said_once() {
+    let ws =
+        Workspace::new(&TINY_SCENE.replace("albedo = 0.7", "albedo_texture = \"missing.png\""));
+    let once = |run: &crate::support::process::Run, reason: &str| {
+        assert_eq!(
+            run.stderr.matches(reason).count(),
+            1,
+            "{reason:?} not said once:\n{}",
+            run.stderr
+        );
+    };
+    let render =
+        |scene: &str| gpu_render(&[&ws.arg(scene), "-o", &ws.arg("out.png"), "--backend", "cpu"]);
+    let missing_scene = render("no-such-scene.toml");
+    assert_fails_with(&missing_scene, &["no-such-scene.toml"]);
+    once(&missing_scene, "No such file or directory");
+    let missing_texture = render("scene.toml");
+    assert_fails_with(&missing_texture, &["missing.png"]);
+    once(&missing_texture, "No such file or directory");
+    #[cfg(unix)]
+    {
+        let fifo = ws.path("fifo.png");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .expect("run mkfifo");
+        assert!(made.success());
+        std::fs::write(
+            ws.path("fifo.toml"),
+            TINY_SCENE.replace("albedo = 0.7", "albedo_texture = \"fifo.png\""),
+        )
+        .expect("write the scene");
+        let run = render("fifo.toml");
+        assert_fails_with(&run, &["fifo.png"]);
+        once(&run, "it is a FIFO, not a regular file");
+        ws.assert_old_output_kept_beside(&["fifo.png", "fifo.toml"]);
+    }
+}
+
 #[test]
 fn unknown_output_extension() {
     let ws = Workspace::new(TINY_SCENE);
@@ -148,6 +191,23 @@ fn adapter_with_cpu_backend_is_refused() {
         "0",
     ]);
     assert_fails_with(&run, &["--adapter", "--backend cpu"]);
+    // The GPU's other flags are refused alike (issue 49, item 6: they were ignored).
+    for flags in [
+        ["--traversal", "hardware"],
+        ["--iteration-budget", "1000"],
+        ["--gpu-timeout", "10"],
+    ] {
+        let run = gpu_render(&[
+            &ws.arg("scene.toml"),
+            "-o",
+            &ws.arg("out.png"),
+            "--backend",
+            "cpu",
+            flags[0],
+            flags[1],
+        ]);
+        assert_fails_with(&run, &[flags[0], "--backend cpu"]);
+    }
     ws.assert_old_output_kept();
 }
 

@@ -1895,3 +1895,41 @@ fn unlit_materials_show_their_base_colour_unshaded() {
         );
     }
 }
+
+/// Positions outside their accessor's declared `min`/`max` (issue 49, item 7:
+/// `ZeroLengthBufferView`, whose first vertex lies at x = 2^31 against a declared max
+/// of 1) are warned about as the glTF validator reports them, naming the accessor and
+/// the vertex; the model is framed by the positions read.
+#[test]
+fn positions_outside_their_declared_bounds_are_warned_about() {
+    let Some(model) = crate::corpus::corpus_model(
+        "draco/testdata/ZeroLengthBufferView/ZeroLengthBufferView.gltf",
+    ) else {
+        return;
+    };
+    let warning = model
+        .warnings
+        .iter()
+        .find(|w| w.contains("outside the min"))
+        .unwrap_or_else(|| panic!("no bounds warning in {:?}", model.warnings));
+    assert!(
+        warning.contains("POSITION (accessor 1)")
+            && warning.contains("1 of 4 vertices")
+            && warning.contains("vertex 0")
+            && warning.contains("2147483648"),
+        "{warning}"
+    );
+    let (low, high) = model.bounds().expect("bounds");
+    assert!(high.x >= 2.0e9 && low.x <= 0.0, "{low} {high}");
+    // A file whose positions keep to their bounds gets no such warning.
+    let Some(duck) =
+        crate::corpus::corpus_model("draco/testdata/KhronosSampleModels/Duck/glTF/Duck.gltf")
+    else {
+        return;
+    };
+    assert!(
+        !duck.warnings.iter().any(|w| w.contains("outside the min")),
+        "{:?}",
+        duck.warnings
+    );
+}

@@ -849,6 +849,34 @@ pub enum BackendArg {
     Cpu,
 }
 
+impl DeviceArgs {
+    /// Refuses the GPU's flags with `--backend cpu`, which has no use for them: the
+    /// adapter, the traversal, the iteration budget and the GPU timeout are all
+    /// refused alike rather than some silently ignored.
+    pub fn check_for_backend(&self) -> Result<(), String> {
+        if self.backend != BackendArg::Cpu {
+            return Ok(());
+        }
+        let flag = if self.adapter.is_some() {
+            Some(("--adapter", "selects a GPU adapter"))
+        } else if self.traversal != TraversalArg::Auto {
+            Some(("--traversal", "chooses how the GPU finds triangles"))
+        } else if self.iteration_budget.is_some() {
+            Some(("--iteration-budget", "bounds the GPU kernels' loops"))
+        } else if self.gpu_timeout.is_some() {
+            Some(("--gpu-timeout", "bounds the GPU's submissions"))
+        } else {
+            None
+        };
+        match flag {
+            Some((flag, what)) => Err(format!(
+                "{flag} {what}; it cannot be used with --backend cpu"
+            )),
+            None => Ok(()),
+        }
+    }
+}
+
 /// `--traversal` values ([`gpu_render::gpu::Traversal`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum TraversalArg {

@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Result, anyhow, bail};
 use gpu_render::tiles::{PixelWindow, tile_window};
 
-use crate::args::{BackendArg, EstimateArgs};
+use crate::args::EstimateArgs;
 use crate::backend::{Backend, GpuOptions};
 
 /// The most frames of an animation calibrated when no `--frame` is given.
@@ -26,9 +26,9 @@ const SAMPLED_FRAMES: u32 = 5;
 
 /// Calibrates and prints the table on stdout.
 pub fn run(args: &EstimateArgs) -> Result<()> {
-    if args.device.backend == BackendArg::Cpu && args.device.adapter.is_some() {
-        bail!("--adapter selects a GPU adapter; it cannot be used with --backend cpu");
-    }
+    args.device
+        .check_for_backend()
+        .map_err(anyhow::Error::msg)?;
     crate::apply_overrides(&args.settings, crate::minimal_settings(), None)?;
     let started = Instant::now();
     // A model file is framed as a scene of its own, as the render command frames it.

@@ -34,7 +34,7 @@ use gpu_render::output::{self, HDR_MAX, OutputFormat, Written};
 use gpu_render::scene::{self, Integrator, LightingSpace, RenderSettings, Scene};
 use gpu_render::tiles::{Fingerprint, PixelWindow, Tile, TileInfo, tile_window};
 
-use crate::args::{AdapterArg, AovList, BackendArg, Cli, DenoiserArg, RenderArgs, SettingsArgs};
+use crate::args::{AdapterArg, AovList, Cli, DenoiserArg, RenderArgs, SettingsArgs};
 use crate::backend::{Backend, Denoiser, Frame, GpuOptions};
 use crate::loading::{LoadArgs, Loaded};
 use crate::memory::{BackendKind, Estimate};
@@ -42,19 +42,59 @@ use crate::progress::Progress;
 use crate::summary::Summary;
 use gpu_render::low_level::input::InputFile;
 
+/// The programs of the `gpu-render-tools` crate, which users reach for as subcommands
+/// (`gpu-render bench SCENE`).
+const TOOLS: &[&str] = &[
+    "bench",
+    "embed_bench",
+    "fuzz_campaign",
+    "fuzz_probe",
+    "fuzz_replay",
+    "load_probe",
+    "loop_probe",
+];
+
 fn main() -> ExitCode {
+    if let Some(first) = std::env::args().nth(1)
+        && TOOLS.contains(&first.as_str())
+        && !Path::new(&first).exists()
+    {
+        eprintln!(
+            "error: `{first}` is not a subcommand of gpu-render but a program of the tools \
+             crate: cargo run --release -p gpu-render-tools --bin {first} -- ARGS"
+        );
+        return ExitCode::from(2);
+    }
     let cli = Cli::parse();
     if let Err(error) = signals::install() {
-        eprintln!("error: {error:#}");
+        eprintln!("error: {}", describe_error(&error));
         return ExitCode::FAILURE;
     }
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
-            eprintln!("error: {error:#}");
+            eprintln!("error: {}", describe_error(&error));
             ExitCode::FAILURE
         }
     }
+}
+
+/// `error` and its causes on one line, `message: cause: cause`, each cause said once:
+/// a cause whose words the line holds already (the library's messages quote the
+/// reason they wrap, and expose it as their source too) is left out.
+pub fn describe_error(error: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in error.chain() {
+        let text = cause.to_string();
+        if line.contains(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&text);
+    }
+    line
 }
 
 fn run(cli: Cli) -> Result<()> {
@@ -167,9 +207,9 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
     if args.compare_gamma && piece {
         bail!("--compare-gamma renders two whole images side by side; it cannot be a tile");
     }
-    if args.device.backend == BackendArg::Cpu && args.device.adapter.is_some() {
-        bail!("--adapter selects a GPU adapter; it cannot be used with --backend cpu");
-    }
+    args.device
+        .check_for_backend()
+        .map_err(anyhow::Error::msg)?;
     let tile = args.tile.map(|t| (t.index, t.count));
     // Without a {frame}, every check of the output happens before the scene is read.
     let named_by_frame = naming::contains(output_pattern, naming::FRAME);
@@ -320,7 +360,13 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
                     frame: frame.map(|(k, _)| k),
                     fingerprint: Fingerprint::of(&scene),
                     settings: gpu_render::tiles::describe_settings(&scene.render),
-                    backend: backend.kind_name().to_owned(),
+                    // Ray queries and the software walk agree within docs/model.md's
+                    // stated difference, not bit for bit: the merge keeps them apart.
+                    backend: if rendered.hardware_traversal {
+                        format!("{}-ray-query", backend.kind_name())
+                    } else {
+                        backend.kind_name().to_owned()
+                    },
                     device: backend.device_name(),
                     scene_name: scene_path
                         .file_name()
@@ -360,7 +406,9 @@ fn render(args: &RenderArgs, scene_path: &Path, output_pattern: &Path) -> Result
             passes: if args.compare_gamma { 2 } else { 1 },
             piece: piece_name.as_deref(),
             frame: frame.map(|(k, _)| k),
-            backend: &if rendered.hardware_traversal {
+            backend: &if rendered.hardware_traversal
+                && gpu_render::gpu::ShaderFeatures::for_scene(&scene).triangles
+            {
                 format!("{}, triangles by ray query", backend.describe())
             } else {
                 backend.describe()

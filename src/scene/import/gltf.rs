@@ -23,7 +23,7 @@ use super::{
     ImportOptions, ImportedCamera, ImportedMaterial, ImportedMesh, ImportedModel,
     MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES, TextureRef, WrapMode, error, read_file,
 };
-use crate::echo::short;
+use crate::echo::{short, short3};
 use crate::scene::{
     AlphaMode, Camera, Light, MAX_ORTHOGRAPHIC_HALF_HEIGHT, MAX_RADIANCE, Material, MaterialKind,
     SceneError, TextureTransform,
@@ -883,6 +883,7 @@ impl Importer<'_> {
             &self.buffers,
         )?);
         self.check_quantization(&positions_accessor, name, "POSITION", false);
+        self.check_declared_bounds(&positions_accessor, name, &positions);
         let same_count = |accessor: &::gltf::Accessor<'_>, name: &str| {
             if accessor.count() == count {
                 Ok(())
@@ -1162,6 +1163,46 @@ impl Importer<'_> {
         )
     }
 
+    /// Warns when positions lie outside the `min` and `max` their accessor declares, as
+    /// the glTF validator does (ACCESSOR_MIN_MISMATCH, ACCESSOR_MAX_MISMATCH): the
+    /// declared bounds are wrong or the positions are damaged. The model is framed by
+    /// the positions read, never by the declaration. A position within a relative
+    /// 1e-5 of the declared box (the JSON numbers' rounding) is inside.
+    fn check_declared_bounds(
+        &mut self,
+        accessor: &::gltf::Accessor<'_>,
+        primitive: &str,
+        positions: &[DVec3],
+    ) {
+        let declared = |value: Option<::gltf::json::Value>| -> Option<DVec3> {
+            let array = value?;
+            let array = array.as_array()?;
+            let component = |i: usize| array.get(i)?.as_f64();
+            Some(DVec3::new(component(0)?, component(1)?, component(2)?))
+        };
+        let (Some(min), Some(max)) = (declared(accessor.min()), declared(accessor.max())) else {
+            return;
+        };
+        let slack = (max - min).abs().max_element().max(1.0) * 1e-5;
+        let outside = |p: &DVec3| {
+            (0..3).any(|axis| !(p[axis] >= min[axis] - slack && p[axis] <= max[axis] + slack))
+        };
+        let count = positions.iter().filter(|p| outside(p)).count();
+        let Some((first, at)) = positions.iter().enumerate().find(|(_, p)| outside(p)) else {
+            return;
+        };
+        self.warn(format!(
+            "{primitive}: POSITION (accessor {}) has {count} of {} vertices outside the min {} \
+             and max {} it declares (the first, vertex {first}, at {}); the bounds are wrong or \
+             the positions damaged, and the model is framed by the positions as read",
+            accessor.index(),
+            positions.len(),
+            short3(min),
+            short3(max),
+            short3(*at)
+        ));
+    }
+
     /// Warns (once per file) when `accessor` holds one of the component types that only
     /// `KHR_mesh_quantization` allows but the file does not list the extension in
     /// `extensionsUsed` (glTF 2.0 §3.12: an extension a file uses must be listed). The
@@ -1278,6 +1319,13 @@ impl Importer<'_> {
             ::gltf::material::AlphaMode::Mask => {
                 let cutoff = f64::from(material.alpha_cutoff().unwrap_or(DEFAULT_ALPHA_CUTOFF));
                 let cutoff = if cutoff.is_finite() && cutoff >= 0.0 {
+                    if cutoff > 1.0 {
+                        // Alpha lies in [0, 1]: no point reaches the cutoff.
+                        self.warn(format!(
+                            "{name}: alphaCutoff {} is above 1, the largest alpha, so the material's every point is cut away and it is invisible",
+                            short(cutoff)
+                        ));
+                    }
                     cutoff
                 } else {
                     self.warn(format!(

@@ -5,7 +5,20 @@ use std::path::Path;
 
 use glam::{DVec2, DVec3};
 
+use crate::echo::{short, short3};
 use crate::scene::SceneError;
+
+/// A vertex colour as messages quote it: each channel in at most about 24 characters
+/// ([`short`]), so that 1e38 is not spelt out in 39 digits.
+fn short4(color: glam::DVec4) -> String {
+    format!(
+        "[{}, {}, {}, {}]",
+        short(color.x),
+        short(color.y),
+        short(color.z),
+        short(color.w)
+    )
+}
 
 use super::{
     ImportedMesh, MAX_MODEL_INSTANCES, MAX_MODEL_TEXELS, MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES,
@@ -90,7 +103,7 @@ pub(super) fn finish_mesh(
             Some(i) => {
                 warn(format!(
                     "{name}: the normal of vertex {i} is zero or not finite ({}); the normals are ignored",
-                    normals[i]
+                    short3(normals[i])
                 ));
                 None
             }
@@ -131,7 +144,7 @@ pub(super) fn finish_mesh(
         if let Some(i) = colors.iter().position(|c| c.is_nan()) {
             warn(format!(
                 "{name}: the colour of vertex {i} is not a number ({}); the vertex colours are ignored",
-                colors[i]
+                short4(colors[i])
             ));
             return None;
         }
@@ -149,11 +162,13 @@ pub(super) fn finish_mesh(
                     .iter()
                     .position(|c| c.min_element() < 0.0 || c.max_element() > 1.0)
                     .unwrap_or(0),
-                colors
-                    .iter()
-                    .find(|c| c.min_element() < 0.0 || c.max_element() > 1.0)
-                    .copied()
-                    .unwrap_or_default(),
+                short4(
+                    colors
+                        .iter()
+                        .find(|c| c.min_element() < 0.0 || c.max_element() > 1.0)
+                        .copied()
+                        .unwrap_or_default()
+                ),
             ));
         }
         Some(

@@ -671,7 +671,7 @@ impl Viewer {
                 self.status = Some(format!("saved {}", path.display()));
             }
             Err(error) => {
-                eprintln!("error: {error:#}");
+                eprintln!("error: {}", crate::describe_error(&error));
                 self.status = Some(format!("cannot save: {error}"));
             }
         }
@@ -745,8 +745,12 @@ impl Viewer {
                 self.status = None;
             }
             Err(error) => {
-                eprintln!("error: reloading {}: {error:#}", self.scene_path.display());
-                let first_line = format!("{error:#}");
+                let described = crate::describe_error(&error);
+                eprintln!(
+                    "error: reloading {}: {described}",
+                    self.scene_path.display()
+                );
+                let first_line = described;
                 let first_line = first_line.lines().next().unwrap_or_default().to_owned();
                 self.status = Some(format!("reload failed: {first_line}"));
             }
