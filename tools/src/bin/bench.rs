@@ -578,18 +578,7 @@ fn compare_specialisation(
 ) -> Result<()> {
     let features = gpu_render::gpu::ShaderFeatures::for_scene(scene);
     println!("scene features: {}", features.label());
-    let tiny = gpu_render::scene::Scene {
-        render: scene
-            .render
-            .with_overrides(&RenderOverrides {
-                width: Some(8),
-                height: Some(8),
-                samples_per_pixel: Some(1),
-                ..RenderOverrides::default()
-            })
-            .map_err(anyhow::Error::msg)?,
-        ..scene.clone()
-    };
+    let tiny = tiny_copy(scene)?;
     let mut renderers = Vec::new();
     for (name, specialise) in [("specialised", true), ("general", false)] {
         let renderer = Renderer::new(
@@ -639,16 +628,9 @@ fn compare_specialisation(
     Ok(())
 }
 
-/// Prints each trace kernel's compile time and its module's size: the upload of a
-/// tiny copy of `scene` on a new renderer builds the kernels and dispatches each once
-/// ([`gpu_render::gpu::GpuScene::kernel_compiles`]).
-fn compile_figures(
-    gpu: &HeadlessGpu,
-    scene: &gpu_render::scene::Scene,
-    options: RendererOptions,
-) -> Result<()> {
-    let renderer = Renderer::new(&gpu.device, options)?;
-    let tiny = gpu_render::scene::Scene {
+/// `scene` at 8x8 and 1 spp: enough to build and dispatch its kernels.
+fn tiny_copy(scene: &gpu_render::scene::Scene) -> Result<gpu_render::scene::Scene> {
+    Ok(gpu_render::scene::Scene {
         render: scene
             .render
             .with_overrides(&RenderOverrides {
@@ -659,7 +641,19 @@ fn compile_figures(
             })
             .map_err(anyhow::Error::msg)?,
         ..scene.clone()
-    };
+    })
+}
+
+/// Prints each trace kernel's compile time and its module's size: the upload of a
+/// tiny copy of `scene` on a new renderer builds the kernels and dispatches each once
+/// ([`gpu_render::gpu::GpuScene::kernel_compiles`]).
+fn compile_figures(
+    gpu: &HeadlessGpu,
+    scene: &gpu_render::scene::Scene,
+    options: RendererOptions,
+) -> Result<()> {
+    let renderer = Renderer::new(&gpu.device, options)?;
+    let tiny = tiny_copy(scene)?;
     let started = Instant::now();
     let uploaded = renderer.upload(&gpu.device, &gpu.queue, &tiny)?;
     let upload = started.elapsed().as_secs_f64();
