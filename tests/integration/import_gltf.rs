@@ -1662,11 +1662,19 @@ fn unsupported_features_that_are_not_required_are_warnings() {
     assert_eq!(camera.camera.orthographic_half_height, Some(1.0));
     assert_eq!(camera.aspect_ratio, Some(1.0));
 
-    // xmag or ymag of zero (or a node scale of zero): a located error.
+    // A node scale of zero along y: a located error that quotes the scale and the
+    // half height it makes, not only xmag and ymag (issue 49, item 6).
+    let flat = body.replace(r#"{"camera":0}"#, r#"{"camera":0,"scale":[1,0,1]}"#);
+    let message = failure("flat.gltf", doc.embedded(&flat).as_bytes());
+    assert!(
+        message.contains("flat.gltf: camera 0 on node 2: orthographic xmag 1 and ymag 1 times the node's y scale 0 (a half height of 0) must be positive, finite and at most 1000000000000000"),
+        "{message}"
+    );
+    // xmag or ymag of zero: the same located error.
     let body = body.replace(r#""ymag":1,"#, r#""ymag":0,"#);
     let message = failure("flat.gltf", doc.embedded(&body).as_bytes());
     assert!(
-        message.contains("flat.gltf: camera 0 on node 2: orthographic xmag 1 and ymag 0 (times the node's scale) must be positive, finite and at most 1000000000000000"),
+        message.contains("flat.gltf: camera 0 on node 2: orthographic xmag 1 and ymag 0 times the node's y scale 1 (a half height of 0) must be positive"),
         "{message}"
     );
 }

@@ -1641,13 +1641,18 @@ impl Importer<'_> {
                     f64::from(orthographic.xmag()).abs(),
                     f64::from(orthographic.ymag()).abs(),
                 );
-                let half_height = ymag * world.transform_vector3(DVec3::Y).length();
+                let y_scale = world.transform_vector3(DVec3::Y).length();
+                let half_height = ymag * y_scale;
                 let usable = |v: f64| v.is_finite() && v > 0.0 && v <= MAX_ORTHOGRAPHIC_HALF_HEIGHT;
                 if !(usable(xmag) && usable(half_height)) {
+                    // The half height the view gets is ymag times the node's scale along
+                    // its y axis: say both, so that a scale of 0 is seen for what it is.
                     return Err(self.fail(format!(
-                        "{name} on {node}: orthographic xmag {} and ymag {} (times the node's scale) must be positive, finite and at most {}",
+                        "{name} on {node}: orthographic xmag {} and ymag {} times the node's y scale {} (a half height of {}) must be positive, finite and at most {}",
                         short(orthographic.xmag()),
                         short(orthographic.ymag()),
+                        short(y_scale),
+                        short(half_height),
                         short(MAX_ORTHOGRAPHIC_HALF_HEIGHT)
                     )));
                 }
