@@ -554,7 +554,7 @@ pub(crate) fn encode_rounds(
 }
 
 /// How long one kernel took to compile: its entry point and the time of its first
-/// dispatch over no work ([`warm_up`]), which is the compile on drivers that compile
+/// dispatch over no work at upload, which is the compile on drivers that compile
 /// there (lavapipe) and nearly nothing on those that compiled at creation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct KernelCompile {
