@@ -336,11 +336,9 @@ fn path_continue(path: ptr<function, PathState>, origin: vec3<f32>, direction: v
     (*path).stack_len = 1u;
 }
 
-// Shades the hit (or miss) of the path's current ray, one bounce of path_radiance: a
-// miss adds the background; a hit adds its emission (MIS-weighted after a BRDF sample),
-// picks an event in proportion to its weight (dimension 0) and records the
-// continuation; for the base BRDF it samples the next direction (dimensions 1-3) and
-// starts gathering direct light (PHASE_NEXT_LIGHT), else it goes on to PHASE_POP.
+// Shades a miss of the path's current ray, the end of path_radiance's bounce: adds the
+// background, the environment weighted against next-event estimation where that
+// could have found it, and goes on to PHASE_POP.
 fn path_miss(path: ptr<function, PathState>) {
     var background = frame.background;
     //#if ENVIRONMENT_MAP
@@ -359,6 +357,11 @@ fn path_miss(path: ptr<function, PathState>) {
     (*path).phase = PHASE_POP;
 }
 
+// Shades the hit of the path's current ray, `surface` (resolve_surface), one bounce of
+// path_radiance: adds its emission (MIS-weighted after a BRDF sample), picks an event
+// in proportion to its weight (dimension 0) and records the continuation; for the
+// base BRDF it samples the next direction (dimensions 1-3) and starts gathering direct
+// light (PHASE_NEXT_LIGHT), else it goes on to PHASE_POP.
 fn path_closest_hit(path: ptr<function, PathState>, trace: TraceRay, surface: Surface) {
     let ray = Ray((*path).origin, (*path).direction);
     let hit = surface.hit;

@@ -447,8 +447,9 @@ pub(crate) fn upload_scene(
 }
 
 /// Uploads the scene's images as one `Rgba32Float` 2D array texture (one layer per
-/// image, see [`super::upload::image_layers`]), with its mip chain where the scene filters textures
-/// ([`super::upload::image_layer_levels`]), and returns its view and its bytes (every level's).
+/// image, see [`super::upload::image_layers`]), with its mip chain where the scene
+/// filters textures ([`image_layer_level`]), and returns its view and its bytes (every
+/// level's).
 ///
 /// One layer at a time: its level 0 and its mip chain are made, written and submitted
 /// before the next, so that the host holds one layer's copies (and wgpu one layer's
@@ -521,10 +522,8 @@ fn upload_images(
     };
     let mut bytes = 0;
     if scene.images.is_empty() {
+        // One 1x1 zero layer (WGSL needs a bound texture), which has no levels beyond 0.
         bytes += write_layer(0, 0, width, height, &[[0.0; 4]]);
-        for k in 1..=extra_levels {
-            bytes += write_layer(0, k, 1, 1, &[[0.0; 4]]);
-        }
     }
     for (layer, image) in scene.images.iter().enumerate() {
         let layer_texels = image_layer(image, cdfs.of_image(layer), width, height);

@@ -634,44 +634,20 @@ pub fn image_layer(
     texels
 }
 
-/// Levels 1 and up of the image array's mip chain (level 0 is [`image_layers`]): the
-/// `k`-th of them is `max(1, width >> k) × max(1, height >> k)` texels per layer (the
-/// array's level size, wgpu's), each layer holding level `k` of its image's chain
-/// `levels[layer]` ([`crate::texture::mip_levels`], whose level sizes are the same
-/// shifts of the image's own size, so it fits) in its top-left corner, the rest zero;
-/// a layer whose image's chain is shorter than the array's holds its last level there
-/// (the shaders clamp each image's level of detail to its own chain). `width` and
-/// `height` are the array's level 0 size; the array has `⌊log2(max(width, height))⌋`
-/// levels beyond 0. Returns each level's `(width, height, texels)`, layer by layer,
-/// row-major.
-pub fn image_layer_levels(
-    levels: &[Vec<Image>],
-    width: u32,
-    height: u32,
-    layers: u32,
-) -> Vec<(u32, u32, Vec<[f32; 4]>)> {
-    (1..=image_array_levels(width, height))
-        .map(|k| {
-            let (w, h) = ((width >> k).max(1), (height >> k).max(1));
-            let mut texels = Vec::with_capacity(w as usize * h as usize * layers as usize);
-            for chain in levels {
-                texels.extend(image_layer_level(chain, k, width, height).2);
-            }
-            texels.resize(w as usize * h as usize * layers as usize, [0.0; 4]);
-            (w, h, texels)
-        })
-        .collect()
-}
-
 /// The number of mip levels beyond 0 of an image array whose level 0 is `width ×
 /// height`: `⌊log2(max(width, height))⌋`.
 pub fn image_array_levels(width: u32, height: u32) -> u32 {
     width.max(height).max(1).ilog2()
 }
 
-/// One layer of level `k` (at least 1) of [`image_layer_levels`]: level `k` of the
-/// image's chain `chain` (or its last level, if the chain is shorter) in the top-left
-/// corner of the array's level size, the rest zero. Returns `(width, height, texels)`.
+/// One layer of level `k` (at least 1) of the image array's mip chain (level 0 is
+/// [`image_layers`]): the level is `max(1, width >> k) × max(1, height >> k)` texels
+/// (the array's level size, wgpu's) and holds level `k` of the image's chain `chain`
+/// ([`crate::texture::mip_levels`], whose level sizes are the same shifts of the
+/// image's own size, so it fits) in its top-left corner, the rest zero; where the
+/// image's chain is shorter than the array's, its last level (the shaders clamp each
+/// image's level of detail to its own chain). `width` and `height` are the array's
+/// level 0 size. Returns `(width, height, texels)`.
 pub fn image_layer_level(
     chain: &[Image],
     k: u32,

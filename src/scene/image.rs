@@ -138,7 +138,8 @@ impl EncodedImage {
     /// The most bytes held while it is decoded: the file's bytes and
     /// [`DECODING_BYTES_PER_TEXEL`] a texel.
     pub fn decoding_peak_bytes(&self) -> u64 {
-        self.bytes.len() as u64 + texel_count(self.width, self.height) * DECODING_BYTES_PER_TEXEL
+        self.decoded_bytes()
+            + decoding_transient_bytes(self.bytes.len() as u64, self.width, self.height)
     }
 
     /// Decodes it as [`load_image`] does.
@@ -149,6 +150,13 @@ impl EncodedImage {
 
 fn texel_count(width: u32, height: u32) -> u64 {
     u64::from(width) * u64::from(height)
+}
+
+/// The bytes decoding an image file of `file_bytes` bytes and `width × height` texels
+/// holds for a moment beside the decoded image it keeps: the file and the decoder's
+/// image ([`DECODING_BYTES_PER_TEXEL`] less [`DECODED_BYTES_PER_TEXEL`] a texel).
+pub fn decoding_transient_bytes(file_bytes: u64, width: u32, height: u32) -> u64 {
+    file_bytes + texel_count(width, height) * (DECODING_BYTES_PER_TEXEL - DECODED_BYTES_PER_TEXEL)
 }
 
 /// Reads the image at `path` into linear RGBA `f32`: 8- and 16-bit files (PNG) are

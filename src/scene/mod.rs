@@ -24,8 +24,8 @@ pub use file::{
 };
 pub use image::{
     DECODED_BYTES_PER_TEXEL, DECODING_BYTES_PER_TEXEL, EncodedImage, ImageError,
-    MAX_IMAGE_FILE_BYTES, MAX_IMAGE_SIDE, decode_image, image_dimensions, load_confined_image,
-    load_image,
+    MAX_IMAGE_FILE_BYTES, MAX_IMAGE_SIDE, decode_image, decoding_transient_bytes, image_dimensions,
+    load_confined_image, load_image,
 };
 pub use medium::{MEDIUM_STACK_SIZE, MediumStack};
 pub use model::*;

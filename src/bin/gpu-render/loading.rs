@@ -38,15 +38,6 @@ pub struct LoadArgs<'a> {
     pub max_memory: Option<u64>,
 }
 
-impl Loaded {
-    /// Refuses `output` when it is the scene file, one of the scene's images, or any
-    /// other file the load read (compared by device and inode, so links and other
-    /// spellings count).
-    pub fn check_output(&self, scene_path: &Path, output: &Path) -> Result<(), OutputError> {
-        check_inputs_survive(output, scene_path, &self.scene, &self.inputs)
-    }
-}
-
 /// Refuses an output that is the scene file, one of its images (textures, BRDF maps,
 /// the environment map), or any other file the load read (`inputs`: models, material
 /// libraries, buffers, images read and dropped or merged into another).

@@ -40,7 +40,7 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
             max_memory: None,
         },
     )?;
-    let scene = loaded.scene.clone();
+    let crate::loading::Loaded { scene, inputs, .. } = loaded;
     let height = (u64::from(scene.render.height) * u64::from(args.width)
         / u64::from(scene.render.width))
     .max(1) as u32;
@@ -95,7 +95,7 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
     );
     for name in &outputs {
         let path = args.out_dir.join(name);
-        loaded.check_output(&args.scene, &path)?;
+        crate::loading::check_inputs_survive(&path, &args.scene, &scene, &inputs)?;
     }
     std::fs::create_dir_all(&args.out_dir)
         .with_context(|| format!("cannot create {}", args.out_dir.display()))?;

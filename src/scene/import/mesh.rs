@@ -8,6 +8,10 @@ use glam::{DVec2, DVec3};
 use crate::echo::{short, short3};
 use crate::scene::SceneError;
 
+use super::{
+    ImportedMesh, MAX_MODEL_INSTANCES, MAX_MODEL_TEXELS, MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES,
+};
+
 /// A vertex colour as messages quote it: each channel in at most about 24 characters
 /// ([`short`]), so that 1e38 is not spelt out in 39 digits.
 fn short4(color: glam::DVec4) -> String {
@@ -19,10 +23,6 @@ fn short4(color: glam::DVec4) -> String {
         short(color.w)
     )
 }
-
-use super::{
-    ImportedMesh, MAX_MODEL_INSTANCES, MAX_MODEL_TEXELS, MAX_MODEL_TRIANGLES, MAX_MODEL_VERTICES,
-};
 
 /// Twice the area, relative to the squared longest edge, below which a triangle counts
 /// as degenerate: the scene format's rule (`src/scene/file/objects.rs`).
@@ -257,8 +257,6 @@ pub(super) fn finish_mesh(
 pub(super) const BYTES_PER_VERTEX: u64 = 64;
 /// Bytes of an imported triangle (three `u32` indices).
 pub(super) const BYTES_PER_TRIANGLE: u64 = 12;
-/// Bytes of a decoded texel (linear RGBA `f32`).
-pub(super) const BYTES_PER_TEXEL: u64 = 16;
 
 /// The model-wide totals, checked against the limits as the importers go: the fixed
 /// limits on counts, and the caller's cap on the bytes the import holds
@@ -366,7 +364,10 @@ impl Budget {
     /// Counts a texture of `width × height` texels.
     pub fn charge_texels(&mut self, width: u32, height: u32) -> Result<(), LimitExceeded> {
         let texels = u64::from(width) * u64::from(height);
-        self.charge_bytes(texels.saturating_mul(BYTES_PER_TEXEL), "its textures")?;
+        self.charge_bytes(
+            texels.saturating_mul(crate::scene::DECODED_BYTES_PER_TEXEL),
+            "its textures",
+        )?;
         self.texels = self
             .texels
             .saturating_add(u64::from(width) * u64::from(height));

@@ -7,8 +7,7 @@ use super::mesh::Budget;
 use crate::color::srgb_encode;
 use crate::input::read_input;
 use crate::scene::{
-    DECODED_BYTES_PER_TEXEL, DECODING_BYTES_PER_TEXEL, Image, MAX_IMAGE_FILE_BYTES, decode_image,
-    image_dimensions,
+    Image, MAX_IMAGE_FILE_BYTES, decode_image, decoding_transient_bytes, image_dimensions,
 };
 
 /// How a texture's values are meant.
@@ -106,10 +105,7 @@ impl Textures {
             .charge_texels(width, height)
             .map_err(|e| TextureFailure::Budget(e.into()))?;
         // Decoding holds the file and the decoder's image beside the texels it keeps.
-        let transient = bytes.len() as u64
-            + u64::from(width)
-                * u64::from(height)
-                * (DECODING_BYTES_PER_TEXEL - DECODED_BYTES_PER_TEXEL);
+        let transient = decoding_transient_bytes(bytes.len() as u64, width, height);
         budget
             .check_transient(transient, "its textures while one is decoded")
             .map_err(|e| TextureFailure::Budget(e.into()))?;

@@ -64,7 +64,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     let watcher = SceneWatcher::new(&args.scene);
     let loaded = load_view_scene(args)?;
     if let Some(path) = &args.screenshot {
-        loaded.check_output(&args.scene, path)?;
+        crate::loading::check_inputs_survive(path, &args.scene, &loaded.scene, &loaded.inputs)?;
     }
     let event_loop = EventLoop::new().context(
         "cannot open a window: no display server (set DISPLAY or WAYLAND_DISPLAY, or run \
