@@ -1347,7 +1347,7 @@ fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
                 1,
             )
             .into_bytes(),
-            "the file requires the extension KHR_draco_mesh_compression, which is not supported (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_materials_unlit, KHR_mesh_quantization, KHR_texture_transform). Its meshes are Draco-compressed (KHR_draco_mesh_compression), and Draco mesh compression is not supported: decompress the file first, e.g. with `gltf-transform cp IN OUT`",
+            "the file requires the extension KHR_draco_mesh_compression, which is not supported (supported: EXT_mesh_gpu_instancing, KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_materials_unlit, KHR_mesh_quantization, KHR_texture_transform). Its meshes are Draco-compressed (KHR_draco_mesh_compression), and Draco mesh compression is not supported: decompress the file first, e.g. with `gltf-transform cp IN OUT`",
         ),
         (
             "meshopt required",
@@ -1357,7 +1357,7 @@ fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
                 1,
             )
             .into_bytes(),
-            "requires the extension EXT_meshopt_compression, which is not supported (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_materials_unlit, KHR_mesh_quantization, KHR_texture_transform). Its buffers are meshopt-compressed (EXT_meshopt_compression), and meshopt compression is not supported: decompress the file first, e.g. with `gltfpack -i IN -o OUT`",
+            "requires the extension EXT_meshopt_compression, which is not supported (supported: EXT_mesh_gpu_instancing, KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_materials_unlit, KHR_mesh_quantization, KHR_texture_transform). Its buffers are meshopt-compressed (EXT_meshopt_compression), and meshopt compression is not supported: decompress the file first, e.g. with `gltfpack -i IN -o OUT`",
         ),
         (
             "several required extensions",
@@ -1367,7 +1367,7 @@ fn bad_documents() -> Vec<(&'static str, Vec<u8>, &'static str)> {
                 1,
             )
             .into_bytes(),
-            "the file requires 3 extensions that are not supported: KHR_materials_sheen, KHR_materials_clearcoat, EXT_meshopt_compression (supported: KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_materials_unlit, KHR_mesh_quantization, KHR_texture_transform). Its buffers are meshopt-compressed (EXT_meshopt_compression)",
+            "the file requires 3 extensions that are not supported: KHR_materials_sheen, KHR_materials_clearcoat, EXT_meshopt_compression (supported: EXT_mesh_gpu_instancing, KHR_lights_punctual, KHR_materials_emissive_strength, KHR_materials_ior, KHR_materials_transmission, KHR_materials_unlit, KHR_mesh_quantization, KHR_texture_transform). Its buffers are meshopt-compressed (EXT_meshopt_compression)",
         ),
         (
             // As gltf-transform's BoxDraco.gltf: Draco used, not required, and no
@@ -1940,4 +1940,239 @@ fn positions_outside_their_declared_bounds_are_warned_about() {
         "{:?}",
         duck.warnings
     );
+}
+
+/// `triangle_doc`'s mesh under a node at `node_json` (its other properties) with an
+/// `EXT_mesh_gpu_instancing` whose `attributes` are `attributes`, the extension listed
+/// as used and required.
+fn instanced_body(meshes: &str, node_json: &str, attributes: &str) -> String {
+    format!(
+        r#""extensionsUsed":["EXT_mesh_gpu_instancing"],"extensionsRequired":["EXT_mesh_gpu_instancing"],
+        "scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0,{node_json}"extensions":{{"EXT_mesh_gpu_instancing":{{"attributes":{{{attributes}}}}}}}}}],{meshes}"#
+    )
+}
+
+#[test]
+fn gpu_instancing_places_the_mesh_at_each_instance_after_the_node() {
+    let (mut doc, meshes) = triangle_doc();
+    let translations = doc.vec3(&[[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [0.0, 4.0, -1.0]]);
+    let half = std::f32::consts::FRAC_1_SQRT_2;
+    let rotations = doc.vec4(&[
+        [0.0, 0.0, 0.0, 1.0],
+        [0.0, 0.0, half, half],
+        [half, 0.0, 0.0, half],
+    ]);
+    let scales = doc.vec3(&[[1.0, 1.0, 1.0], [2.0, 2.0, 2.0], [1.0, 3.0, 1.0]]);
+    let body = instanced_body(
+        &meshes,
+        r#""translation":[0,0,5],"#,
+        &format!(r#""TRANSLATION":{translations},"ROTATION":{rotations},"SCALE":{scales}"#),
+    );
+    let model = imported("instanced.gltf", doc.embedded(&body).as_bytes());
+    assert!(
+        !model
+            .warnings
+            .iter()
+            .any(|w| w.contains("EXT_mesh_gpu_instancing")),
+        "{:?}",
+        model.warnings
+    );
+    assert_eq!(model.meshes.len(), 1, "one mesh, stored once");
+    let instances = &model.meshes[0].instances;
+    assert_eq!(instances.len(), 3);
+    // NodeWorldXform * T * R * S, from the file's f32 values.
+    let node = DMat4::from_translation(DVec3::new(0.0, 0.0, 5.0));
+    let half = f64::from(half);
+    let expected = [
+        DMat4::IDENTITY,
+        DMat4::from_scale_rotation_translation(
+            DVec3::splat(2.0),
+            DQuat::from_xyzw(0.0, 0.0, half, half).normalize(),
+            DVec3::new(3.0, 0.0, 0.0),
+        ),
+        DMat4::from_scale_rotation_translation(
+            DVec3::new(1.0, 3.0, 1.0),
+            DQuat::from_xyzw(half, 0.0, 0.0, half).normalize(),
+            DVec3::new(0.0, 4.0, -1.0),
+        ),
+    ];
+    for (got, want) in instances.iter().zip(expected) {
+        assert!(
+            got.abs_diff_eq(node * want, 1e-12),
+            "{got} vs {}",
+            node * want
+        );
+    }
+    // The second instance by hand: (1, 0, 0) → ×2 → rotate 90° about z: (0, 2, 0) →
+    // + (3, 0, 0) → + (0, 0, 5).
+    let p = instances[1].transform_point3(DVec3::X);
+    assert_close(p, DVec3::new(3.0, 2.0, 5.0), 1e-6);
+}
+
+#[test]
+fn gpu_instancing_reads_any_one_attribute_and_rotations_as_normalized_shorts() {
+    let (mut doc, meshes) = triangle_doc();
+    // A quarter turn about y as normalized shorts: 23170 / 32767 ≈ 1/√2.
+    let rotations = doc.integers(
+        "VEC4",
+        5122,
+        true,
+        &[vec![0, 23170, 0, 23170], vec![0, 0, 0, 32767]],
+    );
+    let body = instanced_body(
+        &meshes,
+        "",
+        &format!(r#""ROTATION":{rotations},"_ID":{rotations}"#),
+    );
+    let model = imported("rotated.gltf", doc.embedded(&body).as_bytes());
+    let instances = &model.meshes[0].instances;
+    assert_eq!(instances.len(), 2);
+    assert_close(
+        instances[0].transform_point3(DVec3::X),
+        DVec3::new(0.0, 0.0, -1.0),
+        1e-9,
+    );
+    assert!(
+        instances[1].abs_diff_eq(DMat4::IDENTITY, 1e-12),
+        "{}",
+        instances[1]
+    );
+}
+
+/// Writes a case's accessors into the document and returns its `attributes` JSON.
+type InstancingAttributes = fn(&mut Doc) -> String;
+
+#[test]
+fn bad_gpu_instancing_is_refused_naming_the_node_and_the_attribute() {
+    let cases: [(&str, InstancingAttributes, &str); 5] = [
+        (
+            "different counts",
+            |doc| {
+                let t = doc.vec3(&[[0.0; 3], [1.0, 0.0, 0.0]]);
+                let s = doc.vec3(&[[1.0; 3]]);
+                format!(r#""TRANSLATION":{t},"SCALE":{s}"#)
+            },
+            "TRANSLATION has 2 elements but SCALE has 1",
+        ),
+        (
+            "no such accessor",
+            |_| r#""TRANSLATION":99"#.into(),
+            "TRANSLATION is 99, which is not the index of one of the file's",
+        ),
+        (
+            "not an index",
+            |_| r#""SCALE":"big""#.into(),
+            "SCALE is \"big\"",
+        ),
+        (
+            "wrong type",
+            |doc| {
+                let t = doc.vec2(&[[0.0, 1.0]]);
+                format!(r#""TRANSLATION":{t}"#)
+            },
+            "TRANSLATION (accessor",
+        ),
+        (
+            "not finite",
+            |doc| {
+                let t = doc.vec3(&[[0.0; 3], [f32::NAN, 0.0, 0.0]]);
+                format!(r#""TRANSLATION":{t}"#)
+            },
+            "instance 1: its TRANSLATION",
+        ),
+    ];
+    for (what, attributes, expected) in cases {
+        let (mut doc, meshes) = triangle_doc();
+        let attributes = attributes(&mut doc);
+        let body = instanced_body(&meshes, r#""name":"grass","#, &attributes);
+        let message = failure("bad.gltf", doc.embedded(&body).as_bytes());
+        assert!(
+            message.contains("bad.gltf")
+                && message.contains("node 0 ('grass')")
+                && message.contains("EXT_mesh_gpu_instancing")
+                && message.contains(expected),
+            "{what}: {message}"
+        );
+    }
+    // No attributes object at all.
+    let (doc, meshes) = triangle_doc();
+    let body = format!(
+        r#""scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0,"extensions":{{"EXT_mesh_gpu_instancing":{{}}}}}}],{meshes}"#
+    );
+    let message = failure("empty.gltf", doc.embedded(&body).as_bytes());
+    assert!(
+        message.contains("has no \"attributes\" object"),
+        "{message}"
+    );
+}
+
+#[test]
+fn gpu_instancing_without_a_mesh_or_a_transform_attribute_is_warned_about() {
+    let (doc, meshes) = triangle_doc();
+    let body = format!(
+        r#""scenes":[{{"nodes":[0,1]}}],"nodes":[{{"mesh":0,"extensions":{{"EXT_mesh_gpu_instancing":{{"attributes":{{"_ID":0}}}}}}}},
+        {{"extensions":{{"EXT_mesh_gpu_instancing":{{"attributes":{{"TRANSLATION":0}}}}}}}}],{meshes}"#
+    );
+    let model = imported("odd.gltf", doc.embedded(&body).as_bytes());
+    assert_eq!(
+        model.meshes[0].instances,
+        vec![DMat4::IDENTITY],
+        "placed once, by its node"
+    );
+    let warned = |text: &str| model.warnings.iter().any(|w| w.contains(text));
+    assert!(
+        warned("node 0: EXT_mesh_gpu_instancing gives none of TRANSLATION, ROTATION and SCALE"),
+        "{:?}",
+        model.warnings
+    );
+    assert!(
+        warned("node 1: EXT_mesh_gpu_instancing on a node without a mesh"),
+        "{:?}",
+        model.warnings
+    );
+}
+
+/// Khronos's `SimpleInstancing` sample (its README: 125 instances of a unit cube in a
+/// 5x5x5 grid, translations 0 to 10, scales 1 to 2, the first instance the unmodified
+/// cube), read in place from `../shared/khronos-sample-assets`.
+#[test]
+fn the_simple_instancing_sample_places_125_cubes() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(
+        "../shared/khronos-sample-assets/Models/SimpleInstancing/glTF-Binary/SimpleInstancing.glb",
+    );
+    if !path.exists() {
+        let require = std::env::var_os("GPU_RENDER_REQUIRE_CORPUS")
+            .is_some_and(|v| !v.is_empty() && v != "0");
+        assert!(!require, "{} is absent", path.display());
+        eprintln!("note: {} is absent; skipped", path.display());
+        return;
+    }
+    let model = import_gltf(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(model.meshes.len(), 1, "{:?}", model.warnings);
+    let instances = &model.meshes[0].instances;
+    assert_eq!(instances.len(), 125);
+    assert!(
+        instances[0].abs_diff_eq(DMat4::IDENTITY, 1e-6),
+        "{}",
+        instances[0]
+    );
+    let origins: Vec<DVec3> = instances
+        .iter()
+        .map(|m| m.transform_point3(DVec3::ZERO))
+        .collect();
+    let (low, high) = origins
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(*p), hi.max(*p))
+        });
+    assert_close(low, DVec3::ZERO, 1e-6);
+    assert_close(high, DVec3::splat(10.0), 1e-5);
+    // The last instance is scaled by 2 along every axis.
+    let last = instances[124];
+    for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
+        assert!(
+            (last.transform_vector3(axis).length() - 2.0).abs() < 1e-5,
+            "{last}"
+        );
+    }
 }

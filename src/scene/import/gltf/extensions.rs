@@ -4,6 +4,7 @@
 
 /// The extensions this importer understands; a file that requires any other is refused.
 pub(super) const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "EXT_mesh_gpu_instancing",
     "KHR_lights_punctual",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",

@@ -12,6 +12,7 @@ mod document;
 mod extensions;
 mod geometry;
 mod importer;
+mod instancing;
 mod lights;
 mod materials;
 mod scene_graph;

@@ -4,6 +4,7 @@
 use glam::{DMat4, DQuat, DVec3};
 
 use super::importer::{Importer, describe, quote_list};
+use super::instancing::GPU_INSTANCING;
 use crate::scene::SceneError;
 
 /// How far a node matrix's last row may stray from `0 0 0 1` and still count as affine:
@@ -132,20 +133,12 @@ impl Importer<'_> {
                 )));
             }
             if let Some(mesh) = node.mesh() {
-                if node.skin().is_some() {
-                    self.warn_once(
-                        "skin",
-                        "skins are ignored: skinned meshes are placed by their nodes' transforms in the bind pose".into(),
-                    );
-                }
-                let determinant = world.determinant();
-                if determinant == 0.0 || !world.inverse().is_finite() {
-                    self.warn(format!(
-                        "{name}: its transform is singular (a scale of 0?); its mesh is not placed"
-                    ));
-                } else {
-                    placements[mesh.index()].push(world);
-                }
+                let placed = self.mesh_placements(&node, &name, world)?;
+                placements[mesh.index()].extend(placed);
+            } else if node.extension_value(GPU_INSTANCING).is_some() {
+                self.warn(format!(
+                    "{name}: {GPU_INSTANCING} on a node without a mesh, which the extension gives no meaning; ignored"
+                ));
             }
             if let Some(camera) = node.camera() {
                 self.camera(&camera, &name, world)?;
@@ -191,5 +184,45 @@ impl Importer<'_> {
             if count == 1 { "" } else { "s" }
         ));
         Ok(())
+    }
+
+    /// Where `node` (described by `name`, at `world`) places its mesh: at its world
+    /// transform, or at each of its `EXT_mesh_gpu_instancing` instances composed after
+    /// it. Singular placements (a scale of 0) are left out with a warning.
+    fn mesh_placements(
+        &mut self,
+        node: &::gltf::Node<'_>,
+        name: &str,
+        world: DMat4,
+    ) -> Result<Vec<DMat4>, SceneError> {
+        if node.skin().is_some() {
+            self.warn_once(
+                "skin",
+                "skins are ignored: skinned meshes are placed by their nodes' transforms in the bind pose".into(),
+            );
+        }
+        let singular = |m: &DMat4| m.determinant() == 0.0 || !m.inverse().is_finite();
+        let Some(instances) = self.gpu_instances(node, name)? else {
+            if singular(&world) {
+                self.warn(format!(
+                    "{name}: its transform is singular (a scale of 0?); its mesh is not placed"
+                ));
+                return Ok(Vec::new());
+            }
+            return Ok(vec![world]);
+        };
+        let total = instances.len();
+        let placed: Vec<DMat4> = instances
+            .into_iter()
+            .map(|instance| world * instance)
+            .filter(|m| m.is_finite() && !singular(m))
+            .collect();
+        if placed.len() < total {
+            self.warn(format!(
+                "{name}: {} of its {total} {GPU_INSTANCING} instances have a singular or unbounded transform (a scale of 0?); they are not placed",
+                total - placed.len()
+            ));
+        }
+        Ok(placed)
     }
 }
