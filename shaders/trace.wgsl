@@ -21,6 +21,9 @@ const MIN_LIGHT_DISTANCE_SQUARED: f32 = 1.17549435e-38;
 // The least cosine to the geometric surface a bent secondary ray keeps. Twin of
 // MIN_SECONDARY_COSINE (src/cpu/trace.rs).
 const MIN_SECONDARY_COSINE: f32 = 1e-3;
+// The largest height above the geometric surface valid_reflection_normal asks of a
+// mirror reflection. Twin of MIN_REFLECTION_HEIGHT (src/cpu/trace.rs).
+const MIN_REFLECTION_HEIGHT: f32 = 0.01;
 
 // Whether every component is finite, read from the exponent bits so that no
 // fast-math assumption of the shader compiler can fold the test away. The guard on
@@ -107,18 +110,48 @@ fn sample_light(light: Light, origin: vec3<f32>, n: vec3<f32>) -> LightSample {
 //#if MESH_ATTRIBUTES
 // The normal a hit is shaded with: the shading normal `ns`, tilted towards the viewer
 // where the ray would arrive behind it, normalize(ns + (c_min - wo·ns)·wo) (continuous,
-// so no facet edge shows; Veach's thesis, 1997, §5.3, on shading normals). CPU twin:
-// shading_frame_normal.
+// so no facet edge shows; Veach's thesis, 1997, §5.3, on shading normals), then turned
+// towards `ng` until its mirror reflection leaves the surface (valid_reflection_normal).
+// CPU twin: shading_frame_normal.
 fn shading_frame_normal(direction: vec3<f32>, ng: vec3<f32>, ns: vec3<f32>) -> vec3<f32> {
     if all(ns == ng) {
         return ng;
     }
     let wo = -direction;
     let cosine = dot(wo, ns);
-    if cosine >= MIN_SECONDARY_COSINE {
-        return ns;
+    var n = ns;
+    if cosine < MIN_SECONDARY_COSINE {
+        n = normalize(ns + wo * (MIN_SECONDARY_COSINE - cosine));
     }
-    return normalize(ns + wo * (MIN_SECONDARY_COSINE - cosine));
+    return valid_reflection_normal(wo, ng, n);
+}
+
+// `n` turned towards `ng` (the side `wo` arrives from) by the least angle for which the
+// mirror reflection of `wo` about it rises to a height h = min(0.9·wo·ng,
+// MIN_REFLECTION_HEIGHT) above the surface: in the plane of ng and n, with x the unit
+// part of n across ng, n' = sin θ·x + cos θ·ng reflects wo to ρ·cos(2θ - α) (ρ = |(a, b)|,
+// α = atan2(a, b), a = wo·x, b = wo·ng), so θ = (α + acos(h/ρ))/2, at most n's own angle.
+// Blender Cycles' valid specular reflection (ensure_valid_specular_reflection,
+// intern/cycles/kernel/closure/bsdf_util.h), solved directly. CPU twin:
+// valid_reflection_normal.
+fn valid_reflection_normal(wo: vec3<f32>, ng: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let b = dot(wo, ng);
+    let height = min(0.9 * b, MIN_REFLECTION_HEIGHT);
+    let reflected = 2.0 * dot(n, wo) * n - wo;
+    if dot(reflected, ng) >= height {
+        return n;
+    }
+    let across = n - dot(n, ng) * ng;
+    let length_across = length(across);
+    if !(length_across > 0.0) {
+        return ng;
+    }
+    let x = across / length_across;
+    let a = dot(wo, x);
+    let rho = sqrt(a * a + b * b);
+    let theta_n = atan2(length_across, dot(n, ng));
+    let theta = clamp(0.5 * (atan2(a, b) + acos(clamp(height / rho, -1.0, 1.0))), 0.0, theta_n);
+    return sin(theta) * x + cos(theta) * ng;
 }
 
 // A secondary direction computed about a shading normal, kept on the side of the

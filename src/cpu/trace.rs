@@ -416,18 +416,62 @@ pub struct ShadedHit {
 /// `wo = -direction` and `c_min` = [`MIN_SECONDARY_COSINE`], so that `wo` is just
 /// above it. Both steps are continuous, so no facet edge shows where a hard switch to
 /// `ng` would draw one; shading normals are not physical (Veach's thesis, 1997, §5.3),
-/// and this keeps them plausible. Secondary rays that the result would send through the
-/// real surface are bent back by [`keep_on_side`].
+/// and this keeps them plausible. The normal is then turned towards `ng` just enough
+/// that the mirror reflection about it leaves the real surface
+/// ([`valid_reflection_normal`]), so that a steep normal map on a polished surface
+/// reflects its surroundings instead of sending its reflection, and the BRDF samples
+/// around it, into the surface. Secondary rays that the result would still send
+/// through the real surface are bent back by [`keep_on_side`].
 pub fn shading_frame_normal(direction: DVec3, ng: DVec3, ns: DVec3) -> DVec3 {
     if ns == ng {
         return ng;
     }
     let wo = -direction;
     let cosine = wo.dot(ns);
-    if cosine >= MIN_SECONDARY_COSINE {
-        return ns;
+    let n = if cosine >= MIN_SECONDARY_COSINE {
+        ns
+    } else {
+        (ns + wo * (MIN_SECONDARY_COSINE - cosine)).normalize()
+    };
+    valid_reflection_normal(wo, ng, n)
+}
+
+/// The largest height above the geometric surface that [`valid_reflection_normal`]
+/// asks of a mirror reflection: a hundredth of the unit direction (about 0.6 degrees),
+/// less for grazing views.
+pub const MIN_REFLECTION_HEIGHT: f64 = 0.01;
+
+/// The shading normal `n` turned towards the geometric normal `ng` (the side `wo`
+/// arrives from, `wo·ng > 0`) by the least angle for which the mirror reflection of
+/// `wo` about it, `r = 2(n·wo)n - wo`, rises above the surface: `r·ng >= h` with
+/// `h = min(0.9·wo·ng, MIN_REFLECTION_HEIGHT)` (a reflection may always be as shallow
+/// as the ray that arrives). `n` itself where its reflection already does. The idea is
+/// Blender Cycles' valid specular reflection (`ensure_valid_specular_reflection`,
+/// `intern/cycles/kernel/closure/bsdf_util.h`); the solution here is worked out
+/// directly: in the plane of `ng` and `n`, with `x` the unit part of `n` across `ng`,
+/// `n' = sin θ·x + cos θ·ng` reflects `wo` to a height `a·sin 2θ + b·cos 2θ` with
+/// `a = wo·x`, `b = wo·ng`, that is `ρ·cos(2θ - α)` with `ρ = |(a, b)|` and
+/// `α = atan2(a, b)`; it is at least `b >= h` at `θ = 0` and below `h` at `n`, so the
+/// largest `θ` that reaches `h` is `(α + acos(h/ρ))/2`. GPU twin: valid_reflection_normal.
+pub fn valid_reflection_normal(wo: DVec3, ng: DVec3, n: DVec3) -> DVec3 {
+    let b = wo.dot(ng);
+    let height = (0.9 * b).min(MIN_REFLECTION_HEIGHT);
+    let reflected = 2.0 * n.dot(wo) * n - wo;
+    if reflected.dot(ng) >= height {
+        return n;
     }
-    (ns + wo * (MIN_SECONDARY_COSINE - cosine)).normalize()
+    let across = n - n.dot(ng) * ng;
+    let length = across.length();
+    if length.is_nan() || length <= 0.0 {
+        return ng;
+    }
+    let x = across / length;
+    let a = wo.dot(x);
+    let rho = (a * a + b * b).sqrt();
+    // The angle of `n` from `ng`: the turn never goes past it.
+    let theta_n = length.atan2(n.dot(ng));
+    let theta = (0.5 * (a.atan2(b) + (height / rho).clamp(-1.0, 1.0).acos())).clamp(0.0, theta_n);
+    theta.sin() * x + theta.cos() * ng
 }
 
 /// The least cosine to the geometric surface that a bent secondary ray keeps

@@ -560,6 +560,10 @@ fn wgsl_constants_equal_their_rust_twins() {
             "MIN_SECONDARY_COSINE",
             gpu_render::low_level::cpu::trace::MIN_SECONDARY_COSINE,
         ),
+        (
+            "MIN_REFLECTION_HEIGHT",
+            gpu_render::low_level::cpu::trace::MIN_REFLECTION_HEIGHT,
+        ),
     ] {
         assert_eq!(wgsl_f32_const(trace, name), rust as f32, "{name}");
     }
