@@ -51,14 +51,28 @@ pub(crate) fn corpus_root() -> PathBuf {
 /// unless `GPU_RENDER_REQUIRE_CORPUS` is set (then a failure, as for the conformance
 /// test).
 pub(crate) fn corpus_model(relative: &str) -> Option<gpu_render::scene::import::ImportedModel> {
-    let path = corpus_root().join(relative);
+    model_in_place(&corpus_root().join(relative), relative)
+}
+
+/// The Khronos sample model at `relative` (to `../shared/khronos-sample-assets`)
+/// imported, as [`corpus_model`] imports a corpus file (absent: skipped with a notice,
+/// or a failure under `GPU_RENDER_REQUIRE_CORPUS`).
+pub(crate) fn khronos_sample_model(
+    relative: &str,
+) -> Option<gpu_render::scene::import::ImportedModel> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/khronos-sample-assets");
+    model_in_place(&root.join(relative), relative)
+}
+
+/// The model file at `path` imported (`relative` names it in messages), read in place.
+fn model_in_place(path: &Path, relative: &str) -> Option<gpu_render::scene::import::ImportedModel> {
     if !path.exists() {
         let notice = format!("{} is absent", path.display());
         assert!(!flag("GPU_RENDER_REQUIRE_CORPUS"), "{notice}");
         eprintln!("note: {notice}; skipped");
         return None;
     }
-    Some(import_model(&path).unwrap_or_else(|e| panic!("{relative}: {e}")))
+    Some(import_model(path).unwrap_or_else(|e| panic!("{relative}: {e}")))
 }
 
 fn flag(name: &str) -> bool {

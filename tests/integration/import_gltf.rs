@@ -2137,17 +2137,11 @@ fn gpu_instancing_without_a_mesh_or_a_transform_attribute_is_warned_about() {
 /// cube), read in place from `../shared/khronos-sample-assets`.
 #[test]
 fn the_simple_instancing_sample_places_125_cubes() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(
-        "../shared/khronos-sample-assets/Models/SimpleInstancing/glTF-Binary/SimpleInstancing.glb",
-    );
-    if !path.exists() {
-        let require = std::env::var_os("GPU_RENDER_REQUIRE_CORPUS")
-            .is_some_and(|v| !v.is_empty() && v != "0");
-        assert!(!require, "{} is absent", path.display());
-        eprintln!("note: {} is absent; skipped", path.display());
+    let Some(model) = crate::corpus::khronos_sample_model(
+        "Models/SimpleInstancing/glTF-Binary/SimpleInstancing.glb",
+    ) else {
         return;
-    }
-    let model = import_gltf(&path).unwrap_or_else(|e| panic!("{e}"));
+    };
     assert_eq!(model.meshes.len(), 1, "{:?}", model.warnings);
     let instances = &model.meshes[0].instances;
     assert_eq!(instances.len(), 125);

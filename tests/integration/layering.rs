@@ -79,38 +79,8 @@ fn the_shared_layer_and_accel_use_no_tracer_and_the_tracers_not_each_other() {
 
 #[test]
 fn no_two_modules_use_each_other() {
-    let uses = module_uses();
-    // Depth-first search for a path back to where it started.
-    fn cycle_from(
-        uses: &BTreeMap<String, BTreeSet<String>>,
-        path: &mut Vec<String>,
-        done: &mut BTreeSet<String>,
-    ) -> Option<Vec<String>> {
-        let current = path.last().cloned().unwrap_or_default();
-        for next in uses.get(&current).into_iter().flatten() {
-            if let Some(start) = path.iter().position(|m| m == next) {
-                let mut cycle = path[start..].to_vec();
-                cycle.push(next.clone());
-                return Some(cycle);
-            }
-            if done.contains(next) {
-                continue;
-            }
-            path.push(next.clone());
-            if let Some(cycle) = cycle_from(uses, path, done) {
-                return Some(cycle);
-            }
-            path.pop();
-        }
-        done.insert(current);
-        None
-    }
-    let mut done = BTreeSet::new();
-    for module in uses.keys() {
-        if let Some(cycle) = cycle_from(&uses, &mut vec![module.clone()], &mut done) {
-            panic!("modules use each other: {}", cycle.join(" -> "));
-        }
-    }
+    let cycles = cycles(&module_uses());
+    assert!(cycles.is_empty(), "modules that use each other: {cycles:?}");
 }
 
 /// Each folder's cycles of files that use each other which are known and listed in
@@ -292,7 +262,8 @@ fn folder_uses() -> BTreeMap<Vec<String>, BTreeMap<String, BTreeSet<String>>> {
 }
 
 /// The strongly connected components of more than one member: the members that reach
-/// each other (by search from each; folders have a few dozen members at most).
+/// each other (by search from each; `src/` and its folders have a few dozen members
+/// at most).
 fn cycles(uses: &BTreeMap<String, BTreeSet<String>>) -> Vec<BTreeSet<String>> {
     let nodes: Vec<&String> = uses
         .keys()
